@@ -1,0 +1,1 @@
+"""Analysis: metrics and figures."""

@@ -1,0 +1,70 @@
+"""Agent model p_{k+1} = p_k + u_k (the paper's eq. 1) on eight headings at a fixed altitude."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from dcee.errors import DceeInputError
+
+
+@dataclass(frozen=True)
+class SearchVolume:
+    """Axis-aligned search volume in m: lower corner ``low`` and upper corner ``high``."""
+
+    low: tuple[float, float, float]
+    high: tuple[float, float, float]
+
+    def contains(self, points: np.ndarray, tol: float = 1e-9) -> np.ndarray:
+        """(K, 3) points → (K,) bool, inside the volume (boundary included)."""
+        p = np.atleast_2d(points)
+        lo = np.asarray(self.low) - tol
+        hi = np.asarray(self.high) + tol
+        return np.all((p >= lo) & (p <= hi), axis=1)
+
+
+@dataclass(frozen=True)
+class GridAgent:
+    """Mobile sensor that moves ``step`` metres along one of ``headings`` directions.
+
+    Headings are measured from +x towards +y (0°, 45°, …, 315° by default). Moves that would leave
+    the search volume are inadmissible. Each move takes ``step / speed + dwell`` seconds: travel
+    plus the sampling dwell the sensor needs for a reading.
+    """
+
+    volume: SearchVolume
+    step: float = 2.0
+    speed: float = 2.0
+    dwell: float = 1.0
+    n_headings: int = 8
+
+    def __post_init__(self) -> None:
+        if not self.step > 0:
+            raise DceeInputError("agent.step", f"must be > 0 m, got {self.step}")
+        if not self.speed > 0:
+            raise DceeInputError("agent.speed", f"must be > 0 m/s, got {self.speed}")
+        if not self.dwell >= 0:
+            raise DceeInputError("agent.dwell", f"must be >= 0 s, got {self.dwell}")
+        if self.n_headings < 1:
+            raise DceeInputError("agent.n_headings", f"must be >= 1, got {self.n_headings}")
+
+    @property
+    def moves(self) -> np.ndarray:
+        """(n_headings, 3) displacement vectors u in m (z component 0)."""
+        angles = 2 * np.pi * np.arange(self.n_headings) / self.n_headings
+        out = np.zeros((self.n_headings, 3))
+        out[:, 0] = np.round(self.step * np.cos(angles), 12)
+        out[:, 1] = np.round(self.step * np.sin(angles), 12)
+        return out
+
+    @property
+    def step_time(self) -> float:
+        """Seconds per move: travel time plus sampling dwell."""
+        return self.step / self.speed + self.dwell
+
+    def candidates(self, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Admissible next positions from ``position``: ((M, 3) positions, (M,) heading indices)."""
+        nxt = np.asarray(position, dtype=np.float64)[None, :] + self.moves
+        ok = self.volume.contains(nxt)
+        return nxt[ok], np.flatnonzero(ok)

@@ -1,0 +1,21 @@
+"""Planners: one shared predicted-posterior machinery, one module per cost.
+
+Choose by name: ``dcee.planners.get("dcee")``. Register a new one with
+``@dcee.planners.register("name")`` on a :class:`Planner` subclass; nothing else changes.
+"""
+
+from dcee.planning import dcee, dcee_multistage, entrotaxis, infotaxis, mpc  # noqa: F401
+from dcee.planning.base import Belief, Decision, Planner, get, names, register
+from dcee.planning.predicted import OneStepPlanner, PredictionContext, SequenceStats
+
+__all__ = [
+    "Belief",
+    "Decision",
+    "OneStepPlanner",
+    "Planner",
+    "PredictionContext",
+    "SequenceStats",
+    "get",
+    "names",
+    "register",
+]

@@ -1,0 +1,140 @@
+"""Planner interface, the belief it sees, and the registry that names planners."""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+
+from dcee.errors import DceeInputError
+from dcee.models.agent import GridAgent
+from dcee.models.plume import IsotropicPlume
+from dcee.models.sensor import Sensor
+
+
+@dataclass(frozen=True)
+class Belief:
+    """A weighted particle approximation of p(Θ | Z_k), as planners see it (no copies made).
+
+    theta: (N, 8) source terms; weights: (N,) normalised; sensor and plume: the models used to
+    predict readings.
+    """
+
+    theta: np.ndarray
+    weights: np.ndarray
+    sensor: Sensor
+    plume: IsotropicPlume
+
+    @property
+    def source(self) -> np.ndarray:
+        """(N, 3) source locations."""
+        return self.theta[:, :3]
+
+    def source_mean(self) -> np.ndarray:
+        return self.weights @ self.source
+
+
+@dataclass
+class Decision:
+    """A planner's choice among the admissible candidates.
+
+    candidates: (M, 3) admissible next positions; costs: (M,) the planner's cost of each (lower is
+    better); index: the chosen candidate; heading: its heading index in the agent's move set.
+    """
+
+    index: int
+    candidates: np.ndarray
+    costs: np.ndarray
+    headings: np.ndarray
+    info: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def position(self) -> np.ndarray:
+        return self.candidates[self.index]
+
+    @property
+    def heading(self) -> int:
+        return int(self.headings[self.index])
+
+
+class Planner(ABC):
+    """Chooses the next measurement position from the current belief.
+
+    Subclasses implement :meth:`costs`; the choice is the admissible candidate of least cost
+    (ties go to the lowest heading index, so decisions are deterministic).
+    """
+
+    name: ClassVar[str] = ""
+    uses_hypotheses: ClassVar[bool] = False
+    """True if the planner accepts ``n_hypotheses`` (hypothesised readings per candidate)."""
+
+    @abstractmethod
+    def costs(
+        self,
+        belief: Belief,
+        position: np.ndarray,
+        candidates: np.ndarray,
+        agent: GridAgent,
+        rng: np.random.Generator,
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        """(M,) cost of moving to each of the (M, 3) candidates, plus diagnostic info."""
+
+    def decide(
+        self,
+        belief: Belief,
+        position: np.ndarray,
+        agent: GridAgent,
+        rng: np.random.Generator,
+    ) -> Decision:
+        candidates, headings = agent.candidates(position)
+        if len(candidates) == 0:
+            raise DceeInputError("position", f"no admissible move from {position}")
+        costs, info = self.costs(belief, np.asarray(position, float), candidates, agent, rng)
+        return Decision(int(np.argmin(costs)), candidates, costs, headings, info)
+
+    def options(self) -> dict[str, Any]:
+        """The planner's settings (saved with results)."""
+        return {}
+
+
+_REGISTRY: dict[str, type[Planner]] = {}
+
+
+def register(name: str) -> Callable[[type[Planner]], type[Planner]]:
+    """Class decorator: make a planner available as ``dcee.planners.get(name)``."""
+
+    def wrap(cls: type[Planner]) -> type[Planner]:
+        if name in _REGISTRY and _REGISTRY[name] is not cls:
+            raise ValueError(f"planner name {name!r} already registered")
+        cls.name = name
+        _REGISTRY[name] = cls
+        return cls
+
+    return wrap
+
+
+def planner_class(name: str) -> type[Planner]:
+    """The registered planner class; unknown names are a user error."""
+    try:
+        return _REGISTRY[name]
+    except KeyError:
+        raise DceeInputError(
+            "strategy", f"unknown planner {name!r}; choose one of {', '.join(names())}"
+        ) from None
+
+
+def get(name: str, **options: Any) -> Planner:
+    """A new planner instance by registered name; ``options`` go to its constructor."""
+    cls = planner_class(name)
+    try:
+        return cls(**options)
+    except TypeError as exc:
+        raise DceeInputError("planner_options", f"{name}: {exc}") from None
+
+
+def names() -> list[str]:
+    """Registered planner names."""
+    return sorted(_REGISTRY)

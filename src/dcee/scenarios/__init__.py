@@ -1,0 +1,7 @@
+"""Scenario files: TOML validated into immutable configuration objects."""
+
+from dcee.scenarios.builtin import builtin_scenarios
+from dcee.scenarios.config import Scenario, validate_scenario
+from dcee.scenarios.loader import load_scenario
+
+__all__ = ["Scenario", "builtin_scenarios", "load_scenario", "validate_scenario"]

@@ -1,0 +1,103 @@
+"""Built-in scenarios: the paper's simulation study (``paper:1`` … ``paper:12``) and its indoor
+experiment in simulation (``lab:downwind``, ``lab:upwind``).
+
+The paper does not give the search area, the 12 source configurations, the sampling dwell or the
+lab plume's parameters; every value chosen here is listed in docs/scenarios.md with its reason.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+# Paper study (section 5, tables 1-2). Chosen: an open 50 m × 50 m area, altitude 0-5 m.
+PAPER_VOLUME = {"low": [0.0, 0.0, 0.0], "high": [50.0, 50.0, 5.0]}
+
+# (x, y, φ in degrees). φ is the direction the wind comes from; the plume extends towards
+# −(cos φ, sin φ). Sources are spread over the area; plumes 2, 3, 7, 8, 9 and 12 point away from
+# the start (2, 2) and do not cross the chord from the start to the source, 4 points straight
+# at the start, the rest cross the area obliquely. paper:1 is the paper's example (fig. 5).
+PAPER_SOURCES: tuple[tuple[float, float, float], ...] = (
+    (37.5, 12.5, 0.0),
+    (25.0, 25.0, 225.0),
+    (12.5, 37.5, 270.0),
+    (40.0, 40.0, 45.0),
+    (10.0, 25.0, 0.0),
+    (40.0, 27.5, 90.0),
+    (25.0, 10.0, 180.0),
+    (30.0, 45.0, 135.0),
+    (45.0, 45.0, 270.0),
+    (20.0, 32.5, 315.0),
+    (45.0, 10.0, 90.0),
+    (15.0, 15.0, 200.0),
+)
+
+
+def _paper(k: int) -> dict[str, Any]:
+    x, y, phi = PAPER_SOURCES[k - 1]
+    return {
+        "name": f"paper:{k}",
+        "description": (
+            f"Paper simulation study, configuration {k}: source ({x}, {y}, 1) m, "
+            f"wind from {phi:g} deg at 4 m/s; UAV at 4 m from (2, 2)."
+        ),
+        "dimensions": 3,
+        "unknown": "source",
+        "volume": PAPER_VOLUME,
+        "truth": {
+            "x": x, "y": y, "z": 1.0, "q": 5.0, "u": 4.0, "phi": phi, "zeta1": 1.0, "zeta2": 8.0,
+        },  # fmt: skip
+        # Table 1: N(m, δ) has variance δ → sd = √δ; φ's prior is centred on the truth.
+        "prior": {
+            "q": {"kind": "gamma", "shape": 2.0, "scale": 5.0},
+            "u": {"kind": "normal", "mean": 4.0, "sd": math.sqrt(2.0)},
+            "phi": {"kind": "normal", "mean": phi, "sd": math.sqrt(10.0)},
+            "zeta1": {"kind": "normal", "mean": 1.0, "sd": math.sqrt(2.0)},
+            "zeta2": {"kind": "normal", "mean": 8.0, "sd": math.sqrt(2.0)},
+        },
+        "sensor": {"threshold": 5e-4, "pd": 0.7, "sigma_min": 1e-4, "sigma_frac": 0.5},
+        # Table 2; dwell (sampling interval) chosen 1 s: 2 s per move, 450 readings in 900 s.
+        "agent": {"start": [2.0, 2.0, 4.0], "step": 2.0, "speed": 2.0, "dwell": 1.0},
+        "search": {"particles": 20_000, "hypotheses": 40, "budget": 900.0, "acquired_rmse": 3.0},
+    }
+
+
+# Indoor experiment (section 6) in simulation. The area, step, wind speed and the seven unknowns
+# are the paper's; the source position, the plume's release rate and dispersion, the robot's
+# speed and dwell and the budget are chosen (docs/scenarios.md). Wind blows along +x (φ = 180°).
+LAB_VOLUME = {"low": [0.0, 0.0, 0.0], "high": [4.5, 3.5, 0.0]}
+LAB_STARTS = {"downwind": [3.9, 1.2, 0.0], "upwind": [0.3, 3.2, 0.0]}
+
+
+def _lab(start: str) -> dict[str, Any]:
+    return {
+        "name": f"lab:{start}",
+        "description": (
+            f"Paper indoor experiment in simulation, {start} start: 4.5 m x 3.5 m, 0.3 m steps, "
+            "~1.5 m/s wind, 2-D, seven unknowns (x, y, q, phi, u, zeta1, zeta2)."
+        ),
+        "dimensions": 2,
+        "unknown": "full",
+        "volume": LAB_VOLUME,
+        "truth": {
+            "x": 0.9, "y": 1.75, "z": 0.0, "q": 0.01, "u": 1.5, "phi": 180.0,
+            "zeta1": 0.2, "zeta2": 5.0,
+        },  # fmt: skip
+        "prior": {
+            "q": {"kind": "gamma", "shape": 2.0, "scale": 0.01},
+            "u": {"kind": "normal", "mean": 1.5, "sd": 0.5},
+            "phi": {"kind": "normal", "mean": 180.0, "sd": 20.0},
+            "zeta1": {"kind": "normal", "mean": 0.2, "sd": 0.1},
+            "zeta2": {"kind": "normal", "mean": 5.0, "sd": 2.0},
+        },
+        "sensor": {"threshold": 5e-4, "pd": 0.7, "sigma_min": 1e-4, "sigma_frac": 0.5},
+        "agent": {"start": LAB_STARTS[start], "step": 0.3, "speed": 0.2, "dwell": 1.5},
+        "search": {"particles": 20_000, "hypotheses": 40, "budget": 450.0, "acquired_rmse": 0.5},
+    }
+
+
+def builtin_scenarios() -> dict[str, dict[str, Any]]:
+    """Raw (unvalidated) built-in scenarios by name."""
+    out = {f"paper:{k}": _paper(k) for k in range(1, len(PAPER_SOURCES) + 1)}
+    out.update({f"lab:{s}": _lab(s) for s in LAB_STARTS})
+    return out

@@ -1,0 +1,32 @@
+"""Find a scenario by built-in name or TOML path and validate it."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+from dcee.errors import DceeInputError
+from dcee.scenarios.builtin import builtin_scenarios
+from dcee.scenarios.config import Scenario, validate_scenario
+
+
+def load_scenario(name_or_path: str) -> Scenario:
+    """A built-in (``paper:3``, ``lab:upwind``) or a TOML file by path."""
+    builtins = builtin_scenarios()
+    if name_or_path in builtins:
+        return validate_scenario(builtins[name_or_path])
+    path = Path(name_or_path)
+    if not path.suffix == ".toml" and ":" in name_or_path:
+        raise DceeInputError(
+            "scenario", f"unknown built-in {name_or_path!r}; choose one of {', '.join(builtins)}"
+        )
+    if not path.is_file():
+        raise DceeInputError("scenario", f"no such file {str(path)!r} and no such built-in")
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise DceeInputError("scenario", f"malformed TOML in {path}: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DceeInputError("scenario", f"cannot read {path}: {exc}") from None
+    data.setdefault("name", path.stem)
+    return validate_scenario(data)

@@ -1,0 +1,87 @@
+"""The robot-facing ask/tell search object. The simulator drives this same object."""
+
+from __future__ import annotations
+
+import math
+import time as _time
+from dataclasses import dataclass
+
+import numpy as np
+
+from dcee.errors import DceeInputError
+from dcee.estimation.particle_filter import ParticleFilter, UpdateInfo
+from dcee.models.agent import GridAgent
+from dcee.planning.base import Belief, Decision, Planner
+
+
+@dataclass(frozen=True)
+class SourceEstimate:
+    """Posterior summary of the source location: mean (3,) m, covariance (3, 3) m², and spread
+    √tr(cov) in m (the RMSE the filter expects of itself)."""
+
+    mean: np.ndarray
+    cov: np.ndarray
+
+    @property
+    def spread(self) -> float:
+        return float(math.sqrt(max(np.trace(self.cov), 0.0)))
+
+
+class Searcher:
+    """Ask/tell source search: ``tell`` a reading, ``ask`` for the next waypoint.
+
+    >>> searcher.tell(position, reading, time)   # after every sample
+    >>> waypoint = searcher.ask()                # where to sample next (3,)
+
+    The planner's random draws come from ``rng`` (seeded by the caller); the filter owns its own.
+    """
+
+    def __init__(
+        self,
+        particle_filter: ParticleFilter,
+        planner: Planner,
+        agent: GridAgent,
+        rng: np.random.Generator,
+    ) -> None:
+        self.filter = particle_filter
+        self.planner = planner
+        self.agent = agent
+        self.rng = rng
+        self.position: np.ndarray | None = None
+        self.time = 0.0
+        self.last_update: UpdateInfo | None = None
+        self.last_decision: Decision | None = None
+        self.last_update_seconds = 0.0
+        self.last_decision_seconds = 0.0
+
+    def tell(self, position: np.ndarray, reading: float, time: float | None = None) -> UpdateInfo:
+        """Assimilate a reading (g/m³) taken at ``position`` (m) at ``time`` (s)."""
+        position = np.asarray(position, dtype=np.float64)
+        if position.shape != (3,) or not np.all(np.isfinite(position)):
+            raise DceeInputError("position", f"must be 3 finite numbers, got {position!r}")
+        if time is not None:
+            if not math.isfinite(time) or time < self.time:
+                raise DceeInputError("time", f"must be finite and non-decreasing, got {time}")
+            self.time = float(time)
+        t0 = _time.perf_counter()
+        self.last_update = self.filter.update(position, reading)
+        self.last_update_seconds = _time.perf_counter() - t0
+        self.position = position
+        return self.last_update
+
+    def ask(self) -> np.ndarray:
+        """Next waypoint (3,) in m, chosen by the planner from the last told position."""
+        if self.position is None:
+            raise DceeInputError("ask", "tell() at least one reading before ask()")
+        t0 = _time.perf_counter()
+        self.last_decision = self.planner.decide(self.belief(), self.position, self.agent, self.rng)
+        self.last_decision_seconds = _time.perf_counter() - t0
+        return self.last_decision.position.copy()
+
+    def belief(self) -> Belief:
+        f = self.filter
+        return Belief(f.theta, f.weights, f.sensor, f.plume)
+
+    def estimate(self) -> SourceEstimate:
+        """Posterior mean and covariance of the source location."""
+        return SourceEstimate(self.filter.source_mean(), self.filter.source_cov())
