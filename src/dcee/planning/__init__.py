@@ -5,7 +5,7 @@ Choose by name: ``dcee.planners.get("dcee")``. Register a new one with
 """
 
 from dcee.planning import dcee, dcee_multistage, entrotaxis, infotaxis, mpc  # noqa: F401
-from dcee.planning.base import Belief, Decision, Planner, get, names, register
+from dcee.planning.base import Belief, Decision, Planner, get, names, planner_class, register
 from dcee.planning.predicted import OneStepPlanner, PredictionContext, SequenceStats
 
 __all__ = [
@@ -17,5 +17,6 @@ __all__ = [
     "SequenceStats",
     "get",
     "names",
+    "planner_class",
     "register",
 ]

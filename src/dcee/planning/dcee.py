@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dcee.planning.base import register
+from dcee.planning.base import Belief, register
 from dcee.planning.predicted import OneStepPlanner, SequenceStats, dcee_cost
 
 
@@ -13,5 +13,7 @@ class DCEEPlanner(OneStepPlanner):
     """J(u) = E_ẑ[‖p_{k+1} − s̄_{k+1|k}‖² + tr P_{k+1|k}]: move towards where the source will be
     believed to be *after* the next reading, penalising the uncertainty that will remain."""
 
-    def cost_from_stats(self, candidates: np.ndarray, stats: SequenceStats) -> np.ndarray:
+    def cost_from_stats(
+        self, candidates: np.ndarray, stats: SequenceStats, belief: Belief
+    ) -> np.ndarray:
         return dcee_cost(candidates, stats)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from dcee.planning.base import register
+from dcee.planning.base import Belief, register
 from dcee.planning.predicted import OneStepPlanner, SequenceStats
 
 
@@ -14,5 +14,7 @@ class InfotaxisPlanner(OneStepPlanner):
     information between the next reading and Θ), estimated over the shared hypothesised
     readings. Cost = −expected KL."""
 
-    def cost_from_stats(self, candidates: np.ndarray, stats: SequenceStats) -> np.ndarray:
+    def cost_from_stats(
+        self, candidates: np.ndarray, stats: SequenceStats, belief: Belief
+    ) -> np.ndarray:
         return -stats.kl.mean(axis=1)

@@ -194,8 +194,10 @@ class OneStepPlanner(Planner):
         rng: np.random.Generator,
     ) -> tuple[np.ndarray, dict[str, Any]]:
         ctx = PredictionContext(belief, self.n_hypotheses, 1, rng)
-        return self.cost_from_stats(candidates, ctx.stats(candidates[:, None, :])), {}
+        return self.cost_from_stats(candidates, ctx.stats(candidates[:, None, :]), belief), {}
 
     @abstractmethod
-    def cost_from_stats(self, candidates: np.ndarray, stats: SequenceStats) -> np.ndarray:
+    def cost_from_stats(
+        self, candidates: np.ndarray, stats: SequenceStats, belief: Belief
+    ) -> np.ndarray:
         """(M,) cost from (M, 3) candidates and their one-step statistics."""

@@ -1,0 +1,138 @@
+"""Figures of one search: plume map, particles, trajectory, readings, RMSE over time."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.colors import LogNorm  # noqa: E402
+
+if TYPE_CHECKING:
+    from dcee.scenarios.config import Scenario
+    from dcee.simulation.episode import EpisodeResult
+    from dcee.simulation.truth import TruthModel
+
+
+def plume_map(
+    truth: TruthModel, scenario: Scenario, time: float, resolution: int = 160
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(xs, ys, C) of the truth at the sensor's altitude; C has shape (len(ys), len(xs))."""
+    lo, hi = scenario.volume.low, scenario.volume.high
+    xs = np.linspace(lo[0], hi[0], resolution)
+    ys = np.linspace(lo[1], hi[1], resolution)
+    gx, gy = np.meshgrid(xs, ys)
+    pts = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, scenario.agent.start[2])])
+    return xs, ys, truth.field(pts, time).reshape(gy.shape)
+
+
+def _draw_map(
+    ax: plt.Axes,
+    result: EpisodeResult,
+    scenario: Scenario,
+    truth: TruthModel,
+    until: float,
+    particles: np.ndarray,
+) -> None:
+    thr = scenario.sensor.threshold
+    xs, ys, conc = plume_map(truth, scenario, until)
+    conc = np.clip(conc, thr / 10, None)
+    mesh = ax.pcolormesh(
+        xs, ys, conc, norm=LogNorm(vmin=thr / 10, vmax=max(conc.max(), 10 * thr)),
+        cmap="YlOrBr", shading="auto", rasterized=True,
+    )  # fmt: skip
+    if conc.min() < thr < conc.max():
+        ax.contour(xs, ys, conc, levels=[thr], colors="k", linewidths=0.6, linestyles="--")
+    recs = [r for r in result.records if r["time"] <= until + 1e-9]
+    ax.scatter(particles[:, 0], particles[:, 1], s=1.0, c="tab:green", alpha=0.35, lw=0,
+               label="particles (source hypotheses)")  # fmt: skip
+    px = np.array([r["x"] for r in recs])
+    py = np.array([r["y"] for r in recs])
+    ax.plot(px, py, "-", color="tab:red", lw=0.8, alpha=0.8, label="trajectory")
+    det = np.array([r["detection"] for r in recs])
+    z = np.array([r["reading"] for r in recs])
+    ax.scatter(px[~det], py[~det], s=4, c="0.35", lw=0, label="non-detection")
+    if det.any():
+        size = 10 + 60 * np.sqrt(z[det] / z[det].max())
+        ax.scatter(px[det], py[det], s=size, facecolors="none", edgecolors="tab:blue", lw=0.8,
+                   label="detection (size ∝ √reading)")  # fmt: skip
+    t = scenario.truth
+    ax.plot(t.x, t.y, "*", ms=14, mec="k", mfc="gold", label="true source")
+    last = recs[-1]
+    ax.plot(last["mean_x"], last["mean_y"], "P", ms=9, mec="k", mfc="tab:cyan",
+            label="posterior mean")  # fmt: skip
+    ax.plot(*scenario.agent.start[:2], "x", ms=9, color="k", mew=2, label="start")
+    ax.set_xlim(scenario.volume.low[0], scenario.volume.high[0])
+    ax.set_ylim(scenario.volume.low[1], scenario.volume.high[1])
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title(f"t = {until:.0f} s, RMSE {last['rmse']:.2f} m")
+    plt.colorbar(mesh, ax=ax, fraction=0.046, pad=0.04,
+                 label=f"truth at z = {scenario.agent.start[2]:g} m (g/m³)")  # fmt: skip
+
+
+def _draw_rmse(ax: plt.Axes, result: EpisodeResult, scenario: Scenario, until: float) -> None:
+    recs = [r for r in result.records if r["time"] <= until + 1e-9]
+    t = np.array([r["time"] for r in recs])
+    ax.semilogy(t, [r["rmse"] for r in recs], color="tab:red", label="RMSE about true source")
+    ax.semilogy(t, [r["spread"] for r in recs], color="tab:blue", ls="--",
+                label="posterior spread √tr P")  # fmt: skip
+    ax.semilogy(t, [r["mean_error"] for r in recs], color="0.4", lw=0.8,
+                label="error of posterior mean")  # fmt: skip
+    for level in (scenario.search.acquired_rmse, 1.0, 0.5):
+        ax.axhline(level, color="0.7", lw=0.6, ls=":")
+    ax.set_xlim(0, scenario.search.budget)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("m")
+    ax.legend(fontsize=7, loc="upper right")
+    ax.grid(alpha=0.3, which="both")
+
+
+def search_figure(
+    result: EpisodeResult, scenario: Scenario, truth: TruthModel, path: str | Path
+) -> None:
+    """Write the summary figure of one search (PNG) to ``path``."""
+    s = result.summary
+    fig, (ax_map, ax_rmse) = plt.subplots(1, 2, figsize=(13, 5.6), width_ratios=[1.15, 1])
+    idx = np.random.default_rng(0).choice(
+        len(result.final_weights), size=min(3000, len(result.final_weights)),
+        p=result.final_weights,
+    )  # fmt: skip
+    _draw_map(ax_map, result, scenario, truth, result.records[-1]["time"],
+              result.final_particles[idx])  # fmt: skip
+    ax_map.legend(fontsize=6.5, loc="upper left", framealpha=0.85, markerscale=0.7)
+    _draw_rmse(ax_rmse, result, scenario, scenario.search.budget)
+    fig.suptitle(
+        f"{s['scenario']} · {s['strategy']} · seed {s['seed']} · final RMSE {s['final_rmse']:.2f} m"
+        f" · source {'acquired' if s['source_acquired'] else 'not acquired'}",
+        fontsize=11,
+    )
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def search_animation(
+    result: EpisodeResult, scenario: Scenario, truth: TruthModel, path: str | Path
+) -> None:
+    """Write an animated GIF of the search (one frame per particle snapshot)."""
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    fig, (ax_map, ax_rmse) = plt.subplots(1, 2, figsize=(11, 4.8), width_ratios=[1.15, 1])
+
+    def frame(k: int) -> None:
+        fig.clear()
+        a1 = fig.add_subplot(1, 2, 1)
+        a2 = fig.add_subplot(1, 2, 2)
+        t, parts = result.snapshots[k]
+        _draw_map(a1, result, scenario, truth, t, parts)
+        _draw_rmse(a2, result, scenario, t)
+
+    anim = FuncAnimation(fig, frame, frames=len(result.snapshots))
+    anim.save(str(path), writer=PillowWriter(fps=4), dpi=70)
+    plt.close(fig)

@@ -1,0 +1,233 @@
+"""The ``dcee`` command line.
+
+Every user mistake (bad option, bad scenario value, unknown name, missing file) ends in one line
+on stderr, ``dcee: error: <field>: <what is allowed>``, and exit code 2; result files are written
+atomically (temporary name, then rename), so an interrupted run leaves no half-written file.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import tempfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import click
+
+from dcee.errors import DceeInputError
+
+
+def _write_atomic(path: Path, writer: Callable[[Path], None]) -> None:
+    """Write via ``writer(tmp)`` to a temporary file beside ``path``, then rename over it."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
+    os.close(fd)
+    try:
+        writer(Path(tmp))
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the usual permissions
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _write_json(path: Path, data: Any) -> None:
+    _write_atomic(path, lambda p: p.write_text(json.dumps(data, indent=2, default=_jsonable)))
+
+
+def _jsonable(obj: Any) -> Any:
+    import numpy as np
+
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    raise TypeError(f"not JSON serialisable: {type(obj)}")
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="dcee")
+def cli() -> None:
+    """Autonomous search for the source of an airborne release (DCEE and peers)."""
+
+
+@cli.command()
+@click.option("--scenario", "scenario_name", required=True,
+              help="Built-in name (see `dcee scenarios`) or path to a TOML file.")
+@click.option("--strategy", default="dcee", show_default=True,
+              help="Planner: dcee, dcee-ms, mpc, entrotaxis, infotaxis.")
+@click.option("--seed", default=0, show_default=True, type=int, help="Run seed.")
+@click.option("--particles", type=int, help="Override search.particles.")
+@click.option("--hypotheses", type=int, help="Override search.hypotheses (per candidate move).")
+@click.option("--budget", type=float, help="Override search.budget (seconds of flight).")
+@click.option("--unknown", type=click.Choice(["source", "full"]), help="Override unknown set.")
+@click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
+              help="Output folder [default: results/<scenario>_<strategy>_seed<seed>].")
+@click.option("--json", "json_file", type=click.Path(dir_okay=False, path_type=Path),
+              help="Also write the summary JSON here.")
+@click.option("--animate", is_flag=True, help="Also write animation.gif.")
+@click.option("--no-figure", is_flag=True, help="Skip figure.png.")
+@click.option("--quiet", "-q", is_flag=True, help="No progress display.")
+def run(
+    scenario_name: str,
+    strategy: str,
+    seed: int,
+    particles: int | None,
+    hypotheses: int | None,
+    budget: float | None,
+    unknown: str | None,
+    out_dir: Path | None,
+    json_file: Path | None,
+    animate: bool,
+    no_figure: bool,
+    quiet: bool,
+) -> None:
+    """Run one simulated search and write its record, summary, configuration and figure."""
+    from dcee import __version__
+    from dcee.planning import planner_class
+    from dcee.scenarios import load_scenario
+    from dcee.simulation import make_truth, run_episode
+
+    if seed < 0:
+        raise DceeInputError("seed", f"must be >= 0, got {seed}")
+    planner_class(strategy)  # fail fast on an unknown name
+    scenario = load_scenario(scenario_name).with_overrides(
+        **{
+            "search.particles": particles,
+            "search.hypotheses": hypotheses,
+            "search.budget": budget,
+            "unknown": unknown,
+        }
+    )
+    out_dir = out_dir or Path("results") / f"{scenario.name.replace(':', '-')}_{strategy}_seed{seed}"
+    truth = make_truth(scenario.truth.model, scenario.truth_theta())
+    result = _run_with_progress(
+        lambda progress: run_episode(
+            scenario, strategy, seed, truth=truth, progress=progress,
+            snapshot_every=scenario.search.budget / 40 if animate else None,
+        ),
+        scenario.search.budget,
+        quiet,
+    )  # fmt: skip
+    summary = result.summary
+    summary["version"] = __version__
+    config = {
+        "scenario": scenario.model_dump(),
+        "strategy": strategy,
+        "seed": seed,
+        "planner_options": summary["planner_options"],
+        "version": __version__,
+    }
+    import pandas as pd
+
+    _write_json(out_dir / "config.json", config)
+    _write_atomic(
+        out_dir / "steps.parquet",
+        lambda p: pd.DataFrame.from_records(result.records).to_parquet(p, index=False),
+    )
+    if not no_figure:
+        from dcee.analysis.figures import search_figure
+
+        _write_atomic(out_dir / "figure.png", lambda p: search_figure(result, scenario, truth, p))
+    if animate:
+        from dcee.analysis.figures import search_animation
+
+        _write_atomic(
+            out_dir / "animation.gif", lambda p: search_animation(result, scenario, truth, p)
+        )
+    _write_json(out_dir / "summary.json", summary)  # written last: marks a complete result
+    if json_file is not None:
+        _write_json(json_file, summary)
+    _print_summary(summary, out_dir)
+
+
+def _run_with_progress(job: Callable[[Any], Any], budget: float, quiet: bool) -> Any:
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    if quiet or not sys.stderr.isatty():
+        return job(None)
+    with Progress(
+        TextColumn("[bold]searching"), BarColumn(), TextColumn("{task.fields[status]}"),
+        TimeElapsedColumn(), transient=True,
+    ) as bar:  # fmt: skip
+        task = bar.add_task("search", total=budget, status="")
+
+        def progress(t: float, rec: dict[str, Any]) -> None:
+            bar.update(task, completed=t, status=f"t={t:.0f}s RMSE {rec['rmse']:.2f} m")
+
+        return job(progress)
+
+
+def _print_summary(summary: dict[str, Any], out_dir: Path) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title=f"{summary['scenario']} · {summary['strategy']} · seed {summary['seed']}")
+    table.add_column("metric")
+    table.add_column("value", justify="right")
+    rows = [
+        ("final RMSE (m)", f"{summary['final_rmse']:.3f}"),
+        ("source acquired", str(summary["source_acquired"])),
+        ("plume acquired", str(summary["plume_acquired"])),
+        ("time to RMSE < 1 m (s)", _fmt(summary["time_to_rmse_1m"])),
+        ("time to RMSE < 0.5 m (s)", _fmt(summary["time_to_rmse_0_5m"])),
+        ("steps", str(summary["steps"])),
+        ("path length (m)", f"{summary['path_length']:.1f}"),
+        ("mean decision time (ms)", f"{1e3 * summary['decision_seconds_mean']:.2f}"),
+        ("total compute (s)", f"{summary['compute_seconds_total']:.2f}"),
+    ]
+    for k, v in rows:
+        table.add_row(k, v)
+    console = Console()
+    console.print(table)
+    console.print(f"results in {out_dir}")
+
+
+def _fmt(v: float | None) -> str:
+    return "never" if v is None else f"{v:.0f}"
+
+
+@cli.command()
+def scenarios() -> None:
+    """List the built-in scenarios."""
+    from dcee.scenarios import builtin_scenarios
+
+    for name, data in builtin_scenarios().items():
+        click.echo(f"{name:14s} {data['description']}")
+
+
+@cli.command()
+@click.argument("scenario_name")
+def show(scenario_name: str) -> None:
+    """Print the resolved configuration of a scenario (built-in or TOML path) as JSON."""
+    from dcee.scenarios import load_scenario
+
+    click.echo(json.dumps(load_scenario(scenario_name).model_dump(), indent=2))
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point: user errors → one line on stderr and exit 2."""
+    try:
+        cli.main(args=argv, prog_name="dcee", standalone_mode=False)
+    except DceeInputError as exc:
+        click.echo(f"dcee: error: {exc}", err=True)
+        sys.exit(2)
+    except click.exceptions.Abort:
+        click.echo("dcee: interrupted", err=True)
+        sys.exit(130)
+    except click.ClickException as exc:
+        click.echo(f"dcee: error: {exc.format_message()}", err=True)
+        sys.exit(2)
+    except KeyboardInterrupt:
+        click.echo("dcee: interrupted", err=True)
+        sys.exit(130)
+    sys.exit(0)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

@@ -1,0 +1,35 @@
+"""Small hand-built problems shared by the tests."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dcee.estimation.priors import Fixed, Gamma, SourcePrior, Uniform
+
+
+def planar_prior(
+    x=(0.0, 10.0), y=(0.0, 10.0), q_gamma=(2.0, 1.0), u=2.0, phi=0.0, zeta1=1.0, zeta2=8.0
+) -> SourcePrior:
+    """x, y, q unknown; source at z = 0; wind and dispersion known."""
+    return SourcePrior.from_dict(
+        {
+            "x": Uniform(*x),
+            "y": Uniform(*y),
+            "z": Fixed(0.0),
+            "q": Gamma(*q_gamma),
+            "u": Fixed(u),
+            "phi": Fixed(phi),
+            "zeta1": Fixed(zeta1),
+            "zeta2": Fixed(zeta2),
+        }
+    )
+
+
+def theta_at(points, q=5.0, u=0.0, phi=0.0, zeta1=1.0, zeta2=8.0) -> np.ndarray:
+    """(N, 8) source terms at the given (N, 3) locations with shared other parameters."""
+    points = np.atleast_2d(np.asarray(points, dtype=float))
+    n = len(points)
+    return np.column_stack(
+        [points, np.full(n, q), np.full(n, u), np.full(n, phi), np.full(n, zeta1),
+         np.full(n, zeta2)]
+    )  # fmt: skip

@@ -1,0 +1,152 @@
+import numpy as np
+import pytest
+
+from dcee import DceeInputError, IsotropicPlume, ParticleFilter, Sensor
+from dcee.estimation.particle_filter import (
+    history_log_likelihood_reference,
+    systematic_resample,
+)
+from dcee import kernels
+from dcee.models.plume import isotropic_concentration_reference
+
+from tests.helpers import planar_prior, theta_at
+
+TRUE_SOURCE = (6.0, 5.0)
+TRUE_Q = 2.0
+READ_POSITIONS = [(1.0, 5.5), (3.0, 3.0), (2.0, 8.0), (4.0, 6.0), (8.5, 5.0), (3.0, 5.0)]
+
+
+def _readings(sensor: Sensor, seed: int = 2) -> list[tuple[np.ndarray, float]]:
+    truth = theta_at([(*TRUE_SOURCE, 0.0)], q=TRUE_Q, u=2.0, phi=0.0)
+    rng = np.random.default_rng(seed)
+    out = []
+    for p in READ_POSITIONS:
+        pos = np.array([*p, 0.0])
+        c = isotropic_concentration_reference(truth, pos[None])[0, 0]
+        out.append((pos, float(sensor.simulate(c, rng))))
+    return out
+
+
+def _grid_posterior(sensor, data):
+    """Exact posterior on an (x, y, q) grid with NumPy reference models (prior: U × U × Γ(2,1))."""
+    xs = np.linspace(0, 10, 161)
+    ys = np.linspace(0, 10, 161)
+    qs = np.linspace(0.01, 9.0, 90)
+    gx, gy, gq = np.meshgrid(xs, ys, qs, indexing="ij")
+    theta = np.column_stack(
+        [gx.ravel(), gy.ravel(), np.zeros(gx.size), gq.ravel(), np.full(gx.size, 2.0),
+         np.zeros(gx.size), np.ones(gx.size), np.full(gx.size, 8.0)]
+    )  # fmt: skip
+    logp = np.log(gq.ravel())  # Γ(2, 1) ∝ q e^{−q}
+    logp -= gq.ravel()
+    pos = np.array([p for p, _ in data])
+    z = np.array([r for _, r in data])
+    logp += history_log_likelihood_reference(theta, pos, z, np.ones(len(z)), sensor,
+                                             IsotropicPlume())  # fmt: skip
+    w = np.exp(logp - logp.max())
+    w /= w.sum()
+    mean = w @ theta[:, [0, 1, 3]]
+    sd = np.sqrt(w @ (theta[:, [0, 1, 3]] - mean) ** 2)
+    return mean, sd
+
+
+@pytest.mark.parametrize("resample_threshold,mcmc_steps", [(0.5, 1), (1.0, 3)])
+def test_filter_matches_exact_grid_posterior(sensor, resample_threshold, mcmc_steps):
+    data = _readings(sensor)
+    assert sum(r >= sensor.threshold for _, r in data) >= 3  # an informative data set
+    grid_mean, grid_sd = _grid_posterior(sensor, data)
+    pf = ParticleFilter(
+        planar_prior(u=2.0), sensor, n_particles=20_000, seed=7,
+        resample_threshold=resample_threshold, mcmc_steps=mcmc_steps,
+    )  # fmt: skip
+    for pos, z in data:
+        pf.update(pos, z)
+    assert pf.n_resamples > 0
+    mean = pf.mean()
+    sd = np.sqrt(np.diag(pf.cov()))
+    assert pf.parameter_names == ("x", "y", "q")
+    np.testing.assert_array_less(np.abs(mean - grid_mean), 0.2 * grid_sd)
+    np.testing.assert_allclose(sd, grid_sd, rtol=0.2)
+
+
+def test_collapse_is_recovered_by_tempering_and_still_matches_the_posterior(sensor):
+    data = _readings(sensor)
+    grid_mean, grid_sd = _grid_posterior(sensor, data)
+    # Assimilate the most informative (largest) reading first, so the flat prior collapses.
+    order = sorted(data, key=lambda d: -d[1])
+    pf = ParticleFilter(planar_prior(u=2.0), sensor, n_particles=20_000, seed=3,
+                        collapse_threshold=0.2)  # fmt: skip
+    infos = [pf.update(pos, z) for pos, z in order]
+    assert pf.recoveries, "a collapsing reading must be recorded as a recovery"
+    assert max(i.tempering_stages for i in infos) > 1
+    assert np.all(np.isfinite(pf.weights)) and pf.ess > 100
+    np.testing.assert_array_less(np.abs(pf.mean() - grid_mean), 0.25 * grid_sd)
+
+
+def test_history_kernel_matches_reference(sensor):
+    rng = np.random.default_rng(0)
+    theta = theta_at(np.column_stack([rng.uniform(0, 10, (500, 2)), np.zeros(500)]), q=2.0,
+                     u=2.0)  # fmt: skip
+    pos = np.column_stack([rng.uniform(0, 10, (30, 2)), np.zeros(30)])
+    z = np.where(rng.random(30) < 0.5, 0.0, rng.gamma(1.0, 5e-3, 30))
+    mult = rng.integers(1, 4, 30).astype(float)
+    out = np.empty(500)
+    kernels.history_log_likelihood(theta, np.ones(500, bool), pos, z, mult, 0.1,
+                                   sensor.params, out)  # fmt: skip
+    ref = history_log_likelihood_reference(theta, pos, z, mult, sensor, IsotropicPlume())
+    np.testing.assert_allclose(out, ref, rtol=1e-9)
+
+
+def test_constraints_hold_after_many_moves(sensor):
+    pf = ParticleFilter(planar_prior(u=2.0), sensor, n_particles=3000, seed=1,
+                        resample_threshold=1.0, mcmc_steps=5)  # fmt: skip
+    for pos, z in _readings(sensor):
+        pf.update(pos, z)
+    p = pf.particles
+    assert np.all(p[:, 2] > 0)  # q > 0
+    assert np.all((p[:, :2] >= 0) & (p[:, :2] <= 10))  # inside the volume
+    assert np.all(pf.theta[:, 2] == 0.0) and np.all(pf.theta[:, 4] == 2.0)  # known stay known
+
+
+def test_same_seed_same_particles(sensor):
+    runs = []
+    for _ in range(2):
+        pf = ParticleFilter(planar_prior(u=2.0), sensor, n_particles=2000, seed=42)
+        for pos, z in _readings(sensor):
+            pf.update(pos, z)
+        runs.append((pf.particles.copy(), pf.weights.copy()))
+    np.testing.assert_array_equal(runs[0][0], runs[1][0])
+    np.testing.assert_array_equal(runs[0][1], runs[1][1])
+
+
+def test_repeated_non_detections_are_merged_but_counted(sensor):
+    pf = ParticleFilter(planar_prior(u=2.0), sensor, n_particles=500, seed=0)
+    for _ in range(3):
+        pf.update(np.array([1.0, 1.0, 0.0]), 0.0)
+    pos, z, mult = pf.history()
+    assert len(z) == 1 and mult[0] == 3.0 and pf.n_readings == 3
+
+
+def test_systematic_resampling_counts_are_within_one_of_expectation():
+    w = np.random.default_rng(0).dirichlet(np.ones(50))
+    idx = systematic_resample(w, np.random.default_rng(1), 1000)
+    counts = np.bincount(idx, minlength=50)
+    assert np.all(np.abs(counts - 1000 * w) < 1.0 + 1e-9)
+
+
+def test_public_shapes(sensor):
+    pf = ParticleFilter(planar_prior(), sensor, n_particles=100, seed=0)
+    assert pf.particles.shape == (100, 3)
+    assert pf.weights.shape == (100,) and pf.weights.sum() == pytest.approx(1.0)
+    assert pf.mean().shape == (3,) and pf.cov().shape == (3, 3)
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf")])
+def test_nan_reading_is_rejected(sensor, bad):
+    pf = ParticleFilter(planar_prior(), sensor, n_particles=100, seed=0)
+    with pytest.raises(DceeInputError, match="reading"):
+        pf.update(np.array([1.0, 1.0, 0.0]), bad)
+    with pytest.raises(DceeInputError, match="position"):
+        pf.update(np.array([1.0, 1.0]), 0.0)
+    with pytest.raises(DceeInputError, match="particles"):
+        ParticleFilter(planar_prior(), sensor, n_particles=-5)

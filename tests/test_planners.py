@@ -1,0 +1,154 @@
+import math
+
+import numpy as np
+import pytest
+
+from dcee import DceeInputError, GridAgent, IsotropicPlume, SearchVolume, Sensor, planners
+from dcee import kernels
+from dcee.planning import Belief, PredictionContext
+from dcee.planning.predicted import predicted_posterior_stats_reference
+
+from tests.helpers import theta_at
+
+AGENT = GridAgent(SearchVolume((0.0, 0.0, 0.0), (40.0, 40.0, 0.0)), step=2.0)
+START = np.array([10.0, 10.0, 0.0])
+
+
+def _belief(points, weights=None, **kw) -> Belief:
+    theta = theta_at([(*p, 0.0) for p in points], **kw)
+    w = np.full(len(points), 1 / len(points)) if weights is None else np.asarray(weights, float)
+    return Belief(theta, w / w.sum(), Sensor(), IsotropicPlume())
+
+
+def _two_point_belief(n_each=500):
+    # Hypothesis A just east of the agent (reachable by a reading), B far north. No wind,
+    # a weak release: only a sensor within ~1.5 m of A detects it.
+    pts = [(13.0, 10.0)] * n_each + [(10.0, 30.0)] * n_each
+    return _belief(pts, q=0.02, u=0.0)
+
+
+def test_registry_lists_all_strategies_and_rejects_unknown():
+    assert set(planners.names()) >= {"dcee", "dcee-ms", "mpc", "entrotaxis", "infotaxis"}
+    assert planners.get("dcee").name == "dcee"
+    with pytest.raises(DceeInputError, match="strategy"):
+        planners.get("nope")
+
+
+def test_new_planner_registers_without_editing_a_dispatcher():
+    @planners.register("test-stay-west")
+    class West(planners.Planner):
+        def costs(self, belief, position, candidates, agent, rng):
+            return candidates[:, 0], {}
+
+    d = planners.get("test-stay-west").decide(_belief([(20, 20)]), START, AGENT,
+                                              np.random.default_rng(0))  # fmt: skip
+    assert d.heading == 4  # 180°: west
+
+
+def test_mpc_moves_towards_the_posterior_mean_with_hand_computed_costs():
+    belief = _two_point_belief()
+    d = planners.get("mpc").decide(belief, START, AGENT, np.random.default_rng(0))
+    mean = np.array([11.5, 20.0, 0.0])
+    expected = np.sum((d.candidates - mean) ** 2, axis=1)
+    np.testing.assert_allclose(d.costs, expected, rtol=1e-12)
+    assert d.heading == 2  # north: (10, 12) is closest to (11.5, 20)
+
+
+@pytest.mark.parametrize("name", ["dcee", "dcee-ms", "mpc"])
+def test_concentrated_belief_leads_straight_to_the_source(name):
+    belief = _belief([(20.0, 20.0)] * 50, q=5.0, u=4.0, phi=math.radians(225))
+    d = planners.get(name).decide(belief, START, AGENT, np.random.default_rng(0))
+    assert d.heading == 1  # 45°: north-east, straight at (20, 20)
+
+
+def test_infotaxis_is_indifferent_when_nothing_is_left_to_learn():
+    # Every particle agrees: no reading can change the belief, so every expected KL is 0.
+    # (Entrotaxis is not indifferent here: sensor noise alone has entropy, its known weakness.)
+    belief = _belief([(30.0, 30.0)] * 50, q=5.0, u=4.0, phi=math.radians(45))
+    d = planners.get("infotaxis").decide(belief, START, AGENT, np.random.default_rng(0))
+    np.testing.assert_allclose(d.costs, 0.0, atol=1e-9)
+
+
+def test_dcee_cost_equals_its_definition_for_a_point_belief():
+    belief = _belief([(20.0, 20.0)] * 10, q=5.0, u=4.0, phi=math.radians(225))
+    d = planners.get("dcee").decide(belief, START, AGENT, np.random.default_rng(0))
+    # All particles at one location: s̄' = s, tr P' = 0, so J(u) = ‖p − s‖² exactly.
+    expected = np.sum((d.candidates - np.array([20.0, 20.0, 0.0])) ** 2, axis=1)
+    np.testing.assert_allclose(d.costs, expected, rtol=1e-9)
+
+
+def test_dcee_expected_cost_is_mpc_cost_plus_trace_by_total_variance():
+    # With hypotheses drawn from the predictive distribution, E[‖p − s̄'‖² + tr P'] equals
+    # ‖p − s̄‖² + tr P (law of total variance). Check the Monte Carlo machinery reproduces it.
+    rng = np.random.default_rng(2)
+    pts = np.column_stack([rng.normal(14, 2, 400), rng.normal(12, 2, 400)])
+    belief = _belief(pts, q=0.5, u=1.0, phi=math.radians(30))
+    dcee = planners.get("dcee", n_hypotheses=20_000)
+    d = dcee.decide(belief, START, AGENT, np.random.default_rng(1))
+    s = belief.source
+    mean = belief.source_mean()
+    trace = belief.weights @ np.sum((s - mean) ** 2, axis=1)
+    expected = np.sum((d.candidates - mean) ** 2, axis=1) + trace
+    np.testing.assert_allclose(d.costs, expected, rtol=0.02)
+
+
+def test_entrotaxis_and_infotaxis_sample_where_the_reading_discriminates():
+    belief = _two_point_belief()
+    for name in ("entrotaxis", "infotaxis"):
+        d = planners.get(name).decide(belief, START, AGENT, np.random.default_rng(0))
+        assert d.heading == 0, name  # east: 1 m from hypothesis A
+    # The east point (1 m from A) resolves the 50/50 belief most often; the diagonals (2.1 m
+    # from A) sometimes; the other moves almost never.
+    d = planners.get("infotaxis", n_hypotheses=4000).decide(belief, START, AGENT,
+                                                             np.random.default_rng(0))  # fmt: skip
+    gain = -d.costs
+    assert gain[0] > 0.2 and gain[1:].max() < 0.5 * gain[0]
+    assert np.all(gain[2:7] < 0.05 * gain[0])
+
+
+def test_multistage_plans_through_an_intermediate_point():
+    # Source 4 m north: horizon 2 ends exactly on it by going north twice.
+    belief = _belief([(10.0, 14.0)] * 20, q=5.0, u=4.0, phi=math.radians(270))
+    planner = planners.get("dcee-ms", horizon=2, beam_width=3)
+    d = planner.decide(belief, START, AGENT, np.random.default_rng(0))
+    assert d.heading == 2
+    assert d.info["sequences_evaluated"] == 8 + 3 * 8
+    assert np.isfinite(d.costs).sum() <= 3
+
+
+def test_candidates_are_compared_on_common_random_numbers():
+    belief = _two_point_belief(50)
+    ctx = PredictionContext(belief, 40, 1, np.random.default_rng(0))
+    twice = np.array([[[12.0, 10.0, 0.0]], [[12.0, 10.0, 0.0]]])
+    st = ctx.stats(twice)
+    np.testing.assert_array_equal(st.readings[0], st.readings[1])
+    np.testing.assert_array_equal(st.mean[0], st.mean[1])
+
+
+def test_compiled_predicted_stats_match_reference():
+    rng = np.random.default_rng(9)
+    n = 3000
+    pts = np.column_stack([rng.uniform(0, 20, n), rng.uniform(0, 20, n)])
+    belief = _belief(pts, weights=rng.random(n), q=2.0, u=2.0, phi=0.5)
+    sensor = belief.sensor
+    positions = np.array([[5.0, 5.0, 0.0], [8.0, 12.0, 0.0], [15.0, 3.0, 0.0]])
+    conc = np.ascontiguousarray(belief.plume.concentration(belief.theta, positions).T)
+    task_pos = np.array([[0, 1], [1, 2], [2, 2], [0, 0]])
+    task_z = np.array([[0.0, 0.0], [3e-3, 0.0], [1e-2, 2e-3], [6e-4, 0.05]])
+    out = [np.empty(4), np.empty((4, 3)), np.empty(4), np.empty(4)]
+    kernels.predicted_posterior_stats(conc, belief.source.copy(), belief.weights,
+                                      belief.source_mean(), task_pos, task_z, sensor.params,
+                                      *out)  # fmt: skip
+    ref = predicted_posterior_stats_reference(conc, belief.source, belief.weights, task_pos,
+                                              task_z, sensor)  # fmt: skip
+    for fast, slow in zip(out, ref, strict=True):
+        np.testing.assert_allclose(fast, slow, rtol=1e-9, atol=1e-12)
+
+
+def test_bad_planner_options_are_user_errors():
+    with pytest.raises(DceeInputError, match="hypotheses"):
+        planners.get("dcee", n_hypotheses=0)
+    with pytest.raises(DceeInputError, match="horizon"):
+        planners.get("dcee-ms", horizon=7)
+    with pytest.raises(DceeInputError, match="planner_options"):
+        planners.get("mpc", n_hypotheses=3)

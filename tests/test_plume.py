@@ -1,0 +1,78 @@
+import math
+
+import numpy as np
+import pytest
+
+from dcee import DceeInputError, isotropic_concentration
+from dcee.models.plume import MIN_DISTANCE, isotropic_concentration_reference
+
+
+def test_hand_calculation_without_wind():
+    # q = 5, u = 0, ζ1 = 1, ζ2 = 8: λ = √8; point 5 m away (3-4-5 triangle).
+    theta = np.array([[0, 0, 0, 5.0, 0.0, 0.0, 1.0, 8.0]])
+    c = isotropic_concentration(theta, np.array([[3.0, 4.0, 0.0]]))[0, 0]
+    expected = 5.0 / (4 * math.pi * 1.0 * 5.0) * math.exp(-5.0 / math.sqrt(8.0))
+    assert c == pytest.approx(expected, rel=1e-13)
+
+
+def test_hand_calculation_with_wind():
+    # q = 2, u = 3, φ = 30°, ζ1 = 0.5, ζ2 = 4; source (1, 2, 1); point (-2, 0, 3).
+    q, u, phi, z1, z2 = 2.0, 3.0, math.radians(30), 0.5, 4.0
+    theta = np.array([[1.0, 2.0, 1.0, q, u, phi, z1, z2]])
+    dx, dy, dz = -3.0, -2.0, 2.0
+    r = math.sqrt(dx * dx + dy * dy + dz * dz)
+    lam = math.sqrt(z1 * z2 / (1 + u * u * z2 / (4 * z1)))
+    expected = (
+        q / (4 * math.pi * z1 * r) * math.exp(-r / lam)
+        * math.exp(-dx * u * math.cos(phi) / (2 * z1))
+        * math.exp(-dy * u * math.sin(phi) / (2 * z1))
+    )  # fmt: skip
+    assert isotropic_concentration(theta, np.array([[-2.0, 0.0, 3.0]]))[0, 0] == pytest.approx(
+        expected, rel=1e-13
+    )
+
+
+def test_plume_extends_towards_minus_wind_direction():
+    for phi_deg in (0, 90, 200):
+        phi = math.radians(phi_deg)
+        theta = np.array([[0, 0, 0, 5.0, 4.0, phi, 1.0, 8.0]])
+        d = np.array([math.cos(phi), math.sin(phi), 0.0])
+        c = isotropic_concentration(theta, np.stack([-5 * d, 5 * d]))[0]
+        # Symmetric points: the ratio is exactly the advection factor e^{2·5u/(2ζ1)} = e^{20}.
+        assert c[0] / c[1] == pytest.approx(math.exp(20.0), rel=1e-9)
+
+
+def test_pure_diffusion_limit():
+    # u = 0 and ζ2 → ∞: λ → ∞, C → q / (4π ζ1 r).
+    theta = np.array([[0, 0, 0, 3.0, 0.0, 0.0, 0.7, 1e14]])
+    c = isotropic_concentration(theta, np.array([[2.0, 0.0, 0.0]]))[0, 0]
+    assert c == pytest.approx(3.0 / (4 * math.pi * 0.7 * 2.0), rel=1e-6)
+
+
+def test_distance_is_clamped_at_the_source():
+    theta = np.array([[1, 1, 1, 5.0, 4.0, 0.3, 1.0, 8.0]])
+    at_source = isotropic_concentration(theta, np.array([[1.0, 1.0, 1.0]]))[0, 0]
+    assert np.isfinite(at_source)
+    c_min = 5.0 / (4 * math.pi * MIN_DISTANCE) * math.exp(-MIN_DISTANCE / math.sqrt(8 / 33))
+    assert at_source == pytest.approx(c_min, rel=1e-12)
+
+
+def test_compiled_matches_reference(rng=np.random.default_rng(3)):
+    n, m = 300, 17
+    theta = np.column_stack(
+        [rng.uniform(0, 50, n), rng.uniform(0, 50, n), rng.uniform(0, 5, n),
+         rng.gamma(2, 5, n), rng.uniform(0, 8, n), rng.uniform(-4, 4, n),
+         rng.uniform(0.1, 3, n), rng.uniform(0.5, 15, n)]
+    )  # fmt: skip
+    pos = np.column_stack([rng.uniform(0, 50, m), rng.uniform(0, 50, m), np.full(m, 4.0)])
+    fast = isotropic_concentration(theta, pos)
+    ref = isotropic_concentration_reference(theta, pos)
+    assert fast.shape == (n, m)
+    np.testing.assert_allclose(fast, ref, rtol=1e-9, atol=0)
+
+
+def test_wrong_shapes_are_rejected():
+    with pytest.raises(DceeInputError, match="theta"):
+        isotropic_concentration(np.zeros((3, 7)), np.zeros((2, 3)))
+    with pytest.raises(DceeInputError, match="positions"):
+        isotropic_concentration(np.zeros((3, 8)), np.zeros((2, 2)))
