@@ -30,6 +30,12 @@ def theta_at(points, q=5.0, u=0.0, phi=0.0, zeta1=1.0, zeta2=8.0) -> np.ndarray:
     points = np.atleast_2d(np.asarray(points, dtype=float))
     n = len(points)
     return np.column_stack(
-        [points, np.full(n, q), np.full(n, u), np.full(n, phi), np.full(n, zeta1),
-         np.full(n, zeta2)]
-    )  # fmt: skip
+        [
+            points,
+            np.full(n, q),
+            np.full(n, u),
+            np.full(n, phi),
+            np.full(n, zeta1),
+            np.full(n, zeta2),
+        ]
+    )

@@ -1,14 +1,12 @@
 import numpy as np
 import pytest
 
-from dcee import DceeInputError, IsotropicPlume, ParticleFilter, Sensor
+from dcee import DceeInputError, IsotropicPlume, ParticleFilter, Sensor, kernels
 from dcee.estimation.particle_filter import (
     history_log_likelihood_reference,
     systematic_resample,
 )
-from dcee import kernels
 from dcee.models.plume import isotropic_concentration_reference
-
 from tests.helpers import planar_prior, theta_at
 
 TRUE_SOURCE = (6.0, 5.0)
@@ -34,15 +32,24 @@ def _grid_posterior(sensor, data):
     qs = np.linspace(0.01, 9.0, 90)
     gx, gy, gq = np.meshgrid(xs, ys, qs, indexing="ij")
     theta = np.column_stack(
-        [gx.ravel(), gy.ravel(), np.zeros(gx.size), gq.ravel(), np.full(gx.size, 2.0),
-         np.zeros(gx.size), np.ones(gx.size), np.full(gx.size, 8.0)]
-    )  # fmt: skip
+        [
+            gx.ravel(),
+            gy.ravel(),
+            np.zeros(gx.size),
+            gq.ravel(),
+            np.full(gx.size, 2.0),
+            np.zeros(gx.size),
+            np.ones(gx.size),
+            np.full(gx.size, 8.0),
+        ]
+    )
     logp = np.log(gq.ravel())  # Γ(2, 1) ∝ q e^{−q}
     logp -= gq.ravel()
     pos = np.array([p for p, _ in data])
     z = np.array([r for _, r in data])
-    logp += history_log_likelihood_reference(theta, pos, z, np.ones(len(z)), sensor,
-                                             IsotropicPlume())  # fmt: skip
+    logp += history_log_likelihood_reference(
+        theta, pos, z, np.ones(len(z)), sensor, IsotropicPlume()
+    )
     w = np.exp(logp - logp.max())
     w /= w.sum()
     mean = w @ theta[:, [0, 1, 3]]
@@ -56,9 +63,13 @@ def test_filter_matches_exact_grid_posterior(sensor, resample_threshold, mcmc_st
     assert sum(r >= sensor.threshold for _, r in data) >= 3  # an informative data set
     grid_mean, grid_sd = _grid_posterior(sensor, data)
     pf = ParticleFilter(
-        planar_prior(u=2.0), sensor, n_particles=20_000, seed=7,
-        resample_threshold=resample_threshold, mcmc_steps=mcmc_steps,
-    )  # fmt: skip
+        planar_prior(u=2.0),
+        sensor,
+        n_particles=20_000,
+        seed=7,
+        resample_threshold=resample_threshold,
+        mcmc_steps=mcmc_steps,
+    )
     for pos, z in data:
         pf.update(pos, z)
     assert pf.n_resamples > 0
@@ -74,8 +85,9 @@ def test_collapse_is_recovered_by_tempering_and_still_matches_the_posterior(sens
     grid_mean, grid_sd = _grid_posterior(sensor, data)
     # Assimilate the most informative (largest) reading first, so the flat prior collapses.
     order = sorted(data, key=lambda d: -d[1])
-    pf = ParticleFilter(planar_prior(u=2.0), sensor, n_particles=20_000, seed=3,
-                        collapse_threshold=0.2)  # fmt: skip
+    pf = ParticleFilter(
+        planar_prior(u=2.0), sensor, n_particles=20_000, seed=3, collapse_threshold=0.2
+    )
     infos = [pf.update(pos, z) for pos, z in order]
     assert pf.recoveries, "a collapsing reading must be recorded as a recovery"
     assert max(i.tempering_stages for i in infos) > 1
@@ -85,21 +97,20 @@ def test_collapse_is_recovered_by_tempering_and_still_matches_the_posterior(sens
 
 def test_history_kernel_matches_reference(sensor):
     rng = np.random.default_rng(0)
-    theta = theta_at(np.column_stack([rng.uniform(0, 10, (500, 2)), np.zeros(500)]), q=2.0,
-                     u=2.0)  # fmt: skip
+    theta = theta_at(np.column_stack([rng.uniform(0, 10, (500, 2)), np.zeros(500)]), q=2.0, u=2.0)
     pos = np.column_stack([rng.uniform(0, 10, (30, 2)), np.zeros(30)])
     z = np.where(rng.random(30) < 0.5, 0.0, rng.gamma(1.0, 5e-3, 30))
     mult = rng.integers(1, 4, 30).astype(float)
     out = np.empty(500)
-    kernels.history_log_likelihood(theta, np.ones(500, bool), pos, z, mult, 0.1,
-                                   sensor.params, out)  # fmt: skip
+    kernels.history_log_likelihood(theta, np.ones(500, bool), pos, z, mult, 0.1, sensor.params, out)
     ref = history_log_likelihood_reference(theta, pos, z, mult, sensor, IsotropicPlume())
     np.testing.assert_allclose(out, ref, rtol=1e-9)
 
 
 def test_constraints_hold_after_many_moves(sensor):
-    pf = ParticleFilter(planar_prior(u=2.0), sensor, n_particles=3000, seed=1,
-                        resample_threshold=1.0, mcmc_steps=5)  # fmt: skip
+    pf = ParticleFilter(
+        planar_prior(u=2.0), sensor, n_particles=3000, seed=1, resample_threshold=1.0, mcmc_steps=5
+    )
     for pos, z in _readings(sensor):
         pf.update(pos, z)
     p = pf.particles
@@ -123,7 +134,7 @@ def test_repeated_non_detections_are_merged_but_counted(sensor):
     pf = ParticleFilter(planar_prior(u=2.0), sensor, n_particles=500, seed=0)
     for _ in range(3):
         pf.update(np.array([1.0, 1.0, 0.0]), 0.0)
-    pos, z, mult = pf.history()
+    _, z, mult = pf.history()
     assert len(z) == 1 and mult[0] == 3.0 and pf.n_readings == 3
 
 

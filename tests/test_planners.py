@@ -3,11 +3,9 @@ import math
 import numpy as np
 import pytest
 
-from dcee import DceeInputError, GridAgent, IsotropicPlume, SearchVolume, Sensor, planners
-from dcee import kernels
+from dcee import DceeInputError, GridAgent, IsotropicPlume, SearchVolume, Sensor, kernels, planners
 from dcee.planning import Belief, PredictionContext
 from dcee.planning.predicted import predicted_posterior_stats_reference
-
 from tests.helpers import theta_at
 
 AGENT = GridAgent(SearchVolume((0.0, 0.0, 0.0), (40.0, 40.0, 0.0)), step=2.0)
@@ -40,8 +38,9 @@ def test_new_planner_registers_without_editing_a_dispatcher():
         def costs(self, belief, position, candidates, agent, rng):
             return candidates[:, 0], {}
 
-    d = planners.get("test-stay-west").decide(_belief([(20, 20)]), START, AGENT,
-                                              np.random.default_rng(0))  # fmt: skip
+    d = planners.get("test-stay-west").decide(
+        _belief([(20, 20)]), START, AGENT, np.random.default_rng(0)
+    )
     assert d.heading == 4  # 180°: west
 
 
@@ -99,8 +98,9 @@ def test_entrotaxis_and_infotaxis_sample_where_the_reading_discriminates():
         assert d.heading == 0, name  # east: 1 m from hypothesis A
     # The east point (1 m from A) resolves the 50/50 belief most often; the diagonals (2.1 m
     # from A) sometimes; the other moves almost never.
-    d = planners.get("infotaxis", n_hypotheses=4000).decide(belief, START, AGENT,
-                                                             np.random.default_rng(0))  # fmt: skip
+    d = planners.get("infotaxis", n_hypotheses=4000).decide(
+        belief, START, AGENT, np.random.default_rng(0)
+    )
     gain = -d.costs
     assert gain[0] > 0.2 and gain[1:].max() < 0.5 * gain[0]
     assert np.all(gain[2:7] < 0.05 * gain[0])
@@ -136,11 +136,19 @@ def test_compiled_predicted_stats_match_reference():
     task_pos = np.array([[0, 1], [1, 2], [2, 2], [0, 0]])
     task_z = np.array([[0.0, 0.0], [3e-3, 0.0], [1e-2, 2e-3], [6e-4, 0.05]])
     out = [np.empty(4), np.empty((4, 3)), np.empty(4), np.empty(4)]
-    kernels.predicted_posterior_stats(conc, belief.source.copy(), belief.weights,
-                                      belief.source_mean(), task_pos, task_z, sensor.params,
-                                      *out)  # fmt: skip
-    ref = predicted_posterior_stats_reference(conc, belief.source, belief.weights, task_pos,
-                                              task_z, sensor)  # fmt: skip
+    kernels.predicted_posterior_stats(
+        conc,
+        belief.source.copy(),
+        belief.weights,
+        belief.source_mean(),
+        task_pos,
+        task_z,
+        sensor.params,
+        *out,
+    )
+    ref = predicted_posterior_stats_reference(
+        conc, belief.source, belief.weights, task_pos, task_z, sensor
+    )
     for fast, slow in zip(out, ref, strict=True):
         np.testing.assert_allclose(fast, slow, rtol=1e-9, atol=1e-12)
 

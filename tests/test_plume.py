@@ -23,10 +23,12 @@ def test_hand_calculation_with_wind():
     r = math.sqrt(dx * dx + dy * dy + dz * dz)
     lam = math.sqrt(z1 * z2 / (1 + u * u * z2 / (4 * z1)))
     expected = (
-        q / (4 * math.pi * z1 * r) * math.exp(-r / lam)
+        q
+        / (4 * math.pi * z1 * r)
+        * math.exp(-r / lam)
         * math.exp(-dx * u * math.cos(phi) / (2 * z1))
         * math.exp(-dy * u * math.sin(phi) / (2 * z1))
-    )  # fmt: skip
+    )
     assert isotropic_concentration(theta, np.array([[-2.0, 0.0, 3.0]]))[0, 0] == pytest.approx(
         expected, rel=1e-13
     )
@@ -57,13 +59,21 @@ def test_distance_is_clamped_at_the_source():
     assert at_source == pytest.approx(c_min, rel=1e-12)
 
 
-def test_compiled_matches_reference(rng=np.random.default_rng(3)):
+def test_compiled_matches_reference():
+    rng = np.random.default_rng(3)
     n, m = 300, 17
     theta = np.column_stack(
-        [rng.uniform(0, 50, n), rng.uniform(0, 50, n), rng.uniform(0, 5, n),
-         rng.gamma(2, 5, n), rng.uniform(0, 8, n), rng.uniform(-4, 4, n),
-         rng.uniform(0.1, 3, n), rng.uniform(0.5, 15, n)]
-    )  # fmt: skip
+        [
+            rng.uniform(0, 50, n),
+            rng.uniform(0, 50, n),
+            rng.uniform(0, 5, n),
+            rng.gamma(2, 5, n),
+            rng.uniform(0, 8, n),
+            rng.uniform(-4, 4, n),
+            rng.uniform(0.1, 3, n),
+            rng.uniform(0.5, 15, n),
+        ]
+    )
     pos = np.column_stack([rng.uniform(0, 50, m), rng.uniform(0, 50, m), np.full(m, 4.0)])
     fast = isotropic_concentration(theta, pos)
     ref = isotropic_concentration_reference(theta, pos)

@@ -4,8 +4,7 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from dcee import DceeInputError, Sensor
-from dcee import kernels
+from dcee import DceeInputError, Sensor, kernels
 
 
 @pytest.mark.parametrize("false_alarm", [0.0, 0.05])
@@ -16,8 +15,9 @@ def test_likelihood_is_a_proper_distribution_over_readings(conc, false_alarm):
     sigma = s.sigma_frac * conc + s.sigma_min
     upper = max(conc + 40 * sigma, s.threshold + 60 * s.false_alarm_scale)
     points = [conc] if conc > s.threshold else None
-    mass, _ = integrate.quad(lambda z: float(s.likelihood(z, conc)), s.threshold, upper,
-                             points=points, limit=200)  # fmt: skip
+    mass, _ = integrate.quad(
+        lambda z: float(s.likelihood(z, conc)), s.threshold, upper, points=points, limit=200
+    )
     assert p_nd + mass == pytest.approx(1.0, abs=1e-7)
 
 

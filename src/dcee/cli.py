@@ -57,19 +57,35 @@ def cli() -> None:
 
 
 @cli.command()
-@click.option("--scenario", "scenario_name", required=True,
-              help="Built-in name (see `dcee scenarios`) or path to a TOML file.")
-@click.option("--strategy", default="dcee", show_default=True,
-              help="Planner: dcee, dcee-ms, mpc, entrotaxis, infotaxis.")
+@click.option(
+    "--scenario",
+    "scenario_name",
+    required=True,
+    help="Built-in name (see `dcee scenarios`) or path to a TOML file.",
+)
+@click.option(
+    "--strategy",
+    default="dcee",
+    show_default=True,
+    help="Planner: dcee, dcee-ms, mpc, entrotaxis, infotaxis.",
+)
 @click.option("--seed", default=0, show_default=True, type=int, help="Run seed.")
 @click.option("--particles", type=int, help="Override search.particles.")
 @click.option("--hypotheses", type=int, help="Override search.hypotheses (per candidate move).")
 @click.option("--budget", type=float, help="Override search.budget (seconds of flight).")
 @click.option("--unknown", type=click.Choice(["source", "full"]), help="Override unknown set.")
-@click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
-              help="Output folder [default: results/<scenario>_<strategy>_seed<seed>].")
-@click.option("--json", "json_file", type=click.Path(dir_okay=False, path_type=Path),
-              help="Also write the summary JSON here.")
+@click.option(
+    "--out",
+    "out_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Output folder [default: results/<scenario>_<strategy>_seed<seed>].",
+)
+@click.option(
+    "--json",
+    "json_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Also write the summary JSON here.",
+)
 @click.option("--animate", is_flag=True, help="Also write animation.gif.")
 @click.option("--no-figure", is_flag=True, help="Skip figure.png.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress display.")
@@ -104,16 +120,22 @@ def run(
             "unknown": unknown,
         }
     )
-    out_dir = out_dir or Path("results") / f"{scenario.name.replace(':', '-')}_{strategy}_seed{seed}"
+    out_dir = (
+        out_dir or Path("results") / f"{scenario.name.replace(':', '-')}_{strategy}_seed{seed}"
+    )
     truth = make_truth(scenario.truth.model, scenario.truth_theta())
     result = _run_with_progress(
         lambda progress: run_episode(
-            scenario, strategy, seed, truth=truth, progress=progress,
+            scenario,
+            strategy,
+            seed,
+            truth=truth,
+            progress=progress,
             snapshot_every=scenario.search.budget / 40 if animate else None,
         ),
         scenario.search.budget,
         quiet,
-    )  # fmt: skip
+    )
     summary = result.summary
     summary["version"] = __version__
     config = {
@@ -152,9 +174,12 @@ def _run_with_progress(job: Callable[[Any], Any], budget: float, quiet: bool) ->
     if quiet or not sys.stderr.isatty():
         return job(None)
     with Progress(
-        TextColumn("[bold]searching"), BarColumn(), TextColumn("{task.fields[status]}"),
-        TimeElapsedColumn(), transient=True,
-    ) as bar:  # fmt: skip
+        TextColumn("[bold]searching"),
+        BarColumn(),
+        TextColumn("{task.fields[status]}"),
+        TimeElapsedColumn(),
+        transient=True,
+    ) as bar:
         task = bar.add_task("search", total=budget, status="")
 
         def progress(t: float, rec: dict[str, Any]) -> None:

@@ -84,8 +84,11 @@ def _plume_terms(theta: np.ndarray, i: int) -> tuple[float, float, float, float]
     z1 = theta[i, 6]
     z2 = theta[i, 7]
     lam = math.sqrt(z1 * z2 / (1.0 + u * u * z2 / (4.0 * z1)))
-    return q / (_FOUR_PI * z1), 1.0 / lam, u * math.cos(phi) / (2.0 * z1), u * math.sin(phi) / (
-        2.0 * z1
+    return (
+        q / (_FOUR_PI * z1),
+        1.0 / lam,
+        u * math.cos(phi) / (2.0 * z1),
+        u * math.sin(phi) / (2.0 * z1),
     )
 
 
@@ -124,9 +127,18 @@ def concentration_grid(theta: np.ndarray, positions: np.ndarray, rmin: float, ou
         sz = theta[i, 2]
         for m in range(m_count):
             out[m, i] = _plume_at(
-                sx, sy, sz, pref, inv_lam, ax, ay,
-                positions[m, 0], positions[m, 1], positions[m, 2], rmin,
-            )  # fmt: skip
+                sx,
+                sy,
+                sz,
+                pref,
+                inv_lam,
+                ax,
+                ay,
+                positions[m, 0],
+                positions[m, 1],
+                positions[m, 2],
+                rmin,
+            )
 
 
 def concentration_matrix(theta: np.ndarray, positions: np.ndarray, rmin: float, out: np.ndarray):
@@ -165,9 +177,18 @@ def history_log_likelihood(
         acc = 0.0
         for k in range(k_count):
             c = _plume_at(
-                sx, sy, sz, pref, inv_lam, ax, ay,
-                positions[k, 0], positions[k, 1], positions[k, 2], rmin,
-            )  # fmt: skip
+                sx,
+                sy,
+                sz,
+                pref,
+                inv_lam,
+                ax,
+                ay,
+                positions[k, 0],
+                positions[k, 1],
+                positions[k, 2],
+                rmin,
+            )
             acc += multiplicity[k] * log_likelihood(readings[k], c, sp)
         out[i] = acc
 

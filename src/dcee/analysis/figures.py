@@ -8,9 +8,9 @@ from typing import TYPE_CHECKING
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.colors import LogNorm  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.colors import LogNorm
 
 if TYPE_CHECKING:
     from dcee.scenarios.config import Scenario
@@ -42,14 +42,26 @@ def _draw_map(
     xs, ys, conc = plume_map(truth, scenario, until)
     conc = np.clip(conc, thr / 10, None)
     mesh = ax.pcolormesh(
-        xs, ys, conc, norm=LogNorm(vmin=thr / 10, vmax=max(conc.max(), 10 * thr)),
-        cmap="YlOrBr", shading="auto", rasterized=True,
-    )  # fmt: skip
+        xs,
+        ys,
+        conc,
+        norm=LogNorm(vmin=thr / 10, vmax=max(conc.max(), 10 * thr)),
+        cmap="YlOrBr",
+        shading="auto",
+        rasterized=True,
+    )
     if conc.min() < thr < conc.max():
         ax.contour(xs, ys, conc, levels=[thr], colors="k", linewidths=0.6, linestyles="--")
     recs = [r for r in result.records if r["time"] <= until + 1e-9]
-    ax.scatter(particles[:, 0], particles[:, 1], s=1.0, c="tab:green", alpha=0.35, lw=0,
-               label="particles (source hypotheses)")  # fmt: skip
+    ax.scatter(
+        particles[:, 0],
+        particles[:, 1],
+        s=1.0,
+        c="tab:green",
+        alpha=0.35,
+        lw=0,
+        label="particles (source hypotheses)",
+    )
     px = np.array([r["x"] for r in recs])
     py = np.array([r["y"] for r in recs])
     ax.plot(px, py, "-", color="tab:red", lw=0.8, alpha=0.8, label="trajectory")
@@ -58,13 +70,21 @@ def _draw_map(
     ax.scatter(px[~det], py[~det], s=4, c="0.35", lw=0, label="non-detection")
     if det.any():
         size = 10 + 60 * np.sqrt(z[det] / z[det].max())
-        ax.scatter(px[det], py[det], s=size, facecolors="none", edgecolors="tab:blue", lw=0.8,
-                   label="detection (size ∝ √reading)")  # fmt: skip
+        ax.scatter(
+            px[det],
+            py[det],
+            s=size,
+            facecolors="none",
+            edgecolors="tab:blue",
+            lw=0.8,
+            label="detection (size ∝ √reading)",
+        )
     t = scenario.truth
     ax.plot(t.x, t.y, "*", ms=14, mec="k", mfc="gold", label="true source")
     last = recs[-1]
-    ax.plot(last["mean_x"], last["mean_y"], "P", ms=9, mec="k", mfc="tab:cyan",
-            label="posterior mean")  # fmt: skip
+    ax.plot(
+        last["mean_x"], last["mean_y"], "P", ms=9, mec="k", mfc="tab:cyan", label="posterior mean"
+    )
     ax.plot(*scenario.agent.start[:2], "x", ms=9, color="k", mew=2, label="start")
     ax.set_xlim(scenario.volume.low[0], scenario.volume.high[0])
     ax.set_ylim(scenario.volume.low[1], scenario.volume.high[1])
@@ -72,18 +92,25 @@ def _draw_map(
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_title(f"t = {until:.0f} s, RMSE {last['rmse']:.2f} m")
-    plt.colorbar(mesh, ax=ax, fraction=0.046, pad=0.04,
-                 label=f"truth at z = {scenario.agent.start[2]:g} m (g/m³)")  # fmt: skip
+    plt.colorbar(
+        mesh,
+        ax=ax,
+        fraction=0.046,
+        pad=0.04,
+        label=f"truth at z = {scenario.agent.start[2]:g} m (g/m³)",
+    )
 
 
 def _draw_rmse(ax: plt.Axes, result: EpisodeResult, scenario: Scenario, until: float) -> None:
     recs = [r for r in result.records if r["time"] <= until + 1e-9]
     t = np.array([r["time"] for r in recs])
     ax.semilogy(t, [r["rmse"] for r in recs], color="tab:red", label="RMSE about true source")
-    ax.semilogy(t, [r["spread"] for r in recs], color="tab:blue", ls="--",
-                label="posterior spread √tr P")  # fmt: skip
-    ax.semilogy(t, [r["mean_error"] for r in recs], color="0.4", lw=0.8,
-                label="error of posterior mean")  # fmt: skip
+    ax.semilogy(
+        t, [r["spread"] for r in recs], color="tab:blue", ls="--", label="posterior spread √tr P"
+    )
+    ax.semilogy(
+        t, [r["mean_error"] for r in recs], color="0.4", lw=0.8, label="error of posterior mean"
+    )
     for level in (scenario.search.acquired_rmse, 1.0, 0.5):
         ax.axhline(level, color="0.7", lw=0.6, ls=":")
     ax.set_xlim(0, scenario.search.budget)
@@ -100,11 +127,13 @@ def search_figure(
     s = result.summary
     fig, (ax_map, ax_rmse) = plt.subplots(1, 2, figsize=(13, 5.6), width_ratios=[1.15, 1])
     idx = np.random.default_rng(0).choice(
-        len(result.final_weights), size=min(3000, len(result.final_weights)),
+        len(result.final_weights),
+        size=min(3000, len(result.final_weights)),
         p=result.final_weights,
-    )  # fmt: skip
-    _draw_map(ax_map, result, scenario, truth, result.records[-1]["time"],
-              result.final_particles[idx])  # fmt: skip
+    )
+    _draw_map(
+        ax_map, result, scenario, truth, result.records[-1]["time"], result.final_particles[idx]
+    )
     ax_map.legend(fontsize=6.5, loc="upper left", framealpha=0.85, markerscale=0.7)
     _draw_rmse(ax_rmse, result, scenario, scenario.search.budget)
     fig.suptitle(
@@ -123,7 +152,7 @@ def search_animation(
     """Write an animated GIF of the search (one frame per particle snapshot)."""
     from matplotlib.animation import FuncAnimation, PillowWriter
 
-    fig, (ax_map, ax_rmse) = plt.subplots(1, 2, figsize=(11, 4.8), width_ratios=[1.15, 1])
+    fig = plt.figure(figsize=(11, 4.8))
 
     def frame(k: int) -> None:
         fig.clear()

@@ -308,7 +308,10 @@ class ParticleFilter:
                 lo, hi = beta, 1.0
                 for _ in range(40):
                     mid = 0.5 * (lo + hi)
-                    if effective_sample_size(_normalise(self._logw + (mid - beta) * d_ll)) >= target:
+                    if (
+                        effective_sample_size(_normalise(self._logw + (mid - beta) * d_ll))
+                        >= target
+                    ):
                         lo = mid
                     else:
                         hi = mid
@@ -330,8 +333,9 @@ class ParticleFilter:
                 acc.append(self._mh_sweep())
             if beta < 1.0:
                 # After the move, recompute the new reading's likelihood for the moved particles.
-                ll_new = self.log_likelihood(self.theta, np.array(self._hist_pos[entry]),
-                                             self._hist_z[entry])
+                ll_new = self.log_likelihood(
+                    self.theta, np.array(self._hist_pos[entry]), self._hist_z[entry]
+                )
                 hist_base = self._hist_loglik - beta * ll_new
         self._hist_mult[entry] = base_mult + 1.0
         self.recoveries.append(

@@ -49,7 +49,9 @@ class Uniform:
 
     def __post_init__(self) -> None:
         if not self.high > self.low:
-            raise DceeInputError("prior.uniform", f"needs high > low, got [{self.low}, {self.high}]")
+            raise DceeInputError(
+                "prior.uniform", f"needs high > low, got [{self.low}, {self.high}]"
+            )
 
     def sample(self, rng: np.random.Generator, n: int) -> np.ndarray:
         return self.low + (self.high - self.low) * rng.random(n)

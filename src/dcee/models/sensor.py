@@ -88,8 +88,9 @@ class Sensor:
         sigma = self.sigma_frac * c + self.sigma_min
         # P(non-detection | C) = (1 − Pd) + Pd Φ((thr − C)/σ)
         log_below = log_ndtr((self.threshold - c) / sigma)
-        log_missed = np.logaddexp(np.log1p(-self.pd) if self.pd < 1 else -np.inf,
-                                  np.log(self.pd) + log_below)
+        log_missed = np.logaddexp(
+            np.log1p(-self.pd) if self.pd < 1 else -np.inf, np.log(self.pd) + log_below
+        )
         log_nd = log_missed + (np.log1p(-self.false_alarm) if self.false_alarm > 0 else 0.0)
         r = (z - c) / sigma
         log_det = np.log(self.pd) - 0.5 * r * r - np.log(sigma) - 0.5 * np.log(2 * np.pi)

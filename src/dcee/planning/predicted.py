@@ -159,9 +159,18 @@ class PredictionContext:
         trace = np.empty(n_tasks)
         kl = np.empty(n_tasks)
         kernels.predicted_posterior_stats(
-            self.conc, self._source, self.belief.weights, self._center,
-            tp, tz, self._sp, log_ev, mean, trace, kl,
-        )  # fmt: skip
+            self.conc,
+            self._source,
+            self.belief.weights,
+            self._center,
+            tp,
+            tz,
+            self._sp,
+            log_ev,
+            mean,
+            trace,
+            kl,
+        )
         return SequenceStats(readings, log_ev[inverse], mean[inverse], trace[inverse], kl[inverse])
 
 

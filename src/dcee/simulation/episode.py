@@ -95,8 +95,12 @@ def run_episode(
             "mean_x": est.mean[0],
             "mean_y": est.mean[1],
             "mean_z": est.mean[2],
-            **{f"cov_{a}{b}": est.cov[i, j] for i, a in enumerate("xyz") for j, b in
-               enumerate("xyz") if j >= i},
+            **{
+                f"cov_{a}{b}": est.cov[i, j]
+                for i, a in enumerate("xyz")
+                for j, b in enumerate("xyz")
+                if j >= i
+            },
             "spread": est.spread,
             "rmse": pf.rmse(true_location),
             "mean_error": float(np.linalg.norm(est.mean - true_location)),
@@ -104,7 +108,7 @@ def run_episode(
             "resampled": info.resampled,
             "tempering_stages": info.tempering_stages,
             "update_seconds": searcher.last_update_seconds,
-        }  # fmt: skip
+        }
         if snapshot_every is not None and t >= next_snapshot:
             snapshots.append((t, _subsample(pf, snapshot_particles, figure_rng)))
             next_snapshot += snapshot_every

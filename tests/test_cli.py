@@ -1,0 +1,137 @@
+import json
+import subprocess
+import sys
+
+import pandas as pd
+import pytest
+
+from dcee.cli import main
+
+
+def _run(argv, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    out = capsys.readouterr()
+    return exc.value.code, out.out, out.err
+
+
+def test_run_writes_all_outputs(tmp_path, capsys):
+    out = tmp_path / "r"
+    code, stdout, _ = _run(
+        [
+            "run",
+            "--scenario",
+            "lab:downwind",
+            "--strategy",
+            "dcee",
+            "--seed",
+            "1",
+            "--particles",
+            "1000",
+            "--budget",
+            "60",
+            "--out",
+            str(out),
+            "--json",
+            str(tmp_path / "s.json"),
+            "--quiet",
+        ],
+        capsys,
+    )
+    assert code == 0, stdout
+    summary = json.loads((tmp_path / "s.json").read_text())
+    for key in (
+        "final_rmse",
+        "plume_acquired",
+        "source_acquired",
+        "time_to_rmse_1m",
+        "time_to_rmse_0_5m",
+        "steps",
+        "path_length",
+        "strategy",
+        "scenario",
+        "seed",
+    ):
+        assert key in summary
+    assert summary["scenario"] == "lab:downwind" and summary["seed"] == 1
+    steps = pd.read_parquet(out / "steps.parquet")
+    assert len(steps) == summary["steps"] + 1
+    config = json.loads((out / "config.json").read_text())
+    assert config["scenario"]["search"]["particles"] == 1000
+    assert (out / "figure.png").stat().st_size > 10_000
+    assert not list(out.glob(".*"))  # no temporary files left behind
+
+
+def test_animation(tmp_path, capsys):
+    out = tmp_path / "a"
+    code, _, _ = _run(
+        [
+            "run",
+            "--scenario",
+            "lab:upwind",
+            "--particles",
+            "300",
+            "--budget",
+            "30",
+            "--out",
+            str(out),
+            "--animate",
+            "--no-figure",
+            "-q",
+        ],
+        capsys,
+    )
+    assert code == 0
+    assert (out / "animation.gif").read_bytes()[:3] == b"GIF"
+
+
+BAD = [
+    (["--particles", "-5"], "search.particles"),
+    (["--strategy", "nope"], "strategy"),
+    (["--budget", "nan"], "search.budget"),
+    (["--hypotheses", "0"], "search.hypotheses"),
+    (["--seed", "-1"], "seed"),
+]
+
+
+@pytest.mark.parametrize("extra,field", BAD)
+def test_bad_options_exit_2_with_one_line(tmp_path, capsys, extra, field):
+    out = tmp_path / "bad"
+    code, _, err = _run(["run", "--scenario", "paper:1", "--out", str(out), *extra], capsys)
+    assert code == 2
+    assert err.count("\n") == 1 and field in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_bad_scenarios_exit_2(tmp_path, capsys):
+    bad_toml = tmp_path / "bad.toml"
+    bad_toml.write_text("[volume\nlow = 1")
+    outside = tmp_path / "outside.toml"
+    outside.write_text(
+        "[volume]\nlow=[0,0,0]\nhigh=[20,20,3]\n"
+        "[truth]\nx=25\ny=5\nz=1\nq=2\nu=3\nphi=90\nzeta1=1\nzeta2=8\n[agent]\nstart=[1,1,2]\n"
+    )
+    for scenario, needle in [
+        ("paper:99", "unknown built-in"),
+        (str(tmp_path / "no.toml"), "no such file"),
+        (str(bad_toml), "malformed TOML"),
+        (str(outside), "outside the search volume"),
+    ]:
+        code, _, err = _run(["run", "--scenario", scenario, "--out", str(tmp_path / "o")], capsys)
+        assert code == 2 and needle in err and err.count("\n") == 1
+    code, _, err = _run(["run", "--bogus"], capsys)
+    assert code == 2 and "bogus" in err
+
+
+def test_scenarios_and_show(capsys):
+    code, out, _ = _run(["scenarios"], capsys)
+    assert code == 0 and out.count("\n") == 14 and "lab:upwind" in out
+    code, out, _ = _run(["show", "paper:3"], capsys)
+    assert code == 0 and json.loads(out)["truth"]["y"] == 37.5
+
+
+def test_console_script_is_installed():
+    res = subprocess.run(
+        [sys.executable, "-m", "dcee.cli", "show", "nope:1"], capture_output=True, text=True
+    )
+    assert res.returncode == 2 and res.stderr.startswith("dcee: error: scenario")

@@ -1,0 +1,81 @@
+import math
+
+import numpy as np
+import pytest
+
+from dcee import DceeInputError
+from dcee.scenarios import builtin_scenarios, load_scenario
+
+
+def test_all_builtins_validate():
+    names = list(builtin_scenarios())
+    assert [f"paper:{k}" for k in range(1, 13)] == names[:12]
+    assert {"lab:downwind", "lab:upwind"} <= set(names)
+    for n in names:
+        load_scenario(n)
+
+
+def test_paper_scenarios_use_the_papers_parameters():
+    s = load_scenario("paper:1")
+    t = s.truth
+    assert (t.x, t.y, t.z, t.q, t.u, t.phi, t.zeta1, t.zeta2) == (37.5, 12.5, 1, 5, 4, 0, 1, 8)
+    assert s.agent.start == (2, 2, 4) and s.agent.step == 2 and s.agent.speed == 2
+    assert s.search.particles == 20_000 and s.search.hypotheses == 40 and s.search.budget == 900
+    assert s.unknown_names == ("x", "y", "z", "q")
+    assert s.prior["q"].shape == 2 and s.prior["q"].scale == 5
+
+
+def test_paper_plumes_are_long_varied_and_half_point_away_from_the_chord():
+    start = np.array([2.0, 2.0])
+    away, directions = [], set()
+    for k in range(1, 13):
+        t = load_scenario(f"paper:{k}").truth
+        src = np.array([t.x, t.y])
+        axis = -np.array([math.cos(math.radians(t.phi)), math.sin(math.radians(t.phi))])
+        inside = [src + r * axis for r in np.arange(1.0, 80.0, 0.5)]
+        inside = [p for p in inside if np.all((p >= 0) & (p <= 50))]
+        assert len(inside) * 0.5 >= 24, f"paper:{k}: plume axis too short inside the area"
+        chord = (start - src) / np.linalg.norm(start - src)
+        if math.degrees(math.acos(np.clip(axis @ chord, -1, 1))) > 45:
+            away.append(k)  # the plume does not lie along the chord from the start
+        directions.add(t.phi)
+    assert away == [4, 5, 7, 8, 11, 12] and len(directions) >= 8
+
+
+def test_lab_scenarios_have_seven_unknowns_in_two_dimensions():
+    for start in ("downwind", "upwind"):
+        s = load_scenario(f"lab:{start}")
+        assert s.dimensions == 2
+        assert s.unknown_names == ("x", "y", "q", "u", "phi", "zeta1", "zeta2")
+        assert s.make_prior().unknown_names == s.unknown_names
+        assert s.agent.step == 0.3
+
+
+def test_overrides_are_revalidated():
+    s = load_scenario("paper:2").with_overrides(**{"search.particles": 500, "unknown": "full"})
+    assert s.search.particles == 500 and len(s.unknown_names) == 8
+    with pytest.raises(DceeInputError, match=r"search\.particles"):
+        s.with_overrides(**{"search.particles": -1})
+
+
+def test_toml_file_errors(tmp_path):
+    good = tmp_path / "site.toml"
+    good.write_text(
+        "[volume]\nlow=[0,0,0]\nhigh=[20,20,3]\n"
+        "[truth]\nx=5\ny=5\nz=1\nq=2\nu=3\nphi=90\nzeta1=1\nzeta2=8\n"
+        "[agent]\nstart=[1,1,2]\n"
+    )
+    s = load_scenario(str(good))
+    assert s.name == "site" and s.search.particles == 20_000
+    outside = tmp_path / "outside.toml"
+    outside.write_text(good.read_text().replace("x=5", "x=50"))
+    with pytest.raises(DceeInputError, match="outside the search volume"):
+        load_scenario(str(outside))
+    typo = tmp_path / "typo.toml"
+    typo.write_text(good.read_text() + "[search]\nparticle=10\n")
+    with pytest.raises(DceeInputError, match=r"search\.particle: unknown field"):
+        load_scenario(str(typo))
+    full = tmp_path / "full.toml"
+    full.write_text('unknown = "full"\n' + good.read_text())
+    with pytest.raises(DceeInputError, match="phi"):
+        load_scenario(str(full))
