@@ -127,7 +127,7 @@ def test_scenarios_and_show(capsys):
     code, out, _ = _run(["scenarios"], capsys)
     assert code == 0 and out.count("\n") == 14 and "lab:upwind" in out
     code, out, _ = _run(["show", "paper:3"], capsys)
-    assert code == 0 and json.loads(out)["truth"]["y"] == 37.5
+    assert code == 0 and json.loads(out)["truth"]["y"] == 40.0
 
 
 def test_console_script_is_installed():

@@ -125,19 +125,23 @@ def test_candidates_are_compared_on_common_random_numbers():
     np.testing.assert_array_equal(st.mean[0], st.mean[1])
 
 
-def test_compiled_predicted_stats_match_reference():
+@pytest.mark.parametrize("false_alarm", [0.0, 0.05])
+def test_compiled_predicted_stats_match_reference(false_alarm):
     rng = np.random.default_rng(9)
     n = 3000
     pts = np.column_stack([rng.uniform(0, 20, n), rng.uniform(0, 20, n)])
     belief = _belief(pts, weights=rng.random(n), q=2.0, u=2.0, phi=0.5)
-    sensor = belief.sensor
+    sensor = Sensor(false_alarm=false_alarm)
     positions = np.array([[5.0, 5.0, 0.0], [8.0, 12.0, 0.0], [15.0, 3.0, 0.0]])
     conc = np.ascontiguousarray(belief.plume.concentration(belief.theta, positions).T)
     task_pos = np.array([[0, 1], [1, 2], [2, 2], [0, 0]])
     task_z = np.array([[0.0, 0.0], [3e-3, 0.0], [1e-2, 2e-3], [6e-4, 0.05]])
     out = [np.empty(4), np.empty((4, 3)), np.empty(4), np.empty(4)]
+    terms = [np.empty_like(conc) for _ in range(3)]
+    kernels.position_terms(conc, sensor.params, *terms)
     kernels.predicted_posterior_stats(
         conc,
+        *terms,
         belief.source.copy(),
         belief.weights,
         belief.source_mean(),

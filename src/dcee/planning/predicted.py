@@ -94,10 +94,9 @@ class PredictionContext:
         self._theta = np.ascontiguousarray(belief.theta)
         self._source = np.ascontiguousarray(belief.source)
         self._center = belief.source_mean()
-        self._positions: list[np.ndarray] = []
-        self._conc_rows: list[np.ndarray] = []
+        self._rows: list[tuple[np.ndarray, ...]] = []
         self._index: dict[tuple[float, ...], int] = {}
-        self._conc: np.ndarray | None = None
+        self._terms: tuple[np.ndarray, ...] | None = None
 
     @property
     def n_hypotheses(self) -> int:
@@ -115,18 +114,28 @@ class PredictionContext:
             out[k] = self._index[key]
         if new:
             pts = np.ascontiguousarray(np.array(new, dtype=np.float64))
-            rows = np.empty((len(pts), self._theta.shape[0]))
-            kernels.concentration_grid(self._theta, pts, self.belief.plume.min_distance, rows)
-            self._conc_rows.append(rows)
-            self._conc = None
+            shape = (len(pts), self._theta.shape[0])
+            conc, log_nd, inv_sigma, log_sigma = (np.empty(shape) for _ in range(4))
+            kernels.concentration_grid(self._theta, pts, self.belief.plume.min_distance, conc)
+            kernels.position_terms(conc, self._sp, log_nd, inv_sigma, log_sigma)
+            self._rows.append((conc, log_nd, inv_sigma, log_sigma))
+            self._terms = None
         return out
+
+    @property
+    def terms(self) -> tuple[np.ndarray, ...]:
+        """(conc, log_nd, inv_sigma, log_sigma), each (P, N), at every cached position."""
+        if self._terms is None:
+            self._terms = tuple(
+                np.ascontiguousarray(np.concatenate([r[k] for r in self._rows], axis=0))
+                for k in range(4)
+            )
+        return self._terms
 
     @property
     def conc(self) -> np.ndarray:
         """(P, N) concentrations of every particle at every cached position."""
-        if self._conc is None:
-            self._conc = np.ascontiguousarray(np.concatenate(self._conc_rows, axis=0))
-        return self._conc
+        return self.terms[0]
 
     def readings(self, pos_idx: np.ndarray) -> np.ndarray:
         """(J, T) hypothesised readings along one sequence of cached positions (T,)."""
@@ -159,7 +168,7 @@ class PredictionContext:
         trace = np.empty(n_tasks)
         kl = np.empty(n_tasks)
         kernels.predicted_posterior_stats(
-            self.conc,
+            *self.terms,
             self._source,
             self.belief.weights,
             self._center,
