@@ -6,6 +6,20 @@ import numpy as np
 
 from dcee.estimation.priors import Fixed, Gamma, SourcePrior, Uniform
 
+SUMMARY_KEYS = {
+    "final_rmse",
+    "plume_acquired",
+    "source_acquired",
+    "time_to_rmse_1m",
+    "time_to_rmse_0_5m",
+    "steps",
+    "path_length",
+    "strategy",
+    "scenario",
+    "seed",
+}
+"""Keys the issue requires in every run summary."""
+
 
 def planar_prior(
     x=(0.0, 10.0), y=(0.0, 10.0), q_gamma=(2.0, 1.0), u=2.0, phi=0.0, zeta1=1.0, zeta2=8.0

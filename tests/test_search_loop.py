@@ -4,19 +4,7 @@ import pytest
 from dcee import DceeInputError, ParticleFilter, Searcher, planners
 from dcee.scenarios import load_scenario
 from dcee.simulation import run_episode
-
-SUMMARY_KEYS = {
-    "final_rmse",
-    "plume_acquired",
-    "source_acquired",
-    "time_to_rmse_1m",
-    "time_to_rmse_0_5m",
-    "steps",
-    "path_length",
-    "strategy",
-    "scenario",
-    "seed",
-}
+from tests.helpers import SUMMARY_KEYS
 
 
 def _small(name, **kw):

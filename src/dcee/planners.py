@@ -1,25 +1,4 @@
-"""``dcee.planners``: the planner registry (alias of :mod:`dcee.planning`)."""
+"""``dcee.planners``: the planner registry (an alias of :mod:`dcee.planning`)."""
 
-from dcee.planning import (
-    Belief,
-    Decision,
-    OneStepPlanner,
-    Planner,
-    PredictionContext,
-    SequenceStats,
-    get,
-    names,
-    register,
-)
-
-__all__ = [
-    "Belief",
-    "Decision",
-    "OneStepPlanner",
-    "Planner",
-    "PredictionContext",
-    "SequenceStats",
-    "get",
-    "names",
-    "register",
-]
+from dcee.planning import *  # noqa: F403
+from dcee.planning import __all__  # noqa: F401
