@@ -125,7 +125,7 @@ def search_figure(
 ) -> None:
     """Write the summary figure of one search (PNG) to ``path``."""
     s = result.summary
-    fig, (ax_map, ax_rmse) = plt.subplots(1, 2, figsize=(13, 5.6), width_ratios=[1.15, 1])
+    fig, (ax_map, ax_rmse) = plt.subplots(1, 2, figsize=(13, 6.4), width_ratios=[1.15, 1])
     idx = np.random.default_rng(0).choice(
         len(result.final_weights),
         size=min(3000, len(result.final_weights)),
@@ -134,7 +134,9 @@ def search_figure(
     _draw_map(
         ax_map, result, scenario, truth, result.records[-1]["time"], result.final_particles[idx]
     )
-    ax_map.legend(fontsize=6.5, loc="upper left", framealpha=0.85, markerscale=0.7)
+    ax_map.legend(
+        fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=4, markerscale=0.8
+    )
     _draw_rmse(ax_rmse, result, scenario, scenario.search.budget)
     fig.suptitle(
         f"{s['scenario']} · {s['strategy']} · seed {s['seed']} · final RMSE {s['final_rmse']:.2f} m"
