@@ -143,8 +143,8 @@ def search_figure(
         f" · source {'acquired' if s['source_acquired'] else 'not acquired'}",
         fontsize=11,
     )
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
 
 
