@@ -248,13 +248,19 @@ class ParticleFilter:
         self._logw = logw - logw.max()
         self._weights = None
 
-    def _resample_move(self, steps: int) -> float:
+    def _resample(self, *per_particle: np.ndarray) -> list[np.ndarray]:
+        """Systematic resampling of the particles, their cached history log-likelihoods and any
+        other per-particle arrays given (returned re-indexed); weights become uniform."""
         idx = systematic_resample(self.weights, self.rng, self.n)
         self.theta = self.theta[idx]
         self._hist_loglik = self._hist_loglik[idx]
         self._logw = np.full(self.n, -math.log(self.n))
         self._weights = None
         self.n_resamples += 1
+        return [a[idx] for a in per_particle]
+
+    def _resample_move(self, steps: int) -> float:
+        self._resample()
         acc = [self._mh_sweep() for _ in range(steps)]
         return float(np.mean(acc)) if acc else math.nan
 
@@ -299,9 +305,8 @@ class ParticleFilter:
         acc: list[float] = []
         while beta < 1.0:
             stages += 1
-            d_ll = ll_new  # per-particle log-likelihood of the new reading (current particles)
             if stages >= self.max_tempering_stages or (
-                effective_sample_size(_normalise(self._logw + (1.0 - beta) * d_ll)) >= target
+                effective_sample_size(_normalise(self._logw + (1.0 - beta) * ll_new)) >= target
             ):
                 new_beta = 1.0
             else:
@@ -309,26 +314,19 @@ class ParticleFilter:
                 for _ in range(40):
                     mid = 0.5 * (lo + hi)
                     if (
-                        effective_sample_size(_normalise(self._logw + (mid - beta) * d_ll))
+                        effective_sample_size(_normalise(self._logw + (mid - beta) * ll_new))
                         >= target
                     ):
                         lo = mid
                     else:
                         hi = mid
                 new_beta = max(lo, beta + 1e-6)
-            self._set_logw(self._logw + (new_beta - beta) * d_ll)
-            self._hist_loglik = hist_base + new_beta * d_ll
+            # ll_new: the new reading's log-likelihood for the current particles.
+            self._set_logw(self._logw + (new_beta - beta) * ll_new)
+            self._hist_loglik = hist_base + new_beta * ll_new
             self._hist_mult[entry] = base_mult + new_beta
             beta = new_beta
-            # Resample both the particles and their cached per-reading log-likelihoods.
-            idx = systematic_resample(self.weights, self.rng, self.n)
-            self.theta = self.theta[idx]
-            ll_new = ll_new[idx]
-            hist_base = hist_base[idx]
-            self._hist_loglik = self._hist_loglik[idx]
-            self._logw = np.full(self.n, -math.log(self.n))
-            self._weights = None
-            self.n_resamples += 1
+            ll_new, hist_base = self._resample(ll_new, hist_base)
             for _ in range(max(1, self.mcmc_steps)):
                 acc.append(self._mh_sweep())
             if beta < 1.0:

@@ -1,9 +1,10 @@
 """One simulated search: truth → sensor noise → reading → Searcher.tell → Searcher.ask → move.
 
 Random streams: ``SeedSequence(seed)`` is split into a *truth* stream (sensor noise of the real
-readings) and an *agent* stream (filter and planner). The truth stream draws the same numbers
-at every step whatever the agent does, so two strategies run with the same seed see identical
-truth noise (common random numbers).
+readings), an *agent* stream (split again into filter and planner) and a *figures* stream
+(particle subsamples for plots only). The truth stream draws the same numbers at every step
+whatever the agent does, so two strategies run with the same seed see identical truth noise
+(common random numbers).
 """
 
 from __future__ import annotations
