@@ -76,8 +76,9 @@ def log_likelihood(z: float, c: float, sp: np.ndarray) -> float:
 
 
 @njit(cache=True, inline="always")
-def _plume_terms(theta: np.ndarray, i: int) -> tuple[float, float, float, float]:
-    """Per-particle constants of the plume: (q/(4π ζ1), 1/λ, u cosφ/(2ζ1), u sinφ/(2ζ1))."""
+def _plume_terms(theta: np.ndarray, i: int):
+    """Per-particle constants of the plume: the source location (x, y, z), then
+    q/(4π ζ1), 1/λ, u cosφ/(2ζ1) and u sinφ/(2ζ1) — computed once, used at every position."""
     q = theta[i, 3]
     u = theta[i, 4]
     phi = theta[i, 5]
@@ -85,6 +86,9 @@ def _plume_terms(theta: np.ndarray, i: int) -> tuple[float, float, float, float]
     z2 = theta[i, 7]
     lam = math.sqrt(z1 * z2 / (1.0 + u * u * z2 / (4.0 * z1)))
     return (
+        theta[i, 0],
+        theta[i, 1],
+        theta[i, 2],
         q / (_FOUR_PI * z1),
         1.0 / lam,
         u * math.cos(phi) / (2.0 * z1),
@@ -93,19 +97,9 @@ def _plume_terms(theta: np.ndarray, i: int) -> tuple[float, float, float, float]
 
 
 @njit(cache=True, inline="always")
-def _plume_at(
-    sx: float,
-    sy: float,
-    sz: float,
-    pref: float,
-    inv_lam: float,
-    ax: float,
-    ay: float,
-    px: float,
-    py: float,
-    pz: float,
-    rmin: float,
-) -> float:
+def _plume_at(terms, px: float, py: float, pz: float, rmin: float) -> float:
+    """Concentration at (px, py, pz) from one particle's :func:`_plume_terms`."""
+    sx, sy, sz, pref, inv_lam, ax, ay = terms
     dx = px - sx
     dy = py - sy
     dz = pz - sz
@@ -121,24 +115,9 @@ def concentration_grid(theta: np.ndarray, positions: np.ndarray, rmin: float, ou
     n = theta.shape[0]
     m_count = positions.shape[0]
     for i in prange(n):
-        pref, inv_lam, ax, ay = _plume_terms(theta, i)
-        sx = theta[i, 0]
-        sy = theta[i, 1]
-        sz = theta[i, 2]
+        terms = _plume_terms(theta, i)
         for m in range(m_count):
-            out[m, i] = _plume_at(
-                sx,
-                sy,
-                sz,
-                pref,
-                inv_lam,
-                ax,
-                ay,
-                positions[m, 0],
-                positions[m, 1],
-                positions[m, 2],
-                rmin,
-            )
+            out[m, i] = _plume_at(terms, positions[m, 0], positions[m, 1], positions[m, 2], rmin)
 
 
 def concentration_matrix(theta: np.ndarray, positions: np.ndarray, rmin: float, out: np.ndarray):
@@ -170,25 +149,10 @@ def history_log_likelihood(
         if not active[i]:
             out[i] = -np.inf
             continue
-        pref, inv_lam, ax, ay = _plume_terms(theta, i)
-        sx = theta[i, 0]
-        sy = theta[i, 1]
-        sz = theta[i, 2]
+        terms = _plume_terms(theta, i)
         acc = 0.0
         for k in range(k_count):
-            c = _plume_at(
-                sx,
-                sy,
-                sz,
-                pref,
-                inv_lam,
-                ax,
-                ay,
-                positions[k, 0],
-                positions[k, 1],
-                positions[k, 2],
-                rmin,
-            )
+            c = _plume_at(terms, positions[k, 0], positions[k, 1], positions[k, 2], rmin)
             acc += multiplicity[k] * log_likelihood(readings[k], c, sp)
         out[i] = acc
 
