@@ -18,26 +18,9 @@ def _run(argv, capsys):
 
 def test_run_writes_all_outputs(tmp_path, capsys):
     out = tmp_path / "r"
+    argv = "run --scenario lab:downwind --strategy dcee --seed 1 --particles 1000 --budget 60"
     code, stdout, _ = _run(
-        [
-            "run",
-            "--scenario",
-            "lab:downwind",
-            "--strategy",
-            "dcee",
-            "--seed",
-            "1",
-            "--particles",
-            "1000",
-            "--budget",
-            "60",
-            "--out",
-            str(out),
-            "--json",
-            str(tmp_path / "s.json"),
-            "--quiet",
-        ],
-        capsys,
+        [*argv.split(), "--out", str(out), "--json", str(tmp_path / "s.json"), "--quiet"], capsys
     )
     assert code == 0, stdout
     summary = json.loads((tmp_path / "s.json").read_text())
@@ -55,18 +38,9 @@ def test_animation(tmp_path, capsys):
     out = tmp_path / "a"
     code, _, _ = _run(
         [
-            "run",
-            "--scenario",
-            "lab:upwind",
-            "--particles",
-            "300",
-            "--budget",
-            "30",
-            "--out",
+            *"run --scenario lab:upwind --particles 300 --budget 30 --out".split(),
             str(out),
-            "--animate",
-            "--no-figure",
-            "-q",
+            *"--animate --no-figure -q".split(),
         ],
         capsys,
     )

@@ -94,3 +94,6 @@ def test_searcher_ask_tell_contract():
         s.tell(nxt, 0.0, time=1.0)
     with pytest.raises(DceeInputError, match="reading"):
         s.tell(nxt, float("nan"), time=4.0)
+    assert s.time == 3.0  # a rejected reading leaves the searcher unchanged
+    with pytest.raises(DceeInputError, match="position"):
+        s.tell(np.array([1.0, 2.0]), 0.0, time=4.0)

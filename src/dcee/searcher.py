@@ -56,17 +56,14 @@ class Searcher:
 
     def tell(self, position: np.ndarray, reading: float, time: float | None = None) -> UpdateInfo:
         """Assimilate a reading (g/m³) taken at ``position`` (m) at ``time`` (s)."""
-        position = np.asarray(position, dtype=np.float64)
-        if position.shape != (3,) or not np.all(np.isfinite(position)):
-            raise DceeInputError("position", f"must be 3 finite numbers, got {position!r}")
-        if time is not None:
-            if not math.isfinite(time) or time < self.time:
-                raise DceeInputError("time", f"must be finite and non-decreasing, got {time}")
-            self.time = float(time)
+        if time is not None and not (math.isfinite(time) and time >= self.time):
+            raise DceeInputError("time", f"must be finite and non-decreasing, got {time}")
         t0 = _time.perf_counter()
-        self.last_update = self.filter.update(position, reading)
+        self.last_update = self.filter.update(position, reading)  # validates position, reading
         self.last_update_seconds = _time.perf_counter() - t0
-        self.position = position
+        self.position = np.asarray(position, dtype=np.float64)
+        if time is not None:
+            self.time = float(time)
         return self.last_update
 
     def ask(self) -> np.ndarray:

@@ -116,17 +116,13 @@ def run_episode(
         stop = t + agent.step_time > search.budget + 1e-9 or (
             search.stop_spread > 0 and est.spread < search.stop_spread
         )
-        if stop:
-            rec["decision_seconds"] = 0.0
-            records.append(rec)
-            if progress:
-                progress(t, rec)
-            break
-        waypoint = searcher.ask()
-        rec["decision_seconds"] = searcher.last_decision_seconds
+        waypoint = None if stop else searcher.ask()
+        rec["decision_seconds"] = 0.0 if stop else searcher.last_decision_seconds
         records.append(rec)
         if progress:
             progress(t, rec)
+        if waypoint is None:
+            break
         path_length += float(np.linalg.norm(waypoint - position))
         position = waypoint
         t += agent.step_time
