@@ -63,7 +63,23 @@ class Sensor:
 
     @property
     def params(self) -> np.ndarray:
-        """Parameters packed for the compiled kernels (order fixed by ``dcee.kernels``)."""
+        """Parameters packed for the compiled kernels (order fixed by ``dcee.kernels``).
+
+        After the six fields come three derived constants for concentrations below
+        ``c_lin = 1e-6 σ_min`` (most particle-reading pairs far from a plume), where the kernels
+        use log P(missed | C) ≈ L0 + L1·C instead of an erfc: c_lin, L0 = log P(missed | 0) and
+        L1 = its derivative at 0. The neglected second-order term is below 1e-15 in absolute
+        log-likelihood (tested).
+        """
+        x0 = self.threshold / self.sigma_min
+        log_missed0 = float(
+            np.logaddexp(
+                np.log1p(-self.pd) if self.pd < 1 else -np.inf, np.log(self.pd) + log_ndtr(x0)
+            )
+        )
+        dx_dc = -(self.sigma_frac * self.threshold + self.sigma_min) / self.sigma_min**2
+        pdf = math.exp(-0.5 * x0 * x0) / math.sqrt(2.0 * math.pi)
+        slope0 = self.pd * pdf * dx_dc / math.exp(log_missed0)
         return np.array(
             [
                 self.threshold,
@@ -72,6 +88,9 @@ class Sensor:
                 self.sigma_frac,
                 self.false_alarm,
                 self.false_alarm_scale,
+                1e-6 * self.sigma_min,
+                log_missed0,
+                slope0,
             ]
         )
 

@@ -57,7 +57,7 @@ class MultistageDCEEPlanner(Planner):
         ctx = PredictionContext(belief, self.n_hypotheses, self.horizon, rng)
         seqs = candidates[:, None, :]
         first = np.arange(len(candidates))
-        cost = dcee_cost(seqs[:, -1], ctx.stats(seqs))
+        cost = dcee_cost(seqs[:, -1], ctx.stats(seqs, kl=False))
         evaluated = len(seqs)
         for _ in range(1, self.horizon):
             keep = np.argsort(cost, kind="stable")[: self.beam_width]
@@ -70,7 +70,7 @@ class MultistageDCEEPlanner(Planner):
                     new_first.append(first[s])
             seqs = np.array(new_seqs)
             first = np.array(new_first)
-            cost = dcee_cost(seqs[:, -1], ctx.stats(seqs))
+            cost = dcee_cost(seqs[:, -1], ctx.stats(seqs, kl=False))
             evaluated += len(seqs)
         best = np.full(len(candidates), np.inf)
         np.minimum.at(best, first, cost)

@@ -21,6 +21,9 @@ class EntrotaxisPlanner(OneStepPlanner):
     scales (σ ~ 1e-4 g/m³), negative, so the rule would *avoid* informative places.
     """
 
+    needs_moments = False
+    needs_kl = False
+
     def cost_from_stats(
         self, candidates: np.ndarray, stats: SequenceStats, belief: Belief
     ) -> np.ndarray:

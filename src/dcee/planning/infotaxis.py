@@ -14,6 +14,8 @@ class InfotaxisPlanner(OneStepPlanner):
     information between the next reading and Θ), estimated over the shared hypothesised
     readings. Cost = −expected KL."""
 
+    needs_moments = False
+
     def cost_from_stats(
         self, candidates: np.ndarray, stats: SequenceStats, belief: Belief
     ) -> np.ndarray:

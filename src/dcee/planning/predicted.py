@@ -125,7 +125,9 @@ class PredictionContext:
     @property
     def terms(self) -> tuple[np.ndarray, ...]:
         """(conc, log_nd, inv_sigma, log_sigma), each (P, N), at every cached position."""
-        if self._terms is None:
+        if self._terms is None and len(self._rows) == 1:
+            self._terms = self._rows[0]
+        elif self._terms is None:
             self._terms = tuple(
                 np.ascontiguousarray(np.concatenate([r[k] for r in self._rows], axis=0))
                 for k in range(4)
@@ -143,8 +145,12 @@ class PredictionContext:
         c = self.conc[pos_idx][:, self.indices].T  # (J, T)
         return self.sensor.simulate_from(c, self.noise[:, :t_count])
 
-    def stats(self, sequences: np.ndarray) -> SequenceStats:
-        """Statistics for (S, T, 3) candidate position sequences (T ≤ horizon)."""
+    def stats(self, sequences: np.ndarray, moments: bool = True, kl: bool = True) -> SequenceStats:
+        """Statistics for (S, T, 3) candidate position sequences (T ≤ horizon).
+
+        ``moments=False`` leaves mean and trace_cov NaN, ``kl=False`` leaves kl NaN: each
+        saves work in the kernel when a planner's cost does not use it.
+        """
         s_count, t_count, _ = sequences.shape
         j_count = self.n_hypotheses
         pos_idx = self.position_index(sequences.reshape(-1, 3)).reshape(s_count, t_count)
@@ -166,7 +172,7 @@ class PredictionContext:
         log_ev = np.empty(n_tasks)
         mean = np.empty((n_tasks, 3))
         trace = np.empty(n_tasks)
-        kl = np.empty(n_tasks)
+        kl_div = np.empty(n_tasks)
         kernels.predicted_posterior_stats(
             *self.terms,
             self._source,
@@ -178,9 +184,13 @@ class PredictionContext:
             log_ev,
             mean,
             trace,
+            kl_div,
+            moments,
             kl,
         )
-        return SequenceStats(readings, log_ev[inverse], mean[inverse], trace[inverse], kl[inverse])
+        return SequenceStats(
+            readings, log_ev[inverse], mean[inverse], trace[inverse], kl_div[inverse]
+        )
 
 
 def dcee_cost(final_positions: np.ndarray, stats: SequenceStats) -> np.ndarray:
@@ -194,6 +204,9 @@ class OneStepPlanner(Planner):
     """A planner whose cost is a function of one-step predicted-posterior statistics."""
 
     uses_hypotheses = True
+    #: which optional statistics :meth:`cost_from_stats` reads (see PredictionContext.stats)
+    needs_moments = True
+    needs_kl = True
 
     def __init__(self, n_hypotheses: int = 40) -> None:
         if int(n_hypotheses) != n_hypotheses or n_hypotheses < 1:
@@ -212,7 +225,8 @@ class OneStepPlanner(Planner):
         rng: np.random.Generator,
     ) -> tuple[np.ndarray, dict[str, Any]]:
         ctx = PredictionContext(belief, self.n_hypotheses, 1, rng)
-        return self.cost_from_stats(candidates, ctx.stats(candidates[:, None, :]), belief), {}
+        stats = ctx.stats(candidates[:, None, :], moments=self.needs_moments, kl=self.needs_kl)
+        return self.cost_from_stats(candidates, stats, belief), {}
 
     @abstractmethod
     def cost_from_stats(

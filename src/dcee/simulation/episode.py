@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from dcee.allocator import tune_allocator
 from dcee.analysis.metrics import summarise
 from dcee.estimation.particle_filter import ParticleFilter
 from dcee.models.sensor import Sensor
@@ -56,6 +57,7 @@ def run_episode(
     snapshot_particles: int = 2000,
 ) -> EpisodeResult:
     """Fly one search until the budget is spent (or the posterior spread < ``stop_spread``)."""
+    tune_allocator()
     search = scenario.search
     planner = get_planner(strategy, **_planner_defaults(strategy, scenario, planner_options))
     truth_rng, filter_rng, planner_rng, figure_rng = streams(seed)
