@@ -10,7 +10,6 @@ from __future__ import annotations
 import json
 import os
 import sys
-import tempfile
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -18,36 +17,8 @@ from typing import Any
 import click
 
 from dcee.errors import DceeInputError
-
-
-def _write_atomic(path: Path, writer: Callable[[Path], None]) -> None:
-    """Write via ``writer(tmp)`` to a temporary file beside ``path``, then rename over it."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=path.suffix, dir=path.parent)
-    os.close(fd)
-    try:
-        writer(Path(tmp))
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the usual permissions
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def _write_json(path: Path, data: Any) -> None:
-    _write_atomic(path, lambda p: p.write_text(json.dumps(data, indent=2, default=_jsonable)))
-
-
-def _jsonable(obj: Any) -> Any:
-    import numpy as np
-
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    raise TypeError(f"not JSON serialisable: {type(obj)}")
+from dcee.io import write_atomic as _write_atomic
+from dcee.io import write_json as _write_json
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -233,6 +204,84 @@ def show(scenario_name: str) -> None:
     from dcee.scenarios import load_scenario
 
     click.echo(json.dumps(load_scenario(scenario_name).model_dump(), indent=2))
+
+
+@cli.command()
+@click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Also write JSON here.")
+@click.option("--quick", is_flag=True, help="Fewer repeats; skip the whole-search workloads.")
+@click.option(
+    "--compare-stonesoup",
+    is_flag=True,
+    help="Time Stone Soup's STE example side by side (needs the 'bench' extra).",
+)
+@click.option("--decisions", default=10, show_default=True, help="Decisions per side to time.")
+def perf(json_path: str | None, quick: bool, compare_stonesoup: bool, decisions: int) -> None:
+    """Time the standard workloads against their targets (see docs/performance.md)."""
+    import platform
+
+    from rich.console import Console
+    from rich.table import Table
+
+    console = Console(stderr=False)
+    machine = {
+        "cpus": os.cpu_count(),
+        "machine": platform.machine(),
+        "processor": platform.processor(),
+        "python": platform.python_version(),
+        "numba_threads": _numba_threads(),
+    }
+    if compare_stonesoup:
+        from dcee.perf.stonesoup_compare import compare
+
+        if decisions < 1:
+            raise DceeInputError("decisions", f"must be >= 1, got {decisions}")
+        result = compare(decisions)
+        console.print(
+            f"{result['workload']}, {decisions} decisions each (medians, same process):\n"
+            f"  Stone Soup {result['stonesoup_median_ms']:.2f} ms · "
+            f"dcee infotaxis {result['dcee_infotaxis_median_ms']:.2f} ms · "
+            f"ratio {result['speedup']:.1f}x (target >= {result['target_speedup']:.0f}x)"
+        )
+        if json_path:
+            _write_json(Path(json_path), {"machine": machine, "stonesoup": result})
+        return
+    from dcee.perf import run_workloads
+
+    with console.status("timing") as status:
+        timings = run_workloads(quick, progress=lambda name: status.update(f"timing {name}"))
+    table = Table(title=f"dcee perf · {machine['cpus']} CPUs · {machine['machine']}")
+    for col in ("workload", "median", "min", "max", "target", "pass"):
+        if col == "workload":
+            table.add_column(col, no_wrap=True, min_width=30)
+        else:
+            table.add_column(col, justify="right", no_wrap=True)
+    for t in timings:
+        d = t.as_dict()
+        mark = {True: "[green]pass", False: "[red]FAIL", None: "—"}[t.passed]
+        target = f"{t.target:.3g} {t.unit}" if t.target is not None else "—"
+        table.add_row(
+            t.name,
+            f"{d['median']:.3g} {t.unit}",
+            f"{d['min']:.3g}",
+            f"{d['max']:.3g}",
+            target,
+            mark,
+        )
+    console.print(table)
+    for t in timings:
+        if t.note:
+            console.print(f"  {t.name}: {t.note}")
+    if json_path:
+        _write_json(
+            Path(json_path),
+            {"machine": machine, "workloads": [t.as_dict() for t in timings]},
+        )
+
+
+def _numba_threads() -> int:
+    import numba
+
+    return int(numba.get_num_threads())
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -67,7 +67,8 @@ def predicted_posterior_stats_reference(
         for t in range(t_count):
             ll += sensor.log_likelihood(task_readings[s, t], conc[task_positions[s, t]])
         mx = ll[weights > 0].max()
-        e = weights * np.exp(ll - mx)
+        # zero-weight particles may exceed mx; clip them so that 0 · exp(·) stays 0
+        e = weights * np.exp(np.minimum(ll - mx, 0.0))
         w_post = e / e.sum()
         log_ev[s] = mx + np.log(e.sum())
         mean[s] = w_post @ source

@@ -1,0 +1,267 @@
+"""The standard performance workloads and their targets (issue 3).
+
+Every workload starts from a *real* posterior, not the flat prior: a particle filter at the
+stated size that has assimilated readings along the plume of ``paper:1`` (most hypothesised
+readings are then detections, the expensive case). Timings are medians of repeated calls in one
+process; the machine is shared, so compare ratios measured in the same run.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import os
+import time
+import tracemalloc
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from dcee.allocator import tune_allocator
+from dcee.estimation import ParticleFilter
+from dcee.models import isotropic_concentration
+from dcee.planning import get as get_planner
+from dcee.scenarios import load_scenario
+from dcee.searcher import Searcher
+from dcee.simulation import run_episode, streams
+
+
+@dataclass
+class Timing:
+    """One workload's repeated measurements (milliseconds, or MB for memory workloads)."""
+
+    name: str
+    description: str
+    target: float | None
+    values: list[float] = field(default_factory=list)
+    unit: str = "ms"
+    note: str = ""
+
+    @property
+    def median(self) -> float:
+        return float(np.median(self.values)) if self.values else math.nan
+
+    @property
+    def passed(self) -> bool | None:
+        """True/False against the target; None when the workload has no target."""
+        if self.target is None or not self.values:
+            return None
+        return self.median <= self.target
+
+    def as_dict(self) -> dict:
+        out = {
+            "name": self.name,
+            "description": self.description,
+            "unit": self.unit,
+            "median": self.median,
+            "min": float(np.min(self.values)) if self.values else None,
+            "max": float(np.max(self.values)) if self.values else None,
+            "target": self.target,
+            "passed": self.passed,
+            "repeats": len(self.values),
+            "note": self.note,
+        }
+        if self.unit == "ms":
+            out["median_ms"] = out["median"]
+            out["target_ms"] = self.target
+        return out
+
+
+def _times_ms(fn: Callable[[], object], repeats: int, setup: Callable[[], None] | None = None):
+    fn_setup = setup or (lambda: None)
+    fn_setup()
+    fn()  # warm-up: compilation caches, allocator
+    out = []
+    for _ in range(repeats):
+        fn_setup()
+        t0 = time.perf_counter()
+        fn()
+        out.append(1e3 * (time.perf_counter() - t0))
+    return out
+
+
+def posterior_filter(n_particles: int, n_readings: int = 5, seed: int = 0) -> ParticleFilter:
+    """A ``paper:1`` filter after ``n_readings`` readings along the plume's axis (y = 12 m)."""
+    scenario = load_scenario("paper:1")
+    truth_rng, filter_rng, _, _ = streams(seed)
+    sensor = scenario.make_sensor()
+    pf = ParticleFilter(scenario.make_prior(), sensor, n_particles=n_particles, seed=filter_rng)
+    theta = scenario.truth_theta()[None]
+    for x in np.linspace(10.0, 26.0, n_readings):
+        p = np.array([x, 12.0, 4.0])
+        c = isotropic_concentration(theta, p[None])[0, 0]
+        pf.update(p, float(sensor.simulate(c, truth_rng)))
+    return pf
+
+
+def _searcher(pf: ParticleFilter, strategy: str, **options) -> Searcher:
+    agent = load_scenario("paper:1").make_agent()
+    searcher = Searcher(pf, get_planner(strategy, **options), agent, np.random.default_rng(0))
+    searcher.position = np.array([26.0, 12.0, 4.0])
+    return searcher
+
+
+def _decision(
+    name: str, n: int, strategy: str, target: float | None, repeats: int, **options
+) -> Timing:
+    pf = posterior_filter(n)
+    searcher = _searcher(pf, strategy, **options)
+    hyp = options.get("n_hypotheses", 40)
+    extra = f", horizon {options['horizon']}" if "horizon" in options else ""
+    desc = f"one {strategy} decision, {n:,} particles, 8 moves × {hyp} readings{extra}"
+    if strategy == "mpc":
+        desc = f"one mpc decision, {n:,} particles, 8 moves"
+    return Timing(name, desc, target, _times_ms(searcher.ask, repeats))
+
+
+def _filter_update(repeats: int) -> Timing:
+    pf = posterior_filter(20_000)
+    work: list[ParticleFilter] = []
+
+    def setup() -> None:
+        work[:] = [copy.deepcopy(pf)]
+
+    far = np.array([45.0, 45.0, 4.0])  # a non-detection that does not trigger resampling
+    times = _times_ms(lambda: work[0].update(far, 0.0), repeats, setup)
+    return Timing(
+        "filter-update-20k", "filter update for one reading, 20,000 particles", 1.0, times
+    )
+
+
+def _resample_move(repeats: int) -> Timing:
+    pf = posterior_filter(20_000)
+    scenario = load_scenario("paper:1")
+    theta = scenario.truth_theta()[None]
+    rng = np.random.default_rng(5)
+    sensor = pf.sensor
+    while pf.n_readings < 500:  # distinct positions over the whole area
+        p = np.array([*rng.uniform(0, 50, 2), 4.0])
+        c = isotropic_concentration(theta, p[None])[0, 0]
+        pf.update(p, float(sensor.simulate(c, rng)))
+    work: list[ParticleFilter] = []
+
+    def setup() -> None:
+        work[:] = [copy.deepcopy(pf)]
+
+    times = _times_ms(lambda: work[0]._resample_move(1), repeats, setup)
+    return Timing(
+        "resample-mcmc-500-readings-20k",
+        "systematic resampling + full-history MCMC move, 500 readings, 20,000 particles",
+        100.0,
+        times,
+    )
+
+
+def _peak_memory(name: str, n: int) -> Timing:
+    """Peak traced allocation (NumPy buffers included) during one dcee decision."""
+    pf = posterior_filter(n)
+    searcher = _searcher(pf, "dcee")
+    searcher.ask()
+    tracemalloc.start()
+    searcher.ask()
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    mb = peak / 2**20
+    # O(N + M) budget: per particle, 8 positions × 4 cached terms + the 8-parameter copy and
+    # index arrays (≈ 400 B), plus 1 MB for per-task and per-block sums.
+    budget = (400 * n + 2**20) / 2**20
+    return Timing(
+        name,
+        f"peak memory of one dcee decision, {n:,} particles",
+        budget,
+        [mb],
+        unit="MB",
+        note=f"{peak / n:.0f} B per particle",
+    )
+
+
+def _search(strategy: str, target: float | None) -> Timing:
+    scenario = load_scenario("paper:1")
+    t0 = time.perf_counter()
+    result = run_episode(scenario, strategy, 0)
+    wall = 1e3 * (time.perf_counter() - t0)
+    rmse = result.summary["final_rmse"]
+    return Timing(
+        f"search-900s-{strategy}",
+        f"one complete 900 s paper:1 search with {strategy}, paper scale",
+        target,
+        [wall],
+        note=f"final RMSE {rmse:.2f} m",
+    )
+
+
+def run_workloads(quick: bool = False, progress: Callable[[str], None] | None = None) -> list:
+    """Run the standard workloads; ``quick`` uses fewer repeats and skips whole searches."""
+    tune_allocator()
+    say = progress or (lambda _msg: None)
+    r = 3 if quick else 15
+    plan: list[tuple[str, Callable[[], Timing]]] = [
+        ("dcee-decision-20k", lambda: _decision("dcee-decision-20k", 20_000, "dcee", 5.0, r)),
+        (
+            "entrotaxis-decision-20k",
+            lambda: _decision("entrotaxis-decision-20k", 20_000, "entrotaxis", 5.0, r),
+        ),
+        (
+            "infotaxis-decision-20k",
+            lambda: _decision("infotaxis-decision-20k", 20_000, "infotaxis", 5.0, r),
+        ),
+        (
+            "dcee-ms-decision-20k",
+            lambda: _decision(
+                "dcee-ms-decision-20k", 20_000, "dcee-ms", 100.0, max(3, r // 3), horizon=2
+            ),
+        ),
+        ("mpc-decision-20k", lambda: _decision("mpc-decision-20k", 20_000, "mpc", None, r)),
+        ("dcee-decision-2k", lambda: _decision("dcee-decision-2k", 2_000, "dcee", None, r)),
+        (
+            "dcee-decision-100k",
+            lambda: _decision("dcee-decision-100k", 100_000, "dcee", None, max(3, r // 3)),
+        ),
+        (
+            "dcee-decision-20k-10-readings",
+            lambda: _decision(
+                "dcee-decision-20k-10-readings", 20_000, "dcee", None, r, n_hypotheses=10
+            ),
+        ),
+        (
+            "dcee-decision-20k-160-readings",
+            lambda: _decision(
+                "dcee-decision-20k-160-readings", 20_000, "dcee", None, r, n_hypotheses=160
+            ),
+        ),
+        ("filter-update-20k", lambda: _filter_update(r)),
+        ("resample-mcmc-500-readings-20k", lambda: _resample_move(max(3, r // 3))),
+        ("memory-dcee-decision-20k", lambda: _peak_memory("memory-dcee-decision-20k", 20_000)),
+        ("memory-dcee-decision-100k", lambda: _peak_memory("memory-dcee-decision-100k", 100_000)),
+    ]
+    if not quick:
+        plan.append(("search-900s-dcee", lambda: _search("dcee", 10_000.0)))
+    out = []
+    for name, make in plan:
+        say(name)
+        out.append(make())
+    if not quick:
+        out.append(_campaign_estimate(out, say))
+    return out
+
+
+def _campaign_estimate(done: list[Timing], say: Callable[[str], None]) -> Timing:
+    """The paper campaign (12 configurations × 10 repeats × dcee, mpc, entrotaxis = 360 searches)
+    estimated from one complete search per strategy on configuration 1, spread over the cores.
+    ``dcee bench`` measures the real thing (docs/performance.md)."""
+    per_search = {"dcee": next(t.median for t in done if t.name == "search-900s-dcee")}
+    for strategy in ("mpc", "entrotaxis"):
+        say(f"search-900s-{strategy}")
+        per_search[strategy] = _search(strategy, None).median
+    workers = os.cpu_count() or 1
+    minutes = 120 * sum(per_search.values()) / workers / 6e4
+    detail = ", ".join(f"{k} {v / 1e3:.1f} s" for k, v in per_search.items())
+    return Timing(
+        "campaign-360-estimate",
+        f"paper campaign, 360 searches on {workers} cores (estimate from one search each)",
+        30.0,
+        [minutes],
+        unit="min",
+        note=detail,
+    )

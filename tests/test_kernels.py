@@ -1,0 +1,110 @@
+"""Compiled kernels against independent references: math.exp, the NumPy likelihood, and the
+NumPy predicted-posterior statistics in the cases that take the kernels' special paths."""
+
+import math
+
+import numpy as np
+import pytest
+
+from dcee import kernels
+from dcee.models import Sensor
+from dcee.planning.predicted import predicted_posterior_stats_reference
+
+
+def test_vectorised_exp_matches_math_exp():
+    x = np.concatenate([-np.geomspace(1e-12, 700, 20_000), [0.0, -0.5 * math.log(2)]])
+    out = np.empty_like(x)
+    kernels.vexp(x, out)
+    ref = np.exp(x)
+    np.testing.assert_allclose(out, ref, rtol=1e-14, atol=0)
+    below = np.empty(1)
+    kernels.vexp(np.array([-800.0]), below)
+    assert 0.0 <= below[0] <= math.exp(-700)
+
+
+@pytest.mark.parametrize("pd", [0.7, 1.0])
+def test_missed_detection_likelihood_small_and_large_concentrations(pd):
+    """The linearised branch (C < 1e-6 σ_min) and the erfc branch agree with scipy to 1e-15
+    absolute across the switch, and to 1e-9 relative far from it."""
+    sensor = Sensor(pd=pd)
+    sp = sensor.params
+    c_lin = sp[6]
+    c = np.concatenate([[0.0], c_lin * np.array([0.01, 0.5, 0.999, 1.001, 2.0]), [1e-4, 5e-4]])
+    c = np.concatenate([c, np.geomspace(1e-3, 10, 20)])
+    fast = np.array([kernels.log_likelihood(0.0, ci, sp) for ci in c])
+    ref = sensor.log_likelihood(0.0, c)
+    np.testing.assert_allclose(fast, ref, rtol=1e-9, atol=1e-15)
+
+
+def _stats_case(n=2000, seed=3):
+    rng = np.random.default_rng(seed)
+    source = np.column_stack([rng.uniform(0, 20, n), rng.uniform(0, 20, n), rng.uniform(0, 3, n)])
+    weights = rng.random(n)
+    weights[::7] = 0.0  # zero-weight particles must not count
+    weights /= weights.sum()
+    conc = np.ascontiguousarray(rng.lognormal(-8, 2, size=(3, n)))
+    return source, weights, conc
+
+
+def _run(conc, source, weights, task_pos, task_z, sensor, **flags):
+    terms = [np.empty_like(conc) for _ in range(3)]
+    kernels.position_terms(conc, sensor.params, *terms)
+    s = len(task_pos)
+    out = [np.empty(s), np.empty((s, 3)), np.empty(s), np.empty(s)]
+    kernels.predicted_posterior_stats(
+        conc,
+        *terms,
+        source,
+        weights,
+        weights @ source,
+        task_pos,
+        task_z,
+        sensor.params,
+        *out,
+        **flags,
+    )
+    return out
+
+
+def test_predicted_stats_unreachable_reading_takes_exact_path():
+    """A reading no particle can explain (every log-likelihood below −3000) underflows the
+    one-pass sums; the kernel must redo it exactly and still match the reference."""
+    source, weights, conc = _stats_case()
+    conc[1] = np.random.default_rng(0).uniform(1e-6, 2e-5, conc.shape[1])
+    sensor = Sensor()
+    task_pos = np.array([[0], [1], [1], [2]])
+    task_z = np.array([[0.0], [1e-2], [3e-4], [1e-3]])
+    out = _run(conc, source, weights, task_pos, task_z, sensor)
+    ref = predicted_posterior_stats_reference(conc, source, weights, task_pos, task_z, sensor)
+    for fast, slow in zip(out, ref, strict=True):
+        np.testing.assert_allclose(fast, slow, rtol=1e-9, atol=1e-12)
+    assert out[0][1] < -3000  # the unreachable reading really is unreachable
+
+
+def test_predicted_stats_optional_outputs_are_skipped_not_wrong():
+    source, weights, conc = _stats_case()
+    sensor = Sensor()
+    task_pos = np.array([[0], [0], [2]])
+    task_z = np.array([[0.0], [2e-3], [1e-3]])
+    full = _run(conc, source, weights, task_pos, task_z, sensor)
+    only_ev = _run(
+        conc, source, weights, task_pos, task_z, sensor, want_moments=False, want_kl=False
+    )
+    np.testing.assert_array_equal(only_ev[0], full[0])
+    assert np.isnan(only_ev[1]).all() and np.isnan(only_ev[2]).all() and np.isnan(only_ev[3]).all()
+    no_kl = _run(conc, source, weights, task_pos, task_z, sensor, want_kl=False)
+    np.testing.assert_array_equal(no_kl[1], full[1])
+    assert np.isnan(no_kl[3]).all()
+
+
+def test_predicted_stats_multi_step_sequences_match_reference():
+    """Horizon 3 (dcee-ms): several readings per task, mixed detections and non-detections."""
+    source, weights, conc = _stats_case(n=1500, seed=8)
+    sensor = Sensor()
+    rng = np.random.default_rng(1)
+    task_pos = np.repeat(np.array([[0, 1, 2], [2, 2, 0]]), 6, axis=0)
+    task_z = np.where(rng.random((12, 3)) < 0.4, 0.0, rng.lognormal(-7, 1, (12, 3)))
+    out = _run(conc, source, weights, task_pos, task_z, sensor)
+    ref = predicted_posterior_stats_reference(conc, source, weights, task_pos, task_z, sensor)
+    for fast, slow in zip(out, ref, strict=True):
+        np.testing.assert_allclose(fast, slow, rtol=1e-9, atol=1e-12)

@@ -1,0 +1,53 @@
+"""`dcee perf`: the table and the JSON contract (timings themselves are not asserted here: the
+machine is shared; targets are checked by running the command, see docs/performance.md)."""
+
+import json
+import sys
+
+import pytest
+
+from dcee.cli import main
+
+
+def _run(argv, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    out = capsys.readouterr()
+    return exc.value.code, out.out, out.err
+
+
+def test_perf_quick_writes_every_standard_workload(tmp_path, capsys):
+    path = tmp_path / "perf.json"
+    code, stdout, err = _run(["perf", "--quick", "--json", str(path)], capsys)
+    assert code == 0, err
+    data = json.loads(path.read_text())
+    by_name = {w["name"]: w for w in data["workloads"]}
+    expected = {
+        "dcee-decision-20k": 5.0,
+        "entrotaxis-decision-20k": 5.0,
+        "infotaxis-decision-20k": 5.0,
+        "dcee-ms-decision-20k": 100.0,
+        "filter-update-20k": 1.0,
+        "resample-mcmc-500-readings-20k": 100.0,
+    }
+    for name, target in expected.items():
+        w = by_name[name]
+        assert w["target_ms"] == target
+        assert w["median_ms"] > 0 and w["min"] <= w["median_ms"] <= w["max"]
+        assert w["passed"] == (w["median_ms"] <= target)
+        assert name in stdout
+    for n in ("2k", "20k", "100k"):
+        assert by_name[f"dcee-decision-{n}"]["median_ms"] > 0
+    mem = by_name["memory-dcee-decision-100k"]
+    assert mem["unit"] == "MB" and 0 < mem["median"] < 200
+    assert data["machine"]["cpus"] >= 1
+
+
+def test_compare_stonesoup_without_the_extra_is_a_clear_error(monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "stonesoup", None)  # makes `import stonesoup...` fail
+    for key in [k for k in sys.modules if k.startswith("stonesoup.")]:
+        monkeypatch.setitem(sys.modules, key, None)
+    code, _, err = _run(["perf", "--compare-stonesoup", "--decisions", "1"], capsys)
+    assert code == 2
+    assert err.strip().count("\n") == 0
+    assert "stonesoup" in err.lower() and "dcee[bench]" in err
