@@ -222,7 +222,7 @@ def perf(json_path: str | None, quick: bool, compare_stonesoup: bool, decisions:
     from rich.console import Console
     from rich.table import Table
 
-    console = Console(stderr=False)
+    console = Console(width=None if sys.stdout.isatty() else 120)
     machine = {
         "cpus": os.cpu_count(),
         "machine": platform.machine(),
@@ -282,6 +282,100 @@ def _numba_threads() -> int:
     import numba
 
     return int(numba.get_num_threads())
+
+
+@cli.command()
+@click.option("--suite", default="paper", show_default=True, help="paper | smoke")
+@click.option(
+    "--strategies",
+    default="dcee,mpc,entrotaxis,infotaxis,dcee-ms",
+    show_default=True,
+    help="Comma-separated planner names.",
+)
+@click.option("--repeats", default=10, show_default=True, help="Repeats per configuration.")
+@click.option(
+    "--out",
+    "out_dir",
+    required=True,
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Campaign folder (created, or resumed if it holds this campaign).",
+)
+@click.option("--workers", type=int, help="Local worker processes [default: all cores].")
+@click.option("--scheduler", help="Address of a running Dask scheduler, e.g. tcp://host:8786.")
+@click.option("--unknown", type=click.Choice(["source", "full"]), help="Override unknown set.")
+@click.option("--particles", type=int, help="Override the particle count.")
+def bench(
+    suite: str,
+    strategies: str,
+    repeats: int,
+    out_dir: Path,
+    workers: int | None,
+    scheduler: str | None,
+    unknown: str | None,
+    particles: int | None,
+) -> None:
+    """Run a campaign of simulated searches; resumes where a previous run stopped."""
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    from dcee.campaign import Campaign, run_campaign
+
+    if workers is not None and workers < 1:
+        raise DceeInputError("workers", f"must be >= 1, got {workers}")
+    if workers is not None and scheduler:
+        raise DceeInputError("workers", "give either --workers or --scheduler, not both")
+    names = tuple(s.strip() for s in strategies.split(",") if s.strip())
+    campaign = Campaign(out_dir, suite, names, repeats, unknown, particles)
+    failures: list[str] = []
+    columns = (
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("failed {task.fields[failed]}"),
+        TimeElapsedColumn(),
+        TextColumn("ETA"),
+        TimeRemainingColumn(),
+    )
+    with Progress(*columns, disable=not sys.stderr.isatty()) as progress:
+        bar = progress.add_task(suite, total=None, failed=0)
+
+        def on_result(res: dict[str, Any], finished: int, todo: int) -> None:
+            if res["status"] == "failed":
+                t = res.get("task")
+                where = f"{t.config} {t.strategy} seed {t.seed}: " if t else ""
+                failures.append(where + res["error"])
+            progress.update(bar, total=todo, completed=finished, failed=len(failures))
+
+        counts = run_campaign(campaign, workers=workers, scheduler=scheduler, on_result=on_result)
+    click.echo(
+        f"{counts['total']} searches: {counts['skipped']} already done, {counts['done']} run, "
+        f"{counts['failed']} failed · results in {out_dir}"
+    )
+    for line in failures[:20]:
+        click.echo(f"  failed: {line}", err=True)
+
+
+@cli.command()
+@click.argument("campaign_dir", type=click.Path(file_okay=False, path_type=Path))
+@click.option(
+    "--out",
+    "out_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Report folder [default: CAMPAIGN_DIR/report].",
+)
+def report(campaign_dir: Path, out_dir: Path | None) -> None:
+    """Tables (CSV, Markdown), figures and a self-contained HTML report of a campaign."""
+    from dcee.analysis.report import write_report
+
+    paths = write_report(campaign_dir, out_dir or campaign_dir / "report")
+    for p in paths:
+        click.echo(str(p))
 
 
 def main(argv: list[str] | None = None) -> None:

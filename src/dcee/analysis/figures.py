@@ -132,7 +132,7 @@ def search_figure(
         p=result.final_weights,
     )
     _draw_map(
-        ax_map, result, scenario, truth, result.records[-1]["time"], result.final_particles[idx]
+        ax_map, result, scenario, truth, result.records[-1]["time"], result.final_theta[idx, :3]
     )
     ax_map.legend(
         fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=4, markerscale=0.8

@@ -28,12 +28,13 @@ from dcee.simulation.truth import TruthModel, make_truth
 
 @dataclass
 class EpisodeResult:
-    """Per-step records (list of dicts, one per reading), the summary, and optional snapshots
-    of the particles' source locations for figures: list of (time, (n, 3) array)."""
+    """Per-step records (list of dicts, one per reading), the summary, the final particles
+    (N, 8) with every parameter (known ones included) and their weights (N,), and optional
+    snapshots of the particles' source locations for figures: list of (time, (n, 3) array)."""
 
     records: list[dict[str, Any]]
     summary: dict[str, Any]
-    final_particles: np.ndarray
+    final_theta: np.ndarray
     final_weights: np.ndarray
     snapshots: list[tuple[float, np.ndarray]] = field(default_factory=list)
 
@@ -134,7 +135,7 @@ def run_episode(
     summary["resamples"] = pf.n_resamples
     if snapshot_every is not None and snapshots[-1][0] != records[-1]["time"]:
         snapshots.append((records[-1]["time"], _subsample(pf, snapshot_particles, figure_rng)))
-    return EpisodeResult(records, summary, pf.source_locations.copy(), pf.weights.copy(), snapshots)
+    return EpisodeResult(records, summary, pf.theta.copy(), pf.weights.copy(), snapshots)
 
 
 def _subsample(pf: ParticleFilter, n: int, rng: np.random.Generator) -> np.ndarray:

@@ -1,0 +1,355 @@
+"""Campaign report: per-strategy metrics with 95% confidence intervals, the paper's figures,
+and a self-contained HTML page (figures embedded) plus the table as CSV and Markdown.
+
+Confidence intervals: Wilson score intervals for rates; for means a normal interval
+(mean ± 1.96 s/√n); for medians a percentile bootstrap (2,000 resamples, fixed seed, so the
+report is reproducible). Times to an RMSE level are over the searches that reached it; the
+fraction that reached it is reported beside.
+"""
+
+from __future__ import annotations
+
+import base64
+import io
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+
+from dcee.errors import DceeInputError
+from dcee.io import write_atomic
+
+Z95 = 1.959963984540054
+SNAPSHOT_TIMES = (90.0, 270.0, 450.0, 900.0)
+
+
+def wilson(k: int, n: int) -> tuple[float, float, float]:
+    """(rate, low, high) with the Wilson score interval at 95%."""
+    if n == 0:
+        return (math.nan, math.nan, math.nan)
+    p = k / n
+    den = 1 + Z95**2 / n
+    centre = (p + Z95**2 / (2 * n)) / den
+    half = Z95 * math.sqrt(p * (1 - p) / n + Z95**2 / (4 * n * n)) / den
+    return (p, max(0.0, centre - half), min(1.0, centre + half))
+
+
+def mean_ci(x: np.ndarray) -> tuple[float, float, float]:
+    x = np.asarray(x, dtype=float)
+    x = x[np.isfinite(x)]
+    if len(x) == 0:
+        return (math.nan, math.nan, math.nan)
+    m = float(x.mean())
+    if len(x) == 1:
+        return (m, math.nan, math.nan)
+    half = Z95 * float(x.std(ddof=1)) / math.sqrt(len(x))
+    return (m, m - half, m + half)
+
+
+def median_ci(x: np.ndarray, n_boot: int = 2000) -> tuple[float, float, float]:
+    x = np.asarray(x, dtype=float)
+    x = x[np.isfinite(x)]
+    if len(x) == 0:
+        return (math.nan, math.nan, math.nan)
+    rng = np.random.default_rng(0)
+    boots = np.median(rng.choice(x, size=(n_boot, len(x)), replace=True), axis=1)
+    lo, hi = np.percentile(boots, [2.5, 97.5])
+    return (float(np.median(x)), float(lo), float(hi))
+
+
+def load_campaign(campaign_dir: Path) -> tuple[dict[str, Any], pd.DataFrame]:
+    """(campaign.json, one row per finished search)."""
+    meta_path = campaign_dir / "campaign.json"
+    if not meta_path.is_file():
+        raise DceeInputError(
+            "campaign", f"{campaign_dir} is not a campaign folder (no campaign.json)"
+        )
+    meta = json.loads(meta_path.read_text())
+    rows = []
+    for path in sorted((campaign_dir / "runs").glob("*/*/seed-*.json")):
+        if path.name.endswith(".error.json"):
+            continue
+        try:
+            s = json.loads(path.read_text())
+        except json.JSONDecodeError:
+            continue  # a corrupt summary is not a finished search
+        s["_stem"] = str(path.with_suffix(""))
+        rows.append(s)
+    if not rows:
+        raise DceeInputError("campaign", f"{campaign_dir} holds no finished searches yet")
+    return meta, pd.DataFrame(rows)
+
+
+def metrics_table(runs: pd.DataFrame) -> pd.DataFrame:
+    """One row per strategy: every metric with its 95% interval."""
+    out = []
+    for strategy, g in runs.groupby("strategy", sort=True):
+        n = len(g)
+        row: dict[str, Any] = {"strategy": strategy, "searches": n}
+        for key, col in (
+            ("source_acquired", "source_acquired"),
+            ("plume_acquired", "plume_acquired"),
+        ):
+            r, lo, hi = wilson(int(g[col].sum()), n)
+            row.update({f"{key}_rate": r, f"{key}_lo": lo, f"{key}_hi": hi})
+        for key, fn in (("mean", mean_ci), ("median", median_ci)):
+            v, lo, hi = fn(g["final_rmse"].to_numpy())
+            row.update(
+                {f"{key}_final_rmse": v, f"{key}_final_rmse_lo": lo, f"{key}_final_rmse_hi": hi}
+            )
+        for level, col in (("1m", "time_to_rmse_1m"), ("0_5m", "time_to_rmse_0_5m")):
+            t = pd.to_numeric(g[col], errors="coerce").to_numpy()
+            v, lo, hi = mean_ci(t)
+            row.update(
+                {
+                    f"time_to_{level}": v,
+                    f"time_to_{level}_lo": lo,
+                    f"time_to_{level}_hi": hi,
+                    f"reached_{level}": float(np.isfinite(t).mean()),
+                }
+            )
+        for key, col in (("path_length", "path_length"), ("decision_ms", "decision_seconds_mean")):
+            scale = 1e3 if key == "decision_ms" else 1.0
+            v, lo, hi = mean_ci(g[col].to_numpy() * scale)
+            row.update({key: v, f"{key}_lo": lo, f"{key}_hi": hi})
+        out.append(row)
+    return pd.DataFrame(out)
+
+
+def _fmt(v: float, lo: float, hi: float, digits: int = 2, pct: bool = False) -> str:
+    if not np.isfinite(v):
+        return "—"
+    s = 100.0 if pct else 1.0
+    body = f"{v * s:.{0 if pct else digits}f}"
+    if np.isfinite(lo) and np.isfinite(hi):
+        body += f" [{lo * s:.{0 if pct else digits}f}, {hi * s:.{0 if pct else digits}f}]"
+    return body + ("%" if pct else "")
+
+
+def markdown_table(table: pd.DataFrame) -> str:
+    head = (
+        "| strategy | n | source acquired | plume acquired | mean final RMSE (m) | "
+        "median final RMSE (m) | time to RMSE < 1 m (s) | time to < 0.5 m (s) | "
+        "path (m) | decision (ms) |"
+    )
+    lines = [head, "|" + "---|" * 10]
+    for _, r in table.iterrows():
+        src = _fmt(r.source_acquired_rate, r.source_acquired_lo, r.source_acquired_hi, pct=True)
+        plume = _fmt(r.plume_acquired_rate, r.plume_acquired_lo, r.plume_acquired_hi, pct=True)
+        t05 = _fmt(r.time_to_0_5m, r.time_to_0_5m_lo, r.time_to_0_5m_hi, 0)
+        lines.append(
+            f"| {r.strategy} | {r.searches} | {src} | {plume} "
+            f"| {_fmt(r.mean_final_rmse, r.mean_final_rmse_lo, r.mean_final_rmse_hi)} "
+            f"| {_fmt(r.median_final_rmse, r.median_final_rmse_lo, r.median_final_rmse_hi)} "
+            f"| {_fmt(r.time_to_1m, r.time_to_1m_lo, r.time_to_1m_hi, 0)} ({r.reached_1m:.0%}) "
+            f"| {t05} ({r.reached_0_5m:.0%}) "
+            f"| {_fmt(r.path_length, r.path_length_lo, r.path_length_hi, 0)} "
+            f"| {_fmt(r.decision_ms, r.decision_ms_lo, r.decision_ms_hi, 1)} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def rmse_over_time(runs: pd.DataFrame, step: float = 10.0) -> dict[str, pd.DataFrame]:
+    """Per strategy: mean RMSE over searches on a common time grid, with a 95% band. A search
+    that ended early keeps its last value (its estimate no longer changes)."""
+    budget = float(runs["budget"].max())
+    grid = np.arange(0.0, budget + 1e-9, step)
+    out = {}
+    for strategy, g in runs.groupby("strategy", sort=True):
+        curves = []
+        for stem in g["_stem"]:
+            steps = pd.read_parquet(f"{stem}.parquet", columns=["time", "rmse"])
+            t, r = steps["time"].to_numpy(), steps["rmse"].to_numpy()
+            idx = np.clip(np.searchsorted(t, grid, side="right") - 1, 0, len(t) - 1)
+            curves.append(r[idx])
+        c = np.array(curves)
+        mean = c.mean(axis=0)
+        half = (
+            Z95 * c.std(axis=0, ddof=1) / math.sqrt(len(c)) if len(c) > 1 else np.zeros_like(mean)
+        )
+        out[strategy] = pd.DataFrame(
+            {"time": grid, "mean": mean, "lo": mean - half, "hi": mean + half}
+        )
+    return out
+
+
+def _png(fig: plt.Figure) -> bytes:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def figure_rmse(curves: dict[str, pd.DataFrame]) -> bytes:
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for name, c in curves.items():
+        ax.plot(c["time"], c["mean"], label=name)
+        ax.fill_between(c["time"], c["lo"], c["hi"], alpha=0.2)
+    ax.set_yscale("log")
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("mean RMSE of the source location (m)")
+    ax.axhline(0.5, color="0.5", lw=0.8, ls=":")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    ax.set_title("Mean RMSE over time (95% band)")
+    return _png(fig)
+
+
+def figure_acquisition(table: pd.DataFrame) -> bytes:
+    fig, ax = plt.subplots(figsize=(8, 4))
+    x = np.arange(len(table))
+    for k, (key, label) in enumerate(
+        (("source_acquired", "source acquired"), ("plume_acquired", "plume acquired"))
+    ):
+        rate = table[f"{key}_rate"].to_numpy()
+        err = np.vstack([rate - table[f"{key}_lo"], table[f"{key}_hi"] - rate])
+        ax.bar(x + (k - 0.5) * 0.38, 100 * rate, 0.38, yerr=100 * err, capsize=3, label=label)
+    ax.set_xticks(x, table["strategy"])
+    ax.set_ylabel("% of searches")
+    ax.set_ylim(0, 105)
+    ax.legend(loc="lower right")
+    ax.set_title("Acquisition rates (95% Wilson intervals)")
+    return _png(fig)
+
+
+def figure_grid(runs: pd.DataFrame, meta: dict[str, Any]) -> bytes | None:
+    """One representative search per strategy (first configuration, repeat 0) at the snapshot
+    times: particles, trajectory so far, true source."""
+    from dcee.scenarios import Scenario
+
+    reps = runs[runs["seed"] == 0].sort_values(["scenario", "strategy"])
+    if reps.empty:
+        return None
+    config = sorted(reps["scenario"].unique(), key=_config_key)[0]
+    reps = reps[reps["scenario"] == config]
+    scenario = Scenario.model_validate(meta["settings"]["scenarios"][config])
+    truth = scenario.truth_theta()
+    lo, hi = scenario.volume.low, scenario.volume.high
+    fig, axes = plt.subplots(
+        len(reps),
+        len(SNAPSHOT_TIMES),
+        figsize=(3.2 * len(SNAPSHOT_TIMES), 3.1 * len(reps)),
+        squeeze=False,
+    )
+    for row, (_, r) in enumerate(reps.iterrows()):
+        steps = pd.read_parquet(f"{r['_stem']}.parquet", columns=["time", "x", "y"])
+        with np.load(f"{r['_stem']}.npz") as z:
+            times = z["snapshot_times"] if "snapshot_times" in z else np.array([])
+            parts = z["snapshot_particles"] if "snapshot_particles" in z else None
+        for col, t_snap in enumerate(SNAPSHOT_TIMES):
+            ax = axes[row, col]
+            if parts is not None and len(times):
+                k = int(np.argmin(np.abs(times - t_snap)))
+                ax.scatter(parts[k][:, 0], parts[k][:, 1], s=1, alpha=0.3, color="tab:blue")
+            path = steps[steps["time"] <= t_snap]
+            ax.plot(path["x"], path["y"], color="tab:red", lw=1)
+            ax.plot(truth[0], truth[1], marker="*", color="gold", mec="k", ms=12)
+            ax.set_xlim(lo[0], hi[0])
+            ax.set_ylim(lo[1], hi[1])
+            ax.set_aspect("equal")
+            ax.set_xticks([])
+            ax.set_yticks([])
+            if row == 0:
+                ax.set_title(f"t = {t_snap:.0f} s")
+            if col == 0:
+                ax.set_ylabel(r["strategy"])
+    fig.suptitle(f"{config}, repeat 0: particles (blue), path (red), source (star)")
+    return _png(fig)
+
+
+def figure_posteriors(runs: pd.DataFrame, meta: dict[str, Any]) -> bytes:
+    """Histograms of the final posterior's error (particle − truth) per unknown parameter,
+    pooled over the searches of each strategy."""
+    from dcee.models.plume import PARAMETER_NAMES
+    from dcee.scenarios import Scenario
+
+    names = list(runs["parameter_names"].iloc[0])
+    idx = [PARAMETER_NAMES.index(n) for n in names]
+    truths = {
+        k: Scenario.model_validate(v).truth_theta()
+        for k, v in meta["settings"]["scenarios"].items()
+    }
+    fig, axes = plt.subplots(1, len(names), figsize=(3.0 * len(names), 3.0), squeeze=False)
+    for strategy, g in runs.groupby("strategy", sort=True):
+        errs = []
+        for _, r in g.iterrows():
+            with np.load(f"{r['_stem']}.npz") as z:
+                p = z["final_particles"].astype(float)
+            errs.append(p[:, idx] - truths[r["scenario"]][idx])
+        e = np.concatenate(errs)
+        for k, ax in enumerate(axes[0]):
+            lim = np.percentile(np.abs(e[:, k]), 99) or 1.0
+            ax.hist(
+                e[:, k], bins=60, range=(-lim, lim), histtype="step", density=True, label=strategy
+            )
+    for k, ax in enumerate(axes[0]):
+        ax.set_title(f"{names[k]} − true")
+        ax.set_yticks([])
+    axes[0, -1].legend(fontsize=7)
+    fig.suptitle("Final posterior error, pooled over searches")
+    return _png(fig)
+
+
+def _config_key(name: str) -> tuple:
+    head, _, tail = name.partition(":")
+    return (head, int(tail) if tail.isdigit() else tail)
+
+
+def write_report(campaign_dir: Path, out_dir: Path) -> list[Path]:
+    """Write report.html, metrics.csv, metrics.md and the figures; returns the paths."""
+    meta, runs = load_campaign(Path(campaign_dir))
+    table = metrics_table(runs)
+    md = markdown_table(table)
+    figures = {
+        "rmse_over_time.png": figure_rmse(rmse_over_time(runs)),
+        "acquisition.png": figure_acquisition(table),
+        "posteriors.png": figure_posteriors(runs, meta),
+    }
+    grid = figure_grid(runs, meta)
+    if grid is not None:
+        figures["comparison_grid.png"] = grid
+    out_dir.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for name, data in figures.items():
+        write_atomic(out_dir / name, lambda p, d=data: p.write_bytes(d))
+        paths.append(out_dir / name)
+    write_atomic(out_dir / "metrics.csv", lambda p: table.to_csv(p, index=False))
+    write_atomic(out_dir / "metrics.md", lambda p: p.write_text(md))
+    failed = len(list((Path(campaign_dir) / "runs").glob("*/*/seed-*.error.json")))
+    s = meta["settings"]
+    html = [
+        "<!doctype html><html><head><meta charset='utf-8'><title>dcee campaign report</title>",
+        "<style>body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
+        "collapse}td,th{border:1px solid #ccc;padding:4px 8px;font-size:13px}</style></head><body>",
+        f"<h1>Campaign report: {s['suite']} suite</h1>",
+        f"<p>{len(runs)} finished searches ({failed} failed), {runs['scenario'].nunique()} "
+        f"configurations, strategies: {', '.join(sorted(runs['strategy'].unique()))}; unknowns: "
+        f"{s['unknown'] or 'as configured'}; dcee {meta.get('version', '?')}. "
+        "Intervals are 95%.</p>",
+        _md_to_html(md),
+    ]
+    for name, data in figures.items():
+        b64 = base64.b64encode(data).decode()
+        html.append(
+            f"<h2>{name[:-4].replace('_', ' ')}</h2>"
+            f"<img src='data:image/png;base64,{b64}' style='max-width:100%'>"
+        )
+    html.append("</body></html>")
+    write_atomic(out_dir / "report.html", lambda p: p.write_text("\n".join(html)))
+    return [out_dir / "report.html", out_dir / "metrics.csv", out_dir / "metrics.md", *paths]
+
+
+def _md_to_html(md: str) -> str:
+    rows = [r.strip().strip("|").split("|") for r in md.strip().splitlines()]
+    head, body = rows[0], rows[2:]
+    out = ["<table><tr>" + "".join(f"<th>{c.strip()}</th>" for c in head) + "</tr>"]
+    for r in body:
+        out.append("<tr>" + "".join(f"<td>{c.strip()}</td>" for c in r) + "</tr>")
+    return "".join(out) + "</table>"

@@ -1,0 +1,310 @@
+"""Run every (configuration, repeat, strategy) search of a campaign, resumably.
+
+Layout of a campaign folder::
+
+    campaign.json                      settings, resolved scenarios, package version
+    runs/<config>/<strategy>/seed-<k>.parquet   per-step record of one search
+    runs/<config>/<strategy>/seed-<k>.npz       final posterior sample (+ snapshots, repeat 0)
+    runs/<config>/<strategy>/seed-<k>.json      summary, written last: marks the search done
+    runs/<config>/<strategy>/seed-<k>.error.json  why a search failed (retried on the next run)
+
+Every file is written atomically by the worker that ran the search, so a killed worker or
+driver loses only the searches in flight. A search counts as done only when its summary parses
+and names record and posterior files that exist with the recorded row count; anything else is
+redone. Common random numbers: the seed of a search is its repeat index, and the seed alone
+drives the truth's noise, so one (configuration, repeat) gives every strategy the same truth.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+import traceback
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from dcee.errors import DceeInputError
+from dcee.io import write_atomic, write_json
+
+# Snapshot times (s) of repeat 0 for the report's comparison grid (the paper's figure).
+SNAPSHOT_TIMES = (90.0, 270.0, 450.0, 900.0)
+FINAL_SAMPLE = 2000  # particles kept from each final posterior (for the histograms)
+
+
+@dataclass(frozen=True)
+class SearchTask:
+    """One search: everything a worker needs, as plain data (picklable)."""
+
+    out_dir: str
+    config: str
+    strategy: str
+    seed: int
+    scenario: dict[str, Any]
+
+    @property
+    def stem(self) -> Path:
+        safe = self.config.replace(":", "-").replace("/", "_")
+        return Path(self.out_dir) / "runs" / safe / self.strategy / f"seed-{self.seed}"
+
+
+def is_done(task: SearchTask) -> bool:
+    """True when the search's summary, record and posterior sample are complete and consistent."""
+    stem = task.stem
+    try:
+        summary = json.loads(stem.with_suffix(".json").read_text())
+        import pyarrow.parquet as pq
+
+        rows = pq.ParquetFile(stem.with_suffix(".parquet")).metadata.num_rows
+        with np.load(stem.with_suffix(".npz")) as z:
+            n_final = z["final_particles"].shape[0]
+    except Exception:  # missing, truncated or corrupt: redo
+        return False
+    return rows == summary.get("record_rows") and n_final == summary.get("final_sample")
+
+
+def run_search(task: SearchTask) -> dict[str, Any]:
+    """Run one search and write its files; returns {"status": "done"|"failed", ...}.
+
+    Never raises for a failing search: the error is recorded next to where the result would be.
+    """
+    import pandas as pd
+
+    from dcee import __version__
+    from dcee.scenarios import Scenario
+    from dcee.simulation import make_truth, run_episode
+
+    stem = task.stem
+    t0 = time.perf_counter()
+    try:
+        scenario = Scenario.model_validate(task.scenario)
+        truth = make_truth(scenario.truth.model, scenario.truth_theta())
+        snapshots_wanted = task.seed == 0
+        result = run_episode(
+            scenario,
+            task.strategy,
+            task.seed,
+            truth=truth,
+            snapshot_every=SNAPSHOT_TIMES[0] if snapshots_wanted else None,
+        )
+        records = pd.DataFrame.from_records(result.records)
+        rng = np.random.default_rng(task.seed)
+        w = result.final_weights / result.final_weights.sum()
+        idx = rng.choice(len(w), size=min(FINAL_SAMPLE, len(w)), p=w)
+        final = result.final_theta[idx].astype(np.float32)  # (n, 8), every parameter
+        arrays: dict[str, np.ndarray] = {"final_particles": final}
+        snaps = [(t, p) for t, p in result.snapshots if _near_snapshot_time(t)]
+        if snaps:
+            arrays["snapshot_times"] = np.array([t for t, _ in snaps])
+            arrays["snapshot_particles"] = np.stack([p[:1000].astype(np.float32) for _, p in snaps])
+        write_atomic(stem.with_suffix(".parquet"), lambda p: records.to_parquet(p, index=False))
+        write_atomic(stem.with_suffix(".npz"), lambda p: _savez(p, arrays))
+        summary = dict(result.summary)
+        summary.update(
+            config=task.config,
+            strategy=task.strategy,
+            seed=task.seed,
+            version=__version__,
+            record_rows=len(records),
+            final_sample=len(final),
+            parameter_names=list(scenario.unknown_names),
+            wall_seconds=time.perf_counter() - t0,
+        )
+        write_json(stem.with_suffix(".json"), summary)  # last: marks the search done
+        stem.with_suffix(".error.json").unlink(missing_ok=True)
+        return {"status": "done", "task": task, "seconds": summary["wall_seconds"]}
+    except Exception as exc:  # recorded, the campaign goes on
+        error = {
+            "config": task.config,
+            "strategy": task.strategy,
+            "seed": task.seed,
+            "error": f"{type(exc).__name__}: {exc}",
+            "traceback": traceback.format_exc(),
+        }
+        write_json(stem.with_suffix(".error.json"), error)
+        return {"status": "failed", "task": task, "error": error["error"]}
+
+
+def _near_snapshot_time(t: float) -> bool:
+    return any(abs(t - s) < 1.01 for s in SNAPSHOT_TIMES) or t >= SNAPSHOT_TIMES[-1]
+
+
+def _savez(path: Path, arrays: dict[str, np.ndarray]) -> None:
+    with open(path, "wb") as fh:
+        np.savez_compressed(fh, **arrays)
+
+
+@dataclass
+class Campaign:
+    """The searches of one campaign folder and its stored settings."""
+
+    out_dir: Path
+    suite: str
+    strategies: tuple[str, ...]
+    repeats: int
+    unknown: str | None = None
+    particles: int | None = None
+
+    def __post_init__(self) -> None:
+        from dcee.campaign.suites import suite_scenarios
+        from dcee.planning import planner_class
+
+        if self.repeats < 1:
+            raise DceeInputError("repeats", f"must be >= 1, got {self.repeats}")
+        if not self.strategies:
+            raise DceeInputError("strategies", "give at least one strategy")
+        for s in self.strategies:
+            planner_class(s)  # unknown names fail before anything runs
+        self.scenarios = {
+            s.name: s for s in suite_scenarios(self.suite, self.unknown, self.particles)
+        }
+
+    def settings(self) -> dict[str, Any]:
+        """What identifies the results: strategies and repeats may grow, these may not change."""
+        return {
+            "suite": self.suite,
+            "unknown": self.unknown,
+            "particles": self.particles,
+            "scenarios": {k: v.model_dump(mode="json") for k, v in self.scenarios.items()},
+        }
+
+    def prepare(self) -> None:
+        """Create the folder or check that it holds this campaign's results (else refuse)."""
+        from dcee import __version__
+
+        path = self.out_dir / "campaign.json"
+        settings = self.settings()
+        if path.exists():
+            try:
+                stored = json.loads(path.read_text())
+            except (OSError, json.JSONDecodeError):
+                raise DceeInputError(
+                    "out", f"{path} is unreadable; move the folder aside or choose another --out"
+                ) from None
+            if stored.get("settings") != settings:
+                changed = _first_difference(stored.get("settings", {}), settings)
+                raise DceeInputError(
+                    "out",
+                    f"{self.out_dir} holds results of a different configuration ({changed}); "
+                    "use a new --out folder instead of mixing results",
+                )
+            strategies = sorted(set(stored.get("strategies", [])) | set(self.strategies))
+            repeats = max(int(stored.get("repeats", 0)), self.repeats)
+        else:
+            strategies, repeats = sorted(self.strategies), self.repeats
+        write_json(
+            path,
+            {
+                "settings": settings,
+                "strategies": strategies,
+                "repeats": repeats,
+                "version": __version__,
+            },
+        )
+
+    def tasks(self) -> list[SearchTask]:
+        out = []
+        for name, scenario in self.scenarios.items():
+            dump = scenario.model_dump(mode="json")
+            for seed in range(self.repeats):
+                for strategy in self.strategies:
+                    out.append(SearchTask(str(self.out_dir), name, strategy, seed, dump))
+        return out
+
+
+def _first_difference(a: Any, b: Any, path: str = "") -> str:
+    if isinstance(a, dict) and isinstance(b, dict):
+        for k in sorted(set(a) | set(b)):
+            if a.get(k) != b.get(k):
+                return _first_difference(a.get(k), b.get(k), f"{path}.{k}" if path else k)
+    return f"{path or 'settings'}: stored {a!r}, now {b!r}"
+
+
+def _init_worker() -> None:
+    """Worker processes: one numba thread each (parallel kernels degrade badly when several
+    searches share the cores; one search per core is the efficient layout)."""
+    import numba
+
+    numba.set_num_threads(1)
+
+
+def _local_results(tasks: list[SearchTask], workers: int) -> Iterator[dict[str, Any]]:
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+
+    os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # inherited by the spawned workers
+    ctx = mp.get_context("spawn")
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker)
+    futures = [pool.submit(run_search, t) for t in tasks]
+    try:
+        for fut in as_completed(futures):
+            yield _result_or_crash(fut, futures)
+    finally:
+        for f in futures:
+            f.cancel()
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _dask_results(tasks: list[SearchTask], scheduler: Any) -> Iterator[dict[str, Any]]:
+    try:
+        from distributed import Client, as_completed
+    except ImportError:
+        raise DceeInputError(
+            "scheduler", "dask.distributed is not installed: pip install 'dcee[distributed]'"
+        ) from None
+    client = scheduler if isinstance(scheduler, Client) else Client(scheduler)
+    own = client is not scheduler
+    try:
+        client.run(_init_worker)
+        futures = [client.submit(run_search, t, pure=False) for t in tasks]
+        try:
+            for fut in as_completed(futures):
+                yield _result_or_crash(fut, futures)
+        finally:
+            client.cancel(futures)
+    finally:
+        if own:
+            client.close()
+
+
+def _result_or_crash(fut: Any, futures: list) -> dict[str, Any]:
+    try:
+        return fut.result()
+    except Exception as exc:  # the worker process died (killed, out of memory, ...)
+        return {"status": "failed", "task": None, "error": f"worker lost: {exc}"}
+
+
+def run_campaign(
+    campaign: Campaign,
+    workers: int | None = None,
+    scheduler: Any = None,
+    on_result: Callable[[dict[str, Any], int, int], None] | None = None,
+) -> dict[str, int]:
+    """Run the searches not yet done; returns counts {total, skipped, done, failed}.
+
+    ``scheduler``: a Dask scheduler address (``tcp://host:8786``) or ``distributed.Client``;
+    otherwise ``workers`` local processes (default: all cores). The campaign folder must be on a
+    file system the Dask workers share.
+    """
+    campaign.prepare()
+    tasks = campaign.tasks()
+    todo = [t for t in tasks if not is_done(t)]
+    counts = {"total": len(tasks), "skipped": len(tasks) - len(todo), "done": 0, "failed": 0}
+    if not todo:
+        return counts
+    if scheduler is not None:
+        results = _dask_results(todo, scheduler)
+    else:
+        n = workers or os.cpu_count() or 1
+        if n < 1:
+            raise DceeInputError("workers", f"must be >= 1, got {n}")
+        results = _local_results(todo, n)
+    for res in results:
+        counts[res["status"]] += 1
+        if on_result is not None:
+            on_result(res, counts["done"] + counts["failed"], len(todo))
+    return counts

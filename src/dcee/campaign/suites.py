@@ -1,0 +1,34 @@
+"""Named suites of scenario configurations.
+
+* ``paper``: the 12 configurations of the paper's simulation study (``paper:1`` … ``paper:12``)
+  at paper scale (20,000 particles, 40 hypothesised readings, 900 s).
+* ``smoke``: two of them at toy scale (1,000 particles, 10 hypothesised readings, 60 s) so a
+  campaign with every strategy finishes in well under a minute; for CI and for trying options.
+"""
+
+from __future__ import annotations
+
+from dcee.errors import DceeInputError
+from dcee.scenarios import Scenario, load_scenario
+
+SUITES: dict[str, dict] = {
+    "paper": {"configs": [f"paper:{k}" for k in range(1, 13)], "overrides": {}},
+    "smoke": {
+        "configs": ["paper:1", "paper:6"],
+        "overrides": {"search.particles": 1000, "search.hypotheses": 10, "search.budget": 60.0},
+    },
+}
+
+
+def suite_scenarios(
+    suite: str, unknown: str | None = None, particles: int | None = None
+) -> list[Scenario]:
+    """The suite's scenarios with its overrides, then the user's (``unknown``, ``particles``)."""
+    if suite not in SUITES:
+        raise DceeInputError("suite", f"unknown suite {suite!r}; choose one of {', '.join(SUITES)}")
+    spec = SUITES[suite]
+    out = []
+    for name in spec["configs"]:
+        scenario = load_scenario(name).with_overrides(**spec["overrides"])
+        out.append(scenario.with_overrides(**{"unknown": unknown, "search.particles": particles}))
+    return out
