@@ -1,0 +1,137 @@
+"""Campaigns: resume, corruption, refusal of a changed configuration, failures, Dask, report."""
+
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from dcee.analysis.report import median_ci, wilson, write_report
+from dcee.campaign import Campaign, SearchTask, run_campaign
+from dcee.campaign.runner import is_done, run_search
+from dcee.cli import main
+from dcee.errors import DceeInputError
+
+STRATEGIES = ("mpc", "dcee")
+
+
+def _campaign(out, particles=300, repeats=2):
+    return Campaign(out, "smoke", STRATEGIES, repeats, particles=particles)
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    out = tmp_path_factory.mktemp("campaign")
+    counts = run_campaign(_campaign(out), workers=2)
+    return out, counts
+
+
+def test_campaign_runs_every_search_with_common_random_numbers(finished):
+    out, counts = finished
+    assert counts == {"total": 8, "skipped": 0, "done": 8, "failed": 0}
+    meta = json.loads((out / "campaign.json").read_text())
+    assert meta["version"] and meta["settings"]["particles"] == 300
+    # Same (configuration, repeat): every strategy saw the same truth noise at its first reading
+    # (same start position), and a different repeat saw different noise.
+    first = {}
+    for strategy in STRATEGIES:
+        for seed in (0, 1):
+            steps = pd.read_parquet(out / f"runs/paper-1/{strategy}/seed-{seed}.parquet")
+            first[strategy, seed] = steps["true_concentration"].iloc[0], steps["reading"].iloc[0]
+    assert first["mpc", 0] == first["dcee", 0] and first["mpc", 1] == first["dcee", 1]
+
+
+def test_rerun_skips_finished_and_redoes_corrupt_or_partial(finished, tmp_path):
+    out, _ = finished
+    again = run_campaign(_campaign(out), workers=1)
+    assert again == {"total": 8, "skipped": 8, "done": 0, "failed": 0}
+    # A truncated record, and a search whose summary never got written (killed mid-search).
+    rec = out / "runs/paper-6/dcee/seed-1.parquet"
+    rec.write_bytes(rec.read_bytes()[:100])
+    (out / "runs/paper-1/mpc/seed-0.json").unlink()
+    summary = out / "runs/paper-6/mpc/seed-0.json"
+    summary.write_text(summary.read_text()[:20])  # corrupt JSON
+    redo = run_campaign(_campaign(out), workers=1)
+    assert redo == {"total": 8, "skipped": 5, "done": 3, "failed": 0}
+    assert all(is_done(t) for t in _campaign(out).tasks())
+
+
+def test_changed_configuration_in_the_same_folder_is_refused(finished):
+    out, _ = finished
+    with pytest.raises(DceeInputError, match=r"different configuration.*particles"):
+        run_campaign(_campaign(out, particles=400), workers=1)
+
+
+def test_failing_search_is_recorded_and_does_not_raise(tmp_path):
+    task = SearchTask(str(tmp_path), "paper:1", "dcee", 0, {"name": "broken"})
+    res = run_search(task)
+    assert res["status"] == "failed"
+    err = json.loads(task.stem.with_suffix(".error.json").read_text())
+    assert err["strategy"] == "dcee" and "Error" in err["error"]
+    assert not is_done(task)
+
+
+def test_dask_local_cluster_runs_the_campaign(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    with (
+        distributed.LocalCluster(
+            n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+        ) as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        counts = run_campaign(
+            Campaign(tmp_path, "smoke", ("mpc",), 1, particles=300), scheduler=client
+        )
+    assert counts == {"total": 2, "skipped": 0, "done": 2, "failed": 0}
+    assert all(is_done(t) for t in Campaign(tmp_path, "smoke", ("mpc",), 1, particles=300).tasks())
+
+
+def test_report_tables_and_figures(finished, tmp_path):
+    out, _ = finished
+    paths = write_report(out, tmp_path / "report")
+    assert all(p.stat().st_size > 0 for p in paths)
+    table = pd.read_csv(tmp_path / "report/metrics.csv")
+    assert sorted(table["strategy"]) == sorted(STRATEGIES)
+    assert (table["searches"] == 4).all()
+    for key in ("source_acquired", "plume_acquired"):
+        assert (table[f"{key}_lo"] <= table[f"{key}_rate"]).all()
+        assert (table[f"{key}_rate"] <= table[f"{key}_hi"]).all()
+    assert "mean final RMSE" in (tmp_path / "report/metrics.md").read_text()
+    html = (tmp_path / "report/report.html").read_text()
+    assert html.count("data:image/png;base64,") == 4
+
+
+def test_interval_helpers_against_hand_calculations():
+    rate, lo, hi = wilson(5, 10)  # Wilson (1927): 0.5 ± 0.2634 for n = 10
+    assert (
+        rate == 0.5
+        and lo == pytest.approx(0.2366, abs=1e-4)
+        and hi == pytest.approx(0.7634, abs=1e-4)
+    )
+    assert wilson(10, 10)[2] == pytest.approx(1.0) and wilson(0, 10)[1] == pytest.approx(0.0)
+    m, lo, hi = median_ci(np.arange(101.0))
+    assert m == 50 and lo < 50 < hi
+    assert math.isnan(median_ci(np.array([np.nan]))[0])
+
+
+@pytest.mark.parametrize(
+    "args, field",
+    [
+        (["--workers", "0"], "workers"),
+        (["--strategies", "nope"], "strategy"),
+        (["--suite", "huge"], "suite"),
+        (["--repeats", "0"], "repeats"),
+    ],
+)
+def test_bench_bad_input_is_one_line_exit_2(tmp_path, capsys, args, field):
+    with pytest.raises(SystemExit) as exc:
+        main(["bench", "--suite", "smoke", "--out", str(tmp_path / "c"), *args])
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and field in err and err.count("\n") == 1
+
+
+def test_report_on_a_folder_without_campaign_is_exit_2(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["report", str(tmp_path)])
+    assert exc.value.code == 2 and "campaign" in capsys.readouterr().err
