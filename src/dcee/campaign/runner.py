@@ -236,7 +236,9 @@ def _local_results(tasks: list[SearchTask], workers: int) -> Iterator[dict[str, 
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor, as_completed
 
-    os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # inherited by the spawned workers
+    # Not os.environ["NUMBA_NUM_THREADS"]: numba in *this* process re-reads it at its next
+    # compilation and refuses a value different from its running pool. The initializer limits
+    # each worker instead.
     ctx = mp.get_context("spawn")
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker)
     futures = [pool.submit(run_search, t) for t in tasks]
