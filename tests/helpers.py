@@ -53,3 +53,15 @@ def theta_at(points, q=5.0, u=0.0, phi=0.0, zeta1=1.0, zeta2=8.0) -> np.ndarray:
             np.full(n, zeta2),
         ]
     )
+
+
+def run_cli(argv, capsys):
+    """Run ``dcee argv``; returns (exit code, stdout, stderr)."""
+    import pytest
+
+    from dcee.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    out = capsys.readouterr()
+    return exc.value.code, out.out, out.err

@@ -5,21 +5,13 @@ import sys
 import pandas as pd
 import pytest
 
-from dcee.cli import main
-from tests.helpers import SUMMARY_KEYS
-
-
-def _run(argv, capsys):
-    with pytest.raises(SystemExit) as exc:
-        main(argv)
-    out = capsys.readouterr()
-    return exc.value.code, out.out, out.err
+from tests.helpers import SUMMARY_KEYS, run_cli
 
 
 def test_run_writes_all_outputs(tmp_path, capsys):
     out = tmp_path / "r"
     argv = "run --scenario lab:downwind --strategy dcee --seed 1 --particles 1000 --budget 60"
-    code, stdout, _ = _run(
+    code, stdout, _ = run_cli(
         [*argv.split(), "--out", str(out), "--json", str(tmp_path / "s.json"), "--quiet"], capsys
     )
     assert code == 0, stdout
@@ -36,7 +28,7 @@ def test_run_writes_all_outputs(tmp_path, capsys):
 
 def test_animation(tmp_path, capsys):
     out = tmp_path / "a"
-    code, _, _ = _run(
+    code, _, _ = run_cli(
         [
             *"run --scenario lab:upwind --particles 300 --budget 30 --out".split(),
             str(out),
@@ -60,7 +52,7 @@ BAD = [
 @pytest.mark.parametrize("extra,field", BAD)
 def test_bad_options_exit_2_with_one_line(tmp_path, capsys, extra, field):
     out = tmp_path / "bad"
-    code, _, err = _run(["run", "--scenario", "paper:1", "--out", str(out), *extra], capsys)
+    code, _, err = run_cli(["run", "--scenario", "paper:1", "--out", str(out), *extra], capsys)
     assert code == 2
     assert err.count("\n") == 1 and field in err and "Traceback" not in err
     assert not out.exists()
@@ -80,16 +72,18 @@ def test_bad_scenarios_exit_2(tmp_path, capsys):
         (str(bad_toml), "malformed TOML"),
         (str(outside), "outside the search volume"),
     ]:
-        code, _, err = _run(["run", "--scenario", scenario, "--out", str(tmp_path / "o")], capsys)
+        code, _, err = run_cli(
+            ["run", "--scenario", scenario, "--out", str(tmp_path / "o")], capsys
+        )
         assert code == 2 and needle in err and err.count("\n") == 1
-    code, _, err = _run(["run", "--bogus"], capsys)
+    code, _, err = run_cli(["run", "--bogus"], capsys)
     assert code == 2 and "bogus" in err
 
 
 def test_scenarios_and_show(capsys):
-    code, out, _ = _run(["scenarios"], capsys)
+    code, out, _ = run_cli(["scenarios"], capsys)
     assert code == 0 and out.count("\n") == 14 and "lab:upwind" in out
-    code, out, _ = _run(["show", "paper:3"], capsys)
+    code, out, _ = run_cli(["show", "paper:3"], capsys)
     assert code == 0 and json.loads(out)["truth"]["y"] == 40.0
 
 

@@ -4,21 +4,12 @@ machine is shared; targets are checked by running the command, see docs/performa
 import json
 import sys
 
-import pytest
-
-from dcee.cli import main
-
-
-def _run(argv, capsys):
-    with pytest.raises(SystemExit) as exc:
-        main(argv)
-    out = capsys.readouterr()
-    return exc.value.code, out.out, out.err
+from tests.helpers import run_cli
 
 
 def test_perf_quick_writes_every_standard_workload(tmp_path, capsys):
     path = tmp_path / "perf.json"
-    code, stdout, err = _run(["perf", "--quick", "--json", str(path)], capsys)
+    code, stdout, err = run_cli(["perf", "--quick", "--json", str(path)], capsys)
     assert code == 0, err
     data = json.loads(path.read_text())
     by_name = {w["name"]: w for w in data["workloads"]}
@@ -47,7 +38,7 @@ def test_compare_stonesoup_without_the_extra_is_a_clear_error(monkeypatch, capsy
     monkeypatch.setitem(sys.modules, "stonesoup", None)  # makes `import stonesoup...` fail
     for key in [k for k in sys.modules if k.startswith("stonesoup.")]:
         monkeypatch.setitem(sys.modules, key, None)
-    code, _, err = _run(["perf", "--compare-stonesoup", "--decisions", "1"], capsys)
+    code, _, err = run_cli(["perf", "--compare-stonesoup", "--decisions", "1"], capsys)
     assert code == 2
     assert err.strip().count("\n") == 0
     assert "stonesoup" in err.lower() and "dcee[bench]" in err
