@@ -326,10 +326,6 @@ def bench(
 
     from dcee.campaign import Campaign, run_campaign
 
-    if workers is not None and workers < 1:
-        raise DceeInputError("workers", f"must be >= 1, got {workers}")
-    if workers is not None and scheduler:
-        raise DceeInputError("workers", "give either --workers or --scheduler, not both")
     names = tuple(s.strip() for s in strategies.split(",") if s.strip())
     campaign = Campaign(out_dir, suite, names, repeats, unknown, particles)
     failures: list[str] = []

@@ -23,11 +23,11 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
+from dcee.campaign.runner import SNAPSHOT_TIMES
 from dcee.errors import DceeInputError
 from dcee.io import write_atomic
 
 Z95 = 1.959963984540054
-SNAPSHOT_TIMES = (90.0, 270.0, 450.0, 900.0)
 
 
 def wilson(k: int, n: int) -> tuple[float, float, float]:

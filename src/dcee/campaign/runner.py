@@ -292,6 +292,10 @@ def run_campaign(
     otherwise ``workers`` local processes (default: all cores). The campaign folder must be on a
     file system the Dask workers share.
     """
+    if workers is not None and workers < 1:
+        raise DceeInputError("workers", f"must be >= 1, got {workers}")
+    if workers is not None and scheduler is not None:
+        raise DceeInputError("workers", "give either --workers or --scheduler, not both")
     campaign.prepare()
     tasks = campaign.tasks()
     todo = [t for t in tasks if not is_done(t)]
@@ -301,10 +305,7 @@ def run_campaign(
     if scheduler is not None:
         results = _dask_results(todo, scheduler)
     else:
-        n = workers or os.cpu_count() or 1
-        if n < 1:
-            raise DceeInputError("workers", f"must be >= 1, got {n}")
-        results = _local_results(todo, n)
+        results = _local_results(todo, workers or os.cpu_count() or 1)
     for res in results:
         counts[res["status"]] += 1
         if on_result is not None:
