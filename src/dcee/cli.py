@@ -57,6 +57,11 @@ def cli() -> None:
     type=click.Path(dir_okay=False, path_type=Path),
     help="Also write the summary JSON here.",
 )
+@click.option(
+    "--truth",
+    help="What the sensor sees: isotropic | filament | PATH of a .npy/.h5 recording "
+    "[default: the scenario's truth.model].",
+)
 @click.option("--animate", is_flag=True, help="Also write animation.gif.")
 @click.option("--no-figure", is_flag=True, help="Skip figure.png.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress display.")
@@ -70,6 +75,7 @@ def run(
     unknown: str | None,
     out_dir: Path | None,
     json_file: Path | None,
+    truth: str | None,
     animate: bool,
     no_figure: bool,
     quiet: bool,
@@ -78,6 +84,7 @@ def run(
     from dcee import __version__
     from dcee.planning import planner_class
     from dcee.scenarios import load_scenario
+    from dcee.scenarios.config import truth_choice
     from dcee.simulation import make_truth, run_episode
 
     if seed < 0:
@@ -89,12 +96,13 @@ def run(
             "search.hypotheses": hypotheses,
             "search.budget": budget,
             "unknown": unknown,
+            "truth.model": truth_choice(truth) if truth else None,
         }
     )
     out_dir = (
         out_dir or Path("results") / f"{scenario.name.replace(':', '-')}_{strategy}_seed{seed}"
     )
-    truth = make_truth(scenario.truth.model, scenario.truth_theta())
+    truth = make_truth(scenario, seed)
     result = _run_with_progress(
         lambda progress: run_episode(
             scenario,
@@ -304,6 +312,11 @@ def _numba_threads() -> int:
 @click.option("--scheduler", help="Address of a running Dask scheduler, e.g. tcp://host:8786.")
 @click.option("--unknown", type=click.Choice(["source", "full"]), help="Override unknown set.")
 @click.option("--particles", type=int, help="Override the particle count.")
+@click.option(
+    "--truth",
+    help="What the sensor sees: isotropic | filament | PATH of a .npy/.h5 recording "
+    "[default: the scenario's truth.model].",
+)
 def bench(
     suite: str,
     strategies: str,
@@ -313,6 +326,7 @@ def bench(
     scheduler: str | None,
     unknown: str | None,
     particles: int | None,
+    truth: str | None,
 ) -> None:
     """Run a campaign of simulated searches; resumes where a previous run stopped."""
     from rich.progress import (
@@ -325,9 +339,12 @@ def bench(
     )
 
     from dcee.campaign import Campaign, run_campaign
+    from dcee.scenarios.config import truth_choice
 
     names = tuple(s.strip() for s in strategies.split(",") if s.strip())
-    campaign = Campaign(out_dir, suite, names, repeats, unknown, particles)
+    campaign = Campaign(
+        out_dir, suite, names, repeats, unknown, particles, truth_choice(truth) if truth else None
+    )
     failures: list[str] = []
     columns = (
         TextColumn("[bold]{task.description}"),

@@ -97,7 +97,7 @@ def _draw_map(
         ax=ax,
         fraction=0.046,
         pad=0.04,
-        label=f"truth at z = {scenario.agent.start[2]:g} m (g/m³)",
+        label=f"{truth.label} at z = {scenario.agent.start[2]:g} m, t = {until:.0f} s (g/m³)",
     )
 
 
@@ -139,7 +139,8 @@ def search_figure(
     )
     _draw_rmse(ax_rmse, result, scenario, scenario.search.budget)
     fig.suptitle(
-        f"{s['scenario']} · {s['strategy']} · seed {s['seed']} · final RMSE {s['final_rmse']:.2f} m"
+        f"{s['scenario']} · {s['strategy']} · seed {s['seed']} · {truth.name} truth"
+        f" · final RMSE {s['final_rmse']:.2f} m"
         f" · source {'acquired' if s['source_acquired'] else 'not acquired'}",
         fontsize=11,
     )

@@ -39,7 +39,7 @@ def summarise(
         "strategy": strategy,
         "seed": int(seed),
         "unknown": scenario.unknown,
-        "truth_model": scenario.truth.model,
+        "truth_model": scenario.truth.model_name,
         "particles": scenario.search.particles,
         "hypotheses": scenario.search.hypotheses,
         "budget": scenario.search.budget,

@@ -82,7 +82,7 @@ def run_search(task: SearchTask) -> dict[str, Any]:
     t0 = time.perf_counter()
     try:
         scenario = Scenario.model_validate(task.scenario)
-        truth = make_truth(scenario.truth.model, scenario.truth_theta())
+        truth = make_truth(scenario, task.seed)
         snapshots_wanted = task.seed == 0
         result = run_episode(
             scenario,
@@ -148,6 +148,7 @@ class Campaign:
     repeats: int
     unknown: str | None = None
     particles: int | None = None
+    truth: str | dict[str, str] | None = None
 
     def __post_init__(self) -> None:
         from dcee.campaign.suites import suite_scenarios
@@ -160,17 +161,20 @@ class Campaign:
         for s in self.strategies:
             planner_class(s)  # unknown names fail before anything runs
         self.scenarios = {
-            s.name: s for s in suite_scenarios(self.suite, self.unknown, self.particles)
+            s.name: s for s in suite_scenarios(self.suite, self.unknown, self.particles, self.truth)
         }
 
     def settings(self) -> dict[str, Any]:
         """What identifies the results: strategies and repeats may grow, these may not change."""
-        return {
+        settings = {
             "suite": self.suite,
             "unknown": self.unknown,
             "particles": self.particles,
             "scenarios": {k: v.model_dump(mode="json") for k, v in self.scenarios.items()},
         }
+        if self.truth is not None:  # absent, not null, so that older campaign folders resume
+            settings["truth"] = self.truth
+        return settings
 
     def prepare(self) -> None:
         """Create the folder or check that it holds this campaign's results (else refuse)."""

@@ -21,14 +21,22 @@ SUITES: dict[str, dict] = {
 
 
 def suite_scenarios(
-    suite: str, unknown: str | None = None, particles: int | None = None
+    suite: str,
+    unknown: str | None = None,
+    particles: int | None = None,
+    truth: str | dict[str, str] | None = None,
 ) -> list[Scenario]:
-    """The suite's scenarios with its overrides, then the user's (``unknown``, ``particles``)."""
+    """The suite's scenarios with its overrides, then the user's (``unknown``, ``particles``,
+    ``truth``: the ``truth.model`` every scenario gets)."""
     if suite not in SUITES:
         raise DceeInputError("suite", f"unknown suite {suite!r}; choose one of {', '.join(SUITES)}")
     spec = SUITES[suite]
     out = []
     for name in spec["configs"]:
         scenario = load_scenario(name).with_overrides(**spec["overrides"])
-        out.append(scenario.with_overrides(**{"unknown": unknown, "search.particles": particles}))
+        out.append(
+            scenario.with_overrides(
+                **{"unknown": unknown, "search.particles": particles, "truth.model": truth}
+            )
+        )
     return out

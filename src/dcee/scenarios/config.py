@@ -19,7 +19,7 @@ A scenario is a TOML file (or a built-in, see :mod:`dcee.scenarios.builtin`)::
     phi = 0.0                      # deg; wind comes FROM this direction
     zeta1 = 1.0
     zeta2 = 8.0
-    model = "isotropic"
+    model = "isotropic"            # or "filament", or { file = "plume.h5" } (recorded plume)
 
     [prior]                        # used for unknown parameters; degrees for phi
     q = { kind = "gamma", shape = 2.0, scale = 5.0 }
@@ -54,10 +54,18 @@ Normal priors are truncated to physical values (u ≥ 0, ζ1 > 0, ζ2 > 0) autom
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from dcee.errors import DceeInputError
 from dcee.estimation.priors import Distribution, Fixed, Gamma, Normal, SourcePrior, Uniform
@@ -85,6 +93,52 @@ class Volume(BaseModel):
         return self
 
 
+class FilamentSpec(BaseModel):
+    """Turbulent filament (puff) truth after Farrell et al. (2002); see
+    :mod:`dcee.simulation.filament` for the model and docs/scenarios.md for why each default."""
+
+    model_config = _FROZEN
+    kind: Literal["filament"] = "filament"
+    puff_rate: Annotated[float, Field(gt=0, le=1000, allow_inf_nan=False)] = 10.0
+    """puffs released per second (Farrell: 10/s)"""
+    dt: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.1
+    """integration step of the puff dynamics, s"""
+    puff_radius: Annotated[float, Field(gt=0, allow_inf_nan=False)] = 0.1
+    """initial puff radius (Gaussian σ), m"""
+    puff_share: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.03
+    """share of the diffusivity ζ1 that grows each puff; the rest moves puff centres at random"""
+    meander_intensity: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] = 0.2
+    """standard deviation of each horizontal meander velocity component / mean wind speed"""
+    meander_bandwidth: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.2
+    """natural frequency ω of the coloured-noise meander process, rad/s (Farrell: 0.2-0.71)"""
+    meander_damping: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.1
+    """damping ratio ζ of the meander process (Farrell: 0.07-0.1)"""
+
+    @property
+    def name(self) -> str:
+        return "filament"
+
+
+class PlaybackSpec(BaseModel):
+    """A recorded or externally simulated plume played back as truth
+    (:mod:`dcee.simulation.playback`)."""
+
+    model_config = _FROZEN
+    kind: Literal["playback"] = "playback"
+    file: str = Field(min_length=1)
+    """.npy (metadata in a .json beside it) or .h5 recording; relative to the scenario file"""
+    time_interpolation: Literal["nearest", "linear"] = "linear"
+    loop: bool = False
+    """replay from the first frame when the recording ends (else the budget must fit in it)"""
+
+    @property
+    def name(self) -> str:
+        return f"playback:{Path(self.file).name}"
+
+
+TruthModelSpec = Annotated[FilamentSpec | PlaybackSpec, Field(discriminator="kind")]
+
+
 class Truth(BaseModel):
     model_config = _FROZEN
     x: Finite
@@ -95,7 +149,29 @@ class Truth(BaseModel):
     phi: Finite = Field(description="wind direction in degrees (wind comes from it)")
     zeta1: Positive
     zeta2: Positive
-    model: Literal["isotropic"] = "isotropic"
+    model: Literal["isotropic"] | TruthModelSpec = "isotropic"
+    """what the sensor really sees: "isotropic" (the estimator's own model, the paper's
+    simulation), "filament" (or a table with kind = "filament" and parameters), or a table
+    ``{file = "plume.h5"}`` to play a recording back"""
+
+    @field_validator("model", mode="before")
+    @classmethod
+    def _model_shorthand(cls, value: Any) -> Any:
+        # "filament" is short for the filament table with every default, so that the resolved
+        # configuration saved beside results records every parameter; {file = ...} needs no kind.
+        if value == "filament":
+            return {"kind": "filament"}
+        if isinstance(value, dict) and "kind" not in value:
+            kind = "playback" if "file" in value else "filament"
+            return {"kind": kind, **value}
+        if isinstance(value, str) and value != "isotropic":
+            raise ValueError(f'must be "isotropic", "filament" or {{file = "..."}} (got {value!r})')
+        return value
+
+    @property
+    def model_name(self) -> str:
+        """ "isotropic", "filament" or "playback:<file name>" (for tables and reports)."""
+        return self.model if isinstance(self.model, str) else self.model.name
 
 
 class PriorSpec(BaseModel):
@@ -259,6 +335,22 @@ def _distribution(name: str, spec: PriorSpec) -> Distribution:
     low = spec.low if spec.low is not None else PHYSICAL_TRUNCATION.get(name, -math.inf)
     high = spec.high if spec.high is not None else math.inf
     return Normal(to_rad(spec.mean), to_rad(spec.sd), to_rad(low), to_rad(high))
+
+
+def truth_choice(value: str) -> str | dict[str, str]:
+    """The ``truth.model`` a ``--truth`` option names: "isotropic", "filament", or the path of a
+    recording (``.npy``/``.h5``), made absolute so that it means the same file wherever the
+    configuration is used later."""
+    if value in ("isotropic", "filament"):
+        return value
+    path = Path(value).expanduser()
+    if path.suffix.lower() not in (".npy", ".h5", ".hdf5"):
+        raise DceeInputError(
+            "truth", f"must be isotropic, filament or a .npy/.h5 recording (got {value!r})"
+        )
+    if not path.is_file():
+        raise DceeInputError("truth", f"no such recording {value!r}")
+    return {"file": str(path.resolve())}
 
 
 def validate_scenario(data: dict[str, Any]) -> Scenario:

@@ -29,4 +29,14 @@ def load_scenario(name_or_path: str) -> Scenario:
     except (OSError, UnicodeDecodeError) as exc:
         raise DceeInputError("scenario", f"cannot read {path}: {exc}") from None
     data.setdefault("name", path.stem)
+    _resolve_recording(data, path.parent)
     return validate_scenario(data)
+
+
+def _resolve_recording(data: dict, base: Path) -> None:
+    """A playback file named in a scenario file is relative to that file, not to the cwd."""
+    model = data.get("truth", {}).get("model") if isinstance(data.get("truth"), dict) else None
+    if isinstance(model, dict) and isinstance(model.get("file"), str):
+        file = Path(model["file"]).expanduser()
+        if not file.is_absolute():
+            model["file"] = str((base / file).resolve())

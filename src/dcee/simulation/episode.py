@@ -2,9 +2,10 @@
 
 Random streams: ``SeedSequence(seed)`` is split into a *truth* stream (sensor noise of the real
 readings), an *agent* stream (split again into filter and planner) and a *figures* stream
-(particle subsamples for plots only). The truth stream draws the same numbers at every step
-whatever the agent does, so two strategies run with the same seed see identical truth noise
-(common random numbers).
+(particle subsamples for plots only); child 3 of the seed drives a stochastic truth such as the
+filament plume (:func:`dcee.simulation.truth.plume_stream`). The truth stream draws the same
+numbers at every step whatever the agent does, so two strategies run with the same seed see
+identical truth noise (common random numbers).
 """
 
 from __future__ import annotations
@@ -64,7 +65,7 @@ def run_episode(
     truth_rng, filter_rng, planner_rng, figure_rng = streams(seed)
     sensor: Sensor = scenario.make_sensor()
     agent = scenario.make_agent()
-    truth = truth or make_truth(scenario.truth.model, scenario.truth_theta())
+    truth = truth or make_truth(scenario, seed)
     true_location = scenario.truth_theta()[:3]
     pf = ParticleFilter(
         scenario.make_prior(),

@@ -3,16 +3,23 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+from dcee.errors import DceeInputError
 from dcee.models.plume import IsotropicPlume
+
+if TYPE_CHECKING:
+    from dcee.scenarios.config import Scenario
 
 
 class TruthModel(ABC):
     """Ground-truth concentration field, possibly time-varying."""
 
     name: str = ""
+    label: str = "truth"
+    """what a figure's colour bar calls this field"""
 
     @abstractmethod
     def concentration(self, position: np.ndarray, time: float) -> float:
@@ -27,6 +34,7 @@ class IsotropicTruth(TruthModel):
     """The paper's simulation truth: the same isotropic plume the estimator assumes."""
 
     name = "isotropic"
+    label = "isotropic truth (mean field)"
 
     def __init__(self, theta: np.ndarray, plume: IsotropicPlume | None = None) -> None:
         self.theta = np.asarray(theta, dtype=np.float64).reshape(1, 8)
@@ -39,8 +47,48 @@ class IsotropicTruth(TruthModel):
         return self.plume.concentration(self.theta, positions)[0]
 
 
-def make_truth(kind: str, theta: np.ndarray) -> TruthModel:
-    """Truth model by the scenario's ``truth.model`` name."""
-    if kind == "isotropic":
+PLUME_STREAM = 3
+"""Child of ``SeedSequence(seed)`` that drives a stochastic truth (the filament's puffs and
+meander). Children 0-2 are the episode's sensor-noise, agent and figure streams
+(:func:`dcee.simulation.episode.streams`), so the plume is independent of them and identical for
+every strategy run with the same seed (common random numbers)."""
+
+
+def plume_stream(seed: int) -> np.random.Generator:
+    """The generator of a stochastic truth for episode ``seed``."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(PLUME_STREAM,)))
+
+
+def make_truth(scenario: Scenario, seed: int) -> TruthModel:
+    """The scenario's ``truth.model`` for episode ``seed``: isotropic, filament or playback."""
+    from dcee.scenarios.config import FilamentSpec, PlaybackSpec
+    from dcee.simulation.filament import FilamentTruth
+    from dcee.simulation.playback import load_recording
+
+    spec = scenario.truth.model
+    theta = scenario.truth_theta()
+    low, high = np.array(scenario.volume.low), np.array(scenario.volume.high)
+    if spec == "isotropic":
         return IsotropicTruth(theta)
-    raise ValueError(f"unknown truth model {kind!r}")
+    if isinstance(spec, FilamentSpec):
+        return FilamentTruth(theta, spec, plume_stream(seed), low, high)
+    if isinstance(spec, PlaybackSpec):
+        truth, source = load_recording(spec.file, spec.time_interpolation, spec.loop)
+        problem = truth.covers(low, high)
+        if problem:
+            raise DceeInputError("truth.model.file", problem)
+        if source is not None and not np.allclose(source, theta[:3], atol=1e-6):
+            raise DceeInputError(
+                "truth.model.file",
+                f"the recording's source {tuple(source)} differs from the scenario's truth "
+                f"x, y, z {tuple(theta[:3])}",
+            )
+        budget = scenario.search.budget
+        if not spec.loop and budget > truth.duration + 1e-9 and len(truth.t) > 1:
+            raise DceeInputError(
+                "truth.model.file",
+                f"the recording lasts {truth.duration:g} s but search.budget is {budget:g} s "
+                "(set loop = true or shorten the budget)",
+            )
+        return truth
+    raise ValueError(f"unknown truth model {spec!r}")
