@@ -324,6 +324,7 @@ def write_report(campaign_dir: Path, out_dir: Path) -> list[Path]:
     write_atomic(out_dir / "metrics.md", lambda p: p.write_text(md))
     failed = len(list((Path(campaign_dir) / "runs").glob("*/*/seed-*.error.json")))
     s = meta["settings"]
+    truths = sorted(runs["truth_model"].unique()) if "truth_model" in runs else ["isotropic"]
     html = [
         "<!doctype html><html><head><meta charset='utf-8'><title>dcee campaign report</title>",
         "<style>body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
@@ -331,7 +332,8 @@ def write_report(campaign_dir: Path, out_dir: Path) -> list[Path]:
         f"<h1>Campaign report: {s['suite']} suite</h1>",
         f"<p>{len(runs)} finished searches ({failed} failed), {runs['scenario'].nunique()} "
         f"configurations, strategies: {', '.join(sorted(runs['strategy'].unique()))}; unknowns: "
-        f"{s['unknown'] or 'as configured'}; dcee {meta.get('version', '?')}. "
+        f"{s['unknown'] or 'as configured'}; ground truth: {', '.join(truths)} (the estimator "
+        f"always assumes the isotropic plume); dcee {meta.get('version', '?')}. "
         "Intervals are 95%.</p>",
         _md_to_html(md),
     ]

@@ -136,6 +136,7 @@ class PlaybackSpec(BaseModel):
         return f"playback:{Path(self.file).name}"
 
 
+TRUTH_KINDS = ("filament", "playback")
 TruthModelSpec = Annotated[FilamentSpec | PlaybackSpec, Field(discriminator="kind")]
 
 
@@ -358,8 +359,16 @@ def validate_scenario(data: dict[str, Any]) -> Scenario:
     try:
         return Scenario.model_validate(data)
     except ValidationError as exc:
-        err = exc.errors()[0]
-        loc = ".".join(str(p) for p in err["loc"]) or "scenario"
+        errors = exc.errors()
+        # a union (truth.model) reports every branch; the literal branch's complaint is noise
+        # when a table was given, so report the error of the branch the input was meant for
+        relevant = [e for e in errors if not any(str(p).startswith("literal[") for p in e["loc"])]
+        err = (relevant or errors)[0]
+        # drop pydantic's internal union labels ("tagged-union[...]"), keep the user's field path
+        parts = [str(p) for p in err["loc"] if "[" not in str(p)]
+        if len(parts) > 2 and parts[:2] == ["truth", "model"] and parts[2] in TRUTH_KINDS:
+            del parts[2]  # the union's tag, not a field the user wrote
+        loc = ".".join(parts) or "scenario"
         msg = err["msg"].removeprefix("Value error, ")
         if err["type"] == "extra_forbidden":
             msg = "unknown field"
