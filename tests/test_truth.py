@@ -325,3 +325,18 @@ def test_run_with_a_recording_and_bad_truth_options(tmp_path, capsys):
         assert code == 2
         assert message in err and "Traceback" not in err
     assert not (tmp_path / "x").exists()
+
+
+def test_bench_refuses_a_bad_recording_before_writing_anything(tmp_path, capsys):
+    values, t, x, y, z = linear_recording(True)
+    rec = tmp_path / "short.h5"
+    save_recording(rec, values, t, x, y, z)  # 30 s, but the smoke suite flies 60 s
+    out = tmp_path / "campaign"
+    code, _, err = run_cli(
+        ["bench", "--suite", "smoke", "--strategies", "mpc", "--repeats", "1", "--workers", "1",
+         "--truth", str(rec), "--out", str(out)],
+        capsys,
+    )  # fmt: skip
+    assert code == 2
+    assert "truth.model.file: the recording lasts 30 s" in err and "Traceback" not in err
+    assert not out.exists()

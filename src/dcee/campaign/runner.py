@@ -163,6 +163,11 @@ class Campaign:
         self.scenarios = {
             s.name: s for s in suite_scenarios(self.suite, self.unknown, self.particles, self.truth)
         }
+        if self.truth is not None:
+            from dcee.simulation import make_truth
+
+            for scenario in self.scenarios.values():
+                make_truth(scenario, 0)  # a bad recording fails here, not in every search
 
     def settings(self) -> dict[str, Any]:
         """What identifies the results: strategies and repeats may grow, these may not change."""

@@ -62,16 +62,10 @@ class _State:
     ages: np.ndarray  # (P,) s
     meander: np.ndarray  # (2, 2): [along, cross] x [displacement-like state, its rate]
     released: int  # puffs released so far
-    rng_state: dict
 
     def copy(self) -> _State:
         return _State(
-            self.step,
-            self.centres.copy(),
-            self.ages.copy(),
-            self.meander.copy(),
-            self.released,
-            dict(self.rng_state),
+            self.step, self.centres.copy(), self.ages.copy(), self.meander.copy(), self.released
         )
 
 
@@ -123,8 +117,8 @@ class FilamentTruth(TruthModel):
         meander = np.zeros((2, 2))
         meander[:, 0] = sd * rng.standard_normal(2)  # start in the stationary distribution
         meander[:, 1] = w * sd * rng.standard_normal(2)
-        self._state = _State(0, np.empty((0, 3)), np.empty(0), meander, 0, {})
-        self._checkpoints: dict[int, _State] = {}
+        self._state = _State(0, np.empty((0, 3)), np.empty(0), meander, 0)
+        self._checkpoints: dict[int, tuple[_State, dict]] = {}  # step -> (state, rng state)
         self._advance_to(self.spin_steps)
 
     # --- dynamics -----------------------------------------------------------------------------
@@ -162,15 +156,13 @@ class FilamentTruth(TruthModel):
             keep = near & (s.ages < self.max_age)
             s.centres, s.ages = s.centres[keep], s.ages[keep]
         if s.step >= self.spin_steps and (s.step - self.spin_steps) % self.checkpoint_steps == 0:
-            snap = s.copy()
-            snap.rng_state = self._rng.bit_generator.state
-            self._checkpoints[s.step] = snap
+            self._checkpoints[s.step] = (s.copy(), self._rng.bit_generator.state)
 
     def _advance_to(self, step: int) -> None:
         if step < self._state.step:  # looking back: restart from the last checkpoint before it
-            start = max(k for k in self._checkpoints if k <= step)
-            self._state = self._checkpoints[start].copy()
-            self._rng.bit_generator.state = self._state.rng_state
+            state, rng_state = self._checkpoints[max(k for k in self._checkpoints if k <= step)]
+            self._state = state.copy()
+            self._rng.bit_generator.state = rng_state
         while self._state.step < step:
             self._step()
 
@@ -186,19 +178,22 @@ class FilamentTruth(TruthModel):
 
     def puffs(self, time: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(centres (P, 3) m, radii σ (P,) m, masses (P,) g) of the live puffs at ``time`` s."""
+        centres, var, masses = self._live_puffs(time)
+        return centres.copy(), np.sqrt(var), masses
+
+    def _live_puffs(self, time: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(centres (P, 3) as a view of the state, variances σ² (P,), masses (P,))."""
         self._advance_to(self._step_for(time))
         s = self._state
-        masses = self.puff_mass * np.exp(-s.ages / self.tau)
-        return s.centres.copy(), np.sqrt(self._sigma_sq(s.ages)), masses
+        return s.centres, self._sigma_sq(s.ages), self.puff_mass * np.exp(-s.ages / self.tau)
 
     def field(self, positions: np.ndarray, time: float) -> np.ndarray:
         """(K,) instantaneous concentrations (g/m³) at (K, 3) positions at ``time`` s."""
         positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
-        centres, sigma, masses = self.puffs(time)
+        centres, var, masses = self._live_puffs(time)
         out = np.zeros(len(positions))
         if not len(masses):
             return out
-        var = sigma**2
         amp = masses / (2.0 * math.pi * var) ** 1.5
         chunk = max(1, 2_000_000 // len(masses))  # bound the (K, P) temporaries to ~16 MB
         for a in range(0, len(positions), chunk):
