@@ -232,11 +232,15 @@ def figure_grid(runs: pd.DataFrame, meta: dict[str, Any]) -> bytes | None:
     scenario = Scenario.model_validate(meta["settings"]["scenarios"][config])
     truth = scenario.truth_theta()
     lo, hi = scenario.volume.low, scenario.volume.high
+    # Panels are drawn to scale (equal aspect), so size the figure by the area's aspect ratio
+    # and let constrained layout place the title: a fixed square cell left wide gaps.
+    aspect = (hi[1] - lo[1]) / (hi[0] - lo[0])
     fig, axes = plt.subplots(
         len(reps),
         len(SNAPSHOT_TIMES),
-        figsize=(3.2 * len(SNAPSHOT_TIMES), 3.1 * len(reps)),
+        figsize=(2.8 * len(SNAPSHOT_TIMES), 2.8 * aspect * len(reps) + 0.5),
         squeeze=False,
+        layout="constrained",
     )
     for row, (_, r) in enumerate(reps.iterrows()):
         steps = pd.read_parquet(f"{r['_stem']}.parquet", columns=["time", "x", "y"])
