@@ -2,6 +2,11 @@
 
 import json
 import math
+import os
+import signal
+import subprocess
+import sys
+import time
 
 import numpy as np
 import pandas as pd
@@ -70,6 +75,67 @@ def test_failing_search_is_recorded_and_does_not_raise(tmp_path):
     err = json.loads(task.stem.with_suffix(".error.json").read_text())
     assert err["strategy"] == "dcee" and "Error" in err["error"]
     assert not is_done(task)
+
+
+BENCH = ["bench", "--suite", "smoke", "--strategies", "mpc,dcee", "--repeats", "5"]
+BENCH += ["--particles", "300", "--workers", "2"]
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGKILL], ids=["ctrl-c", "kill-9"])
+def test_interrupted_bench_keeps_finished_searches_and_resumes(tmp_path, capsys, sig):
+    """A real interruption: the signal goes to the driver and its workers (as Ctrl-C in a
+    terminal does) as soon as the first search has finished; the rerun redoes only the rest."""
+    out = tmp_path / "c"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "dcee.cli", *BENCH, "--out", str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    deadline = time.monotonic() + 180
+    while not list(out.glob("runs/*/*/seed-*.json")):
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline, "no search finished in time"
+        time.sleep(0.02)
+    os.killpg(proc.pid, sig)
+    _, err = proc.communicate(timeout=120)
+    if sig == signal.SIGINT:
+        assert proc.returncode == 130 and err.strip().endswith("dcee: interrupted")
+        assert "Traceback" not in err
+    else:
+        assert proc.returncode == -signal.SIGKILL
+    tasks = Campaign(out, "smoke", ("mpc", "dcee"), 5, particles=300).tasks()
+    finished = {t.stem: t.stem.with_suffix(".json").stat().st_mtime_ns for t in tasks if is_done(t)}
+    assert 1 <= len(finished) < len(tasks)
+    # What a kill in the middle of a write leaves: a temporary file beside the result.
+    todo = next(t for t in tasks if t.stem not in finished)
+    stale = todo.stem.parent / f".{todo.stem.name}.parquet.x1y2z3.parquet"
+    stale.parent.mkdir(parents=True, exist_ok=True)
+    stale.write_bytes(b"PAR1 half")
+
+    with pytest.raises(SystemExit) as exc:
+        main([*BENCH, "--out", str(out)])
+    assert exc.value.code == 0
+    assert f"{len(tasks)} searches: {len(finished)} already done" in capsys.readouterr().out
+    assert all(is_done(t) for t in tasks) and not stale.exists()
+    # Finished searches were skipped, not redone.
+    assert all(s.with_suffix(".json").stat().st_mtime_ns == m for s, m in finished.items())
+
+
+def test_dask_cluster_by_address_through_the_cli(tmp_path, capsys):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(
+        n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        out = tmp_path / "c"
+        args = ["bench", "--suite", "smoke", "--strategies", "mpc", "--repeats", "1"]
+        args += ["--particles", "300", "--out", str(out), "--scheduler", cluster.scheduler_address]
+        with pytest.raises(SystemExit) as exc:
+            main(args)
+    assert exc.value.code == 0
+    assert "2 searches: 0 already done, 2 run, 0 failed" in capsys.readouterr().out
+    assert all(is_done(t) for t in Campaign(out, "smoke", ("mpc",), 1, particles=300).tasks())
 
 
 def test_dask_local_cluster_runs_the_campaign(tmp_path):

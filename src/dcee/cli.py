@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import os
 import sys
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -355,7 +356,9 @@ def bench(
         TextColumn("ETA"),
         TimeRemainingColumn(),
     )
-    with Progress(*columns, disable=not sys.stderr.isatty()) as progress:
+    interactive = sys.stderr.isatty()
+    started = time.monotonic()
+    with Progress(*columns, disable=not interactive) as progress:
         bar = progress.add_task(suite, total=None, failed=0)
 
         def on_result(res: dict[str, Any], finished: int, todo: int) -> None:
@@ -364,6 +367,8 @@ def bench(
                 where = f"{t.config} {t.strategy} seed {t.seed}: " if t else ""
                 failures.append(where + res["error"])
             progress.update(bar, total=todo, completed=finished, failed=len(failures))
+            if not interactive:
+                _log_progress(suite, finished, todo, len(failures), time.monotonic() - started)
 
         counts = run_campaign(campaign, workers=workers, scheduler=scheduler, on_result=on_result)
     click.echo(
@@ -372,6 +377,26 @@ def bench(
     )
     for line in failures[:20]:
         click.echo(f"  failed: {line}", err=True)
+
+
+def _log_progress(suite: str, finished: int, todo: int, failed: int, elapsed: float) -> None:
+    """Plain progress lines for logs (stderr not a terminal, e.g. under nohup or a batch
+    system): about twenty per campaign plus the last, each with completed/total, failures and
+    an ETA from the mean rate so far."""
+    if finished != todo and finished % max(1, todo // 20):
+        return
+    eta = elapsed / finished * (todo - finished)
+    click.echo(
+        f"{suite}: {finished}/{todo} searches, failed {failed}, "
+        f"elapsed {_clock(elapsed)}, ETA {_clock(eta)}",
+        err=True,
+    )
+
+
+def _clock(seconds: float) -> str:
+    m, s = divmod(round(seconds), 60)
+    h, m = divmod(m, 60)
+    return f"{h}:{m:02d}:{s:02d}"
 
 
 @cli.command()

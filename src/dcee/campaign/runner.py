@@ -80,6 +80,10 @@ def run_search(task: SearchTask) -> dict[str, Any]:
 
     stem = task.stem
     t0 = time.perf_counter()
+    # A worker killed while writing (SIGKILL, power loss) leaves its temporary file behind;
+    # only this task writes files with this stem, so they are safe to remove on the redo.
+    for leftover in stem.parent.glob(f".{stem.name}.*"):
+        leftover.unlink(missing_ok=True)
     try:
         scenario = Scenario.model_validate(task.scenario)
         truth = make_truth(scenario, task.seed)
