@@ -65,3 +65,16 @@ def run_cli(argv, capsys):
         main(argv)
     out = capsys.readouterr()
     return exc.value.code, out.out, out.err
+
+
+def search_that_kills_its_worker_on_seed_1(task):
+    """A campaign search that, for repeat 1, kills the worker process running it (as the
+    out-of-memory killer would); otherwise the real search. Module-level so that spawned worker
+    processes can import it."""
+    import os
+
+    from dcee.campaign.runner import run_search
+
+    if task.seed == 1:
+        os._exit(9)
+    return run_search(task)

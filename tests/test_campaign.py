@@ -14,9 +14,10 @@ import pytest
 
 from dcee.analysis.report import median_ci, wilson, write_report
 from dcee.campaign import Campaign, SearchTask, run_campaign
-from dcee.campaign.runner import is_done, run_search
+from dcee.campaign.runner import _local_results, is_done, run_search
 from dcee.cli import main
 from dcee.errors import DceeInputError
+from tests.helpers import search_that_kills_its_worker_on_seed_1
 
 STRATEGIES = ("mpc", "dcee")
 
@@ -121,6 +122,48 @@ def test_interrupted_bench_keeps_finished_searches_and_resumes(tmp_path, capsys,
     assert all(is_done(t) for t in tasks) and not stale.exists()
     # Finished searches were skipped, not redone.
     assert all(s.with_suffix(".json").stat().st_mtime_ns == m for s, m in finished.items())
+
+
+def test_a_worker_killed_from_outside_loses_nothing(tmp_path):
+    """SIGKILL one worker process after the first result: the pool breaks, and the searches
+    that were in flight or queued are rerun in the same invocation, none recorded as failed."""
+    import multiprocessing
+
+    killed = []
+
+    def kill_a_worker(res, finished, todo):
+        if not killed:
+            victim = multiprocessing.active_children()[0]
+            os.kill(victim.pid, signal.SIGKILL)
+            killed.append(victim.pid)
+
+    campaign = Campaign(tmp_path, "smoke", ("mpc", "dcee"), 3, particles=300)
+    counts = run_campaign(campaign, workers=2, on_result=kill_a_worker)
+    assert killed and counts == {"total": 12, "skipped": 0, "done": 12, "failed": 0}
+    assert all(is_done(t) for t in campaign.tasks())
+    assert not list(tmp_path.glob("runs/*/*/*.error.json"))
+
+
+def test_a_search_that_kills_its_worker_fails_alone(tmp_path):
+    """Repeat 1 kills its worker every time: it is retried alone, then recorded as failed with
+    an error file; the searches that shared the pool with it still finish."""
+    campaign = Campaign(tmp_path, "smoke", ("mpc",), 2, particles=300)
+    campaign.prepare()
+    tasks = campaign.tasks()  # paper:1 and paper:6, repeats 0 and 1
+    results = list(_local_results(tasks, 2, search=search_that_kills_its_worker_on_seed_1))
+    status = {(r["task"].config, r["task"].seed): r["status"] for r in results}
+    assert len(results) == 4
+    assert status == {
+        ("paper:1", 0): "done",
+        ("paper:6", 0): "done",
+        ("paper:1", 1): "failed",
+        ("paper:6", 1): "failed",
+    }
+    for t in tasks:
+        assert is_done(t) == (t.seed == 0)
+        if t.seed == 1:
+            err = json.loads(t.stem.with_suffix(".error.json").read_text())
+            assert "worker process died" in err["error"]
 
 
 def test_dask_cluster_by_address_through_the_cli(tmp_path, capsys):

@@ -237,34 +237,98 @@ def _first_difference(a: Any, b: Any, path: str = "") -> str:
     return f"{path or 'settings'}: stored {a!r}, now {b!r}"
 
 
-def _init_worker() -> None:
+_STARTED: Any = None  # in a local worker: shared flags, set when a search starts
+
+
+def _init_worker(started: Any = None) -> None:
     """Worker processes: one numba thread each (parallel kernels degrade badly when several
     searches share the cores; one search per core is the efficient layout)."""
     import numba
 
+    global _STARTED
+    _STARTED = started
     numba.set_num_threads(1)
 
 
-def _local_results(tasks: list[SearchTask], workers: int) -> Iterator[dict[str, Any]]:
+def _run_marked(index: int, task: SearchTask, search: Callable[[SearchTask], dict]) -> dict:
+    """Flag search ``index`` as started (so the driver knows which were in flight when a worker
+    died), then run it."""
+    _STARTED[index] = 1
+    return search(task)
+
+
+def _worker_lost(task: SearchTask) -> dict[str, Any]:
+    error = "its worker process died while running it alone (out of memory? killed?)"
+    write_json(
+        task.stem.with_suffix(".error.json"),
+        {"config": task.config, "strategy": task.strategy, "seed": task.seed, "error": error},
+    )
+    return {"status": "failed", "task": task, "error": f"worker lost: {error}"}
+
+
+def _local_results(
+    tasks: list[SearchTask], workers: int, search: Callable[[SearchTask], dict] = run_search
+) -> Iterator[dict[str, Any]]:
+    """Run ``tasks`` on ``workers`` spawned processes and yield each result as it comes.
+
+    A dead worker breaks a ``ProcessPoolExecutor``: every pending future fails with it and the
+    other workers are stopped. So after a break the queued searches go to a fresh pool, and the
+    ones that were in flight (shared flags set by the worker tell them apart from the queued
+    ones) become suspects, each rerun alone on a pool of one: a suspect that kills its worker
+    even alone is recorded as failed (it is what kills it: out of memory, say); the others were
+    bystanders of an external kill and simply finish. A break with no search in flight and no
+    result (a worker that cannot even start) fails what is left, so this always ends.
+    """
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures.process import BrokenProcessPool
 
     # Not os.environ["NUMBA_NUM_THREADS"]: numba in *this* process re-reads it at its next
     # compilation and refuses a value different from its running pool. The initializer limits
     # each worker instead.
     ctx = mp.get_context("spawn")
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_init_worker)
-    futures = [pool.submit(run_search, t) for t in tasks]
-    try:
-        for fut in as_completed(futures):
-            yield _result_or_crash(fut, futures)
-    finally:
-        for f in futures:
-            f.cancel()
-        pool.shutdown(wait=True, cancel_futures=True)
+    todo = list(range(len(tasks)))
+    suspects: list[int] = []
+    while todo or suspects:
+        if suspects:
+            batch, alone = [suspects.pop(0)], True
+        else:
+            batch, alone, todo = todo, False, []
+        started = ctx.Array("b", len(tasks), lock=False)
+        pool = ProcessPoolExecutor(
+            max_workers=min(workers, len(batch)),
+            mp_context=ctx,
+            initializer=_init_worker,
+            initargs=(started,),
+        )
+        futures = {pool.submit(_run_marked, i, tasks[i], search): i for i in batch}
+        lost: list[int] = []
+        try:
+            for fut in as_completed(futures):
+                i = futures[fut]
+                try:
+                    yield fut.result()
+                except BrokenProcessPool:
+                    lost.append(i)
+                except Exception as exc:  # not the search (it never raises): pickling, say
+                    yield {"status": "failed", "task": tasks[i], "error": repr(exc)}
+        finally:
+            for f in futures:
+                f.cancel()
+            pool.shutdown(wait=True, cancel_futures=True)
+        progressed = len(lost) < len(batch) or any(started[i] for i in lost)
+        for i in sorted(lost):
+            if (started[i] and alone) or not progressed:
+                yield _worker_lost(tasks[i])
+            elif started[i]:
+                suspects.append(i)
+            else:
+                todo.append(i)
 
 
 def _dask_results(tasks: list[SearchTask], scheduler: Any) -> Iterator[dict[str, Any]]:
+    """Run ``tasks`` on a Dask cluster. Dask itself reschedules the searches of a lost worker
+    and gives up on one after its ``allowed-failures`` losses (``KilledWorker``)."""
     try:
         from distributed import Client, as_completed
     except ImportError:
@@ -275,22 +339,18 @@ def _dask_results(tasks: list[SearchTask], scheduler: Any) -> Iterator[dict[str,
     own = client is not scheduler
     try:
         client.run(_init_worker)
-        futures = [client.submit(run_search, t, pure=False) for t in tasks]
+        futures = {client.submit(run_search, t, pure=False): t for t in tasks}
         try:
             for fut in as_completed(futures):
-                yield _result_or_crash(fut, futures)
+                try:
+                    yield fut.result()
+                except Exception as exc:  # KilledWorker, a lost connection, ...
+                    yield {"status": "failed", "task": futures[fut], "error": repr(exc)}
         finally:
-            client.cancel(futures)
+            client.cancel(list(futures))
     finally:
         if own:
             client.close()
-
-
-def _result_or_crash(fut: Any, futures: list) -> dict[str, Any]:
-    try:
-        return fut.result()
-    except Exception as exc:  # the worker process died (killed, out of memory, ...)
-        return {"status": "failed", "task": None, "error": f"worker lost: {exc}"}
 
 
 def run_campaign(
