@@ -8,8 +8,9 @@ Layout of a campaign folder::
     runs/<config>/<strategy>/seed-<k>.json      summary, written last: marks the search done
     runs/<config>/<strategy>/seed-<k>.error.json  why a search failed (retried on the next run)
 
-Every file is written atomically by the worker that ran the search, so a killed worker or
-driver loses only the searches in flight. A search counts as done only when its summary parses
+Every file is written atomically by the worker that ran the search, so an interrupted or
+killed driver loses only the searches in flight; the searches of a killed local worker are rerun
+(see ``_local_results``). A search counts as done only when its summary parses
 and names record and posterior files that exist with the recorded row count; anything else is
 redone. Common random numbers: the seed of a search is its repeat index, and the seed alone
 drives the truth's noise, so one (configuration, repeat) gives every strategy the same truth.
