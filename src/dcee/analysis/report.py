@@ -270,8 +270,10 @@ def figure_grid(runs: pd.DataFrame, meta: dict[str, Any]) -> bytes | None:
 
 def figure_posteriors(runs: pd.DataFrame, meta: dict[str, Any]) -> bytes:
     """Histograms of the final posterior's error (particle − truth) per unknown parameter,
-    pooled over the searches of each strategy."""
-    from dcee.models.plume import PARAMETER_NAMES
+    pooled over the searches of each strategy. Every strategy shares one range per parameter:
+    the central 98% of all strategies' errors together, so that a few lost searches do not
+    squeeze the peak of the others into one bin."""
+    from dcee.models.plume import PARAMETER_NAMES, PARAMETER_UNITS
     from dcee.scenarios import Scenario
 
     names = list(runs["parameter_names"].iloc[0])
@@ -280,24 +282,35 @@ def figure_posteriors(runs: pd.DataFrame, meta: dict[str, Any]) -> bytes:
         k: Scenario.model_validate(v).truth_theta()
         for k, v in meta["settings"]["scenarios"].items()
     }
-    fig, axes = plt.subplots(1, len(names), figsize=(3.0 * len(names), 3.0), squeeze=False)
+    errors: dict[str, np.ndarray] = {}
     for strategy, g in runs.groupby("strategy", sort=True):
         errs = []
         for _, r in g.iterrows():
             with np.load(f"{r['_stem']}.npz") as z:
                 p = z["final_particles"].astype(float)
             errs.append(p[:, idx] - truths[r["scenario"]][idx])
-        e = np.concatenate(errs)
-        for k, ax in enumerate(axes[0]):
-            lim = np.percentile(np.abs(e[:, k]), 99) or 1.0
-            ax.hist(
-                e[:, k], bins=60, range=(-lim, lim), histtype="step", density=True, label=strategy
-            )
-    for k, ax in enumerate(axes[0]):
-        ax.set_title(f"{names[k]} − true")
+        errors[str(strategy)] = np.concatenate(errs)
+    pooled = np.concatenate(list(errors.values()))
+    ncols = min(4, len(names))
+    nrows = math.ceil(len(names) / ncols)
+    fig, axes = plt.subplots(
+        nrows, ncols, figsize=(3.2 * ncols, 2.7 * nrows + 0.4), squeeze=False, layout="constrained"
+    )
+    for k, ax in enumerate(axes.flat):
+        if k >= len(names):
+            ax.set_visible(False)
+            continue
+        lo, hi = np.percentile(pooled[:, k], [1, 99])
+        if not hi > lo:
+            lo, hi = lo - 1.0, hi + 1.0
+        for strategy, e in errors.items():
+            ax.hist(e[:, k], bins=60, range=(lo, hi), histtype="step", density=True, label=strategy)
+        ax.axvline(0.0, color="0.4", lw=0.8, ls=":")
+        unit = PARAMETER_UNITS.get(names[k], "")
+        ax.set_title(f"{names[k]} − true" + (f" ({unit})" if unit else ""))
         ax.set_yticks([])
-    axes[0, -1].legend(fontsize=7)
-    fig.suptitle("Final posterior error, pooled over searches")
+    axes.flat[0].legend(fontsize=7)
+    fig.suptitle("Final posterior error, pooled over searches (central 98% of all errors)")
     return _png(fig)
 
 
