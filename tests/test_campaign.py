@@ -207,6 +207,16 @@ def test_report_tables_and_figures(finished, tmp_path):
         assert (table[f"{key}_lo"] <= table[f"{key}_rate"]).all()
         assert (table[f"{key}_rate"] <= table[f"{key}_hi"]).all()
     assert "mean final RMSE" in (tmp_path / "report/metrics.md").read_text()
+    # Per configuration: k/n recounted by hand from the summaries.
+    per_config = pd.read_csv(tmp_path / "report/per_configuration.csv", index_col=0)
+    assert list(per_config.index) == ["paper:1", "paper:6"]
+    for config in per_config.index:
+        for strategy in STRATEGIES:
+            hits = [
+                json.loads(p.read_text())["source_acquired"]
+                for p in out.glob(f"runs/{config.replace(':', '-')}/{strategy}/seed-*.json")
+            ]
+            assert per_config.loc[config, strategy] == f"{sum(hits)}/{len(hits)}"
     html = (tmp_path / "report/report.html").read_text()
     assert html.count("data:image/png;base64,") == 4
 

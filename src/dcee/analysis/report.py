@@ -123,6 +123,28 @@ def metrics_table(runs: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
+def per_configuration_table(runs: pd.DataFrame) -> pd.DataFrame:
+    """Searches that acquired the source, per configuration (rows, in suite order) and strategy
+    (columns), as "k/n" strings: where a strategy fails, which the pooled rates hide."""
+    counts = runs.groupby(["scenario", "strategy"])["source_acquired"].agg(["sum", "count"])
+    cells = counts["sum"].astype(int).astype(str) + "/" + counts["count"].astype(str)
+    table = cells.unstack("strategy").fillna("—")
+    table = table.loc[sorted(table.index, key=_config_key)]
+    table.index.name = "configuration"
+    return table
+
+
+def per_configuration_markdown(table: pd.DataFrame) -> str:
+    cols = list(table.columns)
+    lines = [
+        "| configuration | " + " | ".join(cols) + " |",
+        "|" + "---|" * (len(cols) + 1),
+    ]
+    for config, row in table.iterrows():
+        lines.append(f"| {config} | " + " | ".join(row[c] for c in cols) + " |")
+    return "\n".join(lines) + "\n"
+
+
 def _fmt(v: float, lo: float, hi: float, digits: int = 2, pct: bool = False) -> str:
     if not np.isfinite(v):
         return "—"
@@ -320,7 +342,8 @@ def _config_key(name: str) -> tuple:
 
 
 def write_report(campaign_dir: Path, out_dir: Path) -> list[Path]:
-    """Write report.html, metrics.csv, metrics.md and the figures; returns the paths."""
+    """Write report.html, metrics.csv/.md, per_configuration.csv/.md and the figures; returns
+    the paths."""
     meta, runs = load_campaign(Path(campaign_dir))
     table = metrics_table(runs)
     md = markdown_table(table)
@@ -339,6 +362,10 @@ def write_report(campaign_dir: Path, out_dir: Path) -> list[Path]:
         paths.append(out_dir / name)
     write_atomic(out_dir / "metrics.csv", lambda p: table.to_csv(p, index=False))
     write_atomic(out_dir / "metrics.md", lambda p: p.write_text(md))
+    per_config = per_configuration_table(runs)
+    per_config_md = per_configuration_markdown(per_config)
+    write_atomic(out_dir / "per_configuration.csv", lambda p: per_config.to_csv(p))
+    write_atomic(out_dir / "per_configuration.md", lambda p: p.write_text(per_config_md))
     failed = len(list((Path(campaign_dir) / "runs").glob("*/*/seed-*.error.json")))
     s = meta["settings"]
     truths = sorted(runs["truth_model"].unique()) if "truth_model" in runs else ["isotropic"]
@@ -353,6 +380,8 @@ def write_report(campaign_dir: Path, out_dir: Path) -> list[Path]:
         f"always assumes the isotropic plume); dcee {meta.get('version', '?')}. "
         "Intervals are 95%.</p>",
         _md_to_html(md),
+        "<h2>source acquired per configuration</h2>",
+        _md_to_html(per_config_md),
     ]
     for name, data in figures.items():
         b64 = base64.b64encode(data).decode()
@@ -362,7 +391,8 @@ def write_report(campaign_dir: Path, out_dir: Path) -> list[Path]:
         )
     html.append("</body></html>")
     write_atomic(out_dir / "report.html", lambda p: p.write_text("\n".join(html)))
-    return [out_dir / "report.html", out_dir / "metrics.csv", out_dir / "metrics.md", *paths]
+    tables = ("metrics.csv", "metrics.md", "per_configuration.csv", "per_configuration.md")
+    return [out_dir / "report.html", *(out_dir / t for t in tables), *paths]
 
 
 def _md_to_html(md: str) -> str:
