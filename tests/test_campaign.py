@@ -254,3 +254,15 @@ def test_report_on_a_folder_without_campaign_is_exit_2(tmp_path, capsys):
     with pytest.raises(SystemExit) as exc:
         main(["report", str(tmp_path)])
     assert exc.value.code == 2 and "campaign" in capsys.readouterr().err
+
+
+def test_plain_progress_lines_for_logs(capsys):
+    """Not a terminal: one line per 5% of the searches and the last, with a linear ETA."""
+    from dcee.cli import _log_progress
+
+    for finished in range(1, 41):
+        _log_progress("paper", finished, 40, 1, elapsed=3.0 * finished)
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 20
+    assert lines[0] == "paper: 2/40 searches, failed 1, elapsed 0:00:06, ETA 0:01:54"
+    assert lines[-1] == "paper: 40/40 searches, failed 1, elapsed 0:02:00, ETA 0:00:00"

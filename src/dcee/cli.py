@@ -21,6 +21,13 @@ from dcee.errors import DceeInputError
 from dcee.io import write_atomic as _write_atomic
 from dcee.io import write_json as _write_json
 
+# Shared by ``run`` and ``bench``: what the sensor sees.
+TRUTH_OPTION = click.option(
+    "--truth",
+    help="What the sensor sees: isotropic | filament | PATH of a .npy/.h5 recording "
+    "[default: the scenario's truth.model].",
+)
+
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="dcee")
@@ -58,11 +65,7 @@ def cli() -> None:
     type=click.Path(dir_okay=False, path_type=Path),
     help="Also write the summary JSON here.",
 )
-@click.option(
-    "--truth",
-    help="What the sensor sees: isotropic | filament | PATH of a .npy/.h5 recording "
-    "[default: the scenario's truth.model].",
-)
+@TRUTH_OPTION
 @click.option("--animate", is_flag=True, help="Also write animation.gif.")
 @click.option("--no-figure", is_flag=True, help="Skip figure.png.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress display.")
@@ -313,11 +316,7 @@ def _numba_threads() -> int:
 @click.option("--scheduler", help="Address of a running Dask scheduler, e.g. tcp://host:8786.")
 @click.option("--unknown", type=click.Choice(["source", "full"]), help="Override unknown set.")
 @click.option("--particles", type=int, help="Override the particle count.")
-@click.option(
-    "--truth",
-    help="What the sensor sees: isotropic | filament | PATH of a .npy/.h5 recording "
-    "[default: the scenario's truth.model].",
-)
+@TRUTH_OPTION
 def bench(
     suite: str,
     strategies: str,
@@ -363,9 +362,8 @@ def bench(
 
         def on_result(res: dict[str, Any], finished: int, todo: int) -> None:
             if res["status"] == "failed":
-                t = res.get("task")
-                where = f"{t.config} {t.strategy} seed {t.seed}: " if t else ""
-                failures.append(where + res["error"])
+                t = res["task"]
+                failures.append(f"{t.config} {t.strategy} seed {t.seed}: {res['error']}")
             progress.update(bar, total=todo, completed=finished, failed=len(failures))
             if not interactive:
                 _log_progress(suite, finished, todo, len(failures), time.monotonic() - started)
