@@ -12,7 +12,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from dcee.analysis.report import median_ci, wilson, write_report
+from dcee.analysis.report import (
+    load_campaign,
+    median_ci,
+    median_order_statistic_ranks,
+    rmse_over_time,
+    wilson,
+    write_report,
+)
 from dcee.campaign import Campaign, SearchTask, run_campaign
 from dcee.campaign.runner import _local_results, is_done, run_search
 from dcee.cli import main
@@ -217,6 +224,19 @@ def test_report_tables_and_figures(finished, tmp_path):
                 for p in out.glob(f"runs/{config.replace(':', '-')}/{strategy}/seed-*.json")
             ]
             assert per_config.loc[config, strategy] == f"{sum(hits)}/{len(hits)}"
+    # RMSE curves: the final mean and median recomputed by hand from the per-step records.
+    _, runs = load_campaign(out)
+    curves = rmse_over_time(runs)
+    for strategy in STRATEGIES:
+        finals = [
+            pd.read_parquet(p)["rmse"].iloc[-1]
+            for p in out.glob(f"runs/*/{strategy}/seed-*.parquet")
+        ]
+        last = curves[strategy].iloc[-1]
+        assert last["mean"] == pytest.approx(np.mean(finals))
+        assert last["median"] == pytest.approx(np.median(finals))
+        assert last["median_lo"] <= last["median"] <= last["median_hi"]
+        assert last["median_lo"] == pytest.approx(min(finals))  # n = 4: the sample range
     html = (tmp_path / "report/report.html").read_text()
     assert html.count("data:image/png;base64,") == 4
 
@@ -232,6 +252,36 @@ def test_interval_helpers_against_hand_calculations():
     m, lo, hi = median_ci(np.arange(101.0))
     assert m == 50 and lo < 50 < hi
     assert math.isnan(median_ci(np.array([np.nan]))[0])
+    # Textbook order-statistic intervals for the median (1-based ranks): n = 10 -> 2nd..9th
+    # (coverage 1 - 2 * 11/1024 = 97.9%), n = 100 -> 40th..61st (96.5%).
+    assert median_order_statistic_ranks(10) == (1, 8)
+    assert median_order_statistic_ranks(100) == (39, 60)
+    assert median_order_statistic_ranks(3) == (0, 2)  # too few for 95%: the sample range
+
+
+def test_posterior_histogram_range_ignores_a_lost_minority():
+    """85% of errors ~ N(0, 1) and 15% from lost searches at +20 m: the histogram range keeps
+    the bulk and leaves the lost ones outside; with no outliers it is the central
+    98%."""
+    from dcee.analysis.report import _robust_range
+
+    rng = np.random.default_rng(3)
+    bulk = rng.normal(size=8500)
+    lo, hi = _robust_range(np.concatenate([bulk, np.full(1500, 20.0)]))
+    assert -4.0 < lo < -2.0 and 2.5 < hi < 10.0  # bulk inside (p1, ~p99.7), +20 m outside
+    lo, hi = _robust_range(bulk)
+    assert (lo, hi) == pytest.approx(tuple(np.percentile(bulk, [1, 99])))
+
+
+def test_median_band_covers_the_median_at_95_percent():
+    """Simulated coverage of the order-statistic band over 4,000 samples of n = 30 from a
+    skewed distribution (the band is distribution-free)."""
+    rng = np.random.default_rng(7)
+    n, true_median = 30, np.log(2.0)  # exponential(1)
+    lo, hi = median_order_statistic_ranks(n)
+    x = np.sort(rng.exponential(size=(4000, n)), axis=1)
+    coverage = np.mean((x[:, lo] <= true_median) & (true_median <= x[:, hi]))
+    assert 0.94 <= coverage <= 0.975  # exact: 1 - 2 P(B <= 9) = 95.7%
 
 
 @pytest.mark.parametrize(
