@@ -2,9 +2,10 @@
 and a self-contained HTML page (figures embedded) plus the table as CSV and Markdown.
 
 Confidence intervals: Wilson score intervals for rates; for means a normal interval
-(mean ± 1.96 s/√n); for medians a percentile bootstrap (2,000 resamples, fixed seed, so the
-report is reproducible). Times to an RMSE level are over the searches that reached it; the
-fraction that reached it is reported beside.
+(mean ± 1.96 s/√n); for the table's medians a percentile bootstrap (2,000 resamples, fixed
+seed, so the report is reproducible); for the median RMSE curve, evaluated at every time step,
+the exact order-statistic interval (`median_order_statistic_ranks`). Times to an RMSE level
+are over the searches that reached it; the fraction that reached it is reported beside.
 """
 
 from __future__ import annotations
