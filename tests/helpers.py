@@ -78,3 +78,28 @@ def search_that_kills_its_worker_on_seed_1(task):
     if task.seed == 1:
         os._exit(9)
     return run_search(task)
+
+
+def compiled_predicted_stats(conc, source, weights, task_pos, task_z, sensor, **flags):
+    """The compiled predicted-posterior statistics with the reference's arguments:
+    (log_evidence, mean, trace_cov, kl) for raw concentrations (P, N) and readings (S, T)."""
+    from dcee.models.sensor_kernels import position_terms
+    from dcee.planning.predicted_kernels import predicted_posterior_stats
+
+    conc = np.ascontiguousarray(conc)
+    terms = [np.empty_like(conc) for _ in range(4)]
+    position_terms(conc, sensor.params, *terms)
+    s = len(task_pos)
+    out = [np.empty(s), np.empty((s, 3)), np.empty(s), np.empty(s)]
+    predicted_posterior_stats(
+        *terms,
+        np.ascontiguousarray(source),
+        weights,
+        weights @ source,
+        task_pos,
+        *sensor.transformed_readings(np.asarray(task_z, dtype=float)),
+        sensor.params,
+        *out,
+        **flags,
+    )
+    return out

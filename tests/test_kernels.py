@@ -6,19 +6,21 @@ import math
 import numpy as np
 import pytest
 
-from dcee import kernels
 from dcee.models import Sensor
+from dcee.models.sensor_kernels import log_likelihood
+from dcee.numeric import vexp, vlog1p
 from dcee.planning.predicted import predicted_posterior_stats_reference
+from tests.helpers import compiled_predicted_stats
 
 
 def test_vectorised_exp_matches_math_exp():
     x = np.concatenate([-np.geomspace(1e-12, 700, 20_000), [0.0, -0.5 * math.log(2)]])
     out = np.empty_like(x)
-    kernels.vexp(x, out)
+    vexp(x, out)
     ref = np.exp(x)
     np.testing.assert_allclose(out, ref, rtol=1e-14, atol=0)
     below = np.empty(1)
-    kernels.vexp(np.array([-800.0]), below)
+    vexp(np.array([-800.0]), below)
     assert 0.0 <= below[0] <= math.exp(-700)
 
 
@@ -28,10 +30,10 @@ def test_missed_detection_likelihood_small_and_large_concentrations(pd):
     absolute across the switch, and to 1e-9 relative far from it."""
     sensor = Sensor(pd=pd)
     sp = sensor.params
-    c_lin = sp[6]
+    c_lin = sp.c_lin
     c = np.concatenate([[0.0], c_lin * np.array([0.01, 0.5, 0.999, 1.001, 2.0]), [1e-4, 5e-4]])
     c = np.concatenate([c, np.geomspace(1e-3, 10, 20)])
-    fast = np.array([kernels.log_likelihood(0.0, ci, sp) for ci in c])
+    fast = np.array([log_likelihood(0.0, ci, sp) for ci in c])
     ref = sensor.log_likelihood(0.0, c)
     np.testing.assert_allclose(fast, ref, rtol=1e-9, atol=1e-15)
 
@@ -47,23 +49,7 @@ def _stats_case(n=2000, seed=3):
 
 
 def _run(conc, source, weights, task_pos, task_z, sensor, **flags):
-    terms = [np.empty_like(conc) for _ in range(3)]
-    kernels.position_terms(conc, sensor.params, *terms)
-    s = len(task_pos)
-    out = [np.empty(s), np.empty((s, 3)), np.empty(s), np.empty(s)]
-    kernels.predicted_posterior_stats(
-        conc,
-        *terms,
-        source,
-        weights,
-        weights @ source,
-        task_pos,
-        task_z,
-        sensor.params,
-        *out,
-        **flags,
-    )
-    return out
+    return compiled_predicted_stats(conc, source, weights, task_pos, task_z, sensor, **flags)
 
 
 def test_predicted_stats_unreachable_reading_takes_exact_path():
@@ -108,3 +94,35 @@ def test_predicted_stats_multi_step_sequences_match_reference():
     ref = predicted_posterior_stats_reference(conc, source, weights, task_pos, task_z, sensor)
     for fast, slow in zip(out, ref, strict=True):
         np.testing.assert_allclose(fast, slow, rtol=1e-9, atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    "sensor",
+    [
+        Sensor(family="lognormal", pd=0.5),
+        Sensor(family="lognormal", pd=0.5, outlier=0.01),
+        Sensor(outlier=0.01),
+        Sensor(family="lognormal", pd=0.6, outlier=0.01, false_alarm=0.02),
+    ],
+    ids=["ln", "ln+out", "gauss+out", "ln+out+fa"],
+)
+def test_predicted_stats_match_reference_for_every_family(sensor):
+    """The transformed-frame kernels (vectorised log-sum-exp of the outlier component, the
+    Jacobian added to the evidence) against the plain NumPy likelihood, horizons 1 and 3."""
+    source, weights, conc = _stats_case(n=1500, seed=8)
+    rng = np.random.default_rng(2)
+    for task_pos in (np.repeat(np.array([[0], [2]]), 5, axis=0), np.repeat([[0, 1, 2]], 8, axis=0)):
+        shape = task_pos.shape
+        task_z = np.where(rng.random(shape) < 0.4, 0.0, rng.lognormal(-6, 2, shape))
+        task_z[0, 0] = 500.0  # a spike that only the outlier component explains
+        out = _run(conc, source, weights, task_pos, task_z, sensor)
+        ref = predicted_posterior_stats_reference(conc, source, weights, task_pos, task_z, sensor)
+        for fast, slow in zip(out, ref, strict=True):
+            np.testing.assert_allclose(fast, slow, rtol=1e-8, atol=1e-10)
+
+
+def test_vectorised_log1p_matches_math_log1p():
+    x = np.concatenate([[0.0], np.geomspace(1e-300, 1.0, 20_000)])
+    out = np.empty_like(x)
+    vlog1p(x, out)
+    np.testing.assert_allclose(out, np.log1p(x), rtol=1e-15, atol=0)

@@ -1,7 +1,8 @@
 import numpy as np
 import pytest
 
-from dcee import DceeInputError, IsotropicPlume, ParticleFilter, Sensor, kernels
+from dcee import DceeInputError, IsotropicPlume, ParticleFilter, Sensor
+from dcee.estimation.filter_kernels import history_log_likelihood
 from dcee.estimation.particle_filter import (
     history_log_likelihood_reference,
     systematic_resample,
@@ -102,7 +103,7 @@ def test_history_kernel_matches_reference(sensor):
     z = np.where(rng.random(30) < 0.5, 0.0, rng.gamma(1.0, 5e-3, 30))
     mult = rng.integers(1, 4, 30).astype(float)
     out = np.empty(500)
-    kernels.history_log_likelihood(theta, np.ones(500, bool), pos, z, mult, 0.1, sensor.params, out)
+    history_log_likelihood(theta, np.ones(500, bool), pos, z, mult, 0.1, sensor.params, out)
     ref = history_log_likelihood_reference(theta, pos, z, mult, sensor, IsotropicPlume())
     np.testing.assert_allclose(out, ref, rtol=1e-9)
 

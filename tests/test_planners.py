@@ -3,10 +3,10 @@ import math
 import numpy as np
 import pytest
 
-from dcee import DceeInputError, GridAgent, IsotropicPlume, SearchVolume, Sensor, kernels, planners
+from dcee import DceeInputError, GridAgent, IsotropicPlume, SearchVolume, Sensor, planners
 from dcee.planning import Belief, PredictionContext
 from dcee.planning.predicted import predicted_posterior_stats_reference
-from tests.helpers import theta_at
+from tests.helpers import compiled_predicted_stats, theta_at
 
 AGENT = GridAgent(SearchVolume((0.0, 0.0, 0.0), (40.0, 40.0, 0.0)), step=2.0)
 START = np.array([10.0, 10.0, 0.0])
@@ -136,20 +136,7 @@ def test_compiled_predicted_stats_match_reference(false_alarm):
     conc = np.ascontiguousarray(belief.plume.concentration(belief.theta, positions).T)
     task_pos = np.array([[0, 1], [1, 2], [2, 2], [0, 0]])
     task_z = np.array([[0.0, 0.0], [3e-3, 0.0], [1e-2, 2e-3], [6e-4, 0.05]])
-    out = [np.empty(4), np.empty((4, 3)), np.empty(4), np.empty(4)]
-    terms = [np.empty_like(conc) for _ in range(3)]
-    kernels.position_terms(conc, sensor.params, *terms)
-    kernels.predicted_posterior_stats(
-        conc,
-        *terms,
-        belief.source.copy(),
-        belief.weights,
-        belief.source_mean(),
-        task_pos,
-        task_z,
-        sensor.params,
-        *out,
-    )
+    out = compiled_predicted_stats(conc, belief.source, belief.weights, task_pos, task_z, sensor)
     ref = predicted_posterior_stats_reference(
         conc, belief.source, belief.weights, task_pos, task_z, sensor
     )

@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from dcee import DceeInputError, Sensor, kernels
+from dcee import DceeInputError, Sensor
+from dcee.models.sensor_kernels import log_likelihood
 
 
 @pytest.mark.parametrize("false_alarm", [0.0, 0.05])
@@ -56,14 +57,14 @@ def test_compiled_likelihood_matches_reference():
         c = np.concatenate([[0.0, 1e-9, 5e-4], rng.gamma(0.5, 2e-3, 300), [0.5, 3.0]])
         z = np.concatenate([[0.0, 4e-4], rng.gamma(0.7, 2e-3, 60), [1.0]])
         for zi in z:
-            fast = np.array([kernels.log_likelihood(zi, ci, s.params) for ci in c])
+            fast = np.array([log_likelihood(zi, ci, s.params) for ci in c])
             ref = s.log_likelihood(zi, c)
             np.testing.assert_allclose(fast, ref, rtol=1e-9, atol=1e-12)
 
 
 def test_simulation_is_reproducible_and_common_noise_is_shared():
     s = Sensor()
-    noise = Sensor.draw_noise(np.random.default_rng(1), 5)
+    noise = s.draw_noise(np.random.default_rng(1), 5)
     a = s.simulate_from(np.full(5, 2e-3), noise)
     b = s.simulate(np.full(5, 2e-3), np.random.default_rng(1))
     np.testing.assert_array_equal(a, b)
@@ -75,3 +76,80 @@ def test_simulation_is_reproducible_and_common_noise_is_shared():
 def test_invalid_sensor_parameters_name_the_field(field, value):
     with pytest.raises(DceeInputError, match=f"sensor.{field}"):
         Sensor(**{field: value})
+
+
+FLUCTUATION = Sensor(family="lognormal", pd=0.5, log_sd=1.0)
+ROBUST = Sensor(family="lognormal", pd=0.5, log_sd=1.0, outlier=0.01)
+ROBUST_PAPER = Sensor(outlier=0.02, false_alarm=0.03)
+
+
+@pytest.mark.parametrize("s", [FLUCTUATION, ROBUST, ROBUST_PAPER], ids=["ln", "ln+out", "gauss+out"])
+@pytest.mark.parametrize("conc", [0.0, 2e-4, 5e-4, 3e-3, 0.5])
+def test_every_family_is_a_proper_distribution_over_readings(s, conc):
+    """P(non-detection) + ∫ p(z) dz over [threshold, max_reading] = 1, integrated in ln z."""
+    p_nd = float(s.likelihood(0.0, conc))
+    lo, hi = math.log(s.threshold), math.log(s.max_reading)
+    points = [math.log(conc)] if conc > s.threshold else None
+    mass, _ = integrate.quad(
+        lambda u: float(s.likelihood(math.exp(u), conc)) * math.exp(u),
+        lo,
+        hi,
+        points=points,
+        limit=400,
+        epsabs=1e-10,
+    )
+    assert p_nd + mass == pytest.approx(1.0, abs=2e-6)
+
+
+def test_lognormal_reading_keeps_the_mean_and_intermittency():
+    """Limiting case: a threshold far below C leaves E[z | detected] = C and P(z > 0) = Pd."""
+    s = Sensor(family="lognormal", pd=0.4, log_sd=0.8, threshold=1e-9)
+    z = s.simulate(np.full(400_000, 2e-2), np.random.default_rng(4))
+    assert (z > 0).mean() == pytest.approx(0.4, abs=0.004)
+    assert z[z > 0].mean() == pytest.approx(2e-2, rel=0.01)
+    assert np.log(z[z > 0]).std() == pytest.approx(0.8, rel=0.01)
+
+
+@pytest.mark.parametrize("s", [FLUCTUATION, ROBUST, ROBUST_PAPER], ids=["ln", "ln+out", "gauss+out"])
+def test_simulated_readings_follow_every_family(s):
+    rng = np.random.default_rng(12)
+    conc = 2e-3
+    z = s.simulate(np.full(300_000, conc), rng)
+    nd = z < s.threshold
+    p_nd = float(s.likelihood(0.0, conc))
+    assert nd.mean() == pytest.approx(p_nd, abs=4 * math.sqrt(p_nd * (1 - p_nd) / len(z)))
+    edges = np.array([5e-4, 1e-3, 2e-3, 4e-3, 1e-2, 1.0, 1e4])
+    counts, _ = np.histogram(z[~nd], bins=edges)
+    for k in range(len(edges) - 1):
+        lo, hi = math.log(edges[k]), math.log(edges[k + 1])
+        p, _ = integrate.quad(lambda u: float(s.likelihood(math.exp(u), conc)) * math.exp(u), lo, hi)
+        sd = math.sqrt(p * (1 - p) / len(z))
+        assert counts[k] / len(z) == pytest.approx(p, abs=5 * sd + 1e-6)
+
+
+@pytest.mark.parametrize("s", [FLUCTUATION, ROBUST, ROBUST_PAPER], ids=["ln", "ln+out", "gauss+out"])
+def test_compiled_likelihood_matches_reference_for_every_family(s):
+    rng = np.random.default_rng(6)
+    c = np.concatenate([[0.0, 1e-12, 1e-7, 5e-4], rng.gamma(0.5, 2e-3, 200), [0.5, 30.0]])
+    z = np.concatenate([[0.0, 4e-4, 5e-4], rng.gamma(0.7, 2e-3, 40), [1.0, 500.0, 1e4]])
+    for zi in z:
+        fast = np.array([log_likelihood(zi, ci, s.params) for ci in c])
+        np.testing.assert_allclose(fast, s.log_likelihood(zi, c), rtol=1e-9, atol=1e-12)
+
+
+def test_outlier_component_bounds_the_influence_of_one_reading():
+    """With outliers every particle keeps at least outlier · g(z): the likelihood ratio of a
+    spike between any two concentrations is bounded; without them it is astronomically large."""
+    c = np.geomspace(1e-6, 1e3, 200)
+    for s, bound in ((ROBUST, 1e4), (Sensor(outlier=0.01), 1e4)):
+        ll = s.log_likelihood(500.0, c)
+        assert ll.max() - ll.min() < math.log(bound)
+    ll = FLUCTUATION.log_likelihood(500.0, c)
+    assert ll.max() - ll.min() > 50
+
+
+@pytest.mark.parametrize("bad", [1e5, 1e200, float("inf"), float("nan"), "abc", None, 1j, True])
+def test_readings_outside_the_physical_range_are_refused(bad):
+    with pytest.raises(DceeInputError, match="reading"):
+        Sensor().check_reading(bad)
+    assert Sensor().check_reading(np.float32(2e-3)) == pytest.approx(2e-3)

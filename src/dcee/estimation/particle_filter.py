@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dcee import kernels
 from dcee.errors import DceeInputError
+from dcee.estimation.filter_kernels import history_log_likelihood
 from dcee.estimation.priors import SourcePrior
 from dcee.models.plume import IsotropicPlume, isotropic_concentration_reference
 from dcee.models.sensor import Sensor
@@ -189,7 +189,7 @@ class ParticleFilter:
     def log_likelihood(self, theta: np.ndarray, position: np.ndarray, reading: float) -> np.ndarray:
         """(N,) log p(reading | Θ) at ``position`` for source terms ``theta`` (N, 8)."""
         out = np.empty(theta.shape[0])
-        kernels.history_log_likelihood(
+        history_log_likelihood(
             theta,
             np.ones(theta.shape[0], dtype=np.bool_),
             np.asarray(position, dtype=np.float64).reshape(1, 3),
@@ -285,7 +285,7 @@ class ParticleFilter:
         active = np.isfinite(lp_prop)
         ll_prop = np.empty(self.n)
         pos, z, mult = self.history()
-        kernels.history_log_likelihood(
+        history_log_likelihood(
             proposal, active, pos, z, mult, self.plume.min_distance, self._sp, ll_prop
         )
         log_u = np.log(self.rng.random(self.n))

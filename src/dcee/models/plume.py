@@ -33,8 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from dcee import kernels
 from dcee.errors import DceeInputError
+from dcee.models import plume_kernels
 
 PARAMETER_NAMES: tuple[str, ...] = ("x", "y", "z", "q", "u", "phi", "zeta1", "zeta2")
 """Column order of Θ everywhere in dcee."""
@@ -96,7 +96,7 @@ def isotropic_concentration(
     """
     theta, positions = _check_shapes(theta, positions)
     out = np.empty((theta.shape[0], positions.shape[0]))
-    kernels.concentration_matrix(theta, positions, min_distance, out)
+    plume_kernels.concentration_matrix(theta, positions, min_distance, out)
     return out
 
 

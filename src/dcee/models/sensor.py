@@ -1,31 +1,52 @@
-"""Concentration sensor (the paper's sensor equation, eq. 3) with its exact likelihood.
+"""Concentration sensor and its likelihood: the paper's model and a fluctuation-aware one.
 
-Generative model of one reading z given the expected concentration C (g/m³):
+Generative model of one reading z given the expected (time-mean) concentration C (g/m³):
 
-1. With probability ``pd`` the sensor *detects*: y = C + v, v ~ N(0, σ(C)²),
-   σ(C) = ``sigma_frac``·C + ``sigma_min``. If y ≥ ``threshold`` the reading is y.
-2. Otherwise (missed, or y below the threshold) it is a *non-detection*. With probability
+1. With probability ``outlier`` the reading is an *outlier*: z is log-uniform on
+   [``threshold``, ``max_reading``] whatever C (a spike, a glitch, another source). This bounds
+   the influence of any one reading: no particle's likelihood can fall below
+   outlier · g(z), so one absurd reading cannot collapse the filter.
+2. Otherwise, with probability ``pd`` the sensor *detects*: y is drawn from the family's reading
+   distribution around C; if y ≥ ``threshold`` the reading is y.
+
+   * ``family = "gaussian"`` (the paper's eq. 3): y = C + v, v ~ N(0, σ(C)²),
+     σ(C) = ``sigma_frac``·C + ``sigma_min``.
+   * ``family = "lognormal"`` (concentration fluctuations): ln y ~ N(ln C − s²/2, s²), s =
+     ``log_sd``, so E[y] = C. A turbulent plume's hold-averaged concentration is intermittent
+     (zero for a share of the time: 1 − ``pd``, the intermittency factor) and, when present,
+     close to log-normal with a spread of the order of its mean (Yee & Chan 1997; Yee 2017
+     uses the same two-part form with a clipped gamma). This is the ``"fluctuation"``
+     likelihood of the scenarios.
+
+3. Otherwise (missed, or y below the threshold) it is a *non-detection*. With probability
    ``false_alarm`` a non-detection is replaced by a false alarm, z = threshold + E,
    E ~ Exponential(mean ``false_alarm_scale``); else the reading is reported as 0.
 
 Any reading below the threshold is treated as a non-detection, so a robot may pass its raw
-sub-threshold value. The likelihood below is the exact density of this model with respect to
-(point mass at "non-detection") + (Lebesgue measure above the threshold), so it integrates to 1
-over readings (tested), and :meth:`Sensor.simulate` draws from exactly this model (tested).
+sub-threshold value; a reading above ``max_reading`` (the instrument's physical range) is
+refused. The likelihood below is the exact density of this model with respect to (point mass at
+"non-detection") + (Lebesgue measure above the threshold), so it integrates to 1 over readings
+(tested), and :meth:`Sensor.simulate` draws from exactly this model (tested).
 
 Defaults are the paper's: threshold 0.5 mg/m³ = 5e-4 g/m³, Pd = 0.7; σ_min = 1e-4 g/m³ and
-σ_frac = 0.5 follow the authors' example code. ``false_alarm`` defaults to 0 (the paper's model).
+σ_frac = 0.5 follow the authors' example code; ``false_alarm`` and ``outlier`` default to 0 (the
+paper's model). ``max_reading`` = 1e4 g/m³: no gas in air at ambient conditions is denser than
+about 10 kg/m³, so a larger reading is a fault, not a measurement.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
-from scipy.special import log_ndtr
+from scipy.special import log_ndtr, ndtr
 
 from dcee.errors import DceeInputError
+from dcee.models.sensor_kernels import SensorParams
+
+Family = Literal["gaussian", "lognormal"]
 
 
 @dataclass(frozen=True)
@@ -38,125 +59,246 @@ class Sensor:
     sigma_frac: float = 0.5
     false_alarm: float = 0.0
     false_alarm_scale: float = 5e-4
+    family: Family = "gaussian"
+    log_sd: float = 1.0
+    outlier: float = 0.0
+    max_reading: float = 1e4
 
     def __post_init__(self) -> None:
+        if self.family not in ("gaussian", "lognormal"):
+            raise DceeInputError(
+                "sensor.family", f"must be gaussian or lognormal, got {self.family!r}"
+            )
         checks = {
-            "threshold": self.threshold > 0,
-            "pd": 0 < self.pd <= 1,
-            "sigma_min": self.sigma_min > 0,
-            "sigma_frac": self.sigma_frac >= 0,
-            "false_alarm": 0 <= self.false_alarm < 1,
-            "false_alarm_scale": self.false_alarm_scale > 0,
+            "threshold": (self.threshold > 0, "> 0"),
+            "pd": (0 < self.pd <= 1, "in (0, 1]"),
+            "sigma_min": (self.sigma_min > 0, "> 0"),
+            "sigma_frac": (self.sigma_frac >= 0, ">= 0"),
+            "false_alarm": (0 <= self.false_alarm < 1, "in [0, 1)"),
+            "false_alarm_scale": (self.false_alarm_scale > 0, "> 0"),
+            "log_sd": (0 < self.log_sd <= 5, "in (0, 5]"),
+            "outlier": (0 <= self.outlier < 1, "in [0, 1)"),
+            "max_reading": (self.max_reading > self.threshold, "> threshold"),
         }
-        allowed = {
-            "threshold": "> 0",
-            "pd": "in (0, 1]",
-            "sigma_min": "> 0",
-            "sigma_frac": ">= 0",
-            "false_alarm": "in [0, 1)",
-            "false_alarm_scale": "> 0",
-        }
-        for name, ok in checks.items():
+        for name, (ok, allowed) in checks.items():
             value = getattr(self, name)
             if not (ok and math.isfinite(value)):
-                raise DceeInputError(f"sensor.{name}", f"must be {allowed[name]}, got {value}")
+                raise DceeInputError(f"sensor.{name}", f"must be {allowed}, got {value}")
 
     @property
-    def params(self) -> np.ndarray:
-        """Parameters packed for the compiled kernels (order fixed by ``dcee.kernels``).
+    def lognormal(self) -> bool:
+        return self.family == "lognormal"
 
-        After the six fields come three derived constants for concentrations below
-        ``c_lin = 1e-6 σ_min`` (most particle-reading pairs far from a plume), where the kernels
-        use log P(missed | C) ≈ L0 + L1·C instead of an erfc: c_lin, L0 = log P(missed | 0) and
-        L1 = its derivative at 0. The neglected second-order term is below 1e-15 in absolute
-        log-likelihood (tested).
+    @property
+    def params(self) -> SensorParams:
+        """The model as the compiled kernels read it (:class:`SensorParams`).
+
+        Below ``c_lin`` the kernels use log P(missed | C) ≈ lin0 + lin1·C instead of an erfc.
+        Gaussian family: c_lin = 1e-6 σ_min, lin0 = log P(missed | 0), lin1 its derivative at
+        0; the neglected second-order term is below 1e-15 in absolute log-likelihood (tested).
+        Log-normal family: c_lin puts the threshold 9 s above the location, where
+        P(missed) = 1 − Pd Φ(−9) = 1 to 1e-18, so lin0 = lin1 = 0.
         """
-        x0 = self.threshold / self.sigma_min
-        log_missed0 = float(
-            np.logaddexp(
-                np.log1p(-self.pd) if self.pd < 1 else -np.inf, np.log(self.pd) + log_ndtr(x0)
+        if self.lognormal:
+            s = self.log_sd
+            v_thr = math.log(self.threshold)
+            c_lin = self.threshold * math.exp(0.5 * s * s - 9.0 * s)
+            lin0 = lin1 = 0.0
+        else:
+            v_thr = self.threshold
+            x0 = self.threshold / self.sigma_min
+            lin0 = float(
+                np.logaddexp(
+                    np.log1p(-self.pd) if self.pd < 1 else -np.inf,
+                    np.log(self.pd) + log_ndtr(x0),
+                )
             )
+            dx_dc = -(self.sigma_frac * self.threshold + self.sigma_min) / self.sigma_min**2
+            pdf = math.exp(-0.5 * x0 * x0) / math.sqrt(2.0 * math.pi)
+            lin1 = self.pd * pdf * dx_dc / math.exp(lin0)
+            c_lin = 1e-6 * self.sigma_min
+        return SensorParams(
+            lognormal=1.0 if self.lognormal else 0.0,
+            threshold=self.threshold,
+            v_threshold=v_thr,
+            pd=self.pd,
+            log_pd=math.log(self.pd),
+            sigma_min=self.sigma_min,
+            sigma_frac=self.sigma_frac,
+            log_sd=self.log_sd,
+            half_s2=0.5 * self.log_sd**2,
+            false_alarm=self.false_alarm,
+            false_alarm_scale=self.false_alarm_scale,
+            log_false_alarm=math.log(self.false_alarm) if self.false_alarm > 0 else -math.inf,
+            log_not_false_alarm=math.log1p(-self.false_alarm),
+            log_keep=math.log1p(-self.outlier),
+            log_outlier=self._log_outlier_times_z(),
+            c_lin=c_lin,
+            lin0=lin0,
+            lin1=lin1,
         )
-        dx_dc = -(self.sigma_frac * self.threshold + self.sigma_min) / self.sigma_min**2
-        pdf = math.exp(-0.5 * x0 * x0) / math.sqrt(2.0 * math.pi)
-        slope0 = self.pd * pdf * dx_dc / math.exp(log_missed0)
-        return np.array(
-            [
-                self.threshold,
-                self.pd,
-                self.sigma_min,
-                self.sigma_frac,
-                self.false_alarm,
-                self.false_alarm_scale,
-                1e-6 * self.sigma_min,
-                log_missed0,
-                slope0,
-            ]
-        )
+
+    def _log_outlier_times_z(self) -> float:
+        """log(outlier · g(z) · z) with g the log-uniform density on [threshold, max_reading]."""
+        if self.outlier == 0:
+            return -math.inf
+        return math.log(self.outlier) - math.log(math.log(self.max_reading / self.threshold))
 
     def is_detection(self, reading: np.ndarray | float) -> np.ndarray:
         """True where a reading counts as a detection (at or above the threshold)."""
         return np.asarray(reading) >= self.threshold
 
+    def check_reading(self, reading: object) -> float:
+        """A told reading as a float, or :class:`DceeInputError` naming what is allowed."""
+        if isinstance(reading, bool | str | bytes) or not isinstance(
+            reading, int | float | np.integer | np.floating | np.ndarray
+        ):
+            raise DceeInputError("reading", f"must be a real number in g/m³, got {reading!r}")
+        if isinstance(reading, np.ndarray) and (
+            reading.shape != () or reading.dtype.kind not in "iuf"
+        ):
+            raise DceeInputError("reading", f"must be a real number in g/m³, got {reading!r}")
+        value = float(reading)
+        if not math.isfinite(value):
+            raise DceeInputError("reading", f"must be a finite number, got {value}")
+        if value > self.max_reading:
+            raise DceeInputError(
+                "reading",
+                f"{value:g} g/m³ is above the sensor's physical maximum sensor.max_reading = "
+                f"{self.max_reading:g} g/m³ (a fault, not a measurement)",
+            )
+        return value
+
     # --- likelihood -------------------------------------------------------------------------
+
+    def _loc_sigma(self, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if self.lognormal:
+            loc = np.log(np.maximum(c, 1e-300)) - 0.5 * self.log_sd**2
+            return loc, np.full_like(loc, self.log_sd)
+        return c, self.sigma_frac * c + self.sigma_min
 
     def log_likelihood(self, reading: np.ndarray | float, conc: np.ndarray | float) -> np.ndarray:
         """log p(z | C), NumPy reference; broadcasts ``reading`` against ``conc``."""
         z = np.asarray(reading, dtype=np.float64)
         c = np.asarray(conc, dtype=np.float64)
-        sigma = self.sigma_frac * c + self.sigma_min
-        # P(non-detection | C) = (1 − Pd) + Pd Φ((thr − C)/σ)
-        log_below = log_ndtr((self.threshold - c) / sigma)
+        loc, sigma = self._loc_sigma(c)
+        v_thr = math.log(self.threshold) if self.lognormal else self.threshold
+        # P(no true detection | C) = (1 − Pd) + Pd Φ((v_thr − loc)/σ)
+        log_below = log_ndtr((v_thr - loc) / sigma)
         log_missed = np.logaddexp(
             np.log1p(-self.pd) if self.pd < 1 else -np.inf, np.log(self.pd) + log_below
         )
-        log_nd = log_missed + (np.log1p(-self.false_alarm) if self.false_alarm > 0 else 0.0)
-        r = (z - c) / sigma
+        log_keep = math.log1p(-self.outlier)
+        log_nd = log_missed + math.log1p(-self.false_alarm) + log_keep
+        zd = np.maximum(z, self.threshold)  # detections only; the rest is masked below
+        v = np.log(zd) if self.lognormal else zd
+        r = (v - loc) / sigma
         log_det = np.log(self.pd) - 0.5 * r * r - np.log(sigma) - 0.5 * np.log(2 * np.pi)
+        if self.lognormal:
+            log_det = log_det - np.log(zd)
         if self.false_alarm > 0:
             log_fa = (
                 np.log(self.false_alarm)
                 + log_missed
-                - (z - self.threshold) / self.false_alarm_scale
+                - (zd - self.threshold) / self.false_alarm_scale
                 - np.log(self.false_alarm_scale)
             )
             log_det = np.logaddexp(log_det, log_fa)
+        log_det = log_det + log_keep
+        if self.outlier > 0:
+            log_det = np.logaddexp(log_det, self._log_outlier_times_z() - np.log(zd))
         return np.where(z < self.threshold, log_nd, log_det)
 
     def likelihood(self, reading: np.ndarray | float, conc: np.ndarray | float) -> np.ndarray:
         """p(z | C): probability for a non-detection, density (per g/m³) for a detection."""
         return np.exp(self.log_likelihood(reading, conc))
 
+    def detection_probability(self, conc: np.ndarray | float) -> np.ndarray:
+        """P(z ≥ threshold | C), false alarms and outliers included."""
+        c = np.asarray(conc, dtype=np.float64)
+        loc, sigma = self._loc_sigma(c)
+        v_thr = math.log(self.threshold) if self.lognormal else self.threshold
+        true_det = self.pd * ndtr((loc - v_thr) / sigma)
+        model = true_det + (1 - true_det) * self.false_alarm
+        return (1 - self.outlier) * model + self.outlier
+
+    def transformed_readings(
+        self, readings: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """What the planners' kernels need of readings (any shape), in the transformed frame:
+        (v, false-alarm term, outlier term, log Jacobian), see :mod:`dcee.models.sensor_kernels`.
+
+        Non-detections get v = v_thr − 1 (below the threshold; never a detection). The log
+        Jacobian (−ln z for log-normal detections, else 0) is common to every particle, so it
+        only shifts the log evidence; the other terms are relative to it.
+        """
+        z = np.asarray(readings, dtype=np.float64)
+        det = z >= self.threshold
+        zd = np.where(det, z, self.threshold)
+        log_z = np.log(zd)
+        if self.lognormal:
+            v = np.where(det, log_z, math.log(self.threshold) - 1.0)
+            jac = np.where(det, -log_z, 0.0)
+        else:
+            v = np.where(det, z, 0.5 * self.threshold)
+            jac = np.zeros_like(z)
+        fa = (
+            math.log(self.false_alarm)
+            - (zd - self.threshold) / self.false_alarm_scale
+            - math.log(self.false_alarm_scale)
+            - jac
+            if self.false_alarm > 0
+            else np.full_like(z, -np.inf)
+        )
+        out = self._log_outlier_times_z() - log_z - jac
+        return v, fa, out, jac
+
     # --- simulation -------------------------------------------------------------------------
 
-    @staticmethod
-    def draw_noise(rng: np.random.Generator, size: int | tuple[int, ...]) -> np.ndarray:
-        """Standard random numbers for :meth:`simulate_from`: shape ``size + (4,)``.
+    @property
+    def n_noise(self) -> int:
+        """Standard random numbers per reading: 4, or 6 with outliers."""
+        return 6 if self.outlier > 0 else 4
+
+    def draw_noise(self, rng: np.random.Generator, size: int | tuple[int, ...]) -> np.ndarray:
+        """Standard random numbers for :meth:`simulate_from`: shape ``size + (n_noise,)``.
 
         Columns: uniform for detection, standard normal for the noise, uniform for false alarm,
-        standard exponential for its excess. Drawing the same count per reading keeps seeded
-        streams aligned by step, whatever the positions (common random numbers).
+        standard exponential for its excess, and with outliers a uniform for the outlier and a
+        uniform for its value. Drawing the same count per reading keeps seeded streams aligned
+        by step, whatever the positions (common random numbers).
         """
         size = (size,) if isinstance(size, int) else tuple(size)
-        out = np.empty((*size, 4))
+        out = np.empty((*size, self.n_noise))
         out[..., 0] = rng.random(size)
         out[..., 1] = rng.standard_normal(size)
         out[..., 2] = rng.random(size)
         out[..., 3] = rng.standard_exponential(size)
+        if self.outlier > 0:
+            out[..., 4] = rng.random(size)
+            out[..., 5] = rng.random(size)
         return out
 
     def simulate_from(self, conc: np.ndarray | float, noise: np.ndarray) -> np.ndarray:
-        """Readings for concentrations ``conc`` from pre-drawn ``noise`` (shape conc.shape+(4,)).
+        """Readings for concentrations ``conc`` from pre-drawn ``noise`` (conc.shape + (n,)).
 
         Non-detections are returned as 0.0.
         """
         c = np.asarray(conc, dtype=np.float64)
         noise = np.asarray(noise, dtype=np.float64)
-        y = c + (self.sigma_frac * c + self.sigma_min) * noise[..., 1]
+        if self.lognormal:
+            s = self.log_sd
+            y = c * np.exp(s * noise[..., 1] - 0.5 * s * s)
+        else:
+            y = c + (self.sigma_frac * c + self.sigma_min) * noise[..., 1]
         detected = (noise[..., 0] < self.pd) & (y >= self.threshold)
         false_alarm = (~detected) & (noise[..., 2] < self.false_alarm)
         fa_value = self.threshold + self.false_alarm_scale * noise[..., 3]
-        return np.where(detected, y, np.where(false_alarm, fa_value, 0.0))
+        z = np.where(detected, y, np.where(false_alarm, fa_value, 0.0))
+        if self.outlier > 0 and noise.shape[-1] >= 6:
+            spike = self.threshold * (self.max_reading / self.threshold) ** noise[..., 5]
+            z = np.where(noise[..., 4] < self.outlier, spike, z)
+        return z
 
     def simulate(self, conc: np.ndarray | float, rng: np.random.Generator) -> np.ndarray:
         """Draw readings (g/m³, 0.0 for a non-detection) for expected concentrations ``conc``."""

@@ -25,12 +25,14 @@ from typing import Any
 
 import numpy as np
 
-from dcee import kernels
 from dcee.errors import DceeInputError
 from dcee.estimation.particle_filter import systematic_resample
 from dcee.models.agent import GridAgent
+from dcee.models.plume_kernels import concentration_grid
 from dcee.models.sensor import Sensor
+from dcee.models.sensor_kernels import position_terms
 from dcee.planning.base import Belief, Planner
+from dcee.planning.predicted_kernels import predicted_posterior_stats
 
 
 @dataclass(frozen=True)
@@ -55,8 +57,8 @@ def predicted_posterior_stats_reference(
     task_readings: np.ndarray,
     sensor: Sensor,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """NumPy reference of :func:`dcee.kernels.predicted_posterior_stats` (same arguments, minus
-    ``center`` and the output arrays). Returns (log_evidence, mean, trace_cov, kl)."""
+    """NumPy reference of :func:`dcee.planning.predicted_kernels.predicted_posterior_stats`, from
+    concentrations and raw readings (no transformed terms, no ``center``, no output arrays). Returns (log_evidence, mean, trace_cov, kl)."""
     s_count, t_count = task_positions.shape
     log_ev = np.empty(s_count)
     mean = np.empty((s_count, 3))
@@ -91,7 +93,7 @@ class PredictionContext:
         self.indices = systematic_resample(belief.weights, rng, n_hypotheses)
         # Shuffle so that hypothesis j is not tied to a weight stratum at every stage.
         self.indices = rng.permutation(self.indices)
-        self.noise = Sensor.draw_noise(rng, (n_hypotheses, horizon))
+        self.noise = belief.sensor.draw_noise(rng, (n_hypotheses, horizon))
         self._theta = np.ascontiguousarray(belief.theta)
         self._source = np.ascontiguousarray(belief.source)
         self._center = belief.source_mean()
@@ -116,22 +118,22 @@ class PredictionContext:
         if new:
             pts = np.ascontiguousarray(np.array(new, dtype=np.float64))
             shape = (len(pts), self._theta.shape[0])
-            conc, log_nd, inv_sigma, log_sigma = (np.empty(shape) for _ in range(4))
-            kernels.concentration_grid(self._theta, pts, self.belief.plume.min_distance, conc)
-            kernels.position_terms(conc, self._sp, log_nd, inv_sigma, log_sigma)
-            self._rows.append((conc, log_nd, inv_sigma, log_sigma))
+            conc, loc, log_nd, inv_sigma, log_sigma = (np.empty(shape) for _ in range(5))
+            concentration_grid(self._theta, pts, self.belief.plume.min_distance, conc)
+            position_terms(conc, self._sp, loc, log_nd, inv_sigma, log_sigma)
+            self._rows.append((conc, loc, log_nd, inv_sigma, log_sigma))
             self._terms = None
         return out
 
     @property
     def terms(self) -> tuple[np.ndarray, ...]:
-        """(conc, log_nd, inv_sigma, log_sigma), each (P, N), at every cached position."""
+        """(conc, loc, log_nd, inv_sigma, log_sigma), each (P, N), at every cached position."""
         if self._terms is None and len(self._rows) == 1:
             self._terms = self._rows[0]
         elif self._terms is None:
             self._terms = tuple(
                 np.ascontiguousarray(np.concatenate([r[k] for r in self._rows], axis=0))
-                for k in range(4)
+                for k in range(5)
             )
         return self._terms
 
@@ -174,13 +176,13 @@ class PredictionContext:
         mean = np.empty((n_tasks, 3))
         trace = np.empty(n_tasks)
         kl_div = np.empty(n_tasks)
-        kernels.predicted_posterior_stats(
-            *self.terms,
+        predicted_posterior_stats(
+            *self.terms[1:],
             self._source,
             self.belief.weights,
             self._center,
             tp,
-            tz,
+            *self.sensor.transformed_readings(tz),
             self._sp,
             log_ev,
             mean,

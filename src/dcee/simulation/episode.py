@@ -83,7 +83,7 @@ def run_episode(
     next_snapshot = 0.0
     path_length = 0.0
     while True:
-        noise = Sensor.draw_noise(truth_rng, ())  # 4 numbers per step, whatever the position
+        noise = sensor.draw_noise(truth_rng, ())  # the same count per step, whatever the position
         conc = truth.concentration(position, t)
         reading = float(sensor.simulate_from(conc, noise))
         info = searcher.tell(position, reading, t)

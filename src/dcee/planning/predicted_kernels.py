@@ -1,0 +1,375 @@
+"""Compiled (numba) predicted-posterior statistics; NumPy reference:
+:func:`dcee.planning.predicted.predicted_posterior_stats_reference`.
+
+Readings arrive in the sensor's transformed frame (:mod:`dcee.models.sensor_kernels`,
+:meth:`dcee.models.sensor.Sensor.transformed_readings`): per task and stage the transformed
+reading v, the false-alarm term and the outlier term; the log Jacobian, common to every particle,
+is added to the log evidence by the caller. Kernels that loop over particles or hypotheses run in
+parallel (``prange``); every reduction is sequential within one output element, so results do
+not depend on the thread count.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from dcee.models.sensor_kernels import SensorParams
+from dcee.numeric import HALF_LOG_2PI, _vexp, logaddexp, vlogaddexp
+
+_BLOCK = 512  # particles per work item; fixed, so the summation order never depends on threads
+_N_ACC = 6  # accumulated sums per task: Σe, Σe·dx, Σe·dy, Σe·dz, Σe·|d|², Σe·ll
+
+
+@njit(cache=True, inline="always")
+def _loglik_cached(
+    v: float,
+    fa: float,
+    out: float,
+    loc: float,
+    lnd: float,
+    inv_s: float,
+    log_s: float,
+    sp: SensorParams,
+) -> float:
+    """log p(z | C) less the log Jacobian, from :func:`position_terms` and the transformed
+    reading terms; equals :func:`dcee.models.sensor_kernels.log_likelihood` minus the Jacobian."""
+    if v < sp.v_threshold:
+        return lnd
+    r = (v - loc) * inv_s
+    ld = sp.log_pd - 0.5 * r * r - log_s - HALF_LOG_2PI
+    if sp.false_alarm > 0.0:
+        log_missed = lnd - sp.log_not_false_alarm - sp.log_keep
+        ld = logaddexp(ld, fa + log_missed)
+    ld += sp.log_keep
+    if sp.log_outlier > -np.inf:
+        ld = logaddexp(ld, out)
+    return ld
+
+
+@njit(cache=True, inline="always")
+def _task_bound(
+    s: int,
+    task_positions: np.ndarray,
+    task_v: np.ndarray,
+    task_fa: np.ndarray,
+    task_out: np.ndarray,
+    max_log_nd: np.ndarray,
+    min_log_sigma: np.ndarray,
+    sp: SensorParams,
+) -> float:
+    """An upper bound of Σ_t log p(z_st | C_i) (less the Jacobian) over all particles i.
+
+    A detection's density term is at most log Pd − log σ − ½ log 2π with σ ≥ min σ; a
+    false-alarm term at most its density times max P(missed); the outlier term is exact.
+    """
+    b = 0.0
+    for t in range(task_positions.shape[1]):
+        p = task_positions[s, t]
+        v = task_v[s, t]
+        if v < sp.v_threshold:
+            b += max_log_nd[p]
+            continue
+        ld = sp.log_pd - min_log_sigma[p] - HALF_LOG_2PI
+        if sp.false_alarm > 0.0:
+            log_missed_max = max_log_nd[p] - sp.log_not_false_alarm - sp.log_keep
+            ld = logaddexp(ld, task_fa[s, t] + log_missed_max)
+        ld += sp.log_keep
+        if sp.log_outlier > -np.inf:
+            ld = logaddexp(ld, task_out[s, t])
+        b += ld
+    return b
+
+
+@njit(cache=True)
+def _task_bounds(
+    task_positions: np.ndarray,
+    task_v: np.ndarray,
+    task_fa: np.ndarray,
+    task_out: np.ndarray,
+    max_log_nd: np.ndarray,
+    min_log_sigma: np.ndarray,
+    sp: SensorParams,
+    out: np.ndarray,
+) -> None:
+    for s in range(task_positions.shape[0]):
+        out[s] = _task_bound(
+            s, task_positions, task_v, task_fa, task_out, max_log_nd, min_log_sigma, sp
+        )
+
+
+@njit(cache=True, parallel=True, fastmath={"contract"})
+def _grouped_stats(
+    loc: np.ndarray,
+    log_nd: np.ndarray,
+    inv_sigma: np.ndarray,
+    log_sigma: np.ndarray,
+    source: np.ndarray,
+    weights: np.ndarray,
+    center: np.ndarray,
+    group_start: np.ndarray,
+    task_positions: np.ndarray,
+    task_v: np.ndarray,
+    task_fa: np.ndarray,
+    task_out: np.ndarray,
+    bound: np.ndarray,
+    sp: SensorParams,
+    want_moments: bool,
+    want_kl: bool,
+    partial: np.ndarray,
+) -> None:
+    """partial[b, s, :] = the six sums of task s over particle block b.
+
+    Tasks group_start[g]..group_start[g+1]−1 share one position sequence (equal task_positions
+    rows), so a particle's per-position terms are loaded once and the loops over the group's
+    hypothesised readings are branch-free arithmetic that LLVM vectorises (the outlier
+    component's log-sum-exp included). Weights are e_i = w_i exp(ll_i − bound_s): one pass, no
+    per-task maximum. With false alarms the exact scalar likelihood is used instead (slower, not
+    vectorised). Sums a planner does not need (the location moments, Σ e·ll for the KL
+    divergence) are left at zero when not wanted.
+    """
+    n = source.shape[0]
+    t_count = task_positions.shape[1]
+    n_groups = group_start.shape[0] - 1
+    n_blocks = (n + _BLOCK - 1) // _BLOCK
+    v_thr = sp.v_threshold
+    log_pd_const = sp.log_pd - HALF_LOG_2PI
+    log_keep = sp.log_keep
+    with_false_alarms = sp.false_alarm > 0.0
+    with_outliers = sp.log_outlier > -np.inf
+    for item in prange(n_groups * n_blocks):
+        g = item // n_blocks
+        b = item % n_blocks
+        s0 = group_start[g]
+        k = group_start[g + 1] - s0
+        z = np.empty((t_count, k))
+        fa = np.empty((t_count, k))
+        out = np.empty((t_count, k))
+        for t in range(t_count):
+            for j in range(k):
+                z[t, j] = task_v[s0 + j, t]
+                fa[t, j] = task_fa[s0 + j, t]
+                out[t, j] = task_out[s0 + j, t]
+        bnd = bound[s0 : s0 + k].copy()
+        ll = np.empty(k)
+        a0 = np.zeros(k)
+        a1 = np.zeros(k)
+        a2 = np.zeros(k)
+        a3 = np.zeros(k)
+        a4 = np.zeros(k)
+        a5 = np.zeros(k)
+        for i in range(b * _BLOCK, min(n, (b + 1) * _BLOCK)):
+            wi = weights[i]
+            if wi <= 0.0:
+                continue
+            dx = source[i, 0] - center[0]
+            dy = source[i, 1] - center[1]
+            dz = source[i, 2] - center[2]
+            d2 = dx * dx + dy * dy + dz * dz
+            ll[:] = 0.0
+            for t in range(t_count):
+                p = task_positions[s0, t]
+                m = loc[p, i]
+                lnd = log_nd[p, i]
+                inv_s = inv_sigma[p, i]
+                if with_false_alarms:
+                    for j in range(k):
+                        ll[j] += _loglik_cached(
+                            z[t, j], fa[t, j], out[t, j], m, lnd, inv_s, log_sigma[p, i], sp
+                        )
+                elif with_outliers:
+                    det_const = log_pd_const - log_sigma[p, i] + log_keep
+                    for j in range(k):
+                        zj = z[t, j]
+                        r = (zj - m) * inv_s
+                        d = vlogaddexp(det_const - 0.5 * r * r, out[t, j])
+                        ll[j] += d if zj >= v_thr else lnd
+                else:
+                    det_const = log_pd_const - log_sigma[p, i]
+                    for j in range(k):
+                        zj = z[t, j]
+                        r = (zj - m) * inv_s
+                        ll[j] += det_const - 0.5 * r * r if zj >= v_thr else lnd
+            for j in range(k):
+                e = wi * _vexp(ll[j] - bnd[j])
+                a0[j] += e
+                if want_moments:
+                    a1[j] += e * dx
+                    a2[j] += e * dy
+                    a3[j] += e * dz
+                    a4[j] += e * d2
+                if want_kl:
+                    a5[j] += e * ll[j]
+        for j in range(k):
+            partial[b, s0 + j, 0] = a0[j]
+            partial[b, s0 + j, 1] = a1[j]
+            partial[b, s0 + j, 2] = a2[j]
+            partial[b, s0 + j, 3] = a3[j]
+            partial[b, s0 + j, 4] = a4[j]
+            partial[b, s0 + j, 5] = a5[j]
+
+
+@njit(cache=True, parallel=True)
+def _exact_task_stats(
+    loc: np.ndarray,
+    log_nd: np.ndarray,
+    inv_sigma: np.ndarray,
+    log_sigma: np.ndarray,
+    source: np.ndarray,
+    weights: np.ndarray,
+    center: np.ndarray,
+    tasks: np.ndarray,
+    task_positions: np.ndarray,
+    task_v: np.ndarray,
+    task_fa: np.ndarray,
+    task_out: np.ndarray,
+    sp: SensorParams,
+    sums: np.ndarray,
+    log_max: np.ndarray,
+) -> None:
+    """Two-pass fallback for tasks whose bound was far above every particle's log-likelihood
+    (the one-pass weights would underflow): sums relative to the task's true maximum."""
+    n = source.shape[0]
+    for q in prange(tasks.shape[0]):
+        s = tasks[q]
+        ll = np.empty(n)
+        mx = -np.inf
+        for i in range(n):
+            v = 0.0
+            for t in range(task_positions.shape[1]):
+                p = task_positions[s, t]
+                v += _loglik_cached(
+                    task_v[s, t],
+                    task_fa[s, t],
+                    task_out[s, t],
+                    loc[p, i],
+                    log_nd[p, i],
+                    inv_sigma[p, i],
+                    log_sigma[p, i],
+                    sp,
+                )
+            ll[i] = v
+            if weights[i] > 0.0 and v > mx:
+                mx = v
+        log_max[q] = mx
+        for a in range(_N_ACC):
+            sums[q, a] = 0.0
+        for i in range(n):
+            wi = weights[i]
+            if wi <= 0.0:
+                continue
+            e = wi * math.exp(ll[i] - mx)
+            dx = source[i, 0] - center[0]
+            dy = source[i, 1] - center[1]
+            dz = source[i, 2] - center[2]
+            sums[q, 0] += e
+            sums[q, 1] += e * dx
+            sums[q, 2] += e * dy
+            sums[q, 3] += e * dz
+            sums[q, 4] += e * (dx * dx + dy * dy + dz * dz)
+            sums[q, 5] += e * ll[i]
+
+
+# A task whose best particle lies more than this below its bound is redone exactly: beyond it the
+# one-pass weights of particles within e^-60 of the best would leave float64's normal range.
+_BOUND_SLACK = 600.0
+
+
+def predicted_posterior_stats(
+    loc: np.ndarray,
+    log_nd: np.ndarray,
+    inv_sigma: np.ndarray,
+    log_sigma: np.ndarray,
+    source: np.ndarray,
+    weights: np.ndarray,
+    center: np.ndarray,
+    task_positions: np.ndarray,
+    task_v: np.ndarray,
+    task_fa: np.ndarray,
+    task_out: np.ndarray,
+    task_jac: np.ndarray,
+    sp: SensorParams,
+    log_evidence: np.ndarray,
+    mean: np.ndarray,
+    trace_cov: np.ndarray,
+    kl: np.ndarray,
+    want_moments: bool = True,
+    want_kl: bool = True,
+) -> None:
+    """Statistics of the predicted posterior for each task (a hypothesised reading sequence).
+
+    loc, log_nd, inv_sigma, log_sigma (P, N): :func:`dcee.models.sensor_kernels.position_terms`
+    of every particle at P distinct positions; source (N, 3): source locations; weights (N,)
+    normalised; center (3,): a reference point subtracted before the second moments are formed
+    (keeps trace_cov accurate); task_positions (S, T) int indices into the position terms;
+    task_v, task_fa, task_out, task_jac (S, T): the hypothesised readings as
+    :meth:`~dcee.models.sensor.Sensor.transformed_readings` gives them. Outputs per task s, with
+    w'_i ∝ w_i Π_t p(z_st | C_i(p_st)): log_evidence[s] = log Σ_i w_i Π_t p(z_st | ·);
+    mean[s] (3,) = Σ w'_i s_i; trace_cov[s] = Σ w'_i ‖s_i − mean‖²; kl[s] = KL(w' ‖ w). mean
+    and trace_cov are NaN unless ``want_moments``, kl is NaN unless ``want_kl``.
+
+    Consecutive tasks with the same position row form a group that shares per-particle loads
+    (callers list all hypotheses of one candidate sequence together). Memory: O(S · N / 512).
+    """
+    task_positions = np.ascontiguousarray(task_positions, dtype=np.int64)
+    task_v, task_fa, task_out = (
+        np.ascontiguousarray(a, dtype=np.float64) for a in (task_v, task_fa, task_out)
+    )
+    s_count = task_positions.shape[0]
+    new_group = np.ones(s_count, dtype=bool)
+    new_group[1:] = np.any(task_positions[1:] != task_positions[:-1], axis=1)
+    group_start = np.append(np.flatnonzero(new_group), s_count).astype(np.int64)
+    live = weights > 0.0
+    max_log_nd = np.where(live, log_nd, -np.inf).max(axis=1)
+    min_log_sigma = np.where(live, log_sigma, np.inf).min(axis=1)
+    bound = np.empty(s_count)
+    _task_bounds(task_positions, task_v, task_fa, task_out, max_log_nd, min_log_sigma, sp, bound)
+    n_blocks = (source.shape[0] + _BLOCK - 1) // _BLOCK
+    partial = np.empty((n_blocks, s_count, _N_ACC))
+    common = (loc, log_nd, inv_sigma, log_sigma, source, weights, center)
+    _grouped_stats(
+        *common,
+        group_start,
+        task_positions,
+        task_v,
+        task_fa,
+        task_out,
+        bound,
+        sp,
+        want_moments,
+        want_kl,
+        partial,
+    )
+    sums = partial.sum(axis=0)  # fixed order over blocks: independent of the thread count
+    log_ref = bound.copy()
+    # Σ e_i ll_i was accumulated with e relative to the bound; a task is redone exactly when its
+    # largest weight e^(ll_max − bound) is too small for the one-pass sums to be accurate.
+    with np.errstate(divide="ignore"):
+        too_small = ~(np.log(sums[:, 0]) > -_BOUND_SLACK)
+    if np.any(too_small):
+        redo = np.flatnonzero(too_small).astype(np.int64)
+        redo_sums = np.empty((len(redo), _N_ACC))
+        redo_max = np.empty(len(redo))
+        _exact_task_stats(
+            *common,
+            redo,
+            task_positions,
+            task_v,
+            task_fa,
+            task_out,
+            sp,
+            redo_sums,
+            redo_max,
+        )
+        sums[redo] = redo_sums
+        log_ref[redo] = redo_max
+    s0 = sums[:, 0]
+    offset = sums[:, 1:4] / s0[:, None]
+    log_ev = log_ref + np.log(s0)
+    kl[:] = sums[:, 5] / s0 - log_ev if want_kl else np.nan
+    log_evidence[:] = log_ev + np.asarray(task_jac, dtype=np.float64).sum(axis=1)
+    mean[:] = center + offset if want_moments else np.nan
+    trace = np.maximum(sums[:, 4] / s0 - np.einsum("ij,ij->i", offset, offset), 0.0)
+    trace_cov[:] = trace if want_moments else np.nan
