@@ -83,7 +83,9 @@ ROBUST = Sensor(family="lognormal", pd=0.5, log_sd=1.0, outlier=0.01)
 ROBUST_PAPER = Sensor(outlier=0.02, false_alarm=0.03)
 
 
-@pytest.mark.parametrize("s", [FLUCTUATION, ROBUST, ROBUST_PAPER], ids=["ln", "ln+out", "gauss+out"])
+@pytest.mark.parametrize(
+    "s", [FLUCTUATION, ROBUST, ROBUST_PAPER], ids=["ln", "ln+out", "gauss+out"]
+)
 @pytest.mark.parametrize("conc", [0.0, 2e-4, 5e-4, 3e-3, 0.5])
 def test_every_family_is_a_proper_distribution_over_readings(s, conc):
     """P(non-detection) + ∫ p(z) dz over [threshold, max_reading] = 1, integrated in ln z."""
@@ -110,7 +112,9 @@ def test_lognormal_reading_keeps_the_mean_and_intermittency():
     assert np.log(z[z > 0]).std() == pytest.approx(0.8, rel=0.01)
 
 
-@pytest.mark.parametrize("s", [FLUCTUATION, ROBUST, ROBUST_PAPER], ids=["ln", "ln+out", "gauss+out"])
+@pytest.mark.parametrize(
+    "s", [FLUCTUATION, ROBUST, ROBUST_PAPER], ids=["ln", "ln+out", "gauss+out"]
+)
 def test_simulated_readings_follow_every_family(s):
     rng = np.random.default_rng(12)
     conc = 2e-3
@@ -122,12 +126,16 @@ def test_simulated_readings_follow_every_family(s):
     counts, _ = np.histogram(z[~nd], bins=edges)
     for k in range(len(edges) - 1):
         lo, hi = math.log(edges[k]), math.log(edges[k + 1])
-        p, _ = integrate.quad(lambda u: float(s.likelihood(math.exp(u), conc)) * math.exp(u), lo, hi)
+        p, _ = integrate.quad(
+            lambda u: float(s.likelihood(math.exp(u), conc)) * math.exp(u), lo, hi
+        )
         sd = math.sqrt(p * (1 - p) / len(z))
         assert counts[k] / len(z) == pytest.approx(p, abs=5 * sd + 1e-6)
 
 
-@pytest.mark.parametrize("s", [FLUCTUATION, ROBUST, ROBUST_PAPER], ids=["ln", "ln+out", "gauss+out"])
+@pytest.mark.parametrize(
+    "s", [FLUCTUATION, ROBUST, ROBUST_PAPER], ids=["ln", "ln+out", "gauss+out"]
+)
 def test_compiled_likelihood_matches_reference_for_every_family(s):
     rng = np.random.default_rng(6)
     c = np.concatenate([[0.0, 1e-12, 1e-7, 5e-4], rng.gamma(0.5, 2e-3, 200), [0.5, 30.0]])

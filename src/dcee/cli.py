@@ -27,6 +27,30 @@ TRUTH_OPTION = click.option(
     help="What the sensor sees: isotropic | filament | PATH of a .npy/.h5 recording "
     "[default: the scenario's truth.model].",
 )
+LIKELIHOOD_OPTION = click.option(
+    "--likelihood",
+    type=click.Choice(["paper", "fluctuation"]),
+    help="Reading model of the filter and planners: paper (eq. 3) | fluctuation (intermittent "
+    "log-normal, for turbulent plumes) [default: the scenario's estimator.likelihood].",
+)
+SET_OPTION = click.option(
+    "--set",
+    "settings",
+    multiple=True,
+    metavar="PATH=VALUE",
+    help="Override any scenario setting, e.g. --set sensor.average=0 --set estimator.log_sd=0.8 "
+    "(repeatable; VALUE is TOML).",
+)
+
+
+def _overrides(likelihood: str | None, settings: tuple[str, ...]) -> dict[str, Any]:
+    """The dotted scenario overrides of --likelihood and --set (checked before any work)."""
+    from dcee.scenarios.config import parse_setting
+
+    out: dict[str, Any] = dict(parse_setting(s) for s in settings)
+    if likelihood:
+        out["estimator.likelihood"] = likelihood
+    return out
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -66,6 +90,8 @@ def cli() -> None:
     help="Also write the summary JSON here.",
 )
 @TRUTH_OPTION
+@LIKELIHOOD_OPTION
+@SET_OPTION
 @click.option("--animate", is_flag=True, help="Also write animation.gif.")
 @click.option("--no-figure", is_flag=True, help="Skip figure.png.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress display.")
@@ -80,6 +106,8 @@ def run(
     out_dir: Path | None,
     json_file: Path | None,
     truth: str | None,
+    likelihood: str | None,
+    settings: tuple[str, ...],
     animate: bool,
     no_figure: bool,
     quiet: bool,
@@ -101,6 +129,7 @@ def run(
             "search.budget": budget,
             "unknown": unknown,
             "truth.model": truth_choice(truth) if truth else None,
+            **_overrides(likelihood, settings),
         }
     )
     out_dir = (
@@ -317,6 +346,8 @@ def _numba_threads() -> int:
 @click.option("--unknown", type=click.Choice(["source", "full"]), help="Override unknown set.")
 @click.option("--particles", type=int, help="Override the particle count.")
 @TRUTH_OPTION
+@LIKELIHOOD_OPTION
+@SET_OPTION
 def bench(
     suite: str,
     strategies: str,
@@ -327,6 +358,8 @@ def bench(
     unknown: str | None,
     particles: int | None,
     truth: str | None,
+    likelihood: str | None,
+    settings: tuple[str, ...],
 ) -> None:
     """Run a campaign of simulated searches; resumes where a previous run stopped."""
     from rich.progress import (
@@ -343,7 +376,14 @@ def bench(
 
     names = tuple(s.strip() for s in strategies.split(",") if s.strip())
     campaign = Campaign(
-        out_dir, suite, names, repeats, unknown, particles, truth_choice(truth) if truth else None
+        out_dir,
+        suite,
+        names,
+        repeats,
+        unknown,
+        particles,
+        truth_choice(truth) if truth else None,
+        _overrides(likelihood, settings),
     )
     failures: list[str] = []
     columns = (

@@ -23,7 +23,7 @@ import os
 import time
 import traceback
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -154,6 +154,8 @@ class Campaign:
     unknown: str | None = None
     particles: int | None = None
     truth: str | dict[str, str] | None = None
+    overrides: dict[str, Any] = field(default_factory=dict)
+    """dotted scenario settings applied to every scenario (``--likelihood``, ``--set``)"""
 
     def __post_init__(self) -> None:
         from dcee.campaign.suites import suite_scenarios
@@ -166,7 +168,10 @@ class Campaign:
         for s in self.strategies:
             planner_class(s)  # unknown names fail before anything runs
         self.scenarios = {
-            s.name: s for s in suite_scenarios(self.suite, self.unknown, self.particles, self.truth)
+            s.name: s
+            for s in suite_scenarios(
+                self.suite, self.unknown, self.particles, self.truth, self.overrides
+            )
         }
         if self.truth is not None:
             from dcee.simulation import make_truth
@@ -184,6 +189,8 @@ class Campaign:
         }
         if self.truth is not None:  # absent, not null, so that older campaign folders resume
             settings["truth"] = self.truth
+        if self.overrides:
+            settings["overrides"] = dict(sorted(self.overrides.items()))
         return settings
 
     def prepare(self) -> None:

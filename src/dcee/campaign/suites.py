@@ -8,6 +8,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from dcee.errors import DceeInputError
 from dcee.scenarios import Scenario, load_scenario
 
@@ -25,9 +27,10 @@ def suite_scenarios(
     unknown: str | None = None,
     particles: int | None = None,
     truth: str | dict[str, str] | None = None,
+    overrides: dict[str, Any] | None = None,
 ) -> list[Scenario]:
     """The suite's scenarios with its overrides, then the user's (``unknown``, ``particles``,
-    ``truth``: the ``truth.model`` every scenario gets)."""
+    ``truth``: the ``truth.model`` every scenario gets, and any dotted ``overrides``)."""
     if suite not in SUITES:
         raise DceeInputError("suite", f"unknown suite {suite!r}; choose one of {', '.join(SUITES)}")
     spec = SUITES[suite]
@@ -36,7 +39,12 @@ def suite_scenarios(
         scenario = load_scenario(name).with_overrides(**spec["overrides"])
         out.append(
             scenario.with_overrides(
-                **{"unknown": unknown, "search.particles": particles, "truth.model": truth}
+                **{
+                    "unknown": unknown,
+                    "search.particles": particles,
+                    "truth.model": truth,
+                    **(overrides or {}),
+                }
             )
         )
     return out

@@ -1,10 +1,20 @@
 """Particle filter for the source term (the paper's Algorithm 1), with a full-history MCMC move.
 
 Per reading: weights are updated in log space; when the effective sample size (ESS) falls below
-``resample_threshold · N`` the particles are resampled systematically and moved by
-``mcmc_steps`` random-walk Metropolis–Hastings steps whose acceptance uses the prior and the
-likelihood of *every* reading so far, so the chain leaves the true posterior invariant.
-(AutoSTE and Stone Soup accept on the latest reading only, which does not target the posterior.)
+``resample_threshold · N`` the particles are resampled systematically and *rejuvenated* by
+Metropolis–Hastings sweeps whose acceptance uses the prior and the likelihood of *every* reading
+so far, so the chain leaves the true posterior invariant. (AutoSTE and Stone Soup accept on the
+latest reading only, which does not target the posterior.)
+
+Keeping every mode: a random-walk move cannot carry mass between separated modes, so after a
+resampling that has concentrated the particles in one region a minority mode that later readings
+favour can be lost for good. Each sweep is therefore a mixture: a share ``global_share`` of the
+particles proposes a new source location from the prior (an independence proposal for the
+location block; its acceptance ratio is the likelihood ratio times the prior ratio of the other
+columns, here 1), the rest a regularised random walk. Sweeps repeat until at least
+``diversify`` of the particles have moved since the resampling (at least ``mcmc_steps``, at most
+``max_sweeps`` sweeps); the acceptance rate, the number of distinct particles and the sweeps are
+returned in :class:`UpdateInfo` for every step.
 
 Degeneracy: in log space the weights cannot all underflow, but a reading that every particle
 finds very unlikely can collapse the weight onto a handful of particles. When the ESS after a
@@ -13,6 +23,12 @@ likelihood tempering: exponents 0 = β₀ < β₁ < … < 1 chosen by bisection 
 ESS ≈ ``resample_threshold · N``, with resampling and MCMC moves targeting prior × history ×
 p(z|Θ)^β between stages (an adaptive tempered SMC step; it targets the exact posterior). Each
 such event is recorded in :attr:`ParticleFilter.recoveries`.
+
+Outlier safety: a reading above the sensor's ``max_reading`` (or not a finite real number) is
+refused with :class:`DceeInputError` before anything changes. A reading that *no* particle can
+explain (log-likelihood −inf or NaN for all) is not assimilated and is recorded as a recovery of
+kind "rejected"; so no sequence of inputs leaves the filter with no live particle. The sensor's
+outlier component (``Sensor.outlier``) bounds the influence of any finite reading.
 
 Known parameters stay at their fixed values: the filter stores full (N, 8) source terms but only
 the unknown columns are sampled, moved and reported by :attr:`ParticleFilter.particles`.
@@ -59,12 +75,17 @@ def effective_sample_size(weights: np.ndarray) -> float:
 
 @dataclass(frozen=True)
 class UpdateInfo:
-    """What one :meth:`ParticleFilter.update` did."""
+    """What one :meth:`ParticleFilter.update` did: the ESS the reading left (before any
+    resampling), whether it resampled, the mean Metropolis–Hastings acceptance rate, tempering
+    stages (1 = none), move sweeps, and the distinct particles after the move (N if none)."""
 
     ess: float
     resampled: bool
     acceptance: float
     tempering_stages: int
+    move_sweeps: int = 0
+    distinct: int = 0
+    rejected: bool = False
 
 
 class ParticleFilter:
@@ -77,8 +98,11 @@ class ParticleFilter:
     n_particles: N.
     seed: an int or a ``numpy.random.Generator``; every random draw of the filter comes from it.
     resample_threshold: resample when ESS < this · N (paper: N/2).
-    mcmc_steps: Metropolis–Hastings sweeps after each resampling.
+    mcmc_steps: least Metropolis–Hastings sweeps after each resampling.
     collapse_threshold: below this ESS/N a reading is assimilated by tempering (see module doc).
+    global_share: share of particles proposing a location from the prior in each sweep.
+    diversify: sweep until this share of the particles has moved since the resampling.
+    max_sweeps: most sweeps after one resampling.
     """
 
     def __init__(
@@ -92,6 +116,9 @@ class ParticleFilter:
         mcmc_steps: int = 1,
         collapse_threshold: float = 0.01,
         max_tempering_stages: int = 30,
+        global_share: float = 0.2,
+        diversify: float = 0.5,
+        max_sweeps: int = 8,
     ) -> None:
         if int(n_particles) != n_particles or n_particles < 2:
             raise DceeInputError("particles", f"must be an integer >= 2, got {n_particles}")
@@ -101,6 +128,14 @@ class ParticleFilter:
             raise DceeInputError("collapse_threshold", "must be in [0, resample_threshold)")
         if mcmc_steps < 0:
             raise DceeInputError("mcmc_steps", "must be >= 0")
+        if not 0 <= global_share <= 1:
+            raise DceeInputError("global_share", f"must be in [0, 1], got {global_share}")
+        if not 0 <= diversify <= 1:
+            raise DceeInputError("diversify", f"must be in [0, 1], got {diversify}")
+        if int(max_sweeps) != max_sweeps or max_sweeps < max(1, mcmc_steps):
+            raise DceeInputError(
+                "max_sweeps", f"must be an integer >= mcmc_steps, got {max_sweeps}"
+            )
         self.prior = prior
         self.sensor = sensor
         self.plume = plume or IsotropicPlume()
@@ -110,7 +145,12 @@ class ParticleFilter:
         self.mcmc_steps = mcmc_steps
         self.collapse_threshold = collapse_threshold
         self.max_tempering_stages = max_tempering_stages
+        self.global_share = global_share
+        self.diversify = diversify
+        self.max_sweeps = int(max_sweeps)
         self._unknown = np.array(prior.unknown)
+        # the unknown location columns: the block the global proposal redraws from the prior
+        self._loc_block = [int(i) for i in self._unknown if i < 3]
         self._sp = sensor.params
         self.theta = prior.sample(self.rng, self.n)
         self._logw = np.full(self.n, -math.log(self.n))
@@ -121,7 +161,8 @@ class ParticleFilter:
         self._hist_mult: list[float] = []
         self._nd_index: dict[tuple[float, float, float], int] = {}
         self.n_readings = 0
-        self.recoveries: list[dict[str, float]] = []
+        self.recoveries: list[dict[str, float | str]] = []
+        self._origin = np.arange(self.n)
         self.n_resamples = 0
 
     # --- public state -----------------------------------------------------------------------
@@ -169,6 +210,32 @@ class ParticleFilter:
         d = self.source_locations - np.asarray(true_location)[None, :]
         return float(math.sqrt(self.weights @ np.einsum("ij,ij->i", d, d)))
 
+    def in_credible_region(self, true_location: np.ndarray, level: float = 0.95) -> bool:
+        """Whether ``true_location`` (3,) lies in the posterior's ``level`` credible region of
+        the unknown location coordinates.
+
+        The region is the ellipsoid, shaped by the posterior covariance, that holds ``level`` of
+        the posterior mass: the truth is inside when its Mahalanobis distance is at most the
+        weighted ``level`` quantile of the particles' distances (no Gaussian assumption on the
+        radial profile). Over many searches a calibrated filter contains the truth ``level`` of
+        the time.
+        """
+        cols = [i for i in range(3) if i in self._loc_block]
+        if not cols:
+            return True
+        x = self.theta[:, cols]
+        w = self.weights
+        mean = w @ x
+        cov = np.atleast_2d(np.cov(x, rowvar=False, aweights=w, ddof=0))
+        inv = np.linalg.pinv(cov)
+        d = x - mean
+        dist = np.einsum("ij,jk,ik->i", d, inv, d)
+        t = np.asarray(true_location, dtype=np.float64)[cols] - mean
+        order = np.argsort(dist)
+        cum = np.cumsum(w[order])
+        cutoff = dist[order][min(int(np.searchsorted(cum, level)), len(cum) - 1)]
+        return bool(t @ inv @ t <= cutoff)
+
     @property
     def ess(self) -> float:
         return effective_sample_size(self.weights)
@@ -206,12 +273,20 @@ class ParticleFilter:
         position = np.asarray(position, dtype=np.float64)
         if position.shape != (3,) or not np.all(np.isfinite(position)):
             raise DceeInputError("position", f"must be 3 finite numbers, got {position!r}")
-        if not math.isfinite(float(reading)):
-            raise DceeInputError("reading", f"must be a finite number, got {reading}")
-        reading = float(reading)
+        reading = self.sensor.check_reading(reading)
         if reading < self.sensor.threshold:
             reading = 0.0
         ll_new = self.log_likelihood(self.theta, position, reading)
+        ll_new[np.isnan(ll_new)] = -np.inf
+        live = np.isfinite(self._logw)
+        if not np.any(np.isfinite(ll_new[live])):
+            # No live particle can explain the reading at all: assimilating it would kill the
+            # filter. Keep the belief and record the refusal.
+            self.n_readings += 1
+            self.recoveries.append(
+                {"kind": "rejected", "reading_index": float(self.n_readings), "reading": reading}
+            )
+            return UpdateInfo(self.ess, False, math.nan, 1, 0, self.n, rejected=True)
         entry, base_mult = self._add_to_history(position, reading)
         self.n_readings += 1
 
@@ -222,9 +297,10 @@ class ParticleFilter:
             self._hist_loglik += ll_new
             self._set_logw(logw)
             if ess < self.resample_threshold * self.n:
-                acc = self._resample_move(self.mcmc_steps)
-                return UpdateInfo(ess, True, acc, 1)
-            return UpdateInfo(ess, False, math.nan, 1)
+                self._resample()
+                acc, sweeps, distinct = self._rejuvenate()
+                return UpdateInfo(ess, True, acc, 1, sweeps, distinct)
+            return UpdateInfo(ess, False, math.nan, 1, 0, self.n)
         return self._tempered_update(ll_new, entry, base_mult, ess)
 
     # --- internals --------------------------------------------------------------------------
@@ -257,15 +333,27 @@ class ParticleFilter:
         self._logw = np.full(self.n, -math.log(self.n))
         self._weights = None
         self.n_resamples += 1
+        self._origin = idx
         return [a[idx] for a in per_particle]
 
-    def _resample_move(self, steps: int) -> float:
-        self._resample()
-        acc = [self._mh_sweep() for _ in range(steps)]
-        return float(np.mean(acc)) if acc else math.nan
+    def _rejuvenate(self) -> tuple[float, int, int]:
+        """Sweeps after a resampling until ``diversify`` of the particles have moved (see the
+        module doc). Returns (mean acceptance, sweeps, distinct particles)."""
+        moved = np.zeros(self.n, dtype=bool)
+        acc: list[float] = []
+        while len(acc) < self.max_sweeps and (
+            len(acc) < self.mcmc_steps or moved.mean() < self.diversify
+        ):
+            accepted = self._mh_sweep()
+            moved |= accepted
+            acc.append(float(accepted.mean()))
+        distinct = int(moved.sum()) + len(np.unique(self._origin[~moved]))
+        return (float(np.mean(acc)) if acc else math.nan), len(acc), distinct
 
-    def _mh_sweep(self) -> float:
-        """One random-walk Metropolis–Hastings move of every particle, full-history target."""
+    def _mh_sweep(self) -> np.ndarray:
+        """One Metropolis–Hastings move of every particle, full-history target: a share
+        ``global_share`` proposes its location from the prior, the rest a random walk.
+        Returns the (N,) accepted mask."""
         d = len(self._unknown)
         x = self.theta[:, self._unknown]
         cov = np.atleast_2d(np.cov(x, rowvar=False))
@@ -280,6 +368,19 @@ class ParticleFilter:
             chol = np.diag(np.sqrt(np.maximum(np.diag(cov), floor)))
         proposal = self.theta.copy()
         proposal[:, self._unknown] += self.rng.standard_normal((self.n, d)) @ chol.T
+        # Independence proposals of the location block from its prior: for these particles the
+        # proposal density (the block's prior) cancels the block's prior in the target.
+        jump = self.rng.random(self.n) < self.global_share if self._loc_block else None
+        log_q_ratio = np.zeros(self.n)
+        if jump is not None and jump.any():
+            k = int(jump.sum())
+            dists = self.prior.distributions
+            proposal[jump] = self.theta[jump]
+            for col in self._loc_block:
+                proposal[jump, col] = dists[col].sample(self.rng, k)
+                log_q_ratio[jump] += dists[col].log_pdf(self.theta[jump, col]) - dists[col].log_pdf(
+                    proposal[jump, col]
+                )
         lp_prop = self.prior.log_density(proposal)
         lp_cur = self.prior.log_density(self.theta)
         active = np.isfinite(lp_prop)
@@ -290,16 +391,19 @@ class ParticleFilter:
         )
         log_u = np.log(self.rng.random(self.n))
         with np.errstate(invalid="ignore"):
-            accept = active & (log_u < (ll_prop + lp_prop) - (self._hist_loglik + lp_cur))
+            log_ratio = (ll_prop + lp_prop) - (self._hist_loglik + lp_cur) + log_q_ratio
+            accept = active & (log_u < log_ratio)
         self.theta[accept] = proposal[accept]
         self._hist_loglik[accept] = ll_prop[accept]
-        return float(accept.mean())
+        return accept
 
     def _tempered_update(
         self, ll_new: np.ndarray, entry: int, base_mult: float, ess0: float
     ) -> UpdateInfo:
         beta = 0.0
         stages = 0
+        sweeps = 0
+        distinct = self.n
         target = self.resample_threshold * self.n
         hist_base = self._hist_loglik.copy()
         acc: list[float] = []
@@ -327,8 +431,9 @@ class ParticleFilter:
             self._hist_mult[entry] = base_mult + new_beta
             beta = new_beta
             ll_new, hist_base = self._resample(ll_new, hist_base)
-            for _ in range(max(1, self.mcmc_steps)):
-                acc.append(self._mh_sweep())
+            stage_acc, stage_sweeps, distinct = self._rejuvenate()
+            acc.append(stage_acc)
+            sweeps += stage_sweeps
             if beta < 1.0:
                 # After the move, recompute the new reading's likelihood for the moved particles.
                 ll_new = self.log_likelihood(
@@ -337,9 +442,14 @@ class ParticleFilter:
                 hist_base = self._hist_loglik - beta * ll_new
         self._hist_mult[entry] = base_mult + 1.0
         self.recoveries.append(
-            {"reading_index": float(self.n_readings), "ess_before": ess0, "stages": float(stages)}
+            {
+                "kind": "tempering",
+                "reading_index": float(self.n_readings),
+                "ess_before": ess0,
+                "stages": float(stages),
+            }
         )
-        return UpdateInfo(ess0, True, float(np.mean(acc)), stages)
+        return UpdateInfo(ess0, True, float(np.mean(acc)), stages, sweeps, distinct)
 
 
 def _normalise(logw: np.ndarray) -> np.ndarray:

@@ -63,13 +63,13 @@ def run_episode(
     search = scenario.search
     planner = get_planner(strategy, **_planner_defaults(strategy, scenario, planner_options))
     truth_rng, filter_rng, planner_rng, figure_rng = streams(seed)
-    sensor: Sensor = scenario.make_sensor()
+    sensor: Sensor = scenario.make_sensor()  # the instrument: makes the real readings
     agent = scenario.make_agent()
     truth = truth or make_truth(scenario, seed)
     true_location = scenario.truth_theta()[:3]
     pf = ParticleFilter(
         scenario.make_prior(),
-        sensor,
+        scenario.make_estimator_sensor(),  # the reading model of the filter and the planners
         n_particles=search.particles,
         seed=filter_rng,
         resample_threshold=search.resample_threshold,
@@ -78,13 +78,14 @@ def run_episode(
     searcher = Searcher(pf, planner, agent, planner_rng)
     position = np.array(scenario.agent.start, dtype=np.float64)
     t = agent.dwell  # the first reading is taken at the start after one dwell
+    average = scenario.average
     records: list[dict[str, Any]] = []
     snapshots: list[tuple[float, np.ndarray]] = []
     next_snapshot = 0.0
     path_length = 0.0
     while True:
         noise = sensor.draw_noise(truth_rng, ())  # the same count per step, whatever the position
-        conc = truth.concentration(position, t)
+        conc = truth.sensed(position, t, average, scenario.sensor.response_time)
         reading = float(sensor.simulate_from(conc, noise))
         info = searcher.tell(position, reading, t)
         est = searcher.estimate()
@@ -112,6 +113,10 @@ def run_episode(
             "ess": info.ess,
             "resampled": info.resampled,
             "tempering_stages": info.tempering_stages,
+            "acceptance": info.acceptance,
+            "move_sweeps": info.move_sweeps,
+            "distinct": info.distinct,
+            "rejected": info.rejected,
             "update_seconds": searcher.last_update_seconds,
         }
         if snapshot_every is not None and t >= next_snapshot:
@@ -133,6 +138,10 @@ def run_episode(
     summary = summarise(records, scenario, strategy, seed, path_length)
     summary["planner_options"] = planner.options()
     summary["recoveries"] = len(pf.recoveries)
+    summary["tempering_events"] = sum(r["kind"] == "tempering" for r in pf.recoveries)
+    summary["rejected_readings"] = sum(r["kind"] == "rejected" for r in pf.recoveries)
+    summary["truth_in_95"] = pf.in_credible_region(true_location, 0.95)
+    summary.update(scenario.resolved_settings())
     summary["resamples"] = pf.n_resamples
     if snapshot_every is not None and snapshots[-1][0] != records[-1]["time"]:
         snapshots.append((records[-1]["time"], _subsample(pf, snapshot_particles, figure_rng)))

@@ -204,5 +204,9 @@ class FilamentTruth(TruthModel):
     def concentration(self, position: np.ndarray, time: float) -> float:
         return float(self.field(np.reshape(position, (1, 3)), time)[0])
 
+    @property
+    def time_step(self) -> float:
+        return self.dt
+
 
 __all__ = ["FilamentTruth"]

@@ -97,6 +97,11 @@ class PlaybackTruth(TruthModel):
         last = float(self.t[-1] - self.t[-2]) if len(self.t) > 1 else 0.0
         self.period = self.duration + last
 
+    @property
+    def time_step(self) -> float | None:
+        """The shortest frame interval (None for a single frame)."""
+        return float(np.min(np.diff(self.t))) if len(self.t) > 1 else None
+
     # --- geometry ---------------------------------------------------------------------------
 
     def covers(self, low: np.ndarray, high: np.ndarray) -> str | None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from typing import TYPE_CHECKING
 
@@ -28,6 +29,36 @@ class TruthModel(ABC):
     def field(self, positions: np.ndarray, time: float) -> np.ndarray:
         """(K,) concentrations at (K, 3) positions (for figures)."""
         return np.array([self.concentration(p, time) for p in positions])
+
+    @property
+    def time_step(self) -> float | None:
+        """Seconds between changes of the field; None if it does not change in time."""
+        return None
+
+    def sensed(
+        self, position: np.ndarray, time: float, average: float = 0.0, response_time: float = 0.0
+    ) -> float:
+        """What a sensor held at ``position`` reads at ``time`` s (g/m³, before sensor noise).
+
+        The field is sampled at the truth's time step over the last ``average`` seconds
+        (the samples end at ``time``), passed through a first-order response with time
+        constant ``response_time`` s (its state starts at the window's first sample), and
+        averaged. A field that does not change in time is read once: averaging changes nothing.
+        """
+        dt = self.time_step
+        if dt is None or average <= 0.0:
+            return self.concentration(position, time)
+        n = max(1, round(average / dt))
+        times = time - dt * np.arange(n - 1, -1, -1)
+        times = times[times >= 0.0]
+        c = np.array([self.concentration(position, float(t)) for t in times])
+        if response_time > 0.0:
+            alpha = 1.0 - math.exp(-dt / response_time)
+            y = c[0]
+            for k in range(len(c)):
+                y += alpha * (c[k] - y)
+                c[k] = y
+        return float(c.mean())
 
 
 class IsotropicTruth(TruthModel):
