@@ -80,15 +80,17 @@ def search_that_kills_its_worker_on_seed_1(task):
     return run_search(task)
 
 
-def compiled_predicted_stats(conc, source, weights, task_pos, task_z, sensor, **flags):
+def compiled_predicted_stats(conc, source, weights, task_pos, task_z, sensor, dist=None, **flags):
     """The compiled predicted-posterior statistics with the reference's arguments:
-    (log_evidence, mean, trace_cov, kl) for raw concentrations (P, N) and readings (S, T)."""
+    (log_evidence, mean, trace_cov, kl) for raw concentrations (P, N), distances (P, N; None:
+    far) and readings (S, T)."""
     from dcee.models.sensor_kernels import position_terms
     from dcee.planning.predicted_kernels import predicted_posterior_stats
 
     conc = np.ascontiguousarray(conc)
+    dist = np.full_like(conc, np.inf) if dist is None else np.ascontiguousarray(dist)
     terms = [np.empty_like(conc) for _ in range(4)]
-    position_terms(conc, sensor.params, *terms)
+    position_terms(conc, dist, sensor.params, *terms)
     s = len(task_pos)
     out = [np.empty(s), np.empty((s, 3)), np.empty(s), np.empty(s)]
     predicted_posterior_stats(

@@ -33,7 +33,7 @@ def test_missed_detection_likelihood_small_and_large_concentrations(pd):
     c_lin = sp.c_lin
     c = np.concatenate([[0.0], c_lin * np.array([0.01, 0.5, 0.999, 1.001, 2.0]), [1e-4, 5e-4]])
     c = np.concatenate([c, np.geomspace(1e-3, 10, 20)])
-    fast = np.array([log_likelihood(0.0, ci, sp) for ci in c])
+    fast = np.array([log_likelihood(0.0, ci, math.inf, sp) for ci in c])
     ref = sensor.log_likelihood(0.0, c)
     np.testing.assert_allclose(fast, ref, rtol=1e-9, atol=1e-15)
 
@@ -48,8 +48,8 @@ def _stats_case(n=2000, seed=3):
     return source, weights, conc
 
 
-def _run(conc, source, weights, task_pos, task_z, sensor, **flags):
-    return compiled_predicted_stats(conc, source, weights, task_pos, task_z, sensor, **flags)
+def _run(conc, source, weights, task_pos, task_z, sensor, dist=None, **flags):
+    return compiled_predicted_stats(conc, source, weights, task_pos, task_z, sensor, dist, **flags)
 
 
 def test_predicted_stats_unreachable_reading_takes_exact_path():
@@ -103,20 +103,24 @@ def test_predicted_stats_multi_step_sequences_match_reference():
         Sensor(family="lognormal", pd=0.5, outlier=0.01),
         Sensor(outlier=0.01),
         Sensor(family="lognormal", pd=0.6, outlier=0.01, false_alarm=0.02),
+        Sensor(family="lognormal", pd=0.6, outlier=0.01, near_length=5.0),
+        Sensor(near_length=3.0),
     ],
-    ids=["ln", "ln+out", "gauss+out", "ln+out+fa"],
+    ids=["ln", "ln+out", "gauss+out", "ln+out+fa", "ln+near", "gauss+near"],
 )
 def test_predicted_stats_match_reference_for_every_family(sensor):
     """The transformed-frame kernels (vectorised log-sum-exp of the outlier component, the
     Jacobian added to the evidence) against the plain NumPy likelihood, horizons 1 and 3."""
     source, weights, conc = _stats_case(n=1500, seed=8)
     rng = np.random.default_rng(2)
+    dist = rng.uniform(0.1, 20.0, conc.shape)
     for task_pos in (np.repeat(np.array([[0], [2]]), 5, axis=0), np.repeat([[0, 1, 2]], 8, axis=0)):
         shape = task_pos.shape
         task_z = np.where(rng.random(shape) < 0.4, 0.0, rng.lognormal(-6, 2, shape))
         task_z[0, 0] = 500.0  # a spike that only the outlier component explains
-        out = _run(conc, source, weights, task_pos, task_z, sensor)
-        ref = predicted_posterior_stats_reference(conc, source, weights, task_pos, task_z, sensor)
+        args = (conc, source, weights, task_pos, task_z, sensor, dist)
+        out = _run(*args)
+        ref = predicted_posterior_stats_reference(*args)
         for fast, slow in zip(out, ref, strict=True):
             np.testing.assert_allclose(fast, slow, rtol=1e-8, atol=1e-10)
 

@@ -57,7 +57,7 @@ def test_compiled_likelihood_matches_reference():
         c = np.concatenate([[0.0, 1e-9, 5e-4], rng.gamma(0.5, 2e-3, 300), [0.5, 3.0]])
         z = np.concatenate([[0.0, 4e-4], rng.gamma(0.7, 2e-3, 60), [1.0]])
         for zi in z:
-            fast = np.array([log_likelihood(zi, ci, s.params) for ci in c])
+            fast = np.array([log_likelihood(zi, ci, math.inf, s.params) for ci in c])
             ref = s.log_likelihood(zi, c)
             np.testing.assert_allclose(fast, ref, rtol=1e-9, atol=1e-12)
 
@@ -81,19 +81,24 @@ def test_invalid_sensor_parameters_name_the_field(field, value):
 FLUCTUATION = Sensor(family="lognormal", pd=0.5, log_sd=1.0)
 ROBUST = Sensor(family="lognormal", pd=0.5, log_sd=1.0, outlier=0.01)
 ROBUST_PAPER = Sensor(outlier=0.02, false_alarm=0.03)
+NEAR = Sensor(family="lognormal", pd=0.6, log_sd=1.2, outlier=0.01, near_length=5.0)
+NEAR_PAPER = Sensor(near_length=3.0, false_alarm=0.01)
+FAMILIES = [FLUCTUATION, ROBUST, ROBUST_PAPER, NEAR, NEAR_PAPER]
+FAMILY_IDS = ["ln", "ln+out", "gauss+out", "ln+near", "gauss+near"]
 
 
 @pytest.mark.parametrize(
     "s", [FLUCTUATION, ROBUST, ROBUST_PAPER], ids=["ln", "ln+out", "gauss+out"]
 )
 @pytest.mark.parametrize("conc", [0.0, 2e-4, 5e-4, 3e-3, 0.5])
-def test_every_family_is_a_proper_distribution_over_readings(s, conc):
+@pytest.mark.parametrize("r", [0.5, 40.0])
+def test_every_family_is_a_proper_distribution_over_readings(s, conc, r):
     """P(non-detection) + ∫ p(z) dz over [threshold, max_reading] = 1, integrated in ln z."""
-    p_nd = float(s.likelihood(0.0, conc))
+    p_nd = float(s.likelihood(0.0, conc, r))
     lo, hi = math.log(s.threshold), math.log(s.max_reading)
     points = [math.log(conc)] if conc > s.threshold else None
     mass, _ = integrate.quad(
-        lambda u: float(s.likelihood(math.exp(u), conc)) * math.exp(u),
+        lambda u: float(s.likelihood(math.exp(u), conc, r)) * math.exp(u),
         lo,
         hi,
         points=points,
@@ -117,10 +122,10 @@ def test_lognormal_reading_keeps_the_mean_and_intermittency():
 )
 def test_simulated_readings_follow_every_family(s):
     rng = np.random.default_rng(12)
-    conc = 2e-3
-    z = s.simulate(np.full(300_000, conc), rng)
+    conc, r = 2e-3, 4.0
+    z = s.simulate_from(np.full(300_000, conc), s.draw_noise(rng, 300_000), r)
     nd = z < s.threshold
-    p_nd = float(s.likelihood(0.0, conc))
+    p_nd = float(s.likelihood(0.0, conc, r))
     assert nd.mean() == pytest.approx(p_nd, abs=4 * math.sqrt(p_nd * (1 - p_nd) / len(z)))
     edges = np.array([5e-4, 1e-3, 2e-3, 4e-3, 1e-2, 1.0, 1e4])
     counts, _ = np.histogram(z[~nd], bins=edges)
@@ -141,8 +146,9 @@ def test_compiled_likelihood_matches_reference_for_every_family(s):
     c = np.concatenate([[0.0, 1e-12, 1e-7, 5e-4], rng.gamma(0.5, 2e-3, 200), [0.5, 30.0]])
     z = np.concatenate([[0.0, 4e-4, 5e-4], rng.gamma(0.7, 2e-3, 40), [1.0, 500.0, 1e4]])
     for zi in z:
-        fast = np.array([log_likelihood(zi, ci, s.params) for ci in c])
-        np.testing.assert_allclose(fast, s.log_likelihood(zi, c), rtol=1e-9, atol=1e-12)
+        r = rng.uniform(0.1, 30.0, len(c))
+        fast = np.array([log_likelihood(zi, ci, ri, s.params) for ci, ri in zip(c, r, strict=True)])
+        np.testing.assert_allclose(fast, s.log_likelihood(zi, c, r), rtol=1e-9, atol=1e-12)
 
 
 def test_outlier_component_bounds_the_influence_of_one_reading():

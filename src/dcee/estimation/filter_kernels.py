@@ -35,6 +35,6 @@ def history_log_likelihood(
         terms = plume_terms(theta, i)
         acc = 0.0
         for k in range(k_count):
-            c = plume_at(terms, positions[k, 0], positions[k, 1], positions[k, 2], rmin)
-            acc += multiplicity[k] * log_likelihood(readings[k], c, sp)
+            c, r = plume_at(terms, positions[k, 0], positions[k, 1], positions[k, 2], rmin)
+            acc += multiplicity[k] * log_likelihood(readings[k], c, r, sp)
         out[i] = acc

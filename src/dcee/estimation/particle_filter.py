@@ -58,7 +58,10 @@ def history_log_likelihood_reference(
 ) -> np.ndarray:
     """NumPy reference of the compiled history likelihood: (N,) Σ_k m_k log p(z_k | Θ_i)."""
     conc = isotropic_concentration_reference(theta, positions, plume.min_distance)
-    return (sensor.log_likelihood(readings[None, :], conc) * multiplicity[None, :]).sum(axis=1)
+    d = positions[None, :, :] - theta[:, None, :3]
+    dist = np.maximum(np.sqrt(np.einsum("nki,nki->nk", d, d)), plume.min_distance)
+    ll = sensor.log_likelihood(readings[None, :], conc, dist)
+    return (ll * multiplicity[None, :]).sum(axis=1)
 
 
 def systematic_resample(weights: np.ndarray, rng: np.random.Generator, n: int) -> np.ndarray:

@@ -1,4 +1,6 @@
-"""Compiled (numba) plume kernels; NumPy reference: :func:`dcee.models.plume.isotropic_concentration_reference`.
+"""Compiled (numba) plume kernels.
+
+NumPy reference: :func:`dcee.models.plume.isotropic_concentration_reference`.
 
 Kernels that loop over particles run in parallel (``prange``); every reduction is sequential
 within one output element, so results do not depend on the thread count.
@@ -36,8 +38,9 @@ def plume_terms(theta: np.ndarray, i: int):
 
 
 @njit(cache=True, inline="always")
-def plume_at(terms, px: float, py: float, pz: float, rmin: float) -> float:
-    """Concentration at (px, py, pz) from one particle's :func:`plume_terms`."""
+def plume_at(terms, px: float, py: float, pz: float, rmin: float):
+    """(concentration, clamped distance r) at (px, py, pz) from one particle's
+    :func:`plume_terms`."""
     sx, sy, sz, pref, inv_lam, ax, ay = terms
     dx = px - sx
     dy = py - sy
@@ -45,7 +48,7 @@ def plume_at(terms, px: float, py: float, pz: float, rmin: float) -> float:
     r = math.sqrt(dx * dx + dy * dy + dz * dz)
     if r < rmin:
         r = rmin
-    return pref / r * math.exp(-r * inv_lam - dx * ax - dy * ay)
+    return pref / r * math.exp(-r * inv_lam - dx * ax - dy * ay), r
 
 
 @njit(cache=True, parallel=True)
@@ -56,7 +59,22 @@ def concentration_grid(theta: np.ndarray, positions: np.ndarray, rmin: float, ou
     for i in prange(n):
         terms = plume_terms(theta, i)
         for m in range(m_count):
-            out[m, i] = plume_at(terms, positions[m, 0], positions[m, 1], positions[m, 2], rmin)
+            out[m, i] = plume_at(terms, positions[m, 0], positions[m, 1], positions[m, 2], rmin)[0]
+
+
+@njit(cache=True, parallel=True)
+def concentration_distance_grid(
+    theta: np.ndarray, positions: np.ndarray, rmin: float, conc: np.ndarray, dist: np.ndarray
+):
+    """conc[m, i] = C(positions[m]; theta[i]) and dist[m, i] the clamped source distance r."""
+    n = theta.shape[0]
+    m_count = positions.shape[0]
+    for i in prange(n):
+        terms = plume_terms(theta, i)
+        for m in range(m_count):
+            c, r = plume_at(terms, positions[m, 0], positions[m, 1], positions[m, 2], rmin)
+            conc[m, i] = c
+            dist[m, i] = r
 
 
 def concentration_matrix(theta: np.ndarray, positions: np.ndarray, rmin: float, out: np.ndarray):

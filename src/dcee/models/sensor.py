@@ -18,6 +18,12 @@ Generative model of one reading z given the expected (time-mean) concentration C
      uses the same two-part form with a clipped gamma). This is the ``"fluctuation"``
      likelihood of the scenarios.
 
+   With ``near_length`` > 0 the detection probability falls near the source:
+   Pd(r) = ``pd`` · (1 − exp(−r / near_length)) at distance r from the (hypothesised) source.
+   Close to a release the plume is a thin, meandering thread that a held sensor rarely meets,
+   so non-detections are common exactly where the mean concentration is highest; a constant Pd
+   then pulls the estimate downwind (measured, docs/scenarios.md).
+
 3. Otherwise (missed, or y below the threshold) it is a *non-detection*. With probability
    ``false_alarm`` a non-detection is replaced by a false alarm, z = threshold + E,
    E ~ Exponential(mean ``false_alarm_scale``); else the reading is reported as 0.
@@ -63,6 +69,7 @@ class Sensor:
     log_sd: float = 1.0
     outlier: float = 0.0
     max_reading: float = 1e4
+    near_length: float = 0.0
 
     def __post_init__(self) -> None:
         if self.family not in ("gaussian", "lognormal"):
@@ -79,6 +86,7 @@ class Sensor:
             "log_sd": (0 < self.log_sd <= 5, "in (0, 5]"),
             "outlier": (0 <= self.outlier < 1, "in [0, 1)"),
             "max_reading": (self.max_reading > self.threshold, "> threshold"),
+            "near_length": (0 <= self.near_length <= 1e3, "in [0, 1000] m"),
         }
         for name, (ok, allowed) in checks.items():
             value = getattr(self, name)
@@ -116,13 +124,15 @@ class Sensor:
             dx_dc = -(self.sigma_frac * self.threshold + self.sigma_min) / self.sigma_min**2
             pdf = math.exp(-0.5 * x0 * x0) / math.sqrt(2.0 * math.pi)
             lin1 = self.pd * pdf * dx_dc / math.exp(lin0)
-            c_lin = 1e-6 * self.sigma_min
+            # with a distance-dependent Pd the constant linearisation does not hold: never use it
+            c_lin = 1e-6 * self.sigma_min if self.near_length == 0 else -1.0
         return SensorParams(
             lognormal=1.0 if self.lognormal else 0.0,
             threshold=self.threshold,
             v_threshold=v_thr,
             pd=self.pd,
             log_pd=math.log(self.pd),
+            near_length=self.near_length,
             sigma_min=self.sigma_min,
             sigma_frac=self.sigma_frac,
             log_sd=self.log_sd,
@@ -177,23 +187,36 @@ class Sensor:
             return loc, np.full_like(loc, self.log_sd)
         return c, self.sigma_frac * c + self.sigma_min
 
-    def log_likelihood(self, reading: np.ndarray | float, conc: np.ndarray | float) -> np.ndarray:
-        """log p(z | C), NumPy reference; broadcasts ``reading`` against ``conc``."""
+    def detect_prob(self, distance: np.ndarray | float = np.inf) -> np.ndarray:
+        """Pd(r): detection probability at ``distance`` m from the source (see ``near_length``)."""
+        r = np.asarray(distance, dtype=np.float64)
+        if self.near_length == 0:
+            return np.full_like(r, self.pd)
+        return -self.pd * np.expm1(-r / self.near_length)
+
+    def log_likelihood(
+        self,
+        reading: np.ndarray | float,
+        conc: np.ndarray | float,
+        distance: np.ndarray | float = np.inf,
+    ) -> np.ndarray:
+        """log p(z | C, r), NumPy reference; broadcasts ``reading``, ``conc`` and ``distance``
+        (m from the source; only used with ``near_length`` > 0)."""
         z = np.asarray(reading, dtype=np.float64)
         c = np.asarray(conc, dtype=np.float64)
+        pd = self.detect_prob(distance)
         loc, sigma = self._loc_sigma(c)
         v_thr = math.log(self.threshold) if self.lognormal else self.threshold
         # P(no true detection | C) = (1 − Pd) + Pd Φ((v_thr − loc)/σ)
         log_below = log_ndtr((v_thr - loc) / sigma)
-        log_missed = np.logaddexp(
-            np.log1p(-self.pd) if self.pd < 1 else -np.inf, np.log(self.pd) + log_below
-        )
+        with np.errstate(divide="ignore"):
+            log_missed = np.logaddexp(np.log1p(-pd), np.log(pd) + log_below)
         log_keep = math.log1p(-self.outlier)
         log_nd = log_missed + math.log1p(-self.false_alarm) + log_keep
         zd = np.maximum(z, self.threshold)  # detections only; the rest is masked below
         v = np.log(zd) if self.lognormal else zd
         r = (v - loc) / sigma
-        log_det = np.log(self.pd) - 0.5 * r * r - np.log(sigma) - 0.5 * np.log(2 * np.pi)
+        log_det = np.log(pd) - 0.5 * r * r - np.log(sigma) - 0.5 * np.log(2 * np.pi)
         if self.lognormal:
             log_det = log_det - np.log(zd)
         if self.false_alarm > 0:
@@ -209,16 +232,23 @@ class Sensor:
             log_det = np.logaddexp(log_det, self._log_outlier_times_z() - np.log(zd))
         return np.where(z < self.threshold, log_nd, log_det)
 
-    def likelihood(self, reading: np.ndarray | float, conc: np.ndarray | float) -> np.ndarray:
-        """p(z | C): probability for a non-detection, density (per g/m³) for a detection."""
-        return np.exp(self.log_likelihood(reading, conc))
+    def likelihood(
+        self,
+        reading: np.ndarray | float,
+        conc: np.ndarray | float,
+        distance: np.ndarray | float = np.inf,
+    ) -> np.ndarray:
+        """p(z | C, r): probability for a non-detection, density (per g/m³) for a detection."""
+        return np.exp(self.log_likelihood(reading, conc, distance))
 
-    def detection_probability(self, conc: np.ndarray | float) -> np.ndarray:
-        """P(z ≥ threshold | C), false alarms and outliers included."""
+    def detection_probability(
+        self, conc: np.ndarray | float, distance: np.ndarray | float = np.inf
+    ) -> np.ndarray:
+        """P(z ≥ threshold | C, r), false alarms and outliers included."""
         c = np.asarray(conc, dtype=np.float64)
         loc, sigma = self._loc_sigma(c)
         v_thr = math.log(self.threshold) if self.lognormal else self.threshold
-        true_det = self.pd * ndtr((loc - v_thr) / sigma)
+        true_det = self.detect_prob(distance) * ndtr((loc - v_thr) / sigma)
         model = true_det + (1 - true_det) * self.false_alarm
         return (1 - self.outlier) * model + self.outlier
 
@@ -279,8 +309,14 @@ class Sensor:
             out[..., 5] = rng.random(size)
         return out
 
-    def simulate_from(self, conc: np.ndarray | float, noise: np.ndarray) -> np.ndarray:
-        """Readings for concentrations ``conc`` from pre-drawn ``noise`` (conc.shape + (n,)).
+    def simulate_from(
+        self,
+        conc: np.ndarray | float,
+        noise: np.ndarray,
+        distance: np.ndarray | float = np.inf,
+    ) -> np.ndarray:
+        """Readings for concentrations ``conc`` from pre-drawn ``noise`` (conc.shape + (n,)),
+        ``distance`` m from the source (only used with ``near_length`` > 0).
 
         Non-detections are returned as 0.0.
         """
@@ -291,7 +327,7 @@ class Sensor:
             y = c * np.exp(s * noise[..., 1] - 0.5 * s * s)
         else:
             y = c + (self.sigma_frac * c + self.sigma_min) * noise[..., 1]
-        detected = (noise[..., 0] < self.pd) & (y >= self.threshold)
+        detected = (noise[..., 0] < self.detect_prob(distance)) & (y >= self.threshold)
         false_alarm = (~detected) & (noise[..., 2] < self.false_alarm)
         fa_value = self.threshold + self.false_alarm_scale * noise[..., 3]
         z = np.where(detected, y, np.where(false_alarm, fa_value, 0.0))

@@ -1,4 +1,6 @@
-"""Compiled (numba) sensor likelihood; NumPy reference: :meth:`dcee.models.sensor.Sensor.log_likelihood`.
+"""Compiled (numba) sensor likelihood.
+
+NumPy reference: :meth:`dcee.models.sensor.Sensor.log_likelihood`.
 
 Both likelihood families are written in one *transformed frame* so that every kernel, the
 filter's and the planners', serves both:
@@ -12,8 +14,10 @@ lognormal     ln C − s²/2                  s                           ln z
 
 A detection's density is Pd·φ((v − loc)/σ)/σ · |dv/dz| (the Jacobian is 1/z for the log-normal
 family; it is the same for every particle, so the planners add it to the log evidence only) and a
-non-detection has probability (1 − Pd) + Pd·Φ((v_thr − loc)/σ). Sensor parameters arrive as
-a :class:`SensorParams` record (named fields, all float64).
+non-detection has probability (1 − Pd) + Pd·Φ((v_thr − loc)/σ). With near-source
+intermittency Pd depends on the distance r between the sensor and the hypothesised source,
+Pd(r) = Pd · (1 − exp(−r / near_length)), so every function takes r as well as C. Sensor
+parameters arrive as a :class:`SensorParams` record (named fields, all float64).
 """
 
 from __future__ import annotations
@@ -38,6 +42,7 @@ class SensorParams(NamedTuple):
     v_threshold: float  # threshold in the transformed frame: thr or ln thr
     pd: float  # detection probability (the fluctuation family's intermittency factor)
     log_pd: float
+    near_length: float  # m; > 0: Pd(r) = pd (1 − exp(−r / near_length)); 0: Pd = pd
     sigma_min: float  # gaussian: σ(C) = sigma_frac · C + sigma_min
     sigma_frac: float
     log_sd: float  # lognormal: s, the standard deviation of ln z
@@ -62,8 +67,23 @@ def transform(c: float, sp: SensorParams):
 
 
 @njit(cache=True, inline="always")
-def log_missed(c: float, sp: SensorParams) -> float:
-    """log P(no true detection | C) = log((1 − Pd) + Pd Φ((v_thr − loc)/σ)).
+def detection_probability(r: float, sp: SensorParams) -> float:
+    """Pd(r): the detection probability (intermittency factor) at distance r m from the source."""
+    if sp.near_length > 0.0:
+        return -sp.pd * math.expm1(-r / sp.near_length)
+    return sp.pd
+
+
+@njit(cache=True, inline="always")
+def log_detection_probability(r: float, sp: SensorParams) -> float:
+    if sp.near_length > 0.0:
+        return sp.log_pd + math.log(-math.expm1(-r / sp.near_length))
+    return sp.log_pd
+
+
+@njit(cache=True, inline="always")
+def log_missed(c: float, r: float, sp: SensorParams) -> float:
+    """log P(no true detection | C, r) = log((1 − Pd(r)) + Pd(r) Φ((v_thr − loc)/σ)).
 
     Written as log1p(−Pd Φ(−x)): one erfc and one log1p instead of log Φ, log and logaddexp
     (about 3× cheaper, and exact where Φ(−x) is tiny). With Pd = 1 the log Φ(x) form is kept,
@@ -73,28 +93,31 @@ def log_missed(c: float, sp: SensorParams) -> float:
         return sp.lin0 + sp.lin1 * c
     loc, sigma = transform(c, sp)
     x = (sp.v_threshold - loc) / sigma
-    if sp.pd < 1.0:
-        return math.log1p(-sp.pd * ndtr_upper(x))
+    pd = detection_probability(r, sp)
+    if pd < 1.0:
+        return math.log1p(-pd * ndtr_upper(x))
     return log_ndtr(x)
 
 
 @njit(cache=True, inline="always")
-def log_likelihood(z: float, c: float, sp: SensorParams) -> float:
-    """log p(z | C) of one reading (g/m³; below the threshold = non-detection)."""
+def log_likelihood(z: float, c: float, r: float, sp: SensorParams) -> float:
+    """log p(z | C, r) of one reading (g/m³; below the threshold = non-detection) for an
+    expected concentration C at distance r m from the source."""
     thr = sp.threshold
     if z < thr:
-        return log_missed(c, sp) + sp.log_not_false_alarm + sp.log_keep
+        return log_missed(c, r, sp) + sp.log_not_false_alarm + sp.log_keep
     loc, sigma = transform(c, sp)
+    log_pd = log_detection_probability(r, sp)
     if sp.lognormal > 0.0:
         log_z = math.log(z)
-        r = (log_z - loc) / sigma
-        ld = sp.log_pd - 0.5 * r * r - math.log(sigma) - HALF_LOG_2PI - log_z
+        x = (log_z - loc) / sigma
+        ld = log_pd - 0.5 * x * x - math.log(sigma) - HALF_LOG_2PI - log_z
     else:
-        r = (z - loc) / sigma
-        ld = sp.log_pd - 0.5 * r * r - math.log(sigma) - HALF_LOG_2PI
+        x = (z - loc) / sigma
+        ld = log_pd - 0.5 * x * x - math.log(sigma) - HALF_LOG_2PI
     if sp.false_alarm > 0.0:
         fas = sp.false_alarm_scale
-        lfa = sp.log_false_alarm + log_missed(c, sp) - (z - thr) / fas - math.log(fas)
+        lfa = sp.log_false_alarm + log_missed(c, r, sp) - (z - thr) / fas - math.log(fas)
         ld = logaddexp(ld, lfa)
     ld += sp.log_keep
     if sp.log_outlier > -np.inf:
@@ -105,23 +128,26 @@ def log_likelihood(z: float, c: float, sp: SensorParams) -> float:
 @njit(cache=True, parallel=True)
 def position_terms(
     conc: np.ndarray,
+    dist: np.ndarray,
     sp: SensorParams,
     loc: np.ndarray,
     log_nd: np.ndarray,
     inv_sigma: np.ndarray,
-    log_sigma: np.ndarray,
+    det_offset: np.ndarray,
 ):
     """Per (position, particle) terms of the likelihood that do not depend on the reading.
 
-    conc (P, N) → the transformed location, log p(non-detection | C), 1/σ and log σ, each
-    (P, N). With them a hypothesised reading costs a lookup (non-detection) or a few flops.
+    conc, dist (P, N) → the transformed location, log p(non-detection | C, r), 1/σ and the
+    detection's log normaliser log Pd(r) − log σ, each (P, N). With them a hypothesised reading
+    costs a lookup (non-detection) or a few flops (detection).
     """
     p_count, n = conc.shape
     for i in prange(n):
         for p in range(p_count):
             c = conc[p, i]
+            r = dist[p, i]
             m, sigma = transform(c, sp)
             loc[p, i] = m
-            log_nd[p, i] = log_likelihood(0.0, c, sp)
+            log_nd[p, i] = log_likelihood(0.0, c, r, sp)
             inv_sigma[p, i] = 1.0 / sigma
-            log_sigma[p, i] = math.log(sigma)
+            det_offset[p, i] = log_detection_probability(r, sp) - math.log(sigma)

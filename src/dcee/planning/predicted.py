@@ -28,7 +28,7 @@ import numpy as np
 from dcee.errors import DceeInputError
 from dcee.estimation.particle_filter import systematic_resample
 from dcee.models.agent import GridAgent
-from dcee.models.plume_kernels import concentration_grid
+from dcee.models.plume_kernels import concentration_distance_grid
 from dcee.models.sensor import Sensor
 from dcee.models.sensor_kernels import position_terms
 from dcee.planning.base import Belief, Planner
@@ -56,9 +56,12 @@ def predicted_posterior_stats_reference(
     task_positions: np.ndarray,
     task_readings: np.ndarray,
     sensor: Sensor,
+    dist: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """NumPy reference of :func:`dcee.planning.predicted_kernels.predicted_posterior_stats`, from
-    concentrations and raw readings (no transformed terms, no ``center``, no output arrays). Returns (log_evidence, mean, trace_cov, kl)."""
+    """NumPy reference of :func:`dcee.planning.predicted_kernels.predicted_posterior_stats`
+    from concentrations (P, N), source distances (P, N; None: far) and raw readings (S, T).
+    Returns (log_evidence, mean, trace_cov, kl)."""
+    dist = np.full_like(conc, np.inf) if dist is None else dist
     s_count, t_count = task_positions.shape
     log_ev = np.empty(s_count)
     mean = np.empty((s_count, 3))
@@ -67,7 +70,8 @@ def predicted_posterior_stats_reference(
     for s in range(s_count):
         ll = np.zeros(source.shape[0])
         for t in range(t_count):
-            ll += sensor.log_likelihood(task_readings[s, t], conc[task_positions[s, t]])
+            p = task_positions[s, t]
+            ll += sensor.log_likelihood(task_readings[s, t], conc[p], dist[p])
         mx = ll[weights > 0].max()
         # zero-weight particles may exceed mx; clip them so that 0 · exp(·) stays 0
         e = weights * np.exp(np.minimum(ll - mx, 0.0))
@@ -118,22 +122,24 @@ class PredictionContext:
         if new:
             pts = np.ascontiguousarray(np.array(new, dtype=np.float64))
             shape = (len(pts), self._theta.shape[0])
-            conc, loc, log_nd, inv_sigma, log_sigma = (np.empty(shape) for _ in range(5))
-            concentration_grid(self._theta, pts, self.belief.plume.min_distance, conc)
-            position_terms(conc, self._sp, loc, log_nd, inv_sigma, log_sigma)
-            self._rows.append((conc, loc, log_nd, inv_sigma, log_sigma))
+            conc, dist, loc, log_nd, inv_sigma, det_offset = (np.empty(shape) for _ in range(6))
+            rmin = self.belief.plume.min_distance
+            concentration_distance_grid(self._theta, pts, rmin, conc, dist)
+            position_terms(conc, dist, self._sp, loc, log_nd, inv_sigma, det_offset)
+            self._rows.append((conc, dist, loc, log_nd, inv_sigma, det_offset))
             self._terms = None
         return out
 
     @property
     def terms(self) -> tuple[np.ndarray, ...]:
-        """(conc, loc, log_nd, inv_sigma, log_sigma), each (P, N), at every cached position."""
+        """(conc, dist, loc, log_nd, inv_sigma, det_offset), each (P, N), at every cached
+        position (see :func:`dcee.models.sensor_kernels.position_terms`)."""
         if self._terms is None and len(self._rows) == 1:
             self._terms = self._rows[0]
         elif self._terms is None:
             self._terms = tuple(
                 np.ascontiguousarray(np.concatenate([r[k] for r in self._rows], axis=0))
-                for k in range(5)
+                for k in range(6)
             )
         return self._terms
 
@@ -146,7 +152,8 @@ class PredictionContext:
         """(J, T) hypothesised readings along one sequence of cached positions (T,)."""
         t_count = len(pos_idx)
         c = self.conc[pos_idx][:, self.indices].T  # (J, T)
-        return self.sensor.simulate_from(c, self.noise[:, :t_count])
+        r = self.terms[1][pos_idx][:, self.indices].T
+        return self.sensor.simulate_from(c, self.noise[:, :t_count], r)
 
     def stats(self, sequences: np.ndarray, moments: bool = True, kl: bool = True) -> SequenceStats:
         """Statistics for (S, T, 3) candidate position sequences (T ≤ horizon).
@@ -177,7 +184,7 @@ class PredictionContext:
         trace = np.empty(n_tasks)
         kl_div = np.empty(n_tasks)
         predicted_posterior_stats(
-            *self.terms[1:],
+            *self.terms[2:],
             self._source,
             self.belief.weights,
             self._center,

@@ -31,7 +31,7 @@ def _loglik_cached(
     loc: float,
     lnd: float,
     inv_s: float,
-    log_s: float,
+    det_off: float,
     sp: SensorParams,
 ) -> float:
     """log p(z | C) less the log Jacobian, from :func:`position_terms` and the transformed
@@ -39,7 +39,7 @@ def _loglik_cached(
     if v < sp.v_threshold:
         return lnd
     r = (v - loc) * inv_s
-    ld = sp.log_pd - 0.5 * r * r - log_s - HALF_LOG_2PI
+    ld = det_off - 0.5 * r * r - HALF_LOG_2PI
     if sp.false_alarm > 0.0:
         log_missed = lnd - sp.log_not_false_alarm - sp.log_keep
         ld = logaddexp(ld, fa + log_missed)
@@ -57,12 +57,12 @@ def _task_bound(
     task_fa: np.ndarray,
     task_out: np.ndarray,
     max_log_nd: np.ndarray,
-    min_log_sigma: np.ndarray,
+    max_det_offset: np.ndarray,
     sp: SensorParams,
 ) -> float:
     """An upper bound of Σ_t log p(z_st | C_i) (less the Jacobian) over all particles i.
 
-    A detection's density term is at most log Pd − log σ − ½ log 2π with σ ≥ min σ; a
+    A detection's density term is at most max(log Pd − log σ) − ½ log 2π; a
     false-alarm term at most its density times max P(missed); the outlier term is exact.
     """
     b = 0.0
@@ -72,7 +72,7 @@ def _task_bound(
         if v < sp.v_threshold:
             b += max_log_nd[p]
             continue
-        ld = sp.log_pd - min_log_sigma[p] - HALF_LOG_2PI
+        ld = max_det_offset[p] - HALF_LOG_2PI
         if sp.false_alarm > 0.0:
             log_missed_max = max_log_nd[p] - sp.log_not_false_alarm - sp.log_keep
             ld = logaddexp(ld, task_fa[s, t] + log_missed_max)
@@ -90,13 +90,13 @@ def _task_bounds(
     task_fa: np.ndarray,
     task_out: np.ndarray,
     max_log_nd: np.ndarray,
-    min_log_sigma: np.ndarray,
+    max_det_offset: np.ndarray,
     sp: SensorParams,
     out: np.ndarray,
 ) -> None:
     for s in range(task_positions.shape[0]):
         out[s] = _task_bound(
-            s, task_positions, task_v, task_fa, task_out, max_log_nd, min_log_sigma, sp
+            s, task_positions, task_v, task_fa, task_out, max_log_nd, max_det_offset, sp
         )
 
 
@@ -105,7 +105,7 @@ def _grouped_stats(
     loc: np.ndarray,
     log_nd: np.ndarray,
     inv_sigma: np.ndarray,
-    log_sigma: np.ndarray,
+    det_offset: np.ndarray,
     source: np.ndarray,
     weights: np.ndarray,
     center: np.ndarray,
@@ -135,7 +135,6 @@ def _grouped_stats(
     n_groups = group_start.shape[0] - 1
     n_blocks = (n + _BLOCK - 1) // _BLOCK
     v_thr = sp.v_threshold
-    log_pd_const = sp.log_pd - HALF_LOG_2PI
     log_keep = sp.log_keep
     with_false_alarms = sp.false_alarm > 0.0
     with_outliers = sp.log_outlier > -np.inf
@@ -177,17 +176,17 @@ def _grouped_stats(
                 if with_false_alarms:
                     for j in range(k):
                         ll[j] += _loglik_cached(
-                            z[t, j], fa[t, j], out[t, j], m, lnd, inv_s, log_sigma[p, i], sp
+                            z[t, j], fa[t, j], out[t, j], m, lnd, inv_s, det_offset[p, i], sp
                         )
                 elif with_outliers:
-                    det_const = log_pd_const - log_sigma[p, i] + log_keep
+                    det_const = det_offset[p, i] - HALF_LOG_2PI + log_keep
                     for j in range(k):
                         zj = z[t, j]
                         r = (zj - m) * inv_s
                         d = vlogaddexp(det_const - 0.5 * r * r, out[t, j])
                         ll[j] += d if zj >= v_thr else lnd
                 else:
-                    det_const = log_pd_const - log_sigma[p, i]
+                    det_const = det_offset[p, i] - HALF_LOG_2PI
                     for j in range(k):
                         zj = z[t, j]
                         r = (zj - m) * inv_s
@@ -216,7 +215,7 @@ def _exact_task_stats(
     loc: np.ndarray,
     log_nd: np.ndarray,
     inv_sigma: np.ndarray,
-    log_sigma: np.ndarray,
+    det_offset: np.ndarray,
     source: np.ndarray,
     weights: np.ndarray,
     center: np.ndarray,
@@ -247,7 +246,7 @@ def _exact_task_stats(
                     loc[p, i],
                     log_nd[p, i],
                     inv_sigma[p, i],
-                    log_sigma[p, i],
+                    det_offset[p, i],
                     sp,
                 )
             ll[i] = v
@@ -281,7 +280,7 @@ def predicted_posterior_stats(
     loc: np.ndarray,
     log_nd: np.ndarray,
     inv_sigma: np.ndarray,
-    log_sigma: np.ndarray,
+    det_offset: np.ndarray,
     source: np.ndarray,
     weights: np.ndarray,
     center: np.ndarray,
@@ -300,7 +299,7 @@ def predicted_posterior_stats(
 ) -> None:
     """Statistics of the predicted posterior for each task (a hypothesised reading sequence).
 
-    loc, log_nd, inv_sigma, log_sigma (P, N): :func:`dcee.models.sensor_kernels.position_terms`
+    loc, log_nd, inv_sigma, det_offset (P, N): :func:`~dcee.models.sensor_kernels.position_terms`
     of every particle at P distinct positions; source (N, 3): source locations; weights (N,)
     normalised; center (3,): a reference point subtracted before the second moments are formed
     (keeps trace_cov accurate); task_positions (S, T) int indices into the position terms;
@@ -323,12 +322,12 @@ def predicted_posterior_stats(
     group_start = np.append(np.flatnonzero(new_group), s_count).astype(np.int64)
     live = weights > 0.0
     max_log_nd = np.where(live, log_nd, -np.inf).max(axis=1)
-    min_log_sigma = np.where(live, log_sigma, np.inf).min(axis=1)
+    max_det_offset = np.where(live, det_offset, -np.inf).max(axis=1)
     bound = np.empty(s_count)
-    _task_bounds(task_positions, task_v, task_fa, task_out, max_log_nd, min_log_sigma, sp, bound)
+    _task_bounds(task_positions, task_v, task_fa, task_out, max_log_nd, max_det_offset, sp, bound)
     n_blocks = (source.shape[0] + _BLOCK - 1) // _BLOCK
     partial = np.empty((n_blocks, s_count, _N_ACC))
-    common = (loc, log_nd, inv_sigma, log_sigma, source, weights, center)
+    common = (loc, log_nd, inv_sigma, det_offset, source, weights, center)
     _grouped_stats(
         *common,
         group_start,

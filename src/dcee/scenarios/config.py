@@ -39,8 +39,9 @@ A scenario is a TOML file (or a built-in, see :mod:`dcee.scenarios.builtin`)::
 
     [estimator]                    # the reading model of the filter and the planners
     likelihood = "paper"           # or "fluctuation" (intermittent log-normal, for real plumes)
-    intermittency = 0.5            # fluctuation only
-    log_sd = 1.0                   # fluctuation only
+    intermittency = 0.6            # fluctuation only
+    log_sd = 1.2                   # fluctuation only
+    near_source_length = 5.0       # fluctuation only, m
     outlier = 0.0                  # outlier weight [default: 0 paper, 0.01 fluctuation]
 
     [agent]
@@ -254,16 +255,20 @@ class EstimatorSpec(BaseModel):
     ``likelihood = "paper"``: the paper's eq. 3 with the ``[sensor]`` parameters.
     ``likelihood = "fluctuation"``: an intermittent log-normal reading about the isotropic
     plume's time mean (Yee & Chan 1997; see :mod:`dcee.models.sensor`), with the sensor's
-    threshold and ``intermittency`` and ``log_sd`` below (defaults measured on the filament
-    truth with 5 s hold averages, docs/scenarios.md).
+    threshold, ``intermittency``, ``log_sd`` and ``near_source_length`` (defaults fitted by
+    maximum likelihood to 5 s hold averages of the filament truth, readings as the instrument
+    reports them: ``scripts/fluctuation_stats.py``, docs/scenarios.md).
     """
 
     model_config = _FROZEN
     likelihood: Likelihood = "paper"
-    intermittency: Annotated[float, Field(gt=0, le=1)] = 0.5
-    """fluctuation: probability that a reading inside the plume is not zero"""
-    log_sd: Annotated[float, Field(gt=0, le=5)] = 1.0
+    intermittency: Annotated[float, Field(gt=0, le=1)] = 0.6
+    """fluctuation: probability that a reading well inside the plume is not zero"""
+    log_sd: Annotated[float, Field(gt=0, le=5)] = 1.2
     """fluctuation: standard deviation of ln(reading) about ln(mean) − log_sd²/2"""
+    near_source_length: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] = 5.0
+    """fluctuation: m; the intermittency falls near the source as 1 − exp(−r / this)
+    (r: sensor to hypothesised source); 0 = the same everywhere"""
     outlier: Annotated[float | None, Field(ge=0, lt=1)] = None
     """weight of the outlier component (log-uniform up to sensor.max_reading); None: the
     likelihood's default, :data:`OUTLIER_DEFAULT`"""
@@ -398,6 +403,7 @@ class Scenario(BaseModel):
             pd=e.intermittency,
             family="lognormal",
             log_sd=e.log_sd,
+            near_length=e.near_source_length,
             outlier=self.outlier,
             max_reading=s.max_reading,
         )

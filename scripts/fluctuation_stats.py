@@ -1,0 +1,92 @@
+"""Statistics of hold-averaged readings on the filament truth, to choose the fluctuation
+likelihood's parameters by measurement (docs/scenarios.md quotes its output).
+
+For ``paper:1`` (source (37.5, 12.5, 1), wind from +x at 4 m/s, sensor at 4 m) it samples the
+truth at points downwind of the source and across the mean plume, averages over a hold of
+``--hold`` seconds (as ``dcee`` readings do by default), applies the instrument (threshold and
+random misses), and reports per point: the isotropic mean C, the time mean of the averages, the
+share of non-detections, and the log-sd of the detected readings about ln C. It then fits the
+fluctuation likelihood's intermittency γ(r) = γ∞ (1 − exp(−r / r_γ)) by maximum likelihood.
+
+    .venv/bin/python scripts/fluctuation_stats.py [--hold 5] [--seconds 1800] [--seeds 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+from scipy import optimize, stats
+
+from dcee.models.plume import isotropic_concentration
+from dcee.scenarios import load_scenario
+from dcee.simulation import make_truth
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--hold", type=float, default=5.0)
+    ap.add_argument("--seconds", type=float, default=1800.0)
+    ap.add_argument("--seeds", type=int, default=3)
+    args = ap.parse_args()
+    scenario = load_scenario("paper:1").with_overrides(**{"truth.model": "filament"})
+    theta = scenario.truth_theta()
+    sensor = scenario.make_sensor()
+    down = np.array([1.0, 2.0, 3.0, 5.0, 8.0, 12.0, 20.0, 30.0])
+    cross = np.array([0.0, 1.5, 3.0])
+    pts = np.array([[theta[0] - d, theta[1] + c, 4.0] for d in down for c in cross])
+    mean_c = isotropic_concentration(theta, pts)[0]
+    rng = np.random.default_rng(0)
+    readings = []
+    for seed in range(args.seeds):
+        truth = make_truth(scenario, seed)
+        dt = truth.time_step
+        n = round(args.hold / dt)
+        t = 0.0
+        while t + args.hold <= args.seconds:
+            c = np.mean([truth.field(pts, t + dt * (k + 1)) for k in range(n)], axis=0)
+            readings.append(sensor.simulate(c, rng))
+            t += args.hold
+    z = np.array(readings)  # (windows, points)
+    det = z >= sensor.threshold
+    r = np.sqrt((pts[:, 0] - theta[0]) ** 2 + (pts[:, 1] - theta[1]) ** 2 + 9.0)
+    print(f"hold {args.hold:g} s, {len(z)} readings per point, instrument Pd {sensor.pd}")
+    print("down  cross  r      C_iso      mean/C_iso  nd share  logsd(det)  P(nd) iso-model")
+    for k, p in enumerate(pts):
+        d = det[:, k]
+        lsd = np.std(np.log(z[d, k] / mean_c[k])) if d.sum() > 2 else float("nan")
+        print(
+            f"{theta[0] - p[0]:4.0f} {p[1] - theta[1]:6.1f} {r[k]:6.2f} {mean_c[k]:10.3g} "
+            f"{z[:, k].mean() / sensor.pd / mean_c[k]:10.2f} {1 - d.mean():9.2f} {lsd:10.2f} "
+            f"{float(sensor.likelihood(0.0, mean_c[k])):10.2f}"
+        )
+
+    # Fit γ∞, r_γ and s of the fluctuation likelihood to every reading by maximum likelihood
+    # (readings are the instrument's; the likelihood's γ absorbs its random misses).
+    thr = sensor.threshold
+
+    def nll(par: np.ndarray) -> float:
+        g_inf, r_g, s = 1 / (1 + np.exp(-par[0])), np.exp(par[1]), np.exp(par[2])
+        g = g_inf * (1 - np.exp(-r / r_g))
+        mu = np.log(mean_c) - 0.5 * s * s
+        p_nd = 1 - g + g * stats.norm.cdf((np.log(thr) - mu) / s)
+        ll_nd = np.log(p_nd)
+        with np.errstate(divide="ignore"):
+            lz = np.log(np.where(det, z, thr))
+        ll_det = np.log(g) + stats.norm.logpdf(lz, mu, s) - lz
+        return -float(np.where(det, ll_det, ll_nd).sum())
+
+    best = optimize.minimize(nll, np.array([0.0, 0.0, 0.0]), method="Nelder-Mead")
+    g_inf, r_g, s = 1 / (1 + np.exp(-best.x[0])), np.exp(best.x[1]), np.exp(best.x[2])
+    flat = optimize.minimize(
+        lambda q: nll(np.array([q[0], -10.0, q[1]])), np.array([0.0, 0.0]), method="Nelder-Mead"
+    )
+    print(f"fit: gamma_inf {g_inf:.3f}  r_gamma {r_g:.2f} m  log_sd {s:.3f}  (nll {best.fun:.1f})")
+    print(
+        f"constant gamma: gamma {1 / (1 + np.exp(-flat.x[0])):.3f}  log_sd {np.exp(flat.x[1]):.3f}"
+        f"  (nll {flat.fun:.1f}; 2 Δnll = {2 * (flat.fun - best.fun):.1f} for one parameter)"
+    )
+
+
+if __name__ == "__main__":
+    main()
