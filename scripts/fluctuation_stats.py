@@ -28,6 +28,7 @@ def main() -> None:
     ap.add_argument("--hold", type=float, default=5.0)
     ap.add_argument("--seconds", type=float, default=1800.0)
     ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--meander", type=float, default=0.15, help="the model's meander intensity")
     args = ap.parse_args()
     scenario = load_scenario("paper:1").with_overrides(**{"truth.model": "filament"})
     theta = scenario.truth_theta()
@@ -35,7 +36,7 @@ def main() -> None:
     down = np.array([1.0, 2.0, 3.0, 5.0, 8.0, 12.0, 20.0, 30.0])
     cross = np.array([0.0, 1.5, 3.0])
     pts = np.array([[theta[0] - d, theta[1] + c, 4.0] for d in down for c in cross])
-    mean_c = isotropic_concentration(theta, pts)[0]
+    mean_c = isotropic_concentration(theta, pts, meander=args.meander)[0]
     rng = np.random.default_rng(0)
     readings = []
     for seed in range(args.seeds):
@@ -50,7 +51,7 @@ def main() -> None:
     z = np.array(readings)  # (windows, points)
     det = z >= sensor.threshold
     r = np.sqrt((pts[:, 0] - theta[0]) ** 2 + (pts[:, 1] - theta[1]) ** 2 + 9.0)
-    print(f"hold {args.hold:g} s, {len(z)} readings per point, instrument Pd {sensor.pd}")
+    print(f"model meander {args.meander:g}, hold {args.hold:g} s, {len(z)} readings per point, instrument Pd {sensor.pd}")
     print("down  cross  r      C_iso      mean/C_iso  nd share  logsd(det)  P(nd) iso-model")
     for k, p in enumerate(pts):
         d = det[:, k]

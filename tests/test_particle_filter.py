@@ -103,7 +103,7 @@ def test_history_kernel_matches_reference(sensor):
     z = np.where(rng.random(30) < 0.5, 0.0, rng.gamma(1.0, 5e-3, 30))
     mult = rng.integers(1, 4, 30).astype(float)
     out = np.empty(500)
-    history_log_likelihood(theta, np.ones(500, bool), pos, z, mult, 0.1, sensor.params, out)
+    history_log_likelihood(theta, np.ones(500, bool), pos, z, mult, 0.1, 0.0, sensor.params, out)
     ref = history_log_likelihood_reference(theta, pos, z, mult, sensor, IsotropicPlume())
     np.testing.assert_allclose(out, ref, rtol=1e-9)
 

@@ -18,6 +18,7 @@ def history_log_likelihood(
     readings: np.ndarray,
     multiplicity: np.ndarray,
     rmin: float,
+    meander: float,
     sp: SensorParams,
     out: np.ndarray,
 ):
@@ -35,6 +36,6 @@ def history_log_likelihood(
         terms = plume_terms(theta, i)
         acc = 0.0
         for k in range(k_count):
-            c, r = plume_at(terms, positions[k, 0], positions[k, 1], positions[k, 2], rmin)
+            c, r = plume_at(terms, positions[k, 0], positions[k, 1], positions[k, 2], rmin, meander)
             acc += multiplicity[k] * log_likelihood(readings[k], c, r, sp)
         out[i] = acc

@@ -57,7 +57,7 @@ def history_log_likelihood_reference(
     plume: IsotropicPlume,
 ) -> np.ndarray:
     """NumPy reference of the compiled history likelihood: (N,) Σ_k m_k log p(z_k | Θ_i)."""
-    conc = isotropic_concentration_reference(theta, positions, plume.min_distance)
+    conc = isotropic_concentration_reference(theta, positions, plume.min_distance, plume.meander)
     d = positions[None, :, :] - theta[:, None, :3]
     dist = np.maximum(np.sqrt(np.einsum("nki,nki->nk", d, d)), plume.min_distance)
     ll = sensor.log_likelihood(readings[None, :], conc, dist)
@@ -266,6 +266,7 @@ class ParticleFilter:
             np.array([reading], dtype=np.float64),
             np.ones(1),
             self.plume.min_distance,
+            self.plume.meander,
             self._sp,
             out,
         )
@@ -390,7 +391,15 @@ class ParticleFilter:
         ll_prop = np.empty(self.n)
         pos, z, mult = self.history()
         history_log_likelihood(
-            proposal, active, pos, z, mult, self.plume.min_distance, self._sp, ll_prop
+            proposal,
+            active,
+            pos,
+            z,
+            mult,
+            self.plume.min_distance,
+            self.plume.meander,
+            self._sp,
+            ll_prop,
         )
         log_u = np.log(self.rng.random(self.n))
         with np.errstate(invalid="ignore"):

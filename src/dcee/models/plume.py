@@ -21,6 +21,15 @@ Expected concentration (g/m³) at position p from a source at s::
 Wind-direction convention: with this formula the plume extends from the source towards
 −(cos φ, sin φ); φ is the direction the wind *comes from* (φ = 0: wind from +x blowing towards −x).
 
+Meander (``meander`` = i > 0, off by default): a real plume's centreline swings with the
+large eddies, so its *time mean* is wider than the diffusion-only solution above. Following
+Taylor's short-range result (crosswind spread σ_m = i · d at distance d downwind, i the
+crosswind turbulence intensity σ_v/u), the horizontal crosswind profile, Gaussian with
+variance σ_d² = 2 ζ1 d / u in the far field, is convolved with N(0, σ_m²): the concentration
+is the isotropic one at the crosswind offset compressed by f = σ_d / √(σ_d² + σ_m²) =
+1/√(1 + i² d u / (2 ζ1)), times f (mass conserved across the plume). Exact for the far field's
+Gaussian profile, f → 1 at the source and upwind.
+
 The distance is clamped at :data:`MIN_DISTANCE` = 0.1 m, the scale of a sensor inlet, so the
 model stays finite when a hypothesised source sits on the sensor (the authors' MATLAB code uses
 1e-5 m, Stone Soup 0.1 m; a tiny clamp makes a particle at the sensor predict absurd
@@ -69,7 +78,10 @@ def _check_shapes(theta: np.ndarray, positions: np.ndarray) -> tuple[np.ndarray,
 
 
 def isotropic_concentration_reference(
-    theta: np.ndarray, positions: np.ndarray, min_distance: float = MIN_DISTANCE
+    theta: np.ndarray,
+    positions: np.ndarray,
+    min_distance: float = MIN_DISTANCE,
+    meander: float = 0.0,
 ) -> np.ndarray:
     """Plain NumPy implementation of the plume; the compiled kernel is tested against it.
 
@@ -79,15 +91,27 @@ def isotropic_concentration_reference(
     x, y, z, q, u, phi, z1, z2 = (theta[:, k : k + 1] for k in range(8))
     dx = positions[None, :, 0] - x
     dy = positions[None, :, 1] - y
+    factor = np.ones_like(dx)
+    if meander > 0:
+        down = np.maximum(-(dx * np.cos(phi) + dy * np.sin(phi)), 0.0)
+        factor = 1.0 / np.sqrt(1.0 + meander**2 * down * u / (2.0 * z1))
+        cross = -dx * np.sin(phi) + dy * np.cos(phi)
+        along = dx * np.cos(phi) + dy * np.sin(phi)
+        cross = cross * factor
+        dx = along * np.cos(phi) - cross * np.sin(phi)
+        dy = along * np.sin(phi) + cross * np.cos(phi)
     dz = positions[None, :, 2] - z
     r = np.maximum(np.sqrt(dx * dx + dy * dy + dz * dz), min_distance)
     lam = np.sqrt(z1 * z2 / (1.0 + u * u * z2 / (4.0 * z1)))
     advection = (dx * u * np.cos(phi) + dy * u * np.sin(phi)) / (2.0 * z1)
-    return q / (4.0 * np.pi * z1 * r) * np.exp(-r / lam - advection)
+    return factor * q / (4.0 * np.pi * z1 * r) * np.exp(-r / lam - advection)
 
 
 def isotropic_concentration(
-    theta: np.ndarray, positions: np.ndarray, min_distance: float = MIN_DISTANCE
+    theta: np.ndarray,
+    positions: np.ndarray,
+    min_distance: float = MIN_DISTANCE,
+    meander: float = 0.0,
 ) -> np.ndarray:
     """Expected concentration (g/m³) of the isotropic plume, compiled.
 
@@ -96,7 +120,7 @@ def isotropic_concentration(
     """
     theta, positions = _check_shapes(theta, positions)
     out = np.empty((theta.shape[0], positions.shape[0]))
-    plume_kernels.concentration_matrix(theta, positions, min_distance, out)
+    plume_kernels.concentration_matrix(theta, positions, min_distance, meander, out)
     return out
 
 
@@ -105,7 +129,13 @@ class IsotropicPlume:
     """The estimator's dispersion model; wraps :func:`isotropic_concentration`."""
 
     min_distance: float = MIN_DISTANCE
+    meander: float = 0.0
+    """crosswind turbulence intensity i of the time-mean meander broadening (0: none)"""
+
+    def __post_init__(self) -> None:
+        if not (0.0 <= self.meander <= 2.0):
+            raise DceeInputError("meander", f"must be in [0, 2], got {self.meander}")
 
     def concentration(self, theta: np.ndarray, positions: np.ndarray) -> np.ndarray:
         """(N, 8) source terms × (M, 3) positions → (N, M) concentrations in g/m³."""
-        return isotropic_concentration(theta, positions, self.min_distance)
+        return isotropic_concentration(theta, positions, self.min_distance, self.meander)

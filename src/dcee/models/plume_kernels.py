@@ -19,52 +19,79 @@ _FOUR_PI = 4.0 * math.pi
 @njit(cache=True, inline="always")
 def plume_terms(theta: np.ndarray, i: int):
     """Per-particle constants of the plume: the source location (x, y, z), then
-    q/(4π ζ1), 1/λ, u cosφ/(2ζ1) and u sinφ/(2ζ1) — computed once, used at every position."""
+    q/(4π ζ1), 1/λ, u cosφ/(2ζ1), u sinφ/(2ζ1), cos φ, sin φ and u/(2ζ1) — computed once,
+    used at every position."""
     q = theta[i, 3]
     u = theta[i, 4]
     phi = theta[i, 5]
     z1 = theta[i, 6]
     z2 = theta[i, 7]
     lam = math.sqrt(z1 * z2 / (1.0 + u * u * z2 / (4.0 * z1)))
+    c = math.cos(phi)
+    s = math.sin(phi)
+    k = u / (2.0 * z1)
     return (
         theta[i, 0],
         theta[i, 1],
         theta[i, 2],
         q / (_FOUR_PI * z1),
         1.0 / lam,
-        u * math.cos(phi) / (2.0 * z1),
-        u * math.sin(phi) / (2.0 * z1),
+        k * c,
+        k * s,
+        c,
+        s,
+        k,
     )
 
 
 @njit(cache=True, inline="always")
-def plume_at(terms, px: float, py: float, pz: float, rmin: float):
+def plume_at(terms, px: float, py: float, pz: float, rmin: float, meander: float):
     """(concentration, clamped distance r) at (px, py, pz) from one particle's
-    :func:`plume_terms`."""
-    sx, sy, sz, pref, inv_lam, ax, ay = terms
+    :func:`plume_terms`; see :mod:`dcee.models.plume` for ``meander``."""
+    sx, sy, sz, pref, inv_lam, ax, ay, c, s, k = terms
     dx = px - sx
     dy = py - sy
     dz = pz - sz
+    r0 = math.sqrt(dx * dx + dy * dy + dz * dz)
+    factor = 1.0
+    if meander > 0.0:
+        down = -(dx * c + dy * s)  # distance downwind of the source
+        if down > 0.0:
+            factor = 1.0 / math.sqrt(1.0 + meander * meander * down * k)
+            cross = (factor - 1.0) * (-dx * s + dy * c)  # compress the crosswind offset
+            dx -= cross * s
+            dy += cross * c
     r = math.sqrt(dx * dx + dy * dy + dz * dz)
     if r < rmin:
         r = rmin
-    return pref / r * math.exp(-r * inv_lam - dx * ax - dy * ay), r
+    if r0 < rmin:
+        r0 = rmin
+    return factor * pref / r * math.exp(-r * inv_lam - dx * ax - dy * ay), r0
 
 
 @njit(cache=True, parallel=True)
-def concentration_grid(theta: np.ndarray, positions: np.ndarray, rmin: float, out: np.ndarray):
+def concentration_grid(
+    theta: np.ndarray, positions: np.ndarray, rmin: float, meander: float, out: np.ndarray
+):
     """out[m, i] = C(positions[m]; theta[i]). theta (N, 8), positions (M, 3), out (M, N)."""
     n = theta.shape[0]
     m_count = positions.shape[0]
     for i in prange(n):
         terms = plume_terms(theta, i)
         for m in range(m_count):
-            out[m, i] = plume_at(terms, positions[m, 0], positions[m, 1], positions[m, 2], rmin)[0]
+            out[m, i] = plume_at(
+                terms, positions[m, 0], positions[m, 1], positions[m, 2], rmin, meander
+            )[0]
 
 
 @njit(cache=True, parallel=True)
 def concentration_distance_grid(
-    theta: np.ndarray, positions: np.ndarray, rmin: float, conc: np.ndarray, dist: np.ndarray
+    theta: np.ndarray,
+    positions: np.ndarray,
+    rmin: float,
+    meander: float,
+    conc: np.ndarray,
+    dist: np.ndarray,
 ):
     """conc[m, i] = C(positions[m]; theta[i]) and dist[m, i] the clamped source distance r."""
     n = theta.shape[0]
@@ -72,13 +99,15 @@ def concentration_distance_grid(
     for i in prange(n):
         terms = plume_terms(theta, i)
         for m in range(m_count):
-            c, r = plume_at(terms, positions[m, 0], positions[m, 1], positions[m, 2], rmin)
+            c, r = plume_at(terms, positions[m, 0], positions[m, 1], positions[m, 2], rmin, meander)
             conc[m, i] = c
             dist[m, i] = r
 
 
-def concentration_matrix(theta: np.ndarray, positions: np.ndarray, rmin: float, out: np.ndarray):
+def concentration_matrix(
+    theta: np.ndarray, positions: np.ndarray, rmin: float, meander: float, out: np.ndarray
+):
     """out[i, m] = C(positions[m]; theta[i]); out (N, M) C-contiguous."""
     tmp = np.empty((positions.shape[0], theta.shape[0]))
-    concentration_grid(theta, positions, rmin, tmp)
+    concentration_grid(theta, positions, rmin, meander, tmp)
     out[...] = tmp.T

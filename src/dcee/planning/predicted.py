@@ -123,8 +123,10 @@ class PredictionContext:
             pts = np.ascontiguousarray(np.array(new, dtype=np.float64))
             shape = (len(pts), self._theta.shape[0])
             conc, dist, loc, log_nd, inv_sigma, det_offset = (np.empty(shape) for _ in range(6))
-            rmin = self.belief.plume.min_distance
-            concentration_distance_grid(self._theta, pts, rmin, conc, dist)
+            plume = self.belief.plume
+            concentration_distance_grid(
+                self._theta, pts, plume.min_distance, plume.meander, conc, dist
+            )
             position_terms(conc, dist, self._sp, loc, log_nd, inv_sigma, det_offset)
             self._rows.append((conc, dist, loc, log_nd, inv_sigma, det_offset))
             self._terms = None

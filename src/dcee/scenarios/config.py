@@ -39,9 +39,10 @@ A scenario is a TOML file (or a built-in, see :mod:`dcee.scenarios.builtin`)::
 
     [estimator]                    # the reading model of the filter and the planners
     likelihood = "paper"           # or "fluctuation" (intermittent log-normal, for real plumes)
-    intermittency = 0.6            # fluctuation only
-    log_sd = 1.2                   # fluctuation only
-    near_source_length = 5.0       # fluctuation only, m
+    intermittency = 0.63           # fluctuation only
+    log_sd = 1.3                   # fluctuation only
+    near_source_length = 5.4       # fluctuation only, m
+    meander = 0.15                 # plume broadening [default: 0 paper, 0.15 fluctuation]
     outlier = 0.0                  # outlier weight [default: 0 paper, 0.01 fluctuation]
 
     [agent]
@@ -79,7 +80,7 @@ from pydantic import (
 from dcee.errors import DceeInputError
 from dcee.estimation.priors import Distribution, Fixed, Gamma, Normal, SourcePrior, Uniform
 from dcee.models.agent import GridAgent, SearchVolume
-from dcee.models.plume import PARAMETER_NAMES
+from dcee.models.plume import PARAMETER_NAMES, IsotropicPlume
 from dcee.models.sensor import Sensor
 
 _FROZEN = ConfigDict(frozen=True, extra="forbid")
@@ -249,6 +250,12 @@ none (its numbers are reproduced exactly); the fluctuation likelihood, meant for
 bounds the influence of every reading (docs/scenarios.md)."""
 
 
+MEANDER_DEFAULT: dict[str, float] = {"paper": 0.0, "fluctuation": 0.15}
+"""Meander broadening per likelihood when ``estimator.meander`` is not given: none for the
+paper's model; 0.15 for the fluctuation model, the crosswind turbulence intensity that fits the
+filament truth's time mean best (docs/scenarios.md)."""
+
+
 class EstimatorSpec(BaseModel):
     """The reading model the filter and every planner use (one :class:`Sensor` for both).
 
@@ -262,13 +269,16 @@ class EstimatorSpec(BaseModel):
 
     model_config = _FROZEN
     likelihood: Likelihood = "paper"
-    intermittency: Annotated[float, Field(gt=0, le=1)] = 0.6
+    intermittency: Annotated[float, Field(gt=0, le=1)] = 0.63
     """fluctuation: probability that a reading well inside the plume is not zero"""
-    log_sd: Annotated[float, Field(gt=0, le=5)] = 1.2
+    log_sd: Annotated[float, Field(gt=0, le=5)] = 1.3
     """fluctuation: standard deviation of ln(reading) about ln(mean) − log_sd²/2"""
-    near_source_length: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] = 5.0
+    near_source_length: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] = 5.4
     """fluctuation: m; the intermittency falls near the source as 1 − exp(−r / this)
     (r: sensor to hypothesised source); 0 = the same everywhere"""
+    meander: Annotated[float | None, Field(ge=0, le=2)] = None
+    """crosswind turbulence intensity of the plume model's time-mean meander broadening
+    (:mod:`dcee.models.plume`); None: the likelihood's default, :data:`MEANDER_DEFAULT`"""
     outlier: Annotated[float | None, Field(ge=0, lt=1)] = None
     """weight of the outlier component (log-uniform up to sensor.max_reading); None: the
     likelihood's default, :data:`OUTLIER_DEFAULT`"""
@@ -294,6 +304,14 @@ class SearchSpec(BaseModel):
     stop_spread: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
     resample_threshold: Annotated[float, Field(gt=0, le=1)] = 0.5
     mcmc_steps: Annotated[int, Field(ge=0, le=100)] = 1
+    """least Metropolis-Hastings sweeps after a resampling"""
+    global_share: Annotated[float, Field(ge=0, le=1)] = 0.2
+    """share of particles proposing a source location from the prior in each sweep (keeps
+    separated modes alive; 0 = random walk only)"""
+    diversify: Annotated[float, Field(ge=0, le=1)] = 0.5
+    """sweep until this share of the particles has moved since the resampling"""
+    max_sweeps: Annotated[int, Field(ge=1, le=100)] = 8
+    """most sweeps after one resampling"""
 
 
 class Scenario(BaseModel):
@@ -368,6 +386,11 @@ class Scenario(BaseModel):
         return self.dwell if self.time_varying_truth else 0.0
 
     @property
+    def meander(self) -> float:
+        e = self.estimator
+        return e.meander if e.meander is not None else MEANDER_DEFAULT[e.likelihood]
+
+    @property
     def outlier(self) -> float:
         e = self.estimator
         return e.outlier if e.outlier is not None else OUTLIER_DEFAULT[e.likelihood]
@@ -379,6 +402,7 @@ class Scenario(BaseModel):
             "average": self.average,
             "likelihood": self.estimator.likelihood,
             "outlier": self.outlier,
+            "meander": self.meander,
         }
 
     # --- conversion to model objects ----------------------------------------------------------
@@ -407,6 +431,10 @@ class Scenario(BaseModel):
             outlier=self.outlier,
             max_reading=s.max_reading,
         )
+
+    def make_plume(self) -> IsotropicPlume:
+        """The dispersion model of the filter and the planners."""
+        return IsotropicPlume(meander=self.meander)
 
     def make_agent(self) -> GridAgent:
         a = self.agent
@@ -437,10 +465,13 @@ class Scenario(BaseModel):
 
     def with_overrides(self, **changes: Any) -> Scenario:
         """A re-validated copy; keys are dotted paths, e.g. ``{"search.particles": 2000}``."""
-        data = self.model_dump()
+        scenario = self
         for path, value in changes.items():
             if value is None:
                 continue
+            # one at a time, so that a later path may go into what an earlier one set
+            # (e.g. truth.model = "filament", then truth.model.meander_intensity)
+            data = scenario.model_dump()
             node = data
             *parents, leaf = path.split(".")
             for p in parents:
@@ -448,7 +479,8 @@ class Scenario(BaseModel):
                     raise DceeInputError(path, f"no such setting ({p!r} is not a section)")
                 node = node[p]
             node[leaf] = value
-        return validate_scenario(data)
+            scenario = validate_scenario(data)
+        return scenario
 
 
 def _distribution(name: str, spec: PriorSpec) -> Distribution:

@@ -70,10 +70,14 @@ def run_episode(
     pf = ParticleFilter(
         scenario.make_prior(),
         scenario.make_estimator_sensor(),  # the reading model of the filter and the planners
+        scenario.make_plume(),
         n_particles=search.particles,
         seed=filter_rng,
         resample_threshold=search.resample_threshold,
         mcmc_steps=search.mcmc_steps,
+        global_share=search.global_share,
+        diversify=search.diversify,
+        max_sweeps=search.max_sweeps,
     )
     searcher = Searcher(pf, planner, agent, planner_rng)
     position = np.array(scenario.agent.start, dtype=np.float64)

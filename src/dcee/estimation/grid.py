@@ -1,0 +1,91 @@
+"""Exact posterior of the source location on a grid: the reference the particle filter is
+checked against (tests and ``scripts/replay_study.py``).
+
+With only the horizontal location (x, y) unknown and every other parameter known, the posterior
+is a two-dimensional density that can be evaluated everywhere: on a grid of spacing h over the
+search area, p(x, y | Z) ∝ prior × Π_k p(z_k | C(p_k; x, y)). Its mean and standard deviation
+converge to the exact ones as O(h²) for a smooth posterior (midpoint rule); choose h well below
+the posterior's standard deviation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from dcee.estimation.filter_kernels import history_log_likelihood
+from dcee.models.plume import IsotropicPlume
+from dcee.models.sensor import Sensor
+
+
+@dataclass(frozen=True)
+class GridPosterior:
+    """Normalised posterior weights (K,) at grid points (K, 2), with mean (2,) and sd (2,)."""
+
+    points: np.ndarray
+    weights: np.ndarray
+
+    @property
+    def mean(self) -> np.ndarray:
+        return self.weights @ self.points
+
+    @property
+    def sd(self) -> np.ndarray:
+        return np.sqrt(self.weights @ (self.points - self.mean) ** 2)
+
+    def mass_within(self, center: np.ndarray, radius: float) -> float:
+        """Posterior mass within ``radius`` m of ``center`` (2,)."""
+        d = np.linalg.norm(self.points - np.asarray(center)[None, :2], axis=1)
+        return float(self.weights[d <= radius].sum())
+
+
+def location_grid_posterior(
+    theta: np.ndarray,
+    low: tuple[float, float],
+    high: tuple[float, float],
+    spacing: float,
+    positions: np.ndarray,
+    readings: np.ndarray,
+    sensor: Sensor,
+    plume: IsotropicPlume | None = None,
+    refine: int = 1,
+) -> GridPosterior:
+    """Exact posterior of (x, y) under a uniform prior on [low, high], every other parameter of
+    ``theta`` (8,) known; positions (K, 3) m and readings (K,) g/m³ (non-detections below the
+    threshold). Cell centres at ``spacing`` m; with ``refine`` > 1 every cell holding more than
+    1e-12 of the largest cell's weight is split into refine × refine sub-cells (a fine grid
+    where the mass is, for sharp posteriors)."""
+    plume = plume or IsotropicPlume()
+    xs = np.arange(low[0] + spacing / 2, high[0], spacing)
+    ys = np.arange(low[1] + spacing / 2, high[1], spacing)
+    gx, gy = np.meshgrid(xs, ys, indexing="ij")
+    pts = np.column_stack([gx.ravel(), gy.ravel()])
+    loglik = _loglik(theta, pts, positions, readings, sensor, plume)
+    if refine > 1:
+        keep = pts[loglik > loglik.max() + np.log(1e-12)]
+        offsets = (np.arange(refine) + 0.5) / refine * spacing - spacing / 2
+        ox, oy = np.meshgrid(offsets, offsets, indexing="ij")
+        pts = (keep[:, None, :] + np.column_stack([ox.ravel(), oy.ravel()])[None]).reshape(-1, 2)
+        loglik = _loglik(theta, pts, positions, readings, sensor, plume)
+    w = np.exp(loglik - loglik.max())
+    return GridPosterior(pts, w / w.sum())
+
+
+def _loglik(theta, pts, positions, readings, sensor, plume) -> np.ndarray:
+    grid = np.repeat(np.asarray(theta, dtype=np.float64).reshape(1, 8), len(pts), axis=0)
+    grid[:, :2] = pts
+    readings = np.where(np.asarray(readings) < sensor.threshold, 0.0, readings)
+    out = np.empty(len(pts))
+    history_log_likelihood(
+        grid,
+        np.ones(len(pts), dtype=np.bool_),
+        np.ascontiguousarray(positions, dtype=np.float64),
+        np.ascontiguousarray(readings, dtype=np.float64),
+        np.ones(len(readings)),
+        plume.min_distance,
+        plume.meander,
+        sensor.params,
+        out,
+    )
+    return out
