@@ -51,7 +51,10 @@ def main() -> None:
     z = np.array(readings)  # (windows, points)
     det = z >= sensor.threshold
     r = np.sqrt((pts[:, 0] - theta[0]) ** 2 + (pts[:, 1] - theta[1]) ** 2 + 9.0)
-    print(f"model meander {args.meander:g}, hold {args.hold:g} s, {len(z)} readings per point, instrument Pd {sensor.pd}")
+    print(
+        f"model meander {args.meander:g}, hold {args.hold:g} s, {len(z)} readings per point, "
+        f"instrument Pd {sensor.pd}"
+    )
     print("down  cross  r      C_iso      mean/C_iso  nd share  logsd(det)  P(nd) iso-model")
     for k, p in enumerate(pts):
         d = det[:, k]

@@ -46,6 +46,12 @@ BAD = [
     (["--budget", "nan"], "search.budget"),
     (["--hypotheses", "0"], "search.hypotheses"),
     (["--seed", "-1"], "seed"),
+    (["--likelihood", "gauss"], "likelihood"),
+    (["--set", "estimator.log_sd=-1"], "estimator.log_sd"),
+    (["--set", "nonsense"], "set"),
+    (["--set", "estimator.nope=1"], "estimator.nope"),
+    (["--set", "sensor.average=9"], "sensor.average"),
+    (["--set", "sensor.max_reading=1e-9"], "sensor.max_reading"),
 ]
 
 

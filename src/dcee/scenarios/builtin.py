@@ -67,7 +67,7 @@ def _paper(k: int) -> dict[str, Any]:
         },
         "sensor": {"threshold": 5e-4, "pd": 0.7, "sigma_min": 1e-4, "sigma_frac": 0.5},
         # Table 2; the dwell (sampling interval) is left to its default: 1 s against the
-        # isotropic truth (2 s per move, 450 readings in 900 s), a 5 s hold against a turbulent one.
+        # isotropic truth (2 s per move, 450 readings in 900 s), a 4 s hold against a turbulent one.
         "agent": {"start": [2.0, 2.0, 4.0], "step": 2.0, "speed": 2.0},
         "search": {"particles": 20_000, "hypotheses": 40, "budget": 900.0, "acquired_rmse": 3.0},
     }

@@ -1,0 +1,315 @@
+"""Robust estimation on turbulent plumes: hold-averaged readings, the meandering plume model,
+outlier safety, the mode-keeping move against an exact grid posterior on adaptive paths, and
+calibration of the credible region."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from dcee import DceeInputError, IsotropicPlume, ParticleFilter, Sensor
+from dcee.estimation import SourcePrior
+from dcee.estimation.filter_kernels import history_log_likelihood
+from dcee.estimation.grid import location_grid_posterior
+from dcee.estimation.particle_filter import history_log_likelihood_reference
+from dcee.estimation.priors import Fixed, Uniform
+from dcee.models.plume import isotropic_concentration, isotropic_concentration_reference
+from dcee.planning import get as get_planner
+from dcee.scenarios import load_scenario
+from dcee.searcher import Searcher
+from dcee.simulation import make_truth, run_episode
+from tests.helpers import run_cli
+
+PAPER1 = load_scenario("paper:1")  # source (37.5, 12.5, 1), wind from +x at 4 m/s: plume to -x
+THETA = PAPER1.truth_theta()
+
+
+# --- the meandering plume model ---
+
+
+def _random_theta(n: int, rng: np.random.Generator) -> np.ndarray:
+    return np.column_stack(
+        [
+            rng.uniform(0, 50, n),
+            rng.uniform(0, 50, n),
+            rng.uniform(0, 5, n),
+            rng.gamma(2, 5, n),
+            rng.uniform(0, 8, n),
+            rng.uniform(-4, 4, n),
+            rng.uniform(0.1, 3, n),
+            rng.uniform(0.5, 15, n),
+        ]
+    )
+
+
+def test_meander_kernel_matches_reference_and_zero_meander_is_the_paper_plume():
+    rng = np.random.default_rng(4)
+    theta = _random_theta(300, rng)
+    pos = np.column_stack([rng.uniform(0, 50, 23), rng.uniform(0, 50, 23), np.full(23, 4.0)])
+    for meander in (0.0, 0.15, 0.6):
+        fast = isotropic_concentration(theta, pos, meander=meander)
+        ref = isotropic_concentration_reference(theta, pos, meander=meander)
+        np.testing.assert_allclose(fast, ref, rtol=1e-9, atol=0)
+    np.testing.assert_array_equal(
+        isotropic_concentration(theta, pos, meander=0.0), isotropic_concentration(theta, pos)
+    )
+
+
+def test_meander_widens_the_far_field_but_conserves_the_crosswind_integral():
+    """Limiting cases by hand: upwind nothing changes; far downwind the crosswind profile is
+    wider by √(1 + i² d u / 2ζ1), its peak lower by the same factor, and its integral across
+    the plume (the mass flux) is unchanged."""
+    d = 30.0
+    ys = np.linspace(-40, 40, 4001)
+    pts = np.column_stack([np.full_like(ys, THETA[0] - d), THETA[1] + ys, np.full_like(ys, 1.0)])
+    plain = isotropic_concentration(THETA, pts)[0]
+    wide = isotropic_concentration(THETA, pts, meander=0.2)[0]
+    grow = math.sqrt(1 + 0.2**2 * d * THETA[4] / (2 * THETA[6]))
+    assert np.trapezoid(wide, ys) == pytest.approx(np.trapezoid(plain, ys), rel=0.02)
+    assert wide.max() == pytest.approx(plain.max() / grow, rel=0.02)
+    sd = lambda c: math.sqrt(np.trapezoid(c * ys**2, ys) / np.trapezoid(c, ys))  # noqa: E731
+    assert sd(wide) == pytest.approx(sd(plain) * grow, rel=0.03)
+    upwind = np.array([[THETA[0] + 2.0, THETA[1] + 1.0, 4.0]])
+    assert isotropic_concentration(THETA, upwind, meander=0.5)[0, 0] == pytest.approx(
+        isotropic_concentration(THETA, upwind)[0, 0], rel=1e-12
+    )
+
+
+def test_history_kernel_with_meander_and_near_source_intermittency_matches_reference():
+    rng = np.random.default_rng(0)
+    theta = _random_theta(400, rng)
+    pos = np.column_stack([rng.uniform(0, 50, (40, 2)), np.full(40, 4.0)])
+    z = np.where(rng.random(40) < 0.5, 0.0, rng.gamma(1.0, 5e-3, 40))
+    mult = rng.integers(1, 4, 40).astype(float)
+    sensor = Sensor(family="lognormal", pd=0.6, log_sd=1.3, near_length=5.4, outlier=0.01)
+    plume = IsotropicPlume(meander=0.15)
+    out = np.empty(400)
+    history_log_likelihood(theta, np.ones(400, bool), pos, z, mult, 0.1, 0.15, sensor.params, out)
+    ref = history_log_likelihood_reference(theta, pos, z, mult, sensor, plume)
+    np.testing.assert_allclose(out, ref, rtol=1e-9)
+
+
+# --- readings as a holding robot takes them ---
+
+
+def test_hold_average_is_the_mean_of_the_samples_and_the_isotropic_truth_is_unaffected():
+    scenario = PAPER1.with_overrides(**{"truth.model": "filament"})
+    truth = make_truth(scenario, 3)
+    p = np.array([30.0, 12.5, 4.0])
+    t = 40.0
+    samples = [truth.concentration(p, t - 0.1 * k) for k in range(49, -1, -1)]
+    truth2 = make_truth(scenario, 3)  # a fresh copy: sensed() must not depend on history
+    assert truth2.sensed(p, t, 5.0) == pytest.approx(np.mean(samples), rel=1e-12)
+    lagged = truth2.sensed(p, t, 5.0, response_time=2.0)
+    assert lagged != pytest.approx(np.mean(samples))  # the response changes the reading
+    iso = make_truth(PAPER1, 0)
+    assert iso.sensed(p, t, 5.0) == iso.concentration(p, t)
+
+
+def test_turbulent_truth_defaults_to_a_four_second_hold_and_average():
+    filament = PAPER1.with_overrides(**{"truth.model": "filament"})
+    assert (filament.dwell, filament.average) == (4.0, 4.0)
+    assert (PAPER1.dwell, PAPER1.average) == (1.0, 0.0)
+    assert filament.make_agent().step_time == pytest.approx(5.0)
+    fluct = filament.with_overrides(**{"estimator.likelihood": "fluctuation"})
+    s = fluct.make_estimator_sensor()
+    assert (s.family, s.pd, s.log_sd, s.near_length, s.outlier) == (
+        "lognormal",
+        0.63,
+        1.3,
+        5.4,
+        0.01,
+    )
+    assert fluct.make_plume().meander == 0.15
+    assert PAPER1.make_estimator_sensor() == PAPER1.make_sensor()  # the paper's exact model
+
+
+# --- outlier safety ---
+
+
+def _xy_prior(scenario=PAPER1) -> SourcePrior:
+    names = ("x", "y", "z", "q", "u", "phi", "zeta1", "zeta2")
+    t = scenario.truth_theta()
+    d = {n: Fixed(float(t[i])) for i, n in enumerate(names)}
+    lo, hi = scenario.volume.low, scenario.volume.high
+    d["x"], d["y"] = Uniform(lo[0], hi[0]), Uniform(lo[1], hi[1])
+    return SourcePrior.from_dict(d)
+
+
+def test_absurd_readings_are_refused_before_anything_changes():
+    pf = ParticleFilter(_xy_prior(), Sensor(), n_particles=2000, seed=0)
+    before = pf.theta.copy()
+    for bad in (1e200, float("nan"), "12", None, np.array([1.0, 2.0])):
+        with pytest.raises(DceeInputError, match="reading"):
+            pf.update(np.array([30.0, 12.5, 4.0]), bad)
+    assert pf.n_readings == 0 and np.array_equal(pf.theta, before)
+
+
+FUZZ_SENSORS = {
+    "paper": Sensor(),
+    "paper+outlier": Sensor(outlier=0.01),
+    "fluctuation": Sensor(family="lognormal", pd=0.63, log_sd=1.3, near_length=5.4, outlier=0.01),
+}
+
+
+def fuzz_stream(sensor: Sensor, stream: int, readings: int = 6) -> ParticleFilter:
+    """A filter fed random positions and readings from 0 up to the physical maximum
+    (log-uniform over eight decades), as ``scripts/fuzz_filter.py`` does at scale."""
+    rng = np.random.default_rng(stream)
+    pf = ParticleFilter(_xy_prior(), sensor, n_particles=100, seed=stream, max_sweeps=2)
+    for _ in range(readings):
+        pos = np.array([*rng.uniform(0, 50, 2), 4.0])
+        z = 0.0 if rng.random() < 0.3 else float(10 ** rng.uniform(-4, 4))
+        pf.update(pos, z)
+    return pf
+
+
+def filter_is_alive(pf: ParticleFilter, need_diversity: bool) -> bool:
+    """Finite weights, a finite history likelihood for every live particle and (where the model
+    can explain every reading) more than one distinct particle."""
+    w = pf.weights
+    live = w > 0
+    ok = bool(np.all(np.isfinite(w)) and np.all(np.isfinite(pf._hist_loglik[live])))
+    return ok and (not need_diversity or len(np.unique(pf.theta[live], axis=0)) > 1)
+
+
+@pytest.mark.parametrize("name", list(FUZZ_SENSORS))
+def test_no_fuzzed_stream_kills_the_filter(name):
+    """The paper's model (no outlier component) may legitimately collapse onto one point for a
+    reading only one location can explain, but never to NaN or −inf; with the outlier component
+    every filter also stays diverse. (1,000 streams per model: scripts/fuzz_filter.py.)"""
+    dead = [
+        s
+        for s in range(150)
+        if not filter_is_alive(fuzz_stream(FUZZ_SENSORS[name], s), name != "paper")
+    ]
+    assert dead == []
+
+
+def test_one_huge_spike_does_not_decide_a_search():
+    """Limiting case of the issue's measurement: a 500 g/m³ reading (1e6 × threshold) at reading
+    20 of an infotaxis search on the isotropic truth, with the outlier component: the search
+    ends as it ends without the spike (both acquire the source)."""
+    scenario = PAPER1.with_overrides(
+        **{"search.particles": 3000, "search.budget": 300.0, "estimator.outlier": 0.01}
+    )
+    ends = []
+    for spike in (False, True):
+        res = run_episode(scenario, "infotaxis", 0, truth=_SpikedTruth(scenario, spike))
+        ends.append(res.summary["final_rmse"])
+    assert ends[0] < 3.0 and ends[1] < 3.0
+
+
+class _SpikedTruth:
+    """The scenario's truth with one absurd concentration at reading 20 (t = 40 s)."""
+
+    time_step = None
+
+    def __init__(self, scenario, spike: bool) -> None:
+        self.inner = make_truth(scenario, 0)
+        self.spike = spike
+
+    def sensed(self, position, time, average=0.0, response_time=0.0):
+        if self.spike and abs(time - 40.0) < 1e-9:
+            return 500.0
+        return self.inner.concentration(position, time)
+
+    def __getattr__(self, name):
+        return getattr(self.inner, name)
+
+
+# --- a filter that keeps every mode ---
+
+
+def _adaptive_path(config: str, seed: int, n: int = 60):
+    scenario = load_scenario(config)
+    sensor = scenario.make_sensor()
+    rng = np.random.default_rng(seed)
+    pf = ParticleFilter(_xy_prior(scenario), sensor, n_particles=3000, seed=seed + 50)
+    searcher = Searcher(pf, get_planner("dcee", n_hypotheses=20), scenario.make_agent(), rng)
+    truth = make_truth(scenario, seed)
+    pos = np.array(scenario.agent.start, dtype=float)
+    ps, zs = [], []
+    for k in range(n):
+        z = float(sensor.simulate(truth.concentration(pos, 0.0), rng))
+        searcher.tell(pos, z, float(k))
+        ps.append(pos.copy())
+        zs.append(z)
+        pos = searcher.ask()
+    return scenario, np.array(ps), np.array(zs)
+
+
+@pytest.mark.parametrize("config", ["paper:5", "paper:12"])
+def test_filters_on_adaptive_paths_match_the_exact_grid_posterior(config):
+    """Readings chosen by a planner (DCEE) on configurations where it searches far from the
+    plume; 5,000-particle filters replayed on the same readings end within 0.3 exact sd of the
+    exact grid posterior's mean (the study, scripts/replay_study.py, runs 20,000 particles)."""
+    scenario, ps, zs = _adaptive_path(config, 0)
+    sensor = scenario.make_sensor()
+    exact = location_grid_posterior(
+        scenario.truth_theta(), (0, 0), (50, 50), 0.25, ps, zs, sensor, refine=5
+    )
+    for seed in range(3):
+        pf = ParticleFilter(_xy_prior(scenario), sensor, n_particles=5000, seed=seed)
+        for p, z in zip(ps, zs, strict=True):
+            pf.update(p, z)
+        np.testing.assert_array_less(np.abs(pf.mean() - exact.mean), 0.3 * exact.sd)
+
+
+def test_global_moves_rebalance_separated_modes():
+    """Two equally likely separated source locations (a symmetric pair of readings): after a
+    collapse onto one of them, the random-walk-only move never brings the other back, while the
+    mixture move restores both halves (exact answer: 50/50 by symmetry)."""
+    names = ("x", "y", "z", "q", "u", "phi", "zeta1", "zeta2")
+    vals = dict(zip(names, (0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 1.0, 8.0), strict=True))
+    d = {n: Fixed(v) for n, v in vals.items()}
+    d["x"], d["y"] = Uniform(0, 20), Uniform(0, 10)
+    prior = SourcePrior.from_dict(d)
+    sensor = Sensor(pd=1.0)
+    shares = {}
+    for share in (0.0, 0.3):
+        pf = ParticleFilter(prior, sensor, n_particles=4000, seed=2, global_share=share)
+        # every particle starts in the left half: an unlucky earlier history
+        pf.theta[:, 0] = np.random.default_rng(0).uniform(0, 10, pf.n)
+        for _ in range(6):
+            for x in (5.0, 15.0):  # mirror-symmetric: sources at x = 5 and x = 15 equally likely
+                pf.update(np.array([x, 5.0, 0.5]), 0.0)
+            pf._resample()
+            pf._rejuvenate()
+        shares[share] = float(pf.weights @ (pf.theta[:, 0] > 10))
+    assert shares[0.0] < 0.05
+    assert 0.2 < shares[0.3] < 0.8
+
+
+# --- calibration ---
+
+
+def test_credible_region_covers_the_truth_at_its_level():
+    """Truths drawn from the posterior itself are inside its 95% region 95% of the time."""
+    rng = np.random.default_rng(3)
+    pf = ParticleFilter(_xy_prior(), Sensor(), n_particles=4000, seed=0)
+    pf.theta[:, 0] = 20 + 2.0 * rng.standard_normal(pf.n)
+    pf.theta[:, 1] = 20 + rng.standard_t(4, pf.n)  # heavy tails: no Gaussian shortcut
+    hits = [pf.in_credible_region(np.array([*pf.theta[i, :2], 1.0])) for i in range(4000)]
+    assert np.mean(hits) == pytest.approx(0.95, abs=0.01)
+
+
+# --- command line ---
+
+
+def test_run_with_fluctuation_likelihood_records_the_resolved_settings(tmp_path, capsys):
+    out = tmp_path / "r"
+    argv = ["run", "--scenario", "paper:1", "--particles", "500", "--budget", "30", "--truth"]
+    argv += ["filament", "--likelihood", "fluctuation", "--set", "estimator.log_sd=1.1"]
+    code, _, err = run_cli([*argv, "--out", str(out), "-q", "--no-figure"], capsys)
+    assert code == 0, err
+    import json
+
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["likelihood"] == "fluctuation" and summary["dwell"] == 4.0
+    assert summary["average"] == 4.0 and summary["meander"] == 0.15
+    assert isinstance(summary["truth_in_95"], bool)
+    config = json.loads((out / "config.json").read_text())
+    assert config["scenario"]["estimator"]["log_sd"] == 1.1
