@@ -248,7 +248,11 @@ def test_interval_helpers_against_hand_calculations():
         and lo == pytest.approx(0.2366, abs=1e-4)
         and hi == pytest.approx(0.7634, abs=1e-4)
     )
-    assert wilson(10, 10)[2] == pytest.approx(1.0) and wilson(0, 10)[1] == pytest.approx(0.0)
+    for n in range(1, 130):  # exactly at the ends, never 1e-17 inside (the old crash)
+        for k in (0, n):
+            rate, lo, hi = wilson(k, n)
+            assert lo <= rate <= hi
+        assert wilson(n, n)[2] == 1.0 and wilson(0, n)[1] == 0.0
     m, lo, hi = median_ci(np.arange(101.0))
     assert m == 50 and lo < 50 < hi
     assert math.isnan(median_ci(np.array([np.nan]))[0])

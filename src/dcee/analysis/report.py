@@ -23,6 +23,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
+from scipy import stats
 
 from dcee.campaign.runner import SNAPSHOT_TIMES
 from dcee.errors import DceeInputError
@@ -32,14 +33,13 @@ Z95 = 1.959963984540054
 
 
 def wilson(k: int, n: int) -> tuple[float, float, float]:
-    """(rate, low, high) with the Wilson score interval at 95%."""
+    """(rate, low, high) with the Wilson score interval at 95% (scipy), clamped so that
+    low ≤ rate ≤ high holds exactly (round-off left it 1e-17 inside at 0/n and n/n)."""
     if n == 0:
         return (math.nan, math.nan, math.nan)
     p = k / n
-    den = 1 + Z95**2 / n
-    centre = (p + Z95**2 / (2 * n)) / den
-    half = Z95 * math.sqrt(p * (1 - p) / n + Z95**2 / (4 * n * n)) / den
-    return (p, max(0.0, centre - half), min(1.0, centre + half))
+    ci = stats.binomtest(int(k), int(n)).proportion_ci(confidence_level=0.95, method="wilson")
+    return (p, min(float(ci.low), p), max(float(ci.high), p))
 
 
 def mean_ci(x: np.ndarray) -> tuple[float, float, float]:
@@ -97,8 +97,12 @@ def metrics_table(runs: pd.DataFrame) -> pd.DataFrame:
         for key, col in (
             ("source_acquired", "source_acquired"),
             ("plume_acquired", "plume_acquired"),
+            ("truth_in_95", "truth_in_95"),
         ):
-            r, lo, hi = wilson(int(g[col].sum()), n)
+            if col not in g or g[col].isna().any():  # campaigns from before calibration
+                row.update({f"{key}_rate": math.nan, f"{key}_lo": math.nan, f"{key}_hi": math.nan})
+                continue
+            r, lo, hi = wilson(int(g[col].astype(bool).sum()), n)
             row.update({f"{key}_rate": r, f"{key}_lo": lo, f"{key}_hi": hi})
         for key, fn in (("mean", mean_ci), ("median", median_ci)):
             v, lo, hi = fn(g["final_rmse"].to_numpy())
@@ -160,9 +164,9 @@ def markdown_table(table: pd.DataFrame) -> str:
     head = (
         "| strategy | n | source acquired | plume acquired | mean final RMSE (m) | "
         "median final RMSE (m) | time to RMSE < 1 m (s) | time to < 0.5 m (s) | "
-        "path (m) | decision (ms) |"
+        "path (m) | decision (ms) | truth in 95% region |"
     )
-    lines = [head, "|" + "---|" * 10]
+    lines = [head, "|" + "---|" * 11]
     for _, r in table.iterrows():
         src = _fmt(r.source_acquired_rate, r.source_acquired_lo, r.source_acquired_hi, pct=True)
         plume = _fmt(r.plume_acquired_rate, r.plume_acquired_lo, r.plume_acquired_hi, pct=True)
@@ -174,7 +178,8 @@ def markdown_table(table: pd.DataFrame) -> str:
             f"| {_fmt(r.time_to_1m, r.time_to_1m_lo, r.time_to_1m_hi, 0)} ({r.reached_1m:.0%}) "
             f"| {t05} ({r.reached_0_5m:.0%}) "
             f"| {_fmt(r.path_length, r.path_length_lo, r.path_length_hi, 0)} "
-            f"| {_fmt(r.decision_ms, r.decision_ms_lo, r.decision_ms_hi, 1)} |"
+            f"| {_fmt(r.decision_ms, r.decision_ms_lo, r.decision_ms_hi, 1)} "
+            f"| {_fmt(r.truth_in_95_rate, r.truth_in_95_lo, r.truth_in_95_hi, pct=True)} |"
         )
     return "\n".join(lines) + "\n"
 
