@@ -313,3 +313,25 @@ def test_run_with_fluctuation_likelihood_records_the_resolved_settings(tmp_path,
     assert isinstance(summary["truth_in_95"], bool)
     config = json.loads((out / "config.json").read_text())
     assert config["scenario"]["estimator"]["log_sd"] == 1.1
+
+
+@pytest.mark.parametrize(
+    "position,reading,time",
+    [
+        (["a", "b", "c"], 0.0, 1.0),
+        ([1.0, 2.0], 0.0, 1.0),
+        ([1.0, 2.0, 4.0], None, 1.0),
+        ([1.0, 2.0, 4.0], 1j, 1.0),
+        ([1.0, 2.0, 4.0], "abc", 1.0),
+        ([1.0, 2.0, 4.0], np.array([1.0]), 1.0),
+        ([1.0, 2.0, 4.0], np.zeros(0), 1.0),
+        ([1.0, 2.0, 4.0], 0.0, "10"),
+        ([1.0, 2.0, 4.0], 0.0, np.array([1.0])),
+    ],
+)
+def test_searcher_tell_names_the_bad_field(position, reading, time):
+    pf = ParticleFilter(_xy_prior(), Sensor(), n_particles=100, seed=0)
+    searcher = Searcher(pf, get_planner("mpc"), PAPER1.make_agent(), np.random.default_rng(0))
+    with pytest.raises(DceeInputError):
+        searcher.tell(position, reading, time)
+    assert pf.n_readings == 0

@@ -60,8 +60,14 @@ class Searcher:
 
     def tell(self, position: np.ndarray, reading: float, time: float | None = None) -> UpdateInfo:
         """Assimilate a reading (g/m³) taken at ``position`` (m) at ``time`` (s)."""
-        if time is not None and not (math.isfinite(time) and time >= self.time):
-            raise DceeInputError("time", f"must be finite and non-decreasing, got {time}")
+        if time is not None and (
+            isinstance(time, bool)
+            or not isinstance(time, int | float | np.integer | np.floating)
+            or not (math.isfinite(time) and time >= self.time)
+        ):
+            raise DceeInputError(
+                "time", f"must be a finite, non-decreasing number of s, got {time!r}"
+            )
         t0 = _time.perf_counter()
         self.last_update = self.filter.update(position, reading)  # validates position, reading
         self.last_update_seconds = _time.perf_counter() - t0

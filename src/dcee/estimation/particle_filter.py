@@ -274,7 +274,12 @@ class ParticleFilter:
 
     def update(self, position: np.ndarray, reading: float) -> UpdateInfo:
         """Assimilate one reading (g/m³; below the threshold = non-detection) taken at position."""
-        position = np.asarray(position, dtype=np.float64)
+        try:
+            position = np.asarray(position, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise DceeInputError(
+                "position", f"must be 3 finite numbers, got {position!r}"
+            ) from None
         if position.shape != (3,) or not np.all(np.isfinite(position)):
             raise DceeInputError("position", f"must be 3 finite numbers, got {position!r}")
         reading = self.sensor.check_reading(reading)
