@@ -102,7 +102,9 @@ def run_search(task: SearchTask) -> dict[str, Any]:
         idx = rng.choice(len(w), size=min(FINAL_SAMPLE, len(w)), p=w)
         final = result.final_theta[idx].astype(np.float32)  # (n, 8), every parameter
         arrays: dict[str, np.ndarray] = {"final_particles": final}
-        snaps = [(t, p) for t, p in result.snapshots if _near_snapshot_time(t)]
+        step = scenario.make_agent().step_time
+        last = result.snapshots[-1][0] if result.snapshots else None
+        snaps = [(t, p) for t, p in result.snapshots if _near_snapshot_time(t, step) or t == last]
         if snaps:
             arrays["snapshot_times"] = np.array([t for t, _ in snaps])
             arrays["snapshot_particles"] = np.stack([p[:1000].astype(np.float32) for _, p in snaps])
@@ -134,8 +136,11 @@ def run_search(task: SearchTask) -> dict[str, Any]:
         return {"status": "failed", "task": task, "error": error["error"]}
 
 
-def _near_snapshot_time(t: float) -> bool:
-    return any(abs(t - s) < 1.01 for s in SNAPSHOT_TIMES) or t >= SNAPSHOT_TIMES[-1]
+def _near_snapshot_time(t: float, step_time: float) -> bool:
+    """The snapshot taken for one of SNAPSHOT_TIMES (the first reading at or after it, so
+    within one move of it) or at the end."""
+    tol = max(1.01, step_time + 0.01)
+    return any(0 <= t - s < tol for s in SNAPSHOT_TIMES) or t >= SNAPSHOT_TIMES[-1]
 
 
 def _savez(path: Path, arrays: dict[str, np.ndarray]) -> None:
