@@ -9,8 +9,8 @@ FIL="--suite paper --unknown full --truth filament --likelihood fluctuation"
 $D bench $FIL --strategies infotaxis --repeats 1 --particles 10000 --out results/filament-fluct-10k
 # the filament study at paper scale (20,000 particles): infotaxis 12 × 10 first
 $D bench $FIL --strategies infotaxis --repeats 10 --out results/filament-fluct
-# what the fluctuation likelihood costs on the isotropic truth (wind known)
-$D bench --suite paper --strategies infotaxis --repeats 10 --likelihood fluctuation --out results/paper-source-fluct
+# what the fluctuation likelihood costs on the isotropic truth (wind known): 3 repeats first
+$D bench --suite paper --strategies infotaxis --repeats 3 --likelihood fluctuation --out results/paper-source-fluct
 # what each part bought (infotaxis, 12 × 3, 10,000 particles), each part taken away alone
 A="$FIL --strategies infotaxis --repeats 3 --particles 10000"
 $D bench $A --out results/ablation/all
@@ -22,3 +22,4 @@ $D bench --suite paper --unknown full --truth filament --strategies infotaxis --
 # the other strategies on the filament truth: 3 repeats first, then the full 10
 $D bench $FIL --strategies entrotaxis,dcee,mpc --repeats 3 --out results/filament-fluct
 $D bench $FIL --strategies entrotaxis,dcee,mpc --repeats 10 --out results/filament-fluct
+$D bench --suite paper --strategies infotaxis --repeats 10 --likelihood fluctuation --out results/paper-source-fluct
