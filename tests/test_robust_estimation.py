@@ -19,7 +19,7 @@ from dcee.models.plume import isotropic_concentration, isotropic_concentration_r
 from dcee.planning import get as get_planner
 from dcee.scenarios import load_scenario
 from dcee.searcher import Searcher
-from dcee.simulation import make_truth, run_episode
+from dcee.simulation import InjectedTruth, make_truth, run_episode
 from tests.helpers import run_cli
 
 PAPER1 = load_scenario("paper:1")  # source (37.5, 12.5, 1), wind from +x at 4 m/s: plume to -x
@@ -197,27 +197,11 @@ def test_one_huge_spike_does_not_decide_a_search():
     )
     ends = []
     for spike in (False, True):
-        res = run_episode(scenario, "infotaxis", 0, truth=_SpikedTruth(scenario, spike))
+        truth = make_truth(scenario, 0)
+        truth = InjectedTruth(truth, {40.0: 500.0}) if spike else truth
+        res = run_episode(scenario, "infotaxis", 0, truth=truth)
         ends.append(res.summary["final_rmse"])
     assert ends[0] < 3.0 and ends[1] < 3.0
-
-
-class _SpikedTruth:
-    """The scenario's truth with one absurd concentration at reading 20 (t = 40 s)."""
-
-    time_step = None
-
-    def __init__(self, scenario, spike: bool) -> None:
-        self.inner = make_truth(scenario, 0)
-        self.spike = spike
-
-    def sensed(self, position, time, average=0.0, response_time=0.0):
-        if self.spike and abs(time - 40.0) < 1e-9:
-            return 500.0
-        return self.inner.concentration(position, time)
-
-    def __getattr__(self, name):
-        return getattr(self.inner, name)
 
 
 # --- a filter that keeps every mode ---

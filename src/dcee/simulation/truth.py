@@ -78,6 +78,43 @@ class IsotropicTruth(TruthModel):
         return self.plume.concentration(self.theta, positions)[0]
 
 
+class InjectedTruth(TruthModel):
+    """Another truth with chosen concentrations injected at chosen times: fault injection (a
+    spike, a stuck sensor) to test what one reading does to a search.
+
+    ``injections`` maps a reading time (s) to the concentration (g/m³) sensed then."""
+
+    def __init__(self, inner: TruthModel, injections: dict[float, float]) -> None:
+        self.inner = inner
+        self.injections = dict(injections)
+        self.name, self.label = inner.name, inner.label
+
+    def _injected(self, time: float) -> float | None:
+        for t, value in self.injections.items():
+            if abs(time - t) < 1e-9:
+                return value
+        return None
+
+    def concentration(self, position: np.ndarray, time: float) -> float:
+        value = self._injected(time)
+        return self.inner.concentration(position, time) if value is None else value
+
+    def field(self, positions: np.ndarray, time: float) -> np.ndarray:
+        return self.inner.field(positions, time)
+
+    @property
+    def time_step(self) -> float | None:
+        return self.inner.time_step
+
+    def sensed(
+        self, position: np.ndarray, time: float, average: float = 0.0, response_time: float = 0.0
+    ) -> float:
+        value = self._injected(time)
+        if value is None:
+            return self.inner.sensed(position, time, average, response_time)
+        return value
+
+
 PLUME_STREAM = 3
 """Child of ``SeedSequence(seed)`` that drives a stochastic truth (the filament's puffs and
 meander). Children 0-2 are the episode's sensor-noise, agent and figure streams
