@@ -105,3 +105,19 @@ def compiled_predicted_stats(conc, source, weights, task_pos, task_z, sensor, di
         **flags,
     )
     return out
+
+
+def random_theta(n: int, rng: np.random.Generator) -> np.ndarray:
+    """(n, 8) source terms spread over a 50 × 50 × 5 m area and plausible environments."""
+    return np.column_stack(
+        [
+            rng.uniform(0, 50, n),
+            rng.uniform(0, 50, n),
+            rng.uniform(0, 5, n),
+            rng.gamma(2, 5, n),
+            rng.uniform(0, 8, n),
+            rng.uniform(-4, 4, n),
+            rng.uniform(0.1, 3, n),
+            rng.uniform(0.5, 15, n),
+        ]
+    )

@@ -5,6 +5,7 @@ import pytest
 
 from dcee import DceeInputError, isotropic_concentration
 from dcee.models.plume import MIN_DISTANCE, isotropic_concentration_reference
+from tests.helpers import random_theta
 
 
 def test_hand_calculation_without_wind():
@@ -62,18 +63,7 @@ def test_distance_is_clamped_at_the_source():
 def test_compiled_matches_reference():
     rng = np.random.default_rng(3)
     n, m = 300, 17
-    theta = np.column_stack(
-        [
-            rng.uniform(0, 50, n),
-            rng.uniform(0, 50, n),
-            rng.uniform(0, 5, n),
-            rng.gamma(2, 5, n),
-            rng.uniform(0, 8, n),
-            rng.uniform(-4, 4, n),
-            rng.uniform(0.1, 3, n),
-            rng.uniform(0.5, 15, n),
-        ]
-    )
+    theta = random_theta(n, rng)
     pos = np.column_stack([rng.uniform(0, 50, m), rng.uniform(0, 50, m), np.full(m, 4.0)])
     fast = isotropic_concentration(theta, pos)
     ref = isotropic_concentration_reference(theta, pos)

@@ -20,7 +20,7 @@ from dcee.planning import get as get_planner
 from dcee.scenarios import load_scenario
 from dcee.searcher import Searcher
 from dcee.simulation import InjectedTruth, make_truth, run_episode
-from tests.helpers import run_cli
+from tests.helpers import random_theta, run_cli
 
 PAPER1 = load_scenario("paper:1")  # source (37.5, 12.5, 1), wind from +x at 4 m/s: plume to -x
 THETA = PAPER1.truth_theta()
@@ -29,24 +29,9 @@ THETA = PAPER1.truth_theta()
 # --- the meandering plume model ---
 
 
-def _random_theta(n: int, rng: np.random.Generator) -> np.ndarray:
-    return np.column_stack(
-        [
-            rng.uniform(0, 50, n),
-            rng.uniform(0, 50, n),
-            rng.uniform(0, 5, n),
-            rng.gamma(2, 5, n),
-            rng.uniform(0, 8, n),
-            rng.uniform(-4, 4, n),
-            rng.uniform(0.1, 3, n),
-            rng.uniform(0.5, 15, n),
-        ]
-    )
-
-
 def test_meander_kernel_matches_reference_and_zero_meander_is_the_paper_plume():
     rng = np.random.default_rng(4)
-    theta = _random_theta(300, rng)
+    theta = random_theta(300, rng)
     pos = np.column_stack([rng.uniform(0, 50, 23), rng.uniform(0, 50, 23), np.full(23, 4.0)])
     for meander in (0.0, 0.15, 0.6):
         fast = isotropic_concentration(theta, pos, meander=meander)
@@ -79,7 +64,7 @@ def test_meander_widens_the_far_field_but_conserves_the_crosswind_integral():
 
 def test_history_kernel_with_meander_and_near_source_intermittency_matches_reference():
     rng = np.random.default_rng(0)
-    theta = _random_theta(400, rng)
+    theta = random_theta(400, rng)
     pos = np.column_stack([rng.uniform(0, 50, (40, 2)), np.full(40, 4.0)])
     z = np.where(rng.random(40) < 0.5, 0.0, rng.gamma(1.0, 5e-3, 40))
     mult = rng.integers(1, 4, 40).astype(float)
