@@ -47,7 +47,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from scipy.special import log_ndtr, ndtr
+from scipy.special import log_ndtr
 
 from dcee.errors import DceeInputError
 from dcee.models.sensor_kernels import SensorParams
@@ -240,17 +240,6 @@ class Sensor:
     ) -> np.ndarray:
         """p(z | C, r): probability for a non-detection, density (per g/m³) for a detection."""
         return np.exp(self.log_likelihood(reading, conc, distance))
-
-    def detection_probability(
-        self, conc: np.ndarray | float, distance: np.ndarray | float = np.inf
-    ) -> np.ndarray:
-        """P(z ≥ threshold | C, r), false alarms and outliers included."""
-        c = np.asarray(conc, dtype=np.float64)
-        loc, sigma = self._loc_sigma(c)
-        v_thr = math.log(self.threshold) if self.lognormal else self.threshold
-        true_det = self.detect_prob(distance) * ndtr((loc - v_thr) / sigma)
-        model = true_det + (1 - true_det) * self.false_alarm
-        return (1 - self.outlier) * model + self.outlier
 
     def transformed_readings(
         self, readings: np.ndarray
