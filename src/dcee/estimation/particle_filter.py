@@ -223,7 +223,7 @@ class ParticleFilter:
         radial profile). Over many searches a calibrated filter contains the truth ``level`` of
         the time.
         """
-        cols = [i for i in range(3) if i in self._loc_block]
+        cols = self._loc_block  # unknown location columns, in order
         if not cols:
             return True
         x = self.theta[:, cols]

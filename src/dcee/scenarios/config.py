@@ -63,6 +63,7 @@ Normal priors are truncated to physical values (u ≥ 0, ζ1 > 0, ζ2 > 0) autom
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -421,9 +422,7 @@ class Scenario(BaseModel):
         """The reading model of the filter and the planners (``[estimator]``)."""
         s, e = self.sensor, self.estimator
         if e.likelihood == "paper":
-            return Sensor(
-                **s.model_dump(exclude={"average", "response_time"}), outlier=self.outlier
-            )
+            return dataclasses.replace(self.make_sensor(), outlier=self.outlier)
         return Sensor(
             threshold=s.threshold,
             pd=e.intermittency,
