@@ -76,6 +76,18 @@ def test_changed_configuration_in_the_same_folder_is_refused(finished):
         run_campaign(_campaign(out, particles=400), workers=1)
 
 
+def test_planner_specs_are_campaign_strategies(tmp_path):
+    spec = "dcee-cl:reach=4:hypotheses=8"
+    campaign = Campaign(tmp_path, "smoke", (spec,), 1, particles=200)
+    assert run_campaign(campaign, workers=1)["done"] == 2
+    summary = json.loads(
+        (tmp_path / "runs/paper-1/dcee-cl+reach=4+hypotheses=8/seed-0.json").read_text()
+    )
+    assert summary["strategy"] == spec and summary["planner_options"]["reach"] == 4.0
+    with pytest.raises(DceeInputError, match="reach"):
+        Campaign(tmp_path / "bad", "smoke", ("dcee-cl:reach=x",), 1)
+
+
 def test_failing_search_is_recorded_and_does_not_raise(tmp_path):
     task = SearchTask(str(tmp_path), "paper:1", "dcee", 0, {"name": "broken"})
     res = run_search(task)

@@ -43,6 +43,8 @@ def test_animation(tmp_path, capsys):
 BAD = [
     (["--particles", "-5"], "search.particles"),
     (["--strategy", "nope"], "strategy"),
+    (["--strategy", "dcee-cl:reach=-2"], "reach"),
+    (["--strategy", "dcee:hypotheses"], "strategy"),
     (["--budget", "nan"], "search.budget"),
     (["--hypotheses", "0"], "search.hypotheses"),
     (["--seed", "-1"], "seed"),
@@ -98,3 +100,34 @@ def test_console_script_is_installed():
         [sys.executable, "-m", "dcee.cli", "show", "nope:1"], capture_output=True, text=True
     )
     assert res.returncode == 2 and res.stderr.startswith("dcee: error: scenario")
+
+
+def test_strategies_lists_the_registry_with_options(capsys):
+    from dcee.planning import names
+
+    code, out, _ = run_cli(["strategies"], capsys)
+    assert code == 0
+    listed = [line.split()[0] for line in out.splitlines() if not line.startswith(" ")]
+    assert listed == names() and "reach=6.0" in out
+
+
+def test_a_planner_spec_runs_and_is_recorded(tmp_path, capsys):
+    argv = "run --scenario paper:1 --strategy dcee-cl:reach=4:hypotheses=8 --particles 500"
+    code, out, _ = run_cli(
+        [
+            *argv.split(),
+            "--budget",
+            "20",
+            "-q",
+            "--json",
+            str(tmp_path / "s.json"),
+            "--out",
+            str(tmp_path / "o"),
+        ],
+        capsys,
+    )
+    assert code == 0, out
+    summary = json.loads((tmp_path / "s.json").read_text())
+    assert summary["strategy"] == "dcee-cl:reach=4:hypotheses=8"
+    assert summary["planner_options"]["reach"] == 4.0
+    assert summary["planner_options"]["n_hypotheses"] == 8

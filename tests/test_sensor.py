@@ -167,3 +167,29 @@ def test_readings_outside_the_physical_range_are_refused(bad):
     with pytest.raises(DceeInputError, match="reading"):
         Sensor().check_reading(bad)
     assert Sensor().check_reading(np.float32(2e-3)) == pytest.approx(2e-3)
+
+
+@pytest.mark.parametrize(
+    "s", [Sensor(), Sensor(false_alarm=0.05), *FAMILIES], ids=["paper", "gauss+fa", *FAMILY_IDS]
+)
+@pytest.mark.parametrize("conc", [1e-5, 2e-3])
+def test_detection_draws_follow_the_likelihood_given_a_detection(s, conc):
+    """Readings drawn conditioned on a detection (the planners' stratified expectation) have the
+    likelihood's density above the threshold divided by P(detection), bin by bin; C = 1e-5 puts
+    the threshold 4.7 σ into the Gaussian tail."""
+    n, r = 200_000, 2.0
+    z = s.simulate_detection(np.full(n, conc), np.random.default_rng(3).random((n, 2)), r)
+    p_detect = 1.0 - float(s.likelihood(0.0, conc, r))
+    if p_detect < 1e-12:  # no way to detect: the draw says "no detection"
+        assert np.all(z == 0.0)
+        return
+    assert np.all(z >= s.threshold)
+    edges = np.array([5e-4, 5.5e-4, 7e-4, 1e-3, 2e-3, 4e-3, 1e-2, 1.0, 1e4])
+    counts, _ = np.histogram(z, bins=edges)
+    for k in range(len(edges) - 1):
+        lo, hi = math.log(edges[k]), math.log(edges[k + 1])
+        mass, _ = integrate.quad(
+            lambda u: float(s.likelihood(math.exp(u), conc, r)) * math.exp(u), lo, hi, limit=200
+        )
+        p = mass / p_detect
+        assert counts[k] / n == pytest.approx(p, abs=5 * math.sqrt(p * (1 - p) / n) + 1e-5)

@@ -70,7 +70,7 @@ def cli() -> None:
     "--strategy",
     default="dcee",
     show_default=True,
-    help="Planner: dcee, dcee-ms, mpc, entrotaxis, infotaxis.",
+    help="Planner NAME[:KEY=VALUE]..., e.g. dcee-cl:reach=6 (`dcee strategies` lists them).",
 )
 @click.option("--seed", default=0, show_default=True, type=int, help="Run seed.")
 @click.option("--particles", type=int, help="Override search.particles.")
@@ -114,14 +114,14 @@ def run(
 ) -> None:
     """Run one simulated search and write its record, summary, configuration and figure."""
     from dcee import __version__
-    from dcee.planning import planner_class
+    from dcee.planning import get as get_planner
     from dcee.scenarios import load_scenario
     from dcee.scenarios.config import truth_choice
     from dcee.simulation import make_truth, run_episode
 
     if seed < 0:
         raise DceeInputError("seed", f"must be >= 0, got {seed}")
-    planner_class(strategy)  # fail fast on an unknown name
+    get_planner(strategy)  # fail fast on an unknown name or a bad option
     scenario = load_scenario(scenario_name).with_overrides(
         **{
             "search.particles": particles,
@@ -133,7 +133,9 @@ def run(
         }
     )
     out_dir = (
-        out_dir or Path("results") / f"{scenario.name.replace(':', '-')}_{strategy}_seed{seed}"
+        out_dir
+        or Path("results")
+        / f"{scenario.name.replace(':', '-')}_{strategy.replace(':', '+')}_seed{seed}"
     )
     truth = make_truth(scenario, seed)
     result = _run_with_progress(
@@ -239,6 +241,20 @@ def scenarios() -> None:
 
 
 @cli.command()
+def strategies() -> None:
+    """List the registered planners with their options and defaults (use as NAME:KEY=VALUE)."""
+    from dcee.planning import get, names
+
+    for name in names():
+        planner = get(name)
+        doc = planner.summary or (type(planner).__doc__ or "").strip().splitlines()[0]
+        opts = " ".join(f"{k}={v}" for k, v in planner.options().items())
+        click.echo(f"{name:12s} {doc}")
+        if opts:
+            click.echo(f"{'':12s} options: {opts}")
+
+
+@cli.command()
 @click.argument("scenario_name")
 def show(scenario_name: str) -> None:
     """Print the resolved configuration of a scenario (built-in or TOML path) as JSON."""
@@ -326,12 +342,12 @@ def _numba_threads() -> int:
 
 
 @cli.command()
-@click.option("--suite", default="paper", show_default=True, help="paper | smoke")
+@click.option("--suite", default="paper", show_default=True, help="paper | hard-easy | smoke")
 @click.option(
     "--strategies",
     default="dcee,mpc,entrotaxis,infotaxis,dcee-ms",
     show_default=True,
-    help="Comma-separated planner names.",
+    help="Comma-separated planner specs NAME[:KEY=VALUE]... (`dcee strategies` lists them).",
 )
 @click.option("--repeats", default=10, show_default=True, help="Repeats per configuration.")
 @click.option(

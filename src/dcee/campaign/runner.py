@@ -50,7 +50,9 @@ class SearchTask:
     @property
     def stem(self) -> Path:
         safe = self.config.replace(":", "-").replace("/", "_")
-        return Path(self.out_dir) / "runs" / safe / self.strategy / f"seed-{self.seed}"
+        # a planner spec (dcee-cl:reach=6) names its folder with '+' for ':' (portable names)
+        strategy = self.strategy.replace(":", "+").replace("/", "_")
+        return Path(self.out_dir) / "runs" / safe / strategy / f"seed-{self.seed}"
 
 
 def is_done(task: SearchTask) -> bool:
@@ -164,14 +166,14 @@ class Campaign:
 
     def __post_init__(self) -> None:
         from dcee.campaign.suites import suite_scenarios
-        from dcee.planning import planner_class
+        from dcee.planning import get as get_planner
 
         if self.repeats < 1:
             raise DceeInputError("repeats", f"must be >= 1, got {self.repeats}")
         if not self.strategies:
             raise DceeInputError("strategies", "give at least one strategy")
         for s in self.strategies:
-            planner_class(s)  # unknown names fail before anything runs
+            get_planner(s)  # unknown names and bad options fail before anything runs
         self.scenarios = {
             s.name: s
             for s in suite_scenarios(

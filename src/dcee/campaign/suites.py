@@ -2,6 +2,8 @@
 
 * ``paper``: the 12 configurations of the paper's simulation study (``paper:1`` … ``paper:12``)
   at paper scale (20,000 particles, 40 hypothesised readings, 900 s).
+* ``hard-easy``: paper:5, 7 and 12 (the plume points away from the start; MPC and DCEE stall)
+  and paper:1 and 3 (every planner succeeds), at paper scale: the dual-control ablation.
 * ``smoke``: two of them at toy scale (1,000 particles, 10 hypothesised readings, 60 s) so a
   campaign with every strategy finishes in well under a minute; for CI and for trying options.
 """
@@ -15,6 +17,12 @@ from dcee.scenarios import Scenario, load_scenario
 
 SUITES: dict[str, dict] = {
     "paper": {"configs": [f"paper:{k}" for k in range(1, 13)], "overrides": {}},
+    # where the plume points away from the start (exploitation stalls) and two where it does not:
+    # the ablation of docs/dual-control.md
+    "hard-easy": {
+        "configs": ["paper:1", "paper:3", "paper:5", "paper:7", "paper:12"],
+        "overrides": {},
+    },
     "smoke": {
         "configs": ["paper:1", "paper:6"],
         "overrides": {"search.particles": 1000, "search.hypotheses": 10, "search.budget": 60.0},

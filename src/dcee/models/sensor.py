@@ -47,7 +47,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from scipy.special import log_ndtr
+from scipy.special import log_ndtr, ndtri_exp
 
 from dcee.errors import DceeInputError
 from dcee.models.sensor_kernels import SensorParams
@@ -324,6 +324,43 @@ class Sensor:
             spike = self.threshold * (self.max_reading / self.threshold) ** noise[..., 5]
             z = np.where(noise[..., 4] < self.outlier, spike, z)
         return z
+
+    def simulate_detection(
+        self,
+        conc: np.ndarray | float,
+        uniforms: np.ndarray,
+        distance: np.ndarray | float = np.inf,
+    ) -> np.ndarray:
+        """Readings drawn from p(z | C, r, z is a detection), exactly, from pre-drawn standard
+        uniforms (conc.shape + (2,)): column 0 picks the kind of detection (a true one, a false
+        alarm or an outlier) with its probability given C; column 1 places the reading within it
+        (a true detection is the family's reading distribution truncated at the threshold,
+        inverted in the upper tail so that C far below the threshold stays exact).
+
+        Used by the planners' stratified expectation (:mod:`dcee.planning.predicted`). Where
+        C, r admit no detection at all the reading is 0.0 (a non-detection).
+        """
+        c = np.asarray(conc, dtype=np.float64)
+        u = np.asarray(uniforms, dtype=np.float64)
+        loc, sigma = self._loc_sigma(c)
+        v_thr = math.log(self.threshold) if self.lognormal else self.threshold
+        a = (v_thr - loc) / sigma  # the threshold in standard units
+        log_tail = log_ndtr(-a)  # log P(y ≥ threshold | C)
+        keep = 1.0 - self.outlier
+        p_true = keep * self.detect_prob(distance) * np.exp(log_tail)
+        p_false = keep * (1.0 - p_true / keep) * self.false_alarm
+        total = p_true + p_false + self.outlier
+        pick = u[..., 0] * total
+        u1 = np.clip(u[..., 1], 1e-300, 1.0)
+        with np.errstate(over="ignore", invalid="ignore"):
+            x = -ndtri_exp(np.log(u1) + log_tail)  # standard normal truncated to x ≥ a
+            v = np.maximum(loc + sigma * x, v_thr)
+            true_value = np.exp(v) if self.lognormal else v
+        false_value = self.threshold - self.false_alarm_scale * np.log(u1)
+        spike = self.threshold * (self.max_reading / self.threshold) ** u1
+        other = np.where(pick < p_true + p_false, false_value, spike)
+        z = np.where(pick < p_true, true_value, other)
+        return np.where(total > 0, np.maximum(z, self.threshold), 0.0)
 
     def simulate(self, conc: np.ndarray | float, rng: np.random.Generator) -> np.ndarray:
         """Draw readings (g/m³, 0.0 for a non-detection) for expected concentrations ``conc``."""

@@ -4,14 +4,16 @@ Choose by name: ``dcee.planners.get("dcee")``. Register a new one with
 ``@dcee.planners.register("name")`` on a :class:`Planner` subclass; nothing else changes.
 """
 
-from dcee.planning import dcee, dcee_multistage, entrotaxis, infotaxis, mpc  # noqa: F401
+from dcee.planning import dcee, dcee_closed_loop, entrotaxis, infotaxis, mpc  # noqa: F401
 from dcee.planning.base import Belief, Decision, Planner, get, names, planner_class, register
-from dcee.planning.predicted import OneStepPlanner, PredictionContext, SequenceStats
+from dcee.planning.hypothesis import HypothesisPlanner
+from dcee.planning.predicted import EXPECTATIONS, PredictionContext, SequenceStats
 
 __all__ = [
+    "EXPECTATIONS",
     "Belief",
     "Decision",
-    "OneStepPlanner",
+    "HypothesisPlanner",
     "Planner",
     "PredictionContext",
     "SequenceStats",

@@ -68,6 +68,8 @@ class Planner(ABC):
     """
 
     name: ClassVar[str] = ""
+    summary: ClassVar[str] = ""
+    """One line for listings (``dcee strategies``)."""
     uses_hypotheses: ClassVar[bool] = False
     """True if the planner accepts ``n_hypotheses`` (hypothesised readings per candidate)."""
 
@@ -116,8 +118,46 @@ def register(name: str) -> Callable[[type[Planner]], type[Planner]]:
     return wrap
 
 
-def planner_class(name: str) -> type[Planner]:
-    """The registered planner class; unknown names are a user error."""
+OPTION_ALIASES = {"hypotheses": "n_hypotheses"}
+"""Spec keys that name a constructor argument differently (as the scenario files do)."""
+
+
+def parse_spec(spec: str) -> tuple[str, dict[str, Any]]:
+    """Split a planner spec ``NAME[:KEY=VALUE]...`` into its registered name and options.
+
+    ``"dcee-cl:reach=6:expectation=sampled"`` → ``("dcee-cl", {"reach": 6, "expectation":
+    "sampled"})``. Values are read as int, float or true/false where they parse, else kept as
+    text; the planner's constructor checks them. Malformed specs are user errors.
+    """
+    if not isinstance(spec, str) or not spec.strip():
+        raise DceeInputError("strategy", f"must be a planner name, got {spec!r}")
+    name, *parts = spec.strip().split(":")
+    options: dict[str, Any] = {}
+    for part in parts:
+        key, sep, text = part.partition("=")
+        key = key.strip()
+        if not sep or not key or not text.strip():
+            raise DceeInputError(
+                "strategy", f"{spec!r}: options are KEY=VALUE after the name, got {part!r}"
+            )
+        options[OPTION_ALIASES.get(key, key)] = _option_value(text.strip())
+    return name.strip(), options
+
+
+def _option_value(text: str) -> Any:
+    if text.lower() in ("true", "false"):
+        return text.lower() == "true"
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def planner_class(spec: str) -> type[Planner]:
+    """The registered planner class of a name or spec; unknown names are a user error."""
+    name = parse_spec(spec)[0]
     try:
         return _REGISTRY[name]
     except KeyError:
@@ -126,13 +166,15 @@ def planner_class(name: str) -> type[Planner]:
         ) from None
 
 
-def get(name: str, **options: Any) -> Planner:
-    """A new planner instance by registered name; ``options`` go to its constructor."""
-    cls = planner_class(name)
+def get(spec: str, **defaults: Any) -> Planner:
+    """A new planner from a registered name or spec ``NAME[:KEY=VALUE]...``; the spec's options
+    override ``defaults``, and both go to the planner's constructor."""
+    cls = planner_class(spec)
+    options = {**defaults, **parse_spec(spec)[1]}
     try:
         return cls(**options)
     except TypeError as exc:
-        raise DceeInputError("planner_options", f"{name}: {exc}") from None
+        raise DceeInputError("planner_options", f"{spec}: {exc}") from None
 
 
 def names() -> list[str]:

@@ -5,18 +5,18 @@ from __future__ import annotations
 import numpy as np
 
 from dcee.planning.base import Belief, register
-from dcee.planning.predicted import OneStepPlanner, SequenceStats
+from dcee.planning.hypothesis import HypothesisPlanner
+from dcee.planning.predicted import SequenceStats
 
 
 @register("infotaxis")
-class InfotaxisPlanner(OneStepPlanner):
+class InfotaxisPlanner(HypothesisPlanner):
     """Maximise the expected information gain E_ẑ[KL(p(Θ | Z_k, ẑ) ‖ p(Θ | Z_k))] (the mutual
-    information between the next reading and Θ), estimated over the shared hypothesised
-    readings. Cost = −expected KL."""
+    information between the next reading and Θ). Loss = −KL."""
+
+    summary = "Infotaxis: maximise the expected information gain (KL)"
 
     needs_moments = False
 
-    def cost_from_stats(
-        self, candidates: np.ndarray, stats: SequenceStats, belief: Belief
-    ) -> np.ndarray:
-        return -stats.kl.mean(axis=1)
+    def loss(self, final_positions: np.ndarray, stats: SequenceStats, belief: Belief) -> np.ndarray:
+        return -stats.kl

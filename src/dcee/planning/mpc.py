@@ -15,6 +15,8 @@ class MPCPlanner(Planner):
     """J(u) = ‖p_{k+1} − s̄_{k|k}‖²: move towards the current posterior mean (the term P_{k|k}
     does not depend on u and is dropped). No hypothesised readings are needed."""
 
+    summary = "MPC: move towards the posterior mean (exploitation only)"
+
     def costs(
         self,
         belief: Belief,

@@ -19,19 +19,16 @@ O(N · positions + J · sequences); no N × J × moves array is formed.
 
 from __future__ import annotations
 
-from abc import abstractmethod
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.estimation.particle_filter import systematic_resample
-from dcee.models.agent import GridAgent
 from dcee.models.plume_kernels import concentration_distance_grid
 from dcee.models.sensor import Sensor
 from dcee.models.sensor_kernels import position_terms
-from dcee.planning.base import Belief, Planner
+from dcee.planning.base import Belief
 from dcee.planning.predicted_kernels import predicted_posterior_stats
 
 
@@ -39,14 +36,20 @@ from dcee.planning.predicted_kernels import predicted_posterior_stats
 class SequenceStats:
     """Predicted-posterior statistics for S candidate sequences × J hypotheses.
 
-    readings (S, J, T); log_evidence (S, J); mean (S, J, 3); trace_cov (S, J); kl (S, J).
+    readings (S, J, T); probability (S, J): the share of the expectation each hypothesis stands
+    for (rows sum to 1); log_evidence (S, J); mean (S, J, 3); trace_cov (S, J); kl (S, J).
     """
 
     readings: np.ndarray
+    probability: np.ndarray
     log_evidence: np.ndarray
     mean: np.ndarray
     trace_cov: np.ndarray
     kl: np.ndarray
+
+    def expect(self, values: np.ndarray) -> np.ndarray:
+        """(S,) expectation over the next readings of per-hypothesis ``values`` (S, J)."""
+        return np.einsum("sj,sj->s", self.probability, values)
 
 
 def predicted_posterior_stats_reference(
@@ -85,18 +88,55 @@ def predicted_posterior_stats_reference(
     return log_ev, mean, trace, kl
 
 
+EXPECTATIONS = ("sampled", "stratified")
+"""How a planner estimates an expectation over the next readings:
+
+* ``sampled`` (the paper): J hypothesised sources drawn from the belief, each with its own
+  reading; every hypothesis weighs 1/J.
+* ``stratified``: the outcome "no detection at any stage" is one hypothesis weighted by its exact
+  probability Σ_i w_i Π_t P(nd | C_i(p_t)); J detection hypotheses are drawn from the predictive
+  distribution conditioned on at least one detection (source i ∝ w_i (1 − Π_t P(nd | C_i(p_t))),
+  the first detecting stage by its probability, that stage's reading from
+  :meth:`~dcee.models.sensor.Sensor.simulate_detection`, later stages unconditioned), each
+  weighing P(detection)/J. Unbiased for the same expectation, and far less variable when
+  detections are rare: at a stall P(detection) is 0.1–1 % per candidate, so J sampled
+  hypotheses mostly contain none and the cost differences between candidates are noise.
+"""
+
+
 class PredictionContext:
-    """One decision's hypotheses and caches; planners ask it for :class:`SequenceStats`."""
+    """One decision's hypotheses and caches; planners ask it for :class:`SequenceStats`.
+
+    Every random number is drawn here, once per decision, and shared by every candidate
+    sequence (common random numbers): the J hypothesised sources and J × horizon standard noise
+    (sampled), or one systematic-sampling offset and per-hypothesis uniforms (stratified).
+    """
 
     def __init__(
-        self, belief: Belief, n_hypotheses: int, horizon: int, rng: np.random.Generator
+        self,
+        belief: Belief,
+        n_hypotheses: int,
+        horizon: int,
+        rng: np.random.Generator,
+        expectation: str = "sampled",
     ) -> None:
+        if expectation not in EXPECTATIONS:
+            raise DceeInputError(
+                "expectation", f"must be one of {', '.join(EXPECTATIONS)}, got {expectation!r}"
+            )
         self.belief = belief
         self.sensor = belief.sensor
+        self.expectation = expectation
         self._sp = belief.sensor.params
-        self.indices = systematic_resample(belief.weights, rng, n_hypotheses)
-        # Shuffle so that hypothesis j is not tied to a weight stratum at every stage.
-        self.indices = rng.permutation(self.indices)
+        self._n = int(n_hypotheses)
+        if expectation == "sampled":
+            self.indices = systematic_resample(belief.weights, rng, n_hypotheses)
+            # Shuffle so that hypothesis j is not tied to a weight stratum at every stage.
+            self.indices = rng.permutation(self.indices)
+        else:
+            self._offset = rng.random()
+            self._first_u = rng.random(n_hypotheses)  # picks the first detecting stage
+            self._detect_u = rng.random((n_hypotheses, 2))  # that stage's reading
         self.noise = belief.sensor.draw_noise(rng, (n_hypotheses, horizon))
         self._theta = np.ascontiguousarray(belief.theta)
         self._source = np.ascontiguousarray(belief.source)
@@ -107,7 +147,9 @@ class PredictionContext:
 
     @property
     def n_hypotheses(self) -> int:
-        return len(self.indices)
+        """Hypotheses per sequence: J sampled, or J + 1 stratified (the first is "no
+        detection")."""
+        return self._n if self.expectation == "sampled" else self._n + 1
 
     def position_index(self, positions: np.ndarray) -> np.ndarray:
         """Indices of (K, 3) positions in the concentration cache, computing new ones."""
@@ -150,12 +192,52 @@ class PredictionContext:
         """(P, N) concentrations of every particle at every cached position."""
         return self.terms[0]
 
-    def readings(self, pos_idx: np.ndarray) -> np.ndarray:
-        """(J, T) hypothesised readings along one sequence of cached positions (T,)."""
+    def readings(self, pos_idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Hypothesised readings (J', T) along one sequence of cached positions (T,) and the
+        probability (J',) each stands for (summing to 1)."""
+        if self.expectation == "stratified":
+            return self._stratified_readings(pos_idx)
         t_count = len(pos_idx)
         c = self.conc[pos_idx][:, self.indices].T  # (J, T)
         r = self.terms[1][pos_idx][:, self.indices].T
-        return self.sensor.simulate_from(c, self.noise[:, :t_count], r)
+        z = self.sensor.simulate_from(c, self.noise[:, :t_count], r)
+        return z, np.full(self._n, 1.0 / self._n)
+
+    def _stratified_readings(self, pos_idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        t_count = len(pos_idx)
+        j_count = self._n
+        weights = self.belief.weights
+        log_nd = self.terms[3][pos_idx]  # (T, N)
+        log_nd_all = log_nd.sum(axis=0)
+        p_detect_i = weights * -np.expm1(log_nd_all)  # w_i P(≥ 1 detection | Θ_i)
+        p_detect = float(p_detect_i.sum())
+        z = np.zeros((j_count + 1, t_count))
+        prob = np.zeros(j_count + 1)
+        prob[0] = max(1.0 - p_detect, 0.0)
+        if not p_detect > 1e-300:
+            prob[0] = 1.0
+            return z, prob
+        prob[1:] = p_detect / j_count
+        cumulative = np.cumsum(p_detect_i) / p_detect
+        cumulative[-1] = 1.0
+        idx = np.searchsorted(cumulative, (self._offset + np.arange(j_count)) / j_count, "right")
+        idx = idx.clip(0, len(weights) - 1)
+        # first detecting stage t: P ∝ Π_{t'<t} P(nd_t') (1 − P(nd_t)), by inversion
+        nd = np.exp(log_nd[:, idx]).T  # (J, T)
+        before = np.cumprod(np.column_stack([np.ones(j_count), nd[:, :-1]]), axis=1)
+        first_cdf = np.cumsum(before * (1.0 - nd), axis=1)
+        target = self._first_u * first_cdf[:, -1]
+        first = (first_cdf <= target[:, None]).sum(axis=1).clip(0, t_count - 1)
+        conc = self.conc[pos_idx][:, idx].T  # (J, T)
+        dist = self.terms[1][pos_idx][:, idx].T
+        rows = np.arange(j_count)
+        z[1:] = self.sensor.simulate_from(conc, self.noise[:, :t_count], dist)
+        stage = np.arange(t_count)[None, :]
+        z[1:][stage < first[:, None]] = 0.0
+        z[1:][rows, first] = self.sensor.simulate_detection(
+            conc[rows, first], self._detect_u, dist[rows, first]
+        )
+        return z, prob
 
     def stats(self, sequences: np.ndarray, moments: bool = True, kl: bool = True) -> SequenceStats:
         """Statistics for (S, T, 3) candidate position sequences (T ≤ horizon).
@@ -167,12 +249,13 @@ class PredictionContext:
         j_count = self.n_hypotheses
         pos_idx = self.position_index(sequences.reshape(-1, 3)).reshape(s_count, t_count)
         readings = np.empty((s_count, j_count, t_count))
+        probability = np.empty((s_count, j_count))
         task_pos: list[np.ndarray] = []
         task_z: list[np.ndarray] = []
         inverse = np.empty((s_count, j_count), dtype=np.int64)
         n_tasks = 0
         for s in range(s_count):
-            z = self.readings(pos_idx[s])
+            z, probability[s] = self.readings(pos_idx[s])
             readings[s] = z
             uniq, inv = np.unique(z, axis=0, return_inverse=True)
             task_z.append(uniq)
@@ -201,47 +284,10 @@ class PredictionContext:
             kl,
         )
         return SequenceStats(
-            readings, log_ev[inverse], mean[inverse], trace[inverse], kl_div[inverse]
+            readings,
+            probability,
+            log_ev[inverse],
+            mean[inverse],
+            trace[inverse],
+            kl_div[inverse],
         )
-
-
-def dcee_cost(final_positions: np.ndarray, stats: SequenceStats) -> np.ndarray:
-    """(S,) DCEE cost (the paper's theorem 1): mean over hypotheses of
-    ‖p − s̄_{k+T|k}‖² + tr P_{k+T|k}, for (S, 3) final positions."""
-    d = final_positions[:, None, :] - stats.mean
-    return np.mean(np.einsum("sjk,sjk->sj", d, d) + stats.trace_cov, axis=1)
-
-
-class OneStepPlanner(Planner):
-    """A planner whose cost is a function of one-step predicted-posterior statistics."""
-
-    uses_hypotheses = True
-    #: which optional statistics :meth:`cost_from_stats` reads (see PredictionContext.stats)
-    needs_moments = True
-    needs_kl = True
-
-    def __init__(self, n_hypotheses: int = 40) -> None:
-        if int(n_hypotheses) != n_hypotheses or n_hypotheses < 1:
-            raise DceeInputError("hypotheses", f"must be an integer >= 1, got {n_hypotheses}")
-        self.n_hypotheses = int(n_hypotheses)
-
-    def options(self) -> dict[str, Any]:
-        return {"n_hypotheses": self.n_hypotheses}
-
-    def costs(
-        self,
-        belief: Belief,
-        position: np.ndarray,
-        candidates: np.ndarray,
-        agent: GridAgent,
-        rng: np.random.Generator,
-    ) -> tuple[np.ndarray, dict[str, Any]]:
-        ctx = PredictionContext(belief, self.n_hypotheses, 1, rng)
-        stats = ctx.stats(candidates[:, None, :], moments=self.needs_moments, kl=self.needs_kl)
-        return self.cost_from_stats(candidates, stats, belief), {}
-
-    @abstractmethod
-    def cost_from_stats(
-        self, candidates: np.ndarray, stats: SequenceStats, belief: Belief
-    ) -> np.ndarray:
-        """(M,) cost from (M, 3) candidates and their one-step statistics."""

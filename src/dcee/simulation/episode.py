@@ -160,6 +160,8 @@ def _subsample(pf: ParticleFilter, n: int, rng: np.random.Generator) -> np.ndarr
 def _planner_defaults(
     strategy: str, scenario: Scenario, options: dict[str, Any] | None
 ) -> dict[str, Any]:
+    """Constructor defaults: the scenario's hypothesis count (a spec's own, ``dcee:hypotheses=25``,
+    overrides it in :func:`dcee.planning.get`)."""
     opts = dict(options or {})
     if planner_class(strategy).uses_hypotheses:
         opts.setdefault("n_hypotheses", scenario.search.hypotheses)

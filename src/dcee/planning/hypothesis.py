@@ -1,0 +1,124 @@
+"""Planners that score candidate moves by hypothesised readings: cost separate from search.
+
+A :class:`HypothesisPlanner` defines only its *loss*, a function of one hypothesis's predicted
+posterior (S, J). The expectation over the next readings (sampled | stratified, see
+:data:`dcee.planning.predicted.EXPECTATIONS`) and the search over move sequences (one step, or a
+receding-horizon beam) are shared, so every loss gets every expectation and every horizon:
+``infotaxis:horizon=2`` is multistage infotaxis with no code of its own.
+
+Beam search (horizon H > 1), the documented approximation: at depth d the partial sequences are
+ranked by their own d-stage cost and only the best ``beam_width`` are expanded by every
+admissible move, so H = 2 evaluates 8 + 8·K sequences and H = 3 evaluates 8 + 2·8·K (K =
+beam_width) instead of 64 or 512. Hypothesis j uses the same random numbers at every stage and
+for every sequence (common random numbers), and identical reading sequences (e.g. all
+non-detections) are evaluated once. First moves whose every continuation was pruned get cost
++inf.
+"""
+
+from __future__ import annotations
+
+from abc import abstractmethod
+from typing import Any, ClassVar
+
+import numpy as np
+
+from dcee.errors import DceeInputError
+from dcee.models.agent import GridAgent
+from dcee.planning.base import Belief, Planner
+from dcee.planning.predicted import EXPECTATIONS, PredictionContext, SequenceStats
+
+
+class HypothesisPlanner(Planner):
+    """Cost(U) = E_ẑ[loss(U, predicted posterior after ẑ)] over hypothesised readings.
+
+    Options (all planners of this kind): ``n_hypotheses`` J per candidate sequence,
+    ``expectation`` sampled | stratified, ``horizon`` H moves (1–3) and ``beam_width``.
+    """
+
+    uses_hypotheses = True
+    #: which optional statistics :meth:`loss` reads (see PredictionContext.stats)
+    needs_moments: ClassVar[bool] = True
+    needs_kl: ClassVar[bool] = True
+    default_horizon: ClassVar[int] = 1
+    default_expectation: ClassVar[str] = "sampled"
+
+    def __init__(
+        self,
+        n_hypotheses: int = 40,
+        expectation: str | None = None,
+        horizon: int | None = None,
+        beam_width: int = 3,
+    ) -> None:
+        expectation = self.default_expectation if expectation is None else expectation
+        horizon = self.default_horizon if horizon is None else horizon
+        if isinstance(n_hypotheses, bool) or int(n_hypotheses) != n_hypotheses or n_hypotheses < 1:
+            raise DceeInputError("hypotheses", f"must be an integer >= 1, got {n_hypotheses}")
+        if expectation not in EXPECTATIONS:
+            raise DceeInputError(
+                "expectation", f"must be one of {', '.join(EXPECTATIONS)}, got {expectation!r}"
+            )
+        if horizon not in (1, 2, 3):
+            raise DceeInputError("horizon", f"must be 1, 2 or 3, got {horizon}")
+        if isinstance(beam_width, bool) or int(beam_width) != beam_width or beam_width < 1:
+            raise DceeInputError("beam_width", f"must be an integer >= 1, got {beam_width}")
+        self.n_hypotheses = int(n_hypotheses)
+        self.expectation = str(expectation)
+        self.horizon = int(horizon)
+        self.beam_width = int(beam_width)
+
+    def options(self) -> dict[str, Any]:
+        return {
+            "n_hypotheses": self.n_hypotheses,
+            "expectation": self.expectation,
+            "horizon": self.horizon,
+            "beam_width": self.beam_width,
+        }
+
+    @abstractmethod
+    def loss(self, final_positions: np.ndarray, stats: SequenceStats, belief: Belief) -> np.ndarray:
+        """(S, J) loss of each hypothesis for (S, 3) final positions of S sequences."""
+
+    def sequence_costs(
+        self, sequences: np.ndarray, ctx: PredictionContext, belief: Belief
+    ) -> np.ndarray:
+        """(S,) expected loss of (S, T, 3) position sequences."""
+        stats = ctx.stats(sequences, moments=self.needs_moments, kl=self.needs_kl)
+        return stats.expect(self.loss(sequences[:, -1], stats, belief))
+
+    def costs(
+        self,
+        belief: Belief,
+        position: np.ndarray,
+        candidates: np.ndarray,
+        agent: GridAgent,
+        rng: np.random.Generator,
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        ctx = PredictionContext(belief, self.n_hypotheses, self.horizon, rng, self.expectation)
+        seqs = candidates[:, None, :]
+        cost = self.sequence_costs(seqs, ctx, belief)
+        if self.horizon == 1:
+            return cost, {}
+        first = np.arange(len(candidates))
+        evaluated = len(seqs)
+        for _ in range(1, self.horizon):
+            keep = np.argsort(cost, kind="stable")[: self.beam_width]
+            new_seqs: list[np.ndarray] = []
+            new_first: list[int] = []
+            for s in keep:
+                nxt, _ = agent.candidates(seqs[s, -1])
+                for p in nxt:
+                    new_seqs.append(np.vstack([seqs[s], p[None, :]]))
+                    new_first.append(first[s])
+            seqs = np.array(new_seqs)
+            first = np.array(new_first)
+            cost = self.sequence_costs(seqs, ctx, belief)
+            evaluated += len(seqs)
+        best = np.full(len(candidates), np.inf)
+        np.minimum.at(best, first, cost)
+        return best, {"sequences_evaluated": evaluated}
+
+
+def squared_distance(final_positions: np.ndarray, stats: SequenceStats) -> np.ndarray:
+    """(S, J) ‖p − s̄'_j‖² for (S, 3) final positions."""
+    d = final_positions[:, None, :] - stats.mean
+    return np.einsum("sjk,sjk->sj", d, d)
