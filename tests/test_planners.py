@@ -261,3 +261,27 @@ def test_any_loss_takes_the_multistage_search():
     )
     assert d.info["sequences_evaluated"] == 8 + 2 * 8
     assert np.isfinite(d.costs).sum() <= 2
+
+
+def test_ablation_options_change_the_hypotheses_as_documented():
+    belief = _two_point_belief(50)
+    twice = np.array([[[12.0, 10.0, 0.0]], [[12.0, 10.0, 0.0]]])
+    fresh = PredictionContext(belief, 40, 1, np.random.default_rng(0), noise="fresh")
+    st = fresh.stats(twice)
+    assert not np.array_equal(st.readings[0], st.readings[1])  # a new draw per candidate
+    quiet = PredictionContext(belief, 200, 1, np.random.default_rng(0), readings="noise-free")
+    z = quiet.readings(quiet.position_index(twice[0]))[0][:, 0]
+    conc = quiet.conc[0, quiet.indices]
+    det = z > 0
+    np.testing.assert_array_equal(z[det], conc[det])  # a detection reads C exactly
+    seen = PredictionContext(belief, 200, 1, np.random.default_rng(0), readings="miss-free")
+    z = seen.readings(seen.position_index(twice[0]))[0][:, 0]
+    c = seen.conc[0, seen.indices]
+    assert np.all((z > 0) == (c + (0.5 * c + 1e-4) * seen.noise[:, 0, 1] >= 5e-4))
+    with pytest.raises(DceeInputError, match="readings"):
+        planners.get("dcee:expectation=stratified:readings=noise-free")
+    with pytest.raises(DceeInputError, match="subsample"):
+        planners.get("dcee:subsample=0")
+    small = planners.get("dcee:subsample=0.2:noise=fresh:hypotheses=25")
+    d = small.decide(_spread_belief(), START, AGENT, np.random.default_rng(0))
+    assert np.all(np.isfinite(d.costs))

@@ -211,6 +211,10 @@ def run_workloads(quick: bool = False, progress: Callable[[str], None] | None = 
             lambda: _decision("infotaxis-decision-20k", 20_000, "infotaxis", 5.0, r),
         ),
         (
+            "dcee-cl-decision-20k",
+            lambda: _decision("dcee-cl-decision-20k", 20_000, "dcee-cl", None, r),
+        ),
+        (
             "dcee-ms-decision-20k",
             lambda: _decision(
                 "dcee-ms-decision-20k", 20_000, "dcee-ms", 100.0, max(3, r // 3), horizon=2
@@ -245,6 +249,10 @@ def run_workloads(quick: bool = False, progress: Callable[[str], None] | None = 
     for name, make in plan:
         say(name)
         out.append(make())
+    by_name = {t.name: t for t in out}
+    # issue 13's bound: a closed-loop decision costs at most 2× an open-loop one, same run
+    cl, op = by_name["dcee-cl-decision-20k"], by_name["dcee-decision-20k"]
+    cl.note = f"{cl.median / op.median:.2f}× the dcee decision in this run"
     if not quick:
         out.append(_campaign_estimate(out, say))
     return out

@@ -23,16 +23,26 @@ from typing import Any, ClassVar
 import numpy as np
 
 from dcee.errors import DceeInputError
+from dcee.estimation.particle_filter import systematic_resample
 from dcee.models.agent import GridAgent
 from dcee.planning.base import Belief, Planner
-from dcee.planning.predicted import EXPECTATIONS, PredictionContext, SequenceStats
+from dcee.planning.predicted import (
+    EXPECTATIONS,
+    HYPOTHESIS_READINGS,
+    NOISE_SHARING,
+    PredictionContext,
+    SequenceStats,
+)
 
 
 class HypothesisPlanner(Planner):
     """Cost(U) = E_ẑ[loss(U, predicted posterior after ẑ)] over hypothesised readings.
 
     Options (all planners of this kind): ``n_hypotheses`` J per candidate sequence,
-    ``expectation`` sampled | stratified, ``horizon`` H moves (1–3) and ``beam_width``.
+    ``expectation`` sampled | stratified, ``horizon`` H moves (1–3) and ``beam_width``; for
+    ablations, ``noise`` shared | fresh (:data:`~dcee.planning.predicted.NOISE_SHARING`),
+    ``readings`` model | noise-free | miss-free and ``subsample`` (predict with a systematic
+    resample of that share of the particles, equally weighted; the authors' example uses 0.2).
     """
 
     uses_hypotheses = True
@@ -48,6 +58,9 @@ class HypothesisPlanner(Planner):
         expectation: str | None = None,
         horizon: int | None = None,
         beam_width: int = 3,
+        noise: str = "shared",
+        readings: str = "model",
+        subsample: float = 1.0,
     ) -> None:
         expectation = self.default_expectation if expectation is None else expectation
         horizon = self.default_horizon if horizon is None else horizon
@@ -61,6 +74,23 @@ class HypothesisPlanner(Planner):
             raise DceeInputError("horizon", f"must be 1, 2 or 3, got {horizon}")
         if isinstance(beam_width, bool) or int(beam_width) != beam_width or beam_width < 1:
             raise DceeInputError("beam_width", f"must be an integer >= 1, got {beam_width}")
+        for name, value, allowed in (
+            ("noise", noise, NOISE_SHARING),
+            ("readings", readings, HYPOTHESIS_READINGS),
+        ):
+            if value not in allowed:
+                raise DceeInputError(name, f"must be one of {', '.join(allowed)}, got {value!r}")
+        if expectation == "stratified" and readings != "model":
+            raise DceeInputError(
+                "readings", "simplified hypothetical readings need expectation=sampled"
+            )
+        if isinstance(subsample, bool) or not (
+            isinstance(subsample, int | float) and 0 < subsample <= 1
+        ):
+            raise DceeInputError("subsample", f"must be a share in (0, 1], got {subsample!r}")
+        self.noise = str(noise)
+        self.readings = str(readings)
+        self.subsample = float(subsample)
         self.n_hypotheses = int(n_hypotheses)
         self.expectation = str(expectation)
         self.horizon = int(horizon)
@@ -72,6 +102,9 @@ class HypothesisPlanner(Planner):
             "expectation": self.expectation,
             "horizon": self.horizon,
             "beam_width": self.beam_width,
+            "noise": self.noise,
+            "readings": self.readings,
+            "subsample": self.subsample,
         }
 
     @abstractmethod
@@ -93,7 +126,19 @@ class HypothesisPlanner(Planner):
         agent: GridAgent,
         rng: np.random.Generator,
     ) -> tuple[np.ndarray, dict[str, Any]]:
-        ctx = PredictionContext(belief, self.n_hypotheses, self.horizon, rng, self.expectation)
+        if self.subsample < 1.0:
+            n = max(1, round(self.subsample * len(belief.weights)))
+            idx = systematic_resample(belief.weights, rng, n)
+            belief = Belief(belief.theta[idx], np.full(n, 1.0 / n), belief.sensor, belief.plume)
+        ctx = PredictionContext(
+            belief,
+            self.n_hypotheses,
+            self.horizon,
+            rng,
+            self.expectation,
+            self.noise,
+            self.readings,
+        )
         seqs = candidates[:, None, :]
         cost = self.sequence_costs(seqs, ctx, belief)
         if self.horizon == 1:

@@ -104,12 +104,22 @@ EXPECTATIONS = ("sampled", "stratified")
 """
 
 
+NOISE_SHARING = ("shared", "fresh")
+"""``shared``: one set of hypotheses for every candidate (common random numbers, our default);
+``fresh``: new hypotheses and noise for every candidate sequence (the authors' example code)."""
+
+HYPOTHESIS_READINGS = ("model", "noise-free", "miss-free")
+"""How sampled hypothetical readings are made (ablation): from the full reading model; without
+measurement noise (the reading is C wherever it is detected); or without random misses."""
+
+
 class PredictionContext:
     """One decision's hypotheses and caches; planners ask it for :class:`SequenceStats`.
 
     Every random number is drawn here, once per decision, and shared by every candidate
     sequence (common random numbers): the J hypothesised sources and J × horizon standard noise
     (sampled), or one systematic-sampling offset and per-hypothesis uniforms (stratified).
+    ``noise="fresh"`` redraws them for every sequence instead.
     """
 
     def __init__(
@@ -119,31 +129,53 @@ class PredictionContext:
         horizon: int,
         rng: np.random.Generator,
         expectation: str = "sampled",
+        noise: str = "shared",
+        readings: str = "model",
     ) -> None:
-        if expectation not in EXPECTATIONS:
+        for name, value, allowed in (
+            ("expectation", expectation, EXPECTATIONS),
+            ("noise", noise, NOISE_SHARING),
+            ("readings", readings, HYPOTHESIS_READINGS),
+        ):
+            if value not in allowed:
+                raise DceeInputError(name, f"must be one of {', '.join(allowed)}, got {value!r}")
+        if expectation == "stratified" and readings != "model":
             raise DceeInputError(
-                "expectation", f"must be one of {', '.join(EXPECTATIONS)}, got {expectation!r}"
+                "readings", "simplified hypothetical readings need expectation=sampled"
             )
         self.belief = belief
         self.sensor = belief.sensor
         self.expectation = expectation
         self._sp = belief.sensor.params
         self._n = int(n_hypotheses)
-        if expectation == "sampled":
-            self.indices = systematic_resample(belief.weights, rng, n_hypotheses)
-            # Shuffle so that hypothesis j is not tied to a weight stratum at every stage.
-            self.indices = rng.permutation(self.indices)
-        else:
-            self._offset = rng.random()
-            self._first_u = rng.random(n_hypotheses)  # picks the first detecting stage
-            self._detect_u = rng.random((n_hypotheses, 2))  # that stage's reading
-        self.noise = belief.sensor.draw_noise(rng, (n_hypotheses, horizon))
+        self._horizon = int(horizon)
+        self._rng = rng
+        self._fresh = noise == "fresh"
+        self._simplify = readings
+        self._draw()
         self._theta = np.ascontiguousarray(belief.theta)
         self._source = np.ascontiguousarray(belief.source)
         self._center = belief.source_mean()
         self._rows: list[tuple[np.ndarray, ...]] = []
         self._index: dict[tuple[float, ...], int] = {}
         self._terms: tuple[np.ndarray, ...] | None = None
+
+    def _draw(self) -> None:
+        """Every random number one set of hypotheses needs (see the class docstring)."""
+        rng, n = self._rng, self._n
+        if self.expectation == "sampled":
+            self.indices = systematic_resample(self.belief.weights, rng, n)
+            # Shuffle so that hypothesis j is not tied to a weight stratum at every stage.
+            self.indices = rng.permutation(self.indices)
+        else:
+            self._offset = rng.random()
+            self._first_u = rng.random(n)  # picks the first detecting stage
+            self._detect_u = rng.random((n, 2))  # that stage's reading
+        self.noise = self.sensor.draw_noise(rng, (n, self._horizon))
+        if self._simplify == "noise-free":
+            self.noise[..., 1] = 0.0
+        elif self._simplify == "miss-free":
+            self.noise[..., 0] = 0.0  # below any Pd: every reading above the threshold is seen
 
     @property
     def n_hypotheses(self) -> int:
@@ -195,6 +227,8 @@ class PredictionContext:
     def readings(self, pos_idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Hypothesised readings (J', T) along one sequence of cached positions (T,) and the
         probability (J',) each stands for (summing to 1)."""
+        if self._fresh:
+            self._draw()
         if self.expectation == "stratified":
             return self._stratified_readings(pos_idx)
         t_count = len(pos_idx)
