@@ -108,7 +108,7 @@ def test_strategies_lists_the_registry_with_options(capsys):
     code, out, _ = run_cli(["strategies"], capsys)
     assert code == 0
     listed = [line.split()[0] for line in out.splitlines() if not line.startswith(" ")]
-    assert listed == names() and "reach=6.0" in out
+    assert listed == names() and "reach=8.0" in out
 
 
 def test_a_planner_spec_runs_and_is_recorded(tmp_path, capsys):

@@ -33,8 +33,8 @@ from dcee.planning.base import Belief, register
 from dcee.planning.hypothesis import HypothesisPlanner
 from dcee.planning.predicted import SequenceStats
 
-DEFAULT_REACH = 6.0
-"""m: three 2 m steps of the paper's agent; chosen by measurement (docs/dual-control.md)."""
+DEFAULT_REACH = 8.0
+"""m: four 2 m steps of the paper's agent; chosen by measurement (docs/dual-control.md)."""
 
 
 @register("dcee-cl")
