@@ -20,3 +20,6 @@ dcee-cl:reach=12,infotaxis,infotaxis:expectation=stratified,entrotaxis,entrotaxi
 # the rest of the paper's strategies beside them (same seeds)
 $D bench --suite paper --repeats 10 --strategies dcee,mpc --out results/paper-source-cl
 $D bench --suite paper --repeats 10 --unknown full --strategies dcee,mpc --out results/paper-full-cl
+# the authors' 75 m domain: does the area explain the paper's MPC and DCEE? (10,000, 5 repeats)
+$D bench --suite hard-easy75 --repeats 5 --particles 10000 --out results/dual-ablation-75 \
+    --strategies mpc,dcee,dcee-cl,infotaxis

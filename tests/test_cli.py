@@ -90,7 +90,7 @@ def test_bad_scenarios_exit_2(tmp_path, capsys):
 
 def test_scenarios_and_show(capsys):
     code, out, _ = run_cli(["scenarios"], capsys)
-    assert code == 0 and out.count("\n") == 14 and "lab:upwind" in out
+    assert code == 0 and out.count("\n") == 26 and "lab:upwind" in out
     code, out, _ = run_cli(["show", "paper:3"], capsys)
     assert code == 0 and json.loads(out)["truth"]["y"] == 40.0
 

@@ -342,7 +342,12 @@ def _numba_threads() -> int:
 
 
 @cli.command()
-@click.option("--suite", default="paper", show_default=True, help="paper | hard-easy | smoke")
+@click.option(
+    "--suite",
+    default="paper",
+    show_default=True,
+    help="paper | hard-easy | paper75 | hard-easy75 | smoke",
+)
 @click.option(
     "--strategies",
     default="dcee,mpc,entrotaxis,infotaxis,dcee-ms",

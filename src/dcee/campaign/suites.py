@@ -4,6 +4,8 @@
   at paper scale (20,000 particles, 40 hypothesised readings, 900 s).
 * ``hard-easy``: paper:5, 7 and 12 (the plume points away from the start; MPC and DCEE stall)
   and paper:1 and 3 (every planner succeeds), at paper scale: the dual-control ablation.
+* ``paper75`` and ``hard-easy75``: the same in the 75 m × 75 m domain of the authors' example
+  code (sources scaled by 1.5; ``paper75:K``).
 * ``smoke``: two of them at toy scale (1,000 particles, 10 hypothesised readings, 60 s) so a
   campaign with every strategy finishes in well under a minute; for CI and for trying options.
 """
@@ -21,6 +23,11 @@ SUITES: dict[str, dict] = {
     # the ablation of docs/dual-control.md
     "hard-easy": {
         "configs": ["paper:1", "paper:3", "paper:5", "paper:7", "paper:12"],
+        "overrides": {},
+    },
+    "paper75": {"configs": [f"paper75:{k}" for k in range(1, 13)], "overrides": {}},
+    "hard-easy75": {
+        "configs": ["paper75:1", "paper75:3", "paper75:5", "paper75:7", "paper75:12"],
         "overrides": {},
     },
     "smoke": {

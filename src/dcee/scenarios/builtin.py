@@ -36,17 +36,27 @@ PAPER_SOURCES: tuple[tuple[float, float, float], ...] = (
 )
 
 
-def _paper(k: int) -> dict[str, Any]:
+# The authors' public example code searches a 75 m × 75 m domain (anchors.md). ``paper75:K`` is
+# configuration K with its source position scaled by 1.5 into that domain (same wind, start,
+# sensor and budget): does the area explain how the paper's MPC and DCEE behaved?
+PAPER75_SCALE = 1.5
+PAPER75_VOLUME = {"low": [0.0, 0.0, 0.0], "high": [75.0, 75.0, 5.0]}
+
+
+def _paper(k: int, scale: float = 1.0) -> dict[str, Any]:
     x, y, phi = PAPER_SOURCES[k - 1]
+    x, y = scale * x, scale * y
+    name = f"paper:{k}" if scale == 1.0 else f"paper75:{k}"
+    area = "" if scale == 1.0 else " (75 m x 75 m domain)"
     return {
-        "name": f"paper:{k}",
+        "name": name,
         "description": (
-            f"Paper simulation study, configuration {k}: source ({x}, {y}, 1) m, "
+            f"Paper simulation study, configuration {k}{area}: source ({x:g}, {y:g}, 1) m, "
             f"wind from {phi:g} deg at 4 m/s; UAV at 4 m from (2, 2)."
         ),
         "dimensions": 3,
         "unknown": "source",
-        "volume": PAPER_VOLUME,
+        "volume": PAPER_VOLUME if scale == 1.0 else PAPER75_VOLUME,
         "truth": {
             "x": x,
             "y": y,
@@ -116,5 +126,6 @@ def _lab(start: str) -> dict[str, Any]:
 def builtin_scenarios() -> dict[str, dict[str, Any]]:
     """Raw (unvalidated) built-in scenarios by name."""
     out = {f"paper:{k}": _paper(k) for k in range(1, len(PAPER_SOURCES) + 1)}
+    out.update({f"paper75:{k}": _paper(k, PAPER75_SCALE) for k in range(1, len(PAPER_SOURCES) + 1)})
     out.update({f"lab:{s}": _lab(s) for s in LAB_STARTS})
     return out
