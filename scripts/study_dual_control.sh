@@ -8,18 +8,21 @@ D=.venv/bin/dcee
 # the reach R of dcee-cl, chosen on the hard and easy configurations (10,000 particles, 3 repeats)
 $D bench --suite hard-easy --repeats 3 --particles 10000 --out results/reach-10k \
     --strategies infotaxis,dcee-cl:reach=3,dcee-cl:reach=4,dcee-cl:reach=6,dcee-cl:reach=8,dcee-cl:reach=10,dcee-cl:reach=12
-# the paper's studies at paper scale (20,000 particles, 12 × 10), dcee-cl beside infotaxis
+# the paper's wind-known study at paper scale (20,000 particles, 12 × 10), dcee-cl beside infotaxis
 $D bench --suite paper --repeats 10 --strategies dcee-cl,infotaxis --out results/paper-source-cl
-$D bench --suite paper --repeats 10 --unknown full --strategies dcee-cl,infotaxis --out results/paper-full-cl
 # the ablation that explains the paper (10,000 particles, 5 configurations × 5 repeats)
 $D bench --suite hard-easy --repeats 5 --particles 10000 --out results/dual-ablation --strategies \
-mpc,dcee,dcee:hypotheses=10,dcee:hypotheses=160,dcee:noise=fresh,\
-dcee:noise=fresh:subsample=0.2:hypotheses=25,dcee:readings=noise-free,dcee:readings=miss-free,\
-dcee:expectation=stratified,dcee-ms,dcee-cl,dcee-cl:expectation=sampled,dcee-cl:reach=4,\
-dcee-cl:reach=12,infotaxis,infotaxis:expectation=stratified,entrotaxis,entrotaxis:expectation=stratified
-# the rest of the paper's strategies beside them (same seeds)
-$D bench --suite paper --repeats 10 --strategies dcee,mpc --out results/paper-source-cl
-$D bench --suite paper --repeats 10 --unknown full --strategies dcee,mpc --out results/paper-full-cl
+mpc,dcee,dcee:hypotheses=160,dcee:noise=fresh,dcee:noise=fresh:subsample=0.2:hypotheses=25,\
+dcee:readings=noise-free,dcee:readings=miss-free,dcee:expectation=stratified,dcee-cl,\
+dcee-cl:expectation=sampled,infotaxis,infotaxis:expectation=stratified
 # the authors' 75 m domain: does the area explain the paper's MPC and DCEE? (10,000, 5 repeats)
 $D bench --suite hard-easy75 --repeats 5 --particles 10000 --out results/dual-ablation-75 \
     --strategies mpc,dcee,dcee-cl,infotaxis
+# the full-unknown study at paper scale, dcee-cl beside infotaxis
+$D bench --suite paper --repeats 10 --unknown full --strategies dcee-cl,infotaxis --out results/paper-full-cl
+# more of the ablation (hypothesis count, reach, entrotaxis, multistage)
+$D bench --suite hard-easy --repeats 5 --particles 10000 --out results/dual-ablation --strategies \
+dcee:hypotheses=10,dcee-cl:reach=4,dcee-cl:reach=12,entrotaxis,entrotaxis:expectation=stratified,dcee-ms,dcee-cl:horizon=2
+# the rest of the paper's strategies beside them (same seeds)
+$D bench --suite paper --repeats 10 --strategies dcee,mpc --out results/paper-source-cl
+$D bench --suite paper --repeats 10 --unknown full --strategies dcee,mpc --out results/paper-full-cl
