@@ -26,3 +26,6 @@ dcee:hypotheses=10,dcee-cl:reach=4,dcee-cl:reach=12,entrotaxis,entrotaxis:expect
 # the rest of the paper's strategies beside them (same seeds)
 $D bench --suite paper --repeats 10 --strategies dcee,mpc --out results/paper-source-cl
 $D bench --suite paper --repeats 10 --unknown full --strategies dcee,mpc --out results/paper-full-cl
+# the two-move scenario tree against dcee-cl (small: 5,000 particles, 10 + 5 hypotheses, 1 repeat)
+$D bench --suite hard-easy --repeats 1 --particles 5000 --out results/dual-tree \
+    --strategies dcee-cl:hypotheses=10,dcee-cl-tree:hypotheses=10:branch_hypotheses=5

@@ -285,3 +285,41 @@ def test_ablation_options_change_the_hypotheses_as_documented():
     small = planners.get("dcee:subsample=0.2:noise=fresh:hypotheses=25")
     d = small.decide(_spread_belief(), START, AGENT, np.random.default_rng(0))
     assert np.all(np.isfinite(d.costs))
+
+
+@pytest.mark.parametrize("reach", [0.0, 1.5])
+def test_scenario_tree_cost_for_a_point_belief_is_the_best_second_move(reach):
+    # Every particle at s: no reading changes the belief, so J(u1) = min over the moves u2
+    # from p1 of dist(s, disk(p2, R))², computed here by hand.
+    s = np.array([20.0, 20.0, 0.0])
+    belief = _belief([tuple(s[:2])] * 30, q=5.0, u=4.0, phi=math.radians(225))
+    planner = planners.get("dcee-cl-tree", reach=reach, n_hypotheses=6, branch_hypotheses=3)
+    d = planner.decide(belief, START, AGENT, np.random.default_rng(0))
+    expected = []
+    for p1 in d.candidates:
+        p2 = AGENT.candidates(p1)[0]
+        gap = np.maximum(np.hypot(*(p2[:, :2] - s[:2]).T) - reach, 0.0)
+        expected.append(np.min(gap**2))
+    np.testing.assert_allclose(d.costs, expected, rtol=1e-9, atol=1e-9)
+    assert d.heading == 1 and d.info["branches"] >= 8
+    with pytest.raises(DceeInputError, match="horizon"):
+        planners.get("dcee-cl-tree:horizon=2")
+
+
+@pytest.mark.parametrize("expectation", ["sampled", "stratified"])
+def test_a_branch_drops_negligible_particles_without_changing_its_statistics(expectation):
+    belief = _spread_belief()
+    w = belief.weights.copy()
+    w[::2] = 0.0  # half the particles cannot explain the hypothesised reading
+    w /= w.sum()
+    seqs = AGENT.candidates(START)[0][:, None, :]
+    parent = PredictionContext(belief, 10, 1, np.random.default_rng(0), expectation)
+    parent.position_index(seqs[:, 0])
+    pruned = parent.branch(w, 12, np.random.default_rng(4)).stats(seqs)
+    direct_belief = Belief(belief.theta, w, belief.sensor, belief.plume)
+    direct = PredictionContext(direct_belief, 12, 1, np.random.default_rng(4), expectation)
+    full = direct.stats(seqs)
+    np.testing.assert_allclose(pruned.readings, full.readings, rtol=1e-12)
+    for a, b in [(pruned.mean, full.mean), (pruned.trace_cov, full.trace_cov)]:
+        np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(pruned.kl, full.kl, rtol=1e-6, atol=1e-9)

@@ -29,9 +29,10 @@ from typing import Any
 import numpy as np
 
 from dcee.errors import DceeInputError
+from dcee.models.agent import GridAgent
 from dcee.planning.base import Belief, register
 from dcee.planning.hypothesis import HypothesisPlanner
-from dcee.planning.predicted import SequenceStats
+from dcee.planning.predicted import PredictionContext, SequenceStats
 
 DEFAULT_REACH = 8.0
 """m: four 2 m steps of the paper's agent; chosen by measurement (docs/dual-control.md)."""
@@ -62,3 +63,72 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
         horizontal = np.hypot(d[..., 0], d[..., 1])
         beyond = np.maximum(horizontal - self.reach, 0.0)
         return beyond * beyond + d[..., 2] * d[..., 2] + stats.trace_cov
+
+
+@register("dcee-cl-tree")
+class ScenarioTreeDCEEPlanner(ClosedLoopDCEEPlanner):
+    """Closed-loop DCEE over a two-stage scenario tree: the second move is chosen after the
+    first hypothesised reading, then the reach-R cost is charged,
+
+        J(u1) = E_ẑ1[ min_{u2} E_ẑ2|ẑ1[ dist(s̄″, disk(p2, R))² + tr P″ ] ].
+
+    Each distinct first reading (J + 1 stratified) opens a branch whose belief is the predicted
+    posterior after it; ``branch_hypotheses`` readings per second move are drawn from that
+    branch's own predictive distribution (stratified, common random numbers across branches).
+    Cost: 8 × (J + 1) branches × 8 moves × (J2 + 1) readings: far dearer than ``dcee-cl``
+    (docs/dual-control.md measures whether the exact second step adds anything)."""
+
+    summary = "closed-loop DCEE over a two-move scenario tree (second move after the reading)"
+
+    def __init__(self, branch_hypotheses: int = 10, **options: Any) -> None:
+        super().__init__(**options)
+        if self.horizon != 1:
+            raise DceeInputError("horizon", "the scenario tree has its own two stages: use 1")
+        if (
+            isinstance(branch_hypotheses, bool)
+            or int(branch_hypotheses) != branch_hypotheses
+            or branch_hypotheses < 1
+        ):
+            raise DceeInputError(
+                "branch_hypotheses", f"must be an integer >= 1, got {branch_hypotheses!r}"
+            )
+        self.branch_hypotheses = int(branch_hypotheses)
+
+    def options(self) -> dict[str, Any]:
+        return {**super().options(), "branch_hypotheses": self.branch_hypotheses}
+
+    def costs(
+        self,
+        belief: Belief,
+        position: np.ndarray,
+        candidates: np.ndarray,
+        agent: GridAgent,
+        rng: np.random.Generator,
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        ctx = PredictionContext(
+            belief, self.n_hypotheses, 1, rng, self.expectation, self.noise, self.readings
+        )
+        first = ctx.stats(candidates[:, None, :], moments=False, kl=False)
+        seconds = [agent.candidates(p)[0] for p in candidates]
+        first_idx = ctx.position_index(candidates)
+        ctx.position_index(np.concatenate(seconds))  # every position cached before branching
+        conc, dist = ctx.terms[0], ctx.terms[1]
+        branch_seed = int(rng.integers(2**63))
+        with np.errstate(divide="ignore"):
+            log_w = np.log(belief.weights)
+        cost = np.zeros(len(candidates))
+        branches = 0
+        for m, p_idx in enumerate(first_idx):
+            readings, inverse = np.unique(first.readings[m, :, 0], return_inverse=True)
+            prob = np.bincount(inverse.ravel(), weights=first.probability[m])
+            for z1, pz in zip(readings, prob, strict=True):
+                if pz <= 0.0:
+                    continue
+                lw = log_w + belief.sensor.log_likelihood(z1, conc[p_idx], dist[p_idx])
+                w = np.exp(lw - lw.max())
+                w /= w.sum()
+                branch = ctx.branch(w, self.branch_hypotheses, np.random.default_rng(branch_seed))
+                seqs = seconds[m][:, None, :]
+                cost[m] += pz * self.sequence_costs(seqs, branch, branch.belief).min()
+                branches += 1
+        return cost, {"branches": branches}

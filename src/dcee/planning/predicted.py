@@ -19,6 +19,7 @@ O(N · positions + J · sequences); no N × J × moves array is formed.
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 
 import numpy as np
@@ -176,6 +177,32 @@ class PredictionContext:
             self.noise[..., 1] = 0.0
         elif self._simplify == "miss-free":
             self.noise[..., 0] = 0.0  # below any Pd: every reading above the threshold is seen
+
+    def branch(
+        self, weights: np.ndarray, n_hypotheses: int, rng: np.random.Generator
+    ) -> PredictionContext:
+        """A one-stage context for the belief reweighted to ``weights`` (N,) — the predicted
+        posterior after a hypothesised reading — that reuses this context's per-position terms
+        (they depend on Θ, not on the weights) and draws its own hypotheses from ``rng``.
+
+        Particles below 1e-12 of the largest weight are dropped (their total share is below
+        N · 1e-12): after a detection the branch keeps only the few particles that explain it.
+        """
+        keep = weights > 1e-12 * weights.max()
+        other = copy.copy(self)
+        other._rows, other._index = list(self._rows), dict(self._index)  # never shared
+        theta = self.belief.theta
+        if keep.mean() < 0.9:
+            theta, weights = theta[keep], weights[keep] / weights[keep].sum()
+            other._rows = [tuple(np.ascontiguousarray(a[:, keep]) for a in self.terms)]
+            other._terms = None
+            other._theta = np.ascontiguousarray(theta)
+            other._source = np.ascontiguousarray(theta[:, :3])
+        other.belief = Belief(theta, weights, self.sensor, self.belief.plume)
+        other._n, other._horizon, other._rng = int(n_hypotheses), 1, rng
+        other._center = other.belief.source_mean()
+        other._draw()
+        return other
 
     @property
     def n_hypotheses(self) -> int:
