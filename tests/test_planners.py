@@ -248,6 +248,10 @@ def test_planner_specs_set_options_and_reject_bad_ones():
         ("dcee:colour=red", "planner_options"),
         ("nope:reach=3", "strategy"),
         ("infotaxis:horizon=4", "horizon"),
+        ("dcee:hypotheses=abc", "hypotheses"),
+        ("dcee:hypotheses=2.5", "hypotheses"),
+        ("dcee-cl-tree:branch_hypotheses=0", "branch_hypotheses"),
+        ("dcee-ms:beam_width=true", "beam_width"),
     ]:
         with pytest.raises(DceeInputError, match=field):
             planners.get(bad)

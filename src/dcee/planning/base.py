@@ -118,6 +118,20 @@ def register(name: str) -> Callable[[type[Planner]], type[Planner]]:
     return wrap
 
 
+def check_count(field: str, value: object) -> int:
+    """``value`` as an int >= 1, or :class:`DceeInputError` naming ``field`` (planner options
+    arrive from specs and files as int, float or text)."""
+    ok = (
+        isinstance(value, int | float | np.integer | np.floating)
+        and not isinstance(value, bool)
+        and float(value).is_integer()
+        and value >= 1
+    )
+    if not ok:
+        raise DceeInputError(field, f"must be an integer >= 1, got {value!r}")
+    return int(value)
+
+
 OPTION_ALIASES = {"hypotheses": "n_hypotheses"}
 """Spec keys that name a constructor argument differently (as the scenario files do)."""
 

@@ -30,7 +30,7 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.models.agent import GridAgent
-from dcee.planning.base import Belief, register
+from dcee.planning.base import Belief, check_count, register
 from dcee.planning.hypothesis import HypothesisPlanner
 from dcee.planning.predicted import PredictionContext, SequenceStats
 
@@ -84,15 +84,7 @@ class ScenarioTreeDCEEPlanner(ClosedLoopDCEEPlanner):
         super().__init__(**options)
         if self.horizon != 1:
             raise DceeInputError("horizon", "the scenario tree has its own two stages: use 1")
-        if (
-            isinstance(branch_hypotheses, bool)
-            or int(branch_hypotheses) != branch_hypotheses
-            or branch_hypotheses < 1
-        ):
-            raise DceeInputError(
-                "branch_hypotheses", f"must be an integer >= 1, got {branch_hypotheses!r}"
-            )
-        self.branch_hypotheses = int(branch_hypotheses)
+        self.branch_hypotheses = check_count("branch_hypotheses", branch_hypotheses)
 
     def options(self) -> dict[str, Any]:
         return {**super().options(), "branch_hypotheses": self.branch_hypotheses}

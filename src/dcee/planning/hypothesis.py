@@ -25,14 +25,8 @@ import numpy as np
 from dcee.errors import DceeInputError
 from dcee.estimation.particle_filter import systematic_resample
 from dcee.models.agent import GridAgent
-from dcee.planning.base import Belief, Planner
-from dcee.planning.predicted import (
-    EXPECTATIONS,
-    HYPOTHESIS_READINGS,
-    NOISE_SHARING,
-    PredictionContext,
-    SequenceStats,
-)
+from dcee.planning.base import Belief, Planner, check_count
+from dcee.planning.predicted import PredictionContext, SequenceStats, check_hypothesis_options
 
 
 class HypothesisPlanner(Planner):
@@ -64,26 +58,11 @@ class HypothesisPlanner(Planner):
     ) -> None:
         expectation = self.default_expectation if expectation is None else expectation
         horizon = self.default_horizon if horizon is None else horizon
-        if isinstance(n_hypotheses, bool) or int(n_hypotheses) != n_hypotheses or n_hypotheses < 1:
-            raise DceeInputError("hypotheses", f"must be an integer >= 1, got {n_hypotheses}")
-        if expectation not in EXPECTATIONS:
-            raise DceeInputError(
-                "expectation", f"must be one of {', '.join(EXPECTATIONS)}, got {expectation!r}"
-            )
+        n_hypotheses = check_count("hypotheses", n_hypotheses)
+        beam_width = check_count("beam_width", beam_width)
         if horizon not in (1, 2, 3):
             raise DceeInputError("horizon", f"must be 1, 2 or 3, got {horizon}")
-        if isinstance(beam_width, bool) or int(beam_width) != beam_width or beam_width < 1:
-            raise DceeInputError("beam_width", f"must be an integer >= 1, got {beam_width}")
-        for name, value, allowed in (
-            ("noise", noise, NOISE_SHARING),
-            ("readings", readings, HYPOTHESIS_READINGS),
-        ):
-            if value not in allowed:
-                raise DceeInputError(name, f"must be one of {', '.join(allowed)}, got {value!r}")
-        if expectation == "stratified" and readings != "model":
-            raise DceeInputError(
-                "readings", "simplified hypothetical readings need expectation=sampled"
-            )
+        check_hypothesis_options(expectation, noise, readings)
         if isinstance(subsample, bool) or not (
             isinstance(subsample, int | float) and 0 < subsample <= 1
         ):

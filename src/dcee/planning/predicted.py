@@ -114,6 +114,22 @@ HYPOTHESIS_READINGS = ("model", "noise-free", "miss-free")
 measurement noise (the reading is C wherever it is detected); or without random misses."""
 
 
+def check_hypothesis_options(expectation: str, noise: str, readings: str) -> None:
+    """:class:`~dcee.errors.DceeInputError` naming the option unless the three are allowed
+    together (see :data:`EXPECTATIONS`, :data:`NOISE_SHARING`, :data:`HYPOTHESIS_READINGS`)."""
+    for name, value, allowed in (
+        ("expectation", expectation, EXPECTATIONS),
+        ("noise", noise, NOISE_SHARING),
+        ("readings", readings, HYPOTHESIS_READINGS),
+    ):
+        if value not in allowed:
+            raise DceeInputError(name, f"must be one of {', '.join(allowed)}, got {value!r}")
+    if expectation == "stratified" and readings != "model":
+        raise DceeInputError(
+            "readings", "simplified hypothetical readings need expectation=sampled"
+        )
+
+
 class PredictionContext:
     """One decision's hypotheses and caches; planners ask it for :class:`SequenceStats`.
 
@@ -133,17 +149,7 @@ class PredictionContext:
         noise: str = "shared",
         readings: str = "model",
     ) -> None:
-        for name, value, allowed in (
-            ("expectation", expectation, EXPECTATIONS),
-            ("noise", noise, NOISE_SHARING),
-            ("readings", readings, HYPOTHESIS_READINGS),
-        ):
-            if value not in allowed:
-                raise DceeInputError(name, f"must be one of {', '.join(allowed)}, got {value!r}")
-        if expectation == "stratified" and readings != "model":
-            raise DceeInputError(
-                "readings", "simplified hypothetical readings need expectation=sampled"
-            )
+        check_hypothesis_options(expectation, noise, readings)
         self.belief = belief
         self.sensor = belief.sensor
         self.expectation = expectation
