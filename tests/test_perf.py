@@ -29,6 +29,9 @@ def test_perf_quick_writes_every_standard_workload(tmp_path, capsys):
         assert name in stdout
     for n in ("2k", "20k", "100k"):
         assert by_name[f"dcee-decision-{n}"]["median_ms"] > 0
+    cl = by_name["dcee-cl-decision-20k"]
+    ratio = cl["median_ms"] / by_name["dcee-decision-20k"]["median_ms"]
+    assert cl["note"] == f"{ratio:.2f}× the dcee decision in this run"
     mem = by_name["memory-dcee-decision-100k"]
     assert mem["unit"] == "MB" and 0 < mem["median"] < 200
     assert data["machine"]["cpus"] >= 1
