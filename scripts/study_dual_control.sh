@@ -14,7 +14,8 @@ $D bench --suite paper --repeats 10 --strategies dcee-cl,infotaxis --out results
 $D bench --suite hard-easy --repeats 5 --particles 10000 --out results/dual-ablation --strategies \
 mpc,dcee,dcee:hypotheses=160,dcee:noise=fresh,dcee:noise=fresh:subsample=0.2:hypotheses=25,\
 dcee:readings=noise-free,dcee:readings=miss-free,dcee:expectation=stratified,dcee-cl,\
-dcee-cl:expectation=sampled,infotaxis,infotaxis:expectation=stratified
+dcee-cl:expectation=sampled,infotaxis,infotaxis:expectation=stratified,entrotaxis,\
+entrotaxis:expectation=stratified,dcee:hypotheses=10
 # the authors' 75 m domain: does the area explain the paper's MPC and DCEE? (10,000, 5 repeats)
 $D bench --suite hard-easy75 --repeats 5 --particles 10000 --out results/dual-ablation-75 \
     --strategies mpc,dcee,dcee-cl,infotaxis
@@ -22,7 +23,7 @@ $D bench --suite hard-easy75 --repeats 5 --particles 10000 --out results/dual-ab
 $D bench --suite paper --repeats 10 --unknown full --strategies dcee-cl,infotaxis --out results/paper-full-cl
 # more of the ablation (hypothesis count, reach, entrotaxis, multistage)
 $D bench --suite hard-easy --repeats 5 --particles 10000 --out results/dual-ablation --strategies \
-dcee:hypotheses=10,dcee-cl:reach=4,dcee-cl:reach=12,entrotaxis,entrotaxis:expectation=stratified,dcee-ms,dcee-cl:horizon=2
+dcee-cl:reach=4,dcee-cl:reach=12,dcee-ms,dcee-cl:horizon=2
 # the rest of the paper's strategies beside them (same seeds)
 $D bench --suite paper --repeats 10 --strategies dcee,mpc --out results/paper-source-cl
 $D bench --suite paper --repeats 10 --unknown full --strategies dcee,mpc --out results/paper-full-cl
