@@ -51,7 +51,7 @@ def _paper(k: int, scale: float = 1.0) -> dict[str, Any]:
     return {
         "name": name,
         "description": (
-            f"Paper simulation study, configuration {k}{area}: source ({x:g}, {y:g}, 1) m, "
+            f"Paper simulation study, configuration {k}{area}: source ({x}, {y}, 1) m, "
             f"wind from {phi:g} deg at 4 m/s; UAV at 4 m from (2, 2)."
         ),
         "dimensions": 3,
