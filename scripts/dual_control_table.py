@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from scipy.stats import binomtest
+from scipy.stats import binomtest, wilcoxon
 
 from dcee.analysis.report import load_campaign, median_order_statistic_ranks, wilson
 
@@ -60,18 +60,23 @@ def study(runs: pd.DataFrame, reference: str, budget: float) -> None:
     ref = runs[runs["strategy"] == reference].set_index(["scenario", "seed"])
     print(
         "| strategy | n | source acquired | median final RMSE (m) | "
-        f"median time to RMSE < 1 m (s) | only {reference} / only this | McNemar p |"
+        f"median time to RMSE < 1 m (s) | only {reference} / only this | McNemar p | "
+        f"paired final RMSE − {reference}: median, Wilcoxon p |"
     )
-    print("|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|")
     for strategy, g in runs.groupby("strategy", sort=True):
         k, n = int(g["source_acquired"].sum()), len(g)
         r, lo, hi = wilson(k, n)
         rmse = _median_with_interval(g["final_rmse"], budget, 2)
         t1 = _median_with_interval(g["time_to_rmse_1m"].fillna(np.inf), budget, 0)
         only_ref, only_this, p = _mcnemar(ref, g)
+        paired = g.set_index(["scenario", "seed"])["final_rmse"]
+        keys = paired.index.intersection(ref.index)
+        diff = (paired.loc[keys] - ref.loc[keys, "final_rmse"]).to_numpy()
+        w = wilcoxon(diff).pvalue if np.any(diff != 0) else 1.0
         print(
             f"| {strategy} | {n} | {r:.1%} [{lo:.1%}, {hi:.1%}] | {rmse} | {t1} "
-            f"| {only_ref} / {only_this} | {p:.3f} |"
+            f"| {only_ref} / {only_this} | {p:.3f} | {np.median(diff):+.3f} m, {w:.1g} |"
         )
 
 
