@@ -327,3 +327,14 @@ def test_a_branch_drops_negligible_particles_without_changing_its_statistics(exp
     for a, b in [(pruned.mean, full.mean), (pruned.trace_cov, full.trace_cov)]:
         np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9)
     np.testing.assert_allclose(pruned.kl, full.kl, rtol=1e-6, atol=1e-9)
+
+
+def test_spread_reach_scales_the_free_disk_with_the_belief():
+    # Four equally weighted points at (±3, ±4) around (10, 10): var x + var y = 9 + 16 = 25.
+    pts = [(7.0, 6.0), (13.0, 14.0), (7.0, 14.0), (13.0, 6.0)]
+    belief = _belief(pts)
+    assert planners.get("dcee-cl:reach=2").effective_reach(belief) == 2.0
+    assert planners.get("dcee-cl:reach=2:spread_reach=1").effective_reach(belief) == 5.0
+    assert planners.get("dcee-cl:reach=8:spread_reach=1").effective_reach(belief) == 8.0
+    with pytest.raises(DceeInputError, match="spread_reach"):
+        planners.get("dcee-cl:spread_reach=-1")

@@ -47,21 +47,37 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
     needs_kl = False
     default_expectation = "stratified"
 
-    def __init__(self, reach: float = DEFAULT_REACH, **options: Any) -> None:
+    def __init__(
+        self, reach: float = DEFAULT_REACH, spread_reach: float = 0.0, **options: Any
+    ) -> None:
         super().__init__(**options)
-        if isinstance(reach, bool) or not (
-            isinstance(reach, int | float) and math.isfinite(reach) and 0 <= reach <= 1e3
-        ):
-            raise DceeInputError("reach", f"must be a number of m in [0, 1000], got {reach!r}")
+        for name, value, high in (("reach", reach, 1e3), ("spread_reach", spread_reach, 10.0)):
+            if isinstance(value, bool) or not (
+                isinstance(value, int | float) and math.isfinite(value) and 0 <= value <= high
+            ):
+                raise DceeInputError(name, f"must be a number in [0, {high:g}], got {value!r}")
         self.reach = float(reach)
+        self.spread_reach = float(spread_reach)
 
     def options(self) -> dict[str, Any]:
-        return {"reach": self.reach, **super().options()}
+        return {"reach": self.reach, "spread_reach": self.spread_reach, **super().options()}
+
+    def effective_reach(self, belief: Belief) -> float:
+        """R = max(``reach``, ``spread_reach`` · σ_xy) m, σ_xy the belief's horizontal spread
+        √(var x + var y): with ``spread_reach`` > 0 a wide belief makes every move within its
+        spread free of the distance charge (pure variance reduction), and the MPC pull returns
+        as the belief narrows (an option under study, docs/dual-control.md)."""
+        if self.spread_reach == 0.0:
+            return self.reach
+        xy = belief.source[:, :2]
+        centred = xy - belief.weights @ xy
+        spread = math.sqrt(float(belief.weights @ np.einsum("ij,ij->i", centred, centred)))
+        return max(self.reach, self.spread_reach * spread)
 
     def loss(self, final_positions: np.ndarray, stats: SequenceStats, belief: Belief) -> np.ndarray:
         d = stats.mean - final_positions[:, None, :]
         horizontal = np.hypot(d[..., 0], d[..., 1])
-        beyond = np.maximum(horizontal - self.reach, 0.0)
+        beyond = np.maximum(horizontal - self.effective_reach(belief), 0.0)
         return beyond * beyond + d[..., 2] * d[..., 2] + stats.trace_cov
 
 
