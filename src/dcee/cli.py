@@ -247,7 +247,7 @@ def strategies() -> None:
 
     for name in names():
         planner = get(name)
-        doc = planner.summary or (type(planner).__doc__ or "").strip().splitlines()[0]
+        doc = planner.summary or next(iter((type(planner).__doc__ or "").strip().splitlines()), "")
         opts = " ".join(f"{k}={v}" for k, v in planner.options().items())
         click.echo(f"{name:12s} {doc}")
         if opts:
