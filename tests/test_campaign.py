@@ -13,6 +13,7 @@ import pandas as pd
 import pytest
 
 from dcee.analysis.report import (
+    censored_median_time,
     load_campaign,
     median_ci,
     median_order_statistic_ranks,
@@ -24,6 +25,7 @@ from dcee.campaign import Campaign, SearchTask, run_campaign
 from dcee.campaign.runner import _local_results, is_done, run_search
 from dcee.cli import main
 from dcee.errors import DceeInputError
+from dcee.provenance import code_version
 from tests.helpers import search_that_kills_its_worker_on_seed_1
 
 STRATEGIES = ("mpc", "dcee")
@@ -31,6 +33,11 @@ STRATEGIES = ("mpc", "dcee")
 
 def _campaign(out, particles=300, repeats=2):
     return Campaign(out, "smoke", STRATEGIES, repeats, particles=particles)
+
+
+def _run(out, config, strategy, seed):
+    """The folder of one search of a campaign (hive partitions)."""
+    return SearchTask(str(out), config, strategy, seed, {}).folder
 
 
 @pytest.fixture(scope="module")
@@ -45,12 +52,13 @@ def test_campaign_runs_every_search_with_common_random_numbers(finished):
     assert counts == {"total": 8, "skipped": 0, "done": 8, "failed": 0}
     meta = json.loads((out / "campaign.json").read_text())
     assert meta["version"] and meta["settings"]["particles"] == 300
+    assert [c["source_hash"] for c in meta["code_versions"]] == [code_version()["source_hash"]]
     # Same (configuration, repeat): every strategy saw the same truth noise at its first reading
     # (same start position), and a different repeat saw different noise.
     first = {}
     for strategy in STRATEGIES:
         for seed in (0, 1):
-            steps = pd.read_parquet(out / f"runs/paper-1/{strategy}/seed-{seed}.parquet")
+            steps = pd.read_parquet(_run(out, "paper:1", strategy, seed) / "steps.parquet")
             first[strategy, seed] = steps["true_concentration"].iloc[0], steps["reading"].iloc[0]
     assert first["mpc", 0] == first["dcee", 0] and first["mpc", 1] == first["dcee", 1]
 
@@ -60,10 +68,10 @@ def test_rerun_skips_finished_and_redoes_corrupt_or_partial(finished, tmp_path):
     again = run_campaign(_campaign(out), workers=1)
     assert again == {"total": 8, "skipped": 8, "done": 0, "failed": 0}
     # A truncated record, and a search whose summary never got written (killed mid-search).
-    rec = out / "runs/paper-6/dcee/seed-1.parquet"
+    rec = _run(out, "paper:6", "dcee", 1) / "steps.parquet"
     rec.write_bytes(rec.read_bytes()[:100])
-    (out / "runs/paper-1/mpc/seed-0.json").unlink()
-    summary = out / "runs/paper-6/mpc/seed-0.json"
+    (_run(out, "paper:1", "mpc", 0) / "summary.json").unlink()
+    summary = _run(out, "paper:6", "mpc", 0) / "summary.json"
     summary.write_text(summary.read_text()[:20])  # corrupt JSON
     redo = run_campaign(_campaign(out), workers=1)
     assert redo == {"total": 8, "skipped": 5, "done": 3, "failed": 0}
@@ -80,9 +88,8 @@ def test_planner_specs_are_campaign_strategies(tmp_path):
     spec = "dcee-cl:reach=4:hypotheses=8"
     campaign = Campaign(tmp_path, "smoke", (spec,), 1, particles=200)
     assert run_campaign(campaign, workers=1)["done"] == 2
-    summary = json.loads(
-        (tmp_path / "runs/paper-1/dcee-cl+reach=4+hypotheses=8/seed-0.json").read_text()
-    )
+    folder = tmp_path / "runs/config=paper%3A1/strategy=dcee-cl%3Areach%3D4%3Ahypotheses%3D8/seed=0"
+    summary = json.loads((folder / "summary.json").read_text())
     assert summary["strategy"] == spec and summary["planner_options"]["reach"] == 4.0
     with pytest.raises(DceeInputError, match="reach"):
         Campaign(tmp_path / "bad", "smoke", ("dcee-cl:reach=x",), 1)
@@ -92,7 +99,7 @@ def test_failing_search_is_recorded_and_does_not_raise(tmp_path):
     task = SearchTask(str(tmp_path), "paper:1", "dcee", 0, {"name": "broken"})
     res = run_search(task)
     assert res["status"] == "failed"
-    err = json.loads(task.stem.with_suffix(".error.json").read_text())
+    err = json.loads((task.folder / "error.json").read_text())
     assert err["strategy"] == "dcee" and "Error" in err["error"]
     assert not is_done(task)
 
@@ -114,7 +121,7 @@ def test_interrupted_bench_keeps_finished_searches_and_resumes(tmp_path, capsys,
         start_new_session=True,
     )
     deadline = time.monotonic() + 180
-    while not list(out.glob("runs/*/*/seed-*.json")):
+    while not list(out.glob("runs/*/*/*/summary.json")):
         assert proc.poll() is None, proc.communicate()
         assert time.monotonic() < deadline, "no search finished in time"
         time.sleep(0.02)
@@ -126,11 +133,13 @@ def test_interrupted_bench_keeps_finished_searches_and_resumes(tmp_path, capsys,
     else:
         assert proc.returncode == -signal.SIGKILL
     tasks = Campaign(out, "smoke", ("mpc", "dcee"), 5, particles=300).tasks()
-    finished = {t.stem: t.stem.with_suffix(".json").stat().st_mtime_ns for t in tasks if is_done(t)}
+    finished = {
+        t.folder: (t.folder / "summary.json").stat().st_mtime_ns for t in tasks if is_done(t)
+    }
     assert 1 <= len(finished) < len(tasks)
     # What a kill in the middle of a write leaves: a temporary file beside the result.
-    todo = next(t for t in tasks if t.stem not in finished)
-    stale = todo.stem.parent / f".{todo.stem.name}.parquet.x1y2z3.parquet"
+    todo = next(t for t in tasks if t.folder not in finished)
+    stale = todo.folder / ".steps.parquet.x1y2z3.parquet"
     stale.parent.mkdir(parents=True, exist_ok=True)
     stale.write_bytes(b"PAR1 half")
 
@@ -140,7 +149,7 @@ def test_interrupted_bench_keeps_finished_searches_and_resumes(tmp_path, capsys,
     assert f"{len(tasks)} searches: {len(finished)} already done" in capsys.readouterr().out
     assert all(is_done(t) for t in tasks) and not stale.exists()
     # Finished searches were skipped, not redone.
-    assert all(s.with_suffix(".json").stat().st_mtime_ns == m for s, m in finished.items())
+    assert all((f / "summary.json").stat().st_mtime_ns == m for f, m in finished.items())
 
 
 def test_a_worker_killed_from_outside_loses_nothing(tmp_path):
@@ -160,7 +169,7 @@ def test_a_worker_killed_from_outside_loses_nothing(tmp_path):
     counts = run_campaign(campaign, workers=2, on_result=kill_a_worker)
     assert killed and counts == {"total": 12, "skipped": 0, "done": 12, "failed": 0}
     assert all(is_done(t) for t in campaign.tasks())
-    assert not list(tmp_path.glob("runs/*/*/*.error.json"))
+    assert not list(tmp_path.glob("runs/*/*/*/error.json"))
 
 
 def test_a_search_that_kills_its_worker_fails_alone(tmp_path):
@@ -181,7 +190,7 @@ def test_a_search_that_kills_its_worker_fails_alone(tmp_path):
     for t in tasks:
         assert is_done(t) == (t.seed == 0)
         if t.seed == 1:
-            err = json.loads(t.stem.with_suffix(".error.json").read_text())
+            err = json.loads((t.folder / "error.json").read_text())
             assert "worker process died" in err["error"]
 
 
@@ -232,8 +241,10 @@ def test_report_tables_and_figures(finished, tmp_path):
     for config in per_config.index:
         for strategy in STRATEGIES:
             hits = [
-                json.loads(p.read_text())["source_acquired"]
-                for p in out.glob(f"runs/{config.replace(':', '-')}/{strategy}/seed-*.json")
+                json.loads((_run(out, config, strategy, seed) / "summary.json").read_text())[
+                    "source_acquired"
+                ]
+                for seed in (0, 1)
             ]
             assert per_config.loc[config, strategy] == f"{sum(hits)}/{len(hits)}"
     # RMSE curves: the final mean and median recomputed by hand from the per-step records.
@@ -241,8 +252,9 @@ def test_report_tables_and_figures(finished, tmp_path):
     curves = rmse_over_time(runs)
     for strategy in STRATEGIES:
         finals = [
-            pd.read_parquet(p)["rmse"].iloc[-1]
-            for p in out.glob(f"runs/*/{strategy}/seed-*.parquet")
+            pd.read_parquet(_run(out, config, strategy, seed) / "steps.parquet")["rmse"].iloc[-1]
+            for config in ("paper:1", "paper:6")
+            for seed in (0, 1)
         ]
         last = curves[strategy].iloc[-1]
         assert last["mean"] == pytest.approx(np.mean(finals))
@@ -251,6 +263,64 @@ def test_report_tables_and_figures(finished, tmp_path):
         assert last["median_lo"] == pytest.approx(min(finals))  # n = 4: the sample range
     html = (tmp_path / "report/report.html").read_text()
     assert html.count("data:image/png;base64,") == 4
+    # Paired comparison recounted by hand: searches acquired by one strategy and not the other.
+    pairs = pd.read_csv(tmp_path / "report/pairwise.csv")
+    assert len(pairs) == 1 and pairs.loc[0, "pairs"] == 4
+    acquired = runs.set_index(["scenario", "seed", "strategy"])["source_acquired"].unstack()
+    a, b = pairs.loc[0, "a"], pairs.loc[0, "b"]
+    assert pairs.loc[0, "acquired_a_only"] == int((acquired[a] & ~acquired[b]).sum())
+    assert pairs.loc[0, "acquired_b_only"] == int((~acquired[a] & acquired[b]).sum())
+
+
+def test_whole_study_loads_in_one_call(finished):
+    """The hive layout: one call (ours, or pyarrow's dataset reader) loads every record with
+    the configuration, strategy and seed of each search."""
+    import pyarrow.dataset as ds
+
+    from dcee.analysis.results import load_steps, load_summaries
+
+    out, _ = finished
+    runs = load_summaries(out)
+    assert len(runs) == 8 and set(runs["strategy"]) == set(STRATEGIES)
+    steps = load_steps(out, ["time", "rmse"])
+    assert len(steps) == runs["record_rows"].sum()
+    table = ds.dataset(
+        out / "runs", format="parquet", partitioning="hive", exclude_invalid_files=True
+    ).to_table(columns=["config", "strategy", "seed", "rmse"])
+    frame = table.to_pandas()
+    assert len(frame) == len(steps)
+    assert set(frame["config"]) == {"paper:1", "paper:6"} and set(frame["seed"]) == {0, 1}
+
+
+def test_snapshots_follow_the_budget(finished):
+    """Repeat 0 keeps snapshots at 10/30/50/100% of its budget (60 s in the smoke suite), so a
+    short search still fills the comparison grid; later repeats keep none."""
+    from dcee.simulation import EpisodeResult
+
+    out, _ = finished
+    first = EpisodeResult.load(_run(out, "paper:1", "dcee", 0))
+    times = [t for t, _ in first.snapshots]
+    assert times[-1] == first.records[-1]["time"] and len(times) == 4
+    for t, target in zip(times, (6.0, 18.0, 30.0), strict=False):
+        assert target <= t < target + 2.0  # the first reading at or after it (2 s steps)
+    assert EpisodeResult.load(_run(out, "paper:1", "dcee", 1)).snapshots == []
+
+
+def test_resume_with_other_code_is_refused_unless_allowed(finished, monkeypatch):
+    import dcee.campaign.runner as runner
+
+    out, _ = finished
+    other = {**code_version(), "source_hash": "0123456789abcdef", "commit": "f" * 40}
+    monkeypatch.setattr(runner, "code_version", lambda: other)
+    with pytest.raises(DceeInputError, match="other code.*--allow-code-change"):
+        run_campaign(_campaign(out), workers=1)
+    campaign = _campaign(out)
+    campaign.allow_code_change = True
+    assert run_campaign(campaign, workers=1)["skipped"] == 8
+    hashes = [
+        c["source_hash"] for c in json.loads((out / "campaign.json").read_text())["code_versions"]
+    ]
+    assert hashes == [code_version()["source_hash"], "0123456789abcdef"]
 
 
 def test_interval_helpers_against_hand_calculations():
@@ -273,6 +343,26 @@ def test_interval_helpers_against_hand_calculations():
     assert median_order_statistic_ranks(10) == (1, 8)
     assert median_order_statistic_ranks(100) == (39, 60)
     assert median_order_statistic_ranks(3) == (0, 2)  # too few for 95%: the sample range
+    # quantile_test's interval is the same order-statistic interval: n = 10 -> 2nd and 9th
+    x = np.array([5.0, 1.0, 9.0, 3.0, 7.0, 2.0, 8.0, 4.0, 6.0, 10.0])
+    assert median_ci(x) == (5.5, 2.0, 9.0)
+
+
+def test_censored_time_is_kaplan_meier_not_a_mean_over_arrivals():
+    """Searches that never got there are censored at the budget. Hand calculation: with all
+    censoring at the budget the Kaplan-Meier CDF is the plain share arrived by t, so the median
+    is the 5th of 10 sorted times when 5 or more arrived, and beyond the budget otherwise (the
+    old mean over arrivals made a planner that rarely arrives look fast)."""
+    budget = np.full(10, 900.0)
+    t = np.array([100, 200, 300, 400, 500, np.nan, np.nan, np.nan, np.nan, np.nan], dtype=float)
+    median, lo, hi = censored_median_time(t, budget)
+    assert median == 500.0 and lo <= median and math.isinf(hi)
+    rare = np.array([50.0] + [np.nan] * 9)
+    assert censored_median_time(rare, budget)[0] == math.inf  # 1/10 arrived: "> 900"
+    every = np.arange(10.0, 110.0, 10.0)
+    median, lo, hi = censored_median_time(every, budget)
+    assert median == 50.0 and lo <= 50.0 <= hi < 900.0
+    assert censored_median_time(np.full(4, np.nan), budget[:4]) == (math.inf,) * 3
 
 
 def test_posterior_histogram_range_ignores_a_lost_minority():
@@ -316,10 +406,24 @@ def test_bench_bad_input_is_one_line_exit_2(tmp_path, capsys, args, field):
     assert exc.value.code == 2 and field in err and err.count("\n") == 1
 
 
-def test_report_on_a_folder_without_campaign_is_exit_2(tmp_path, capsys):
+def test_report_on_a_folder_without_results_is_exit_2(tmp_path, capsys):
     with pytest.raises(SystemExit) as exc:
         main(["report", str(tmp_path)])
-    assert exc.value.code == 2 and "campaign" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and "no finished searches" in err and err.count("\n") == 1
+
+
+def test_report_on_a_corrupt_campaign_file_is_exit_2(finished, tmp_path, capsys):
+    import shutil
+
+    out, _ = finished
+    copy = tmp_path / "copy"
+    shutil.copytree(out, copy)
+    (copy / "campaign.json").write_text("{not json")
+    with pytest.raises(SystemExit) as exc:
+        main(["report", str(copy)])
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and "campaign" in err and err.count("\n") == 1
 
 
 def test_plain_progress_lines_for_logs(capsys):

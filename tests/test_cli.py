@@ -91,8 +91,49 @@ def test_bad_scenarios_exit_2(tmp_path, capsys):
 def test_scenarios_and_show(capsys):
     code, out, _ = run_cli(["scenarios"], capsys)
     assert code == 0 and out.count("\n") == 26 and "lab:upwind" in out
-    code, out, _ = run_cli(["show", "paper:3"], capsys)
+    code, out, _ = run_cli(["show", "paper:3", "--format", "json"], capsys)
     assert code == 0 and json.loads(out)["truth"]["y"] == 40.0
+
+
+def test_show_writes_a_scenario_file_that_loads_back_equal(capsys, tmp_path):
+    """`dcee show NAME > my.toml` is a scenario file: every resolved setting, loading back to
+    the same scenario (the issue: show printed JSON that --scenario could not load)."""
+    from dcee.scenarios import load_scenario
+
+    for name in ("paper:3", "lab:upwind", "paper75:12"):
+        code, out, _ = run_cli(["show", name], capsys)
+        path = tmp_path / f"{name.replace(':', '-')}.toml"
+        path.write_text(out)
+        assert code == 0 and load_scenario(str(path)) == load_scenario(name)
+    edited = path.read_text().replace("particles = 20000", "particles = 500")
+    path.write_text(edited)
+    assert load_scenario(str(path)).search.particles == 500
+
+
+def test_schema_is_the_models_json_schema(capsys):
+    from dcee.scenarios import Scenario
+
+    code, out, _ = run_cli(["schema"], capsys)
+    assert code == 0 and json.loads(out) == Scenario.model_json_schema()
+
+
+def test_dcee_alone_prints_help_and_exits_0():
+    res = subprocess.run([sys.executable, "-m", "dcee.cli"], capture_output=True, text=True)
+    assert res.returncode == 0 and res.stdout.startswith("Usage: ") and "bench" in res.stdout
+
+
+def test_help_does_not_import_the_numerical_stack():
+    """`dcee --help` stays fast: no NumPy, SciPy, numba or pandas on that path (measured
+    speed is a benchmark matter; the imports are what make it slow)."""
+    code = (
+        "import sys\n"
+        "from dcee.cli import main\n"
+        "try:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
+        "heavy = [m for m in ('numpy', 'scipy', 'numba', 'pandas', 'pydantic') if m in sys.modules]\n"
+        "print(heavy)"
+    )
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert res.returncode == 0 and res.stdout.strip().endswith("[]"), res.stdout + res.stderr
 
 
 def test_console_script_is_installed():
@@ -131,3 +172,79 @@ def test_a_planner_spec_runs_and_is_recorded(tmp_path, capsys):
     assert summary["strategy"] == "dcee-cl:reach=4:hypotheses=8"
     assert summary["planner_options"]["reach"] == 4.0
     assert summary["planner_options"]["n_hypotheses"] == 8
+
+
+def _tiny(scenario="paper:1", strategy="mpc"):
+    return ["run", "--scenario", scenario, "--strategy", strategy, "--particles", "300"] + [
+        "--budget",
+        "10",
+        "-q",
+        "--no-figure",
+    ]
+
+
+def test_run_refuses_a_folder_holding_another_search_and_rewrites_its_own(tmp_path, capsys):
+    out = tmp_path / "o"
+    assert run_cli([*_tiny(), "--out", str(out)], capsys)[0] == 0
+    first = json.loads((out / "summary.json").read_text())
+    # the same search again: allowed, same numbers (reproducible), no stale files
+    (out / "figure.png").write_bytes(b"stale")
+    assert run_cli([*_tiny(), "--out", str(out)], capsys)[0] == 0
+    again = json.loads((out / "summary.json").read_text())
+    assert again["final_rmse"] == first["final_rmse"] and not (out / "figure.png").exists()
+    # a different strategy into the same folder: refused before any work
+    code, _, err = run_cli([*_tiny(strategy="dcee"), "--out", str(out)], capsys)
+    assert code == 2 and "different search" in err and err.count("\n") == 1
+    assert json.loads((out / "summary.json").read_text())["strategy"] == "mpc"
+
+
+def test_default_run_folder_encodes_the_settings(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert run_cli(_tiny(), capsys)[0] == 0
+    assert run_cli([*_tiny(), "--set", "sensor.pd=0.6"], capsys)[0] == 0
+    folders = sorted(p.name for p in (tmp_path / "results").iterdir())
+    assert len(folders) == 2 and folders[0] == "paper-1_mpc_seed0_n300_b10"
+    assert folders[1].startswith("paper-1_mpc_seed0_n300_b10_")
+
+
+def test_report_reads_a_folder_of_run_outputs(tmp_path, capsys):
+    for strategy in ("mpc", "infotaxis"):
+        out = tmp_path / "runs" / strategy
+        assert run_cli([*_tiny(strategy=strategy), "--out", str(out)], capsys)[0] == 0
+    code, out, _ = run_cli(["report", str(tmp_path / "runs")], capsys)
+    assert code == 0
+    table = pd.read_csv(tmp_path / "runs/report/metrics.csv")
+    assert sorted(table["strategy"]) == ["infotaxis", "mpc"] and (table["searches"] == 1).all()
+    assert (tmp_path / "runs/report/pairwise.md").read_text().count("| infotaxis | mpc |") == 1
+
+
+@pytest.mark.parametrize(
+    "where, field",
+    [
+        ("/proc/dcee-test/out", "out"),
+        ("{file}/under", "out"),
+    ],
+)
+def test_unwritable_out_is_exit_2_before_the_search(tmp_path, capsys, where, field):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    code, _, err = run_cli([*_tiny(), "--out", where.format(file=blocker)], capsys)
+    assert code == 2 and err.startswith(f"dcee: error: {field}:") and err.count("\n") == 1
+
+
+def test_unwritable_json_and_report_out_are_exit_2(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    out = tmp_path / "o"
+    code, _, err = run_cli([*_tiny(), "--out", str(out), "--json", f"{blocker}/s.json"], capsys)
+    assert code == 2 and "json" in err and err.count("\n") == 1 and not list(out.iterdir())
+    code, _, err = run_cli([*_tiny(), "--out", str(out), "--json", str(tmp_path)], capsys)
+    assert code == 2 and "json" in err and "directory" in err
+    assert run_cli([*_tiny(), "--out", str(out)], capsys)[0] == 0
+    code, _, err = run_cli(["report", str(out), "--out", "/proc/dcee-report"], capsys)
+    assert code == 2 and "out" in err and err.count("\n") == 1
+
+
+def test_empty_truth_is_an_error_not_ignored(tmp_path, capsys):
+    code, _, err = run_cli([*_tiny(), "--out", str(tmp_path / "o"), "--truth", ""], capsys)
+    assert code == 2 and "truth" in err and err.count("\n") == 1

@@ -2,20 +2,61 @@
 
 Particle-filter source term estimation and Dual Control for Exploration and Exploitation (DCEE)
 planning, after Chen, Rhodes & Liu, Automatica 133 (2021) 109851.
+
+The public names below are imported on first use (PEP 562), so that ``import dcee.errors`` or
+``dcee --help`` does not pay for NumPy, SciPy and the compiled kernels.
 """
 
-from importlib.metadata import PackageNotFoundError, version
+from __future__ import annotations
 
-from dcee import planners
-from dcee.errors import DceeInputError
-from dcee.estimation import ParticleFilter, SourcePrior
-from dcee.models import GridAgent, IsotropicPlume, SearchVolume, Sensor, isotropic_concentration
-from dcee.searcher import Searcher, SourceEstimate
+import importlib
+from typing import TYPE_CHECKING, Any
 
-try:
-    __version__ = version("dcee")
-except PackageNotFoundError:  # running from a source tree without installation
-    __version__ = "0.0.0"
+from dcee.provenance import package_version
+
+__version__ = package_version()
+
+_LAZY = {
+    "DceeInputError": "dcee.errors",
+    "GridAgent": "dcee.models",
+    "IsotropicPlume": "dcee.models",
+    "SearchVolume": "dcee.models",
+    "Sensor": "dcee.models",
+    "isotropic_concentration": "dcee.models",
+    "ParticleFilter": "dcee.estimation",
+    "SourcePrior": "dcee.estimation",
+    "Searcher": "dcee.searcher",
+    "SourceEstimate": "dcee.searcher",
+}
+
+if TYPE_CHECKING:  # pragma: no cover
+    from dcee import planners
+    from dcee.errors import DceeInputError
+    from dcee.estimation import ParticleFilter, SourcePrior
+    from dcee.models import (
+        GridAgent,
+        IsotropicPlume,
+        SearchVolume,
+        Sensor,
+        isotropic_concentration,
+    )
+    from dcee.searcher import Searcher, SourceEstimate
+
+
+def __getattr__(name: str) -> Any:
+    if name == "planners":
+        return importlib.import_module("dcee.planners")
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'dcee' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *_LAZY, "planners"])
+
 
 __all__ = [
     "DceeInputError",

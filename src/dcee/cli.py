@@ -18,8 +18,41 @@ from typing import Any
 import click
 
 from dcee.errors import DceeInputError
+from dcee.io import check_writable_dir, check_writable_file
 from dcee.io import write_atomic as _write_atomic
 from dcee.io import write_json as _write_json
+
+
+class RegistryChoice(click.ParamType):
+    """A choice among the names a registry holds, read when needed (not at import, so that
+    ``dcee --help`` does not import the registries' heavy modules)."""
+
+    name = "choice"
+
+    def __init__(self, names: Callable[[], list[str]]) -> None:
+        self.names = names
+
+    def get_metavar(self, param: click.Parameter, ctx: click.Context | None = None) -> str:
+        return "[" + "|".join(self.names()) + "]"
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> str:
+        allowed = self.names()
+        if value not in allowed:
+            self.fail(f"{value!r} is not one of {', '.join(allowed)}", param, ctx)
+        return value
+
+
+def _suite_names() -> list[str]:
+    from dcee.campaign.suites import SUITES
+
+    return list(SUITES)
+
+
+def _likelihood_names() -> list[str]:
+    from dcee.scenarios.config import LIKELIHOODS
+
+    return list(LIKELIHOODS)
+
 
 # Shared by ``run`` and ``bench``: what the sensor sees.
 TRUTH_OPTION = click.option(
@@ -29,7 +62,7 @@ TRUTH_OPTION = click.option(
 )
 LIKELIHOOD_OPTION = click.option(
     "--likelihood",
-    type=click.Choice(["paper", "fluctuation"]),
+    type=RegistryChoice(_likelihood_names),
     help="Reading model of the filter and planners: paper (eq. 3) | fluctuation (intermittent "
     "log-normal, for turbulent plumes) [default: the scenario's estimator.likelihood].",
 )
@@ -53,10 +86,13 @@ def _overrides(likelihood: str | None, settings: tuple[str, ...]) -> dict[str, A
     return out
 
 
-@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.group(context_settings={"help_option_names": ["-h", "--help"]}, invoke_without_command=True)
 @click.version_option(package_name="dcee")
-def cli() -> None:
+@click.pass_context
+def cli(ctx: click.Context) -> None:
     """Autonomous search for the source of an airborne release (DCEE and peers)."""
+    if ctx.invoked_subcommand is None:
+        click.echo(ctx.get_help())
 
 
 @cli.command()
@@ -81,7 +117,8 @@ def cli() -> None:
     "--out",
     "out_dir",
     type=click.Path(file_okay=False, path_type=Path),
-    help="Output folder [default: results/<scenario>_<strategy>_seed<seed>].",
+    help="Output folder [default: results/<scenario>_<strategy>_seed<seed>[_<settings>]]; "
+    "refused if it holds a different search.",
 )
 @click.option(
     "--json",
@@ -113,73 +150,144 @@ def run(
     quiet: bool,
 ) -> None:
     """Run one simulated search and write its record, summary, configuration and figure."""
-    from dcee import __version__
+    import numpy as np
+
+    from dcee.allocator import tune_allocator
     from dcee.planning import get as get_planner
     from dcee.scenarios import load_scenario
     from dcee.scenarios.config import truth_choice
     from dcee.simulation import make_truth, run_episode
+    from dcee.simulation.episode import snapshot_times
 
     if seed < 0:
         raise DceeInputError("seed", f"must be >= 0, got {seed}")
     get_planner(strategy)  # fail fast on an unknown name or a bad option
-    scenario = load_scenario(scenario_name).with_overrides(
-        **{
-            "search.particles": particles,
-            "search.hypotheses": hypotheses,
-            "search.budget": budget,
-            "unknown": unknown,
-            "truth.model": truth_choice(truth) if truth else None,
-            **_overrides(likelihood, settings),
-        }
-    )
-    out_dir = (
-        out_dir
-        or Path("results")
-        / f"{scenario.name.replace(':', '-')}_{strategy.replace(':', '+')}_seed{seed}"
-    )
-    truth = make_truth(scenario, seed)
+    if truth is not None:
+        truth = truth_choice(truth)
+    base = load_scenario(scenario_name)
+    changes = {
+        "search.particles": particles,
+        "search.hypotheses": hypotheses,
+        "search.budget": budget,
+        "unknown": unknown,
+        "truth.model": truth,
+        **_overrides(likelihood, settings),
+    }
+    scenario = base.with_overrides(**changes)
+    out_dir = out_dir or Path("results") / _default_run_folder(scenario, base, strategy, seed)
+    check_writable_dir(out_dir, "out")
+    _check_same_run(out_dir, scenario, strategy, seed)
+    if json_file is not None:
+        check_writable_file(json_file, "json")
+    truth_model = make_truth(scenario, seed)  # a bad recording fails here, before the search
+    tune_allocator()  # this process is the command line's own (see dcee.allocator)
+    _compile_notice(quiet)
+    dense = np.linspace(0.0, scenario.search.budget, 41) if animate else ()
     result = _run_with_progress(
         lambda progress: run_episode(
             scenario,
             strategy,
             seed,
-            truth=truth,
+            truth=truth_model,
             progress=progress,
-            snapshot_every=scenario.search.budget / 40 if animate else None,
+            snapshot_at=sorted({*snapshot_times(scenario.search.budget), *dense}),
         ),
         scenario.search.budget,
         quiet,
     )
-    summary = result.summary
-    summary["version"] = __version__
-    config = {
-        "scenario": scenario.model_dump(),
-        "strategy": strategy,
-        "seed": seed,
-        "planner_options": summary["planner_options"],
-        "version": __version__,
-    }
-    import pandas as pd
-
-    _write_json(out_dir / "config.json", config)
-    _write_atomic(
-        out_dir / "steps.parquet",
-        lambda p: pd.DataFrame.from_records(result.records).to_parquet(p, index=False),
-    )
+    # stale artefacts of an earlier identical run that this one does not write
+    for name, wanted in (("figure.png", not no_figure), ("animation.gif", animate)):
+        if not wanted:
+            (out_dir / name).unlink(missing_ok=True)
     if not no_figure:
         from dcee.analysis.figures import search_figure
 
-        _write_atomic(out_dir / "figure.png", lambda p: search_figure(result, scenario, truth, p))
+        _write_atomic(
+            out_dir / "figure.png", lambda p: search_figure(result, scenario, truth_model, p)
+        )
     if animate:
         from dcee.analysis.figures import search_animation
 
         _write_atomic(
-            out_dir / "animation.gif", lambda p: search_animation(result, scenario, truth, p)
+            out_dir / "animation.gif",
+            lambda p: search_animation(result, scenario, truth_model, p),
         )
-    _write_json(out_dir / "summary.json", summary)  # written last: marks a complete result
+    result.save(out_dir)  # summary.json last: marks a complete result
     if json_file is not None:
-        _write_json(json_file, summary)
-    _print_summary(summary, out_dir)
+        _write_json(json_file, result.summary)
+    _print_summary(result.summary, out_dir)
+
+
+def _default_run_folder(scenario: Any, base: Any, strategy: str, seed: int) -> str:
+    """``paper-1_dcee_seed0``, plus what differs from the built-in: ``_n10000`` particles,
+    ``_j20`` hypotheses, ``_b300`` budget, ``_full`` unknowns, ``_filament`` truth, and a short
+    hash of any other change (``--likelihood``, ``--set``), so two different runs never share
+    a default folder."""
+    import hashlib
+
+    parts = [scenario.name.replace(":", "-"), strategy.replace(":", "+"), f"seed{seed}"]
+    s, b = scenario.search, base.search
+    if s.particles != b.particles:
+        parts.append(f"n{s.particles}")
+    if s.hypotheses != b.hypotheses:
+        parts.append(f"j{s.hypotheses}")
+    if s.budget != b.budget:
+        parts.append(f"b{s.budget:g}")
+    if scenario.unknown != base.unknown:
+        parts.append(scenario.unknown)
+    if scenario.truth.model != base.truth.model:
+        parts.append(scenario.truth.model_name)
+    rest_now = scenario.model_dump(mode="json", exclude={"search", "unknown", "truth"})
+    rest_base = base.model_dump(mode="json", exclude={"search", "unknown", "truth"})
+    other = {
+        k: v for k, v in scenario.search.model_dump().items() if k not in _NAMED_SEARCH_FIELDS
+    } != {k: v for k, v in base.search.model_dump().items() if k not in _NAMED_SEARCH_FIELDS}
+    if rest_now != rest_base or other or scenario.truth.model_dump() != base.truth.model_dump():
+        digest = hashlib.sha256(
+            json.dumps(scenario.model_dump(mode="json"), sort_keys=True).encode()
+        ).hexdigest()[:8]
+        parts.append(digest)
+    return "_".join(parts)
+
+
+_NAMED_SEARCH_FIELDS = ("particles", "hypotheses", "budget")
+
+
+def _check_same_run(out_dir: Path, scenario: Any, strategy: str, seed: int) -> None:
+    """Refuse an output folder that holds anything but an earlier run of this very search (same
+    resolved scenario, strategy and seed), so results never mix."""
+    entries = [p for p in out_dir.iterdir() if not p.name.startswith(".")]
+    if not entries:
+        return
+    try:
+        config = json.loads((out_dir / "config.json").read_text())
+        same = (
+            config.get("scenario") == scenario.model_dump(mode="json")
+            and config.get("strategy") == strategy
+            and config.get("seed") == seed
+        )
+    except (OSError, ValueError):
+        same = False
+    if not same:
+        raise DceeInputError(
+            "out",
+            f"{str(out_dir)!r} holds other files or a different search; choose another --out "
+            "(or remove it)",
+        )
+
+
+def _compile_notice(quiet: bool) -> None:
+    """Say so when this run will compile the numerical kernels (first use after installing or
+    changing the code: up to a minute of no visible progress otherwise)."""
+    if quiet:
+        return
+    import dcee.models
+
+    cache = Path(dcee.models.__file__).parent / "__pycache__"
+    if not any(cache.glob("*.nbi")):
+        click.echo(
+            "dcee: compiling the numerical kernels (first run only; up to a minute)", err=True
+        )
 
 
 def _run_with_progress(job: Callable[[Any], Any], budget: float, quiet: bool) -> Any:
@@ -194,7 +302,7 @@ def _run_with_progress(job: Callable[[Any], Any], budget: float, quiet: bool) ->
         TimeElapsedColumn(),
         transient=True,
     ) as bar:
-        task = bar.add_task("search", total=budget, status="")
+        task = bar.add_task("search", total=budget, status="preparing (kernels, first step)")
 
         def progress(t: float, rec: dict[str, Any]) -> None:
             bar.update(task, completed=t, status=f"t={t:.0f}s RMSE {rec['rmse']:.2f} m")
@@ -256,11 +364,34 @@ def strategies() -> None:
 
 @cli.command()
 @click.argument("scenario_name")
-def show(scenario_name: str) -> None:
-    """Print the resolved configuration of a scenario (built-in or TOML path) as JSON."""
+@click.option(
+    "--format",
+    "fmt",
+    type=click.Choice(["toml", "json"]),
+    default="toml",
+    show_default=True,
+    help="toml: a scenario file `--scenario` accepts; json: the same settings as JSON.",
+)
+def show(scenario_name: str, fmt: str) -> None:
+    """Print the resolved configuration of a scenario (built-in or TOML path), e.g.
+    `dcee show paper:5 > my.toml`, edit, then `dcee run --scenario my.toml`."""
     from dcee.scenarios import load_scenario
+    from dcee.scenarios.config import to_toml
 
-    click.echo(json.dumps(load_scenario(scenario_name).model_dump(), indent=2))
+    scenario = load_scenario(scenario_name)
+    if fmt == "toml":
+        click.echo(to_toml(scenario), nl=False)
+    else:
+        click.echo(json.dumps(scenario.model_dump(mode="json"), indent=2))
+
+
+@cli.command()
+def schema() -> None:
+    """Print the JSON Schema of scenario files (from the validating models), for editors and
+    other tools."""
+    from dcee.scenarios import Scenario
+
+    click.echo(json.dumps(Scenario.model_json_schema(), indent=2))
 
 
 @cli.command()
@@ -346,7 +477,8 @@ def _numba_threads() -> int:
     "--suite",
     default="paper",
     show_default=True,
-    help="paper | hard-easy | paper75 | hard-easy75 | smoke",
+    type=RegistryChoice(_suite_names),
+    help="Named set of configurations (docs/scenarios.md).",
 )
 @click.option(
     "--strategies",
@@ -369,6 +501,11 @@ def _numba_threads() -> int:
 @TRUTH_OPTION
 @LIKELIHOOD_OPTION
 @SET_OPTION
+@click.option(
+    "--allow-code-change",
+    is_flag=True,
+    help="Resume a campaign that other code started (every version used is recorded).",
+)
 def bench(
     suite: str,
     strategies: str,
@@ -381,6 +518,7 @@ def bench(
     truth: str | None,
     likelihood: str | None,
     settings: tuple[str, ...],
+    allow_code_change: bool,
 ) -> None:
     """Run a campaign of simulated searches; resumes where a previous run stopped."""
     from rich.progress import (
@@ -403,9 +541,12 @@ def bench(
         repeats,
         unknown,
         particles,
-        truth_choice(truth) if truth else None,
+        truth_choice(truth) if truth is not None else None,
         _overrides(likelihood, settings),
+        allow_code_change,
     )
+    check_writable_dir(out_dir, "out")
+    _compile_notice(False)
     failures: list[str] = []
     columns = (
         TextColumn("[bold]{task.description}"),
@@ -459,18 +600,19 @@ def _clock(seconds: float) -> str:
 
 
 @cli.command()
-@click.argument("campaign_dir", type=click.Path(file_okay=False, path_type=Path))
+@click.argument("results_dir", type=click.Path(file_okay=False, path_type=Path))
 @click.option(
     "--out",
     "out_dir",
     type=click.Path(file_okay=False, path_type=Path),
-    help="Report folder [default: CAMPAIGN_DIR/report].",
+    help="Report folder [default: RESULTS_DIR/report].",
 )
-def report(campaign_dir: Path, out_dir: Path | None) -> None:
-    """Tables (CSV, Markdown), figures and a self-contained HTML report of a campaign."""
+def report(results_dir: Path, out_dir: Path | None) -> None:
+    """Tables (CSV, Markdown), paired tests, figures and a self-contained HTML report of a
+    campaign or of any folder of `dcee run` results."""
     from dcee.analysis.report import write_report
 
-    paths = write_report(campaign_dir, out_dir or campaign_dir / "report")
+    paths = write_report(results_dir, out_dir or results_dir / "report")
     for p in paths:
         click.echo(str(p))
 

@@ -9,7 +9,35 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import numpy as np
+
+def check_writable_dir(path: Path, field: str) -> None:
+    """Create ``path`` (a folder) if needed and check that a file can be written in it, so a
+    command fails at once with one line instead of after its work."""
+    path = Path(path)
+    try:
+        if path.exists() and not path.is_dir():
+            raise NotADirectoryError(f"{path} is a file")
+        path.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=".dcee-write-check.", dir=path)
+        os.close(fd)
+        os.unlink(tmp)
+    except OSError as exc:
+        from dcee.errors import DceeInputError
+
+        raise DceeInputError(
+            field, f"cannot write to {str(path)!r} ({exc.strerror or exc})"
+        ) from None
+
+
+def check_writable_file(path: Path, field: str) -> None:
+    """Check that ``path`` (a file) can be written: its folder is writable and it is not a
+    folder itself."""
+    path = Path(path)
+    if path.is_dir():
+        from dcee.errors import DceeInputError
+
+        raise DceeInputError(field, f"{str(path)!r} is a folder; give a file name")
+    check_writable_dir(path.parent, field)
 
 
 def write_atomic(path: Path, writer: Callable[[Path], None]) -> None:
@@ -35,6 +63,8 @@ def write_json(path: Path, data: Any) -> None:
 
 def jsonable(obj: Any) -> Any:
     """JSON fallback for NumPy scalars and arrays."""
+    import numpy as np  # here, not at the top: the command line's start-up stays light
+
     if isinstance(obj, np.generic):
         return obj.item()
     if isinstance(obj, np.ndarray):

@@ -1,1 +1,1 @@
-"""Analysis: metrics and figures."""
+"""Analysis: figures of one search and reports of campaigns (tables, intervals, tests)."""

@@ -1,11 +1,22 @@
-"""Campaign report: per-strategy metrics with 95% confidence intervals, the paper's figures,
-and a self-contained HTML page (figures embedded) plus the table as CSV and Markdown.
+"""Report of a campaign or of any folder of saved searches: per-strategy metrics with 95%
+confidence intervals, paired comparisons, the paper's figures, and a self-contained HTML page
+(figures embedded) plus the tables as CSV and Markdown.
 
-Confidence intervals: Wilson score intervals for rates; for means a normal interval
-(mean ± 1.96 s/√n); for the table's medians a percentile bootstrap (2,000 resamples, fixed
-seed, so the report is reproducible); for the median RMSE curve, evaluated at every time step,
-the exact order-statistic interval (`median_order_statistic_ranks`). Times to an RMSE level
-are over the searches that reached it; the fraction that reached it is reported beside.
+Statistics (all from scipy.stats, all 95%):
+
+* rates: Wilson score intervals (``binomtest(...).proportion_ci``), exactly 0 and 1 at the ends;
+* medians: the distribution-free order-statistic interval (``quantile_test``);
+* means: a normal interval (mean ± 1.96 s/√n);
+* times to an RMSE level: a search that never got there is *censored* at its budget, not
+  dropped, so a planner that rarely arrives cannot look fast. The median time is the
+  Kaplan–Meier estimate (``ecdf`` of ``CensoredData``) with the interval where the log-log
+  confidence band of the CDF crosses 1/2; "> budget" when fewer than half arrive;
+* paired comparisons between every two strategies on their common (configuration, seed)
+  searches, which share the truth's random numbers: the exact McNemar test on source acquired
+  (a two-sided binomial test on the discordant pairs) and the Wilcoxon signed-rank test on the
+  final RMSE;
+* the median RMSE curve at every time step: the exact order-statistic band
+  (:func:`median_order_statistic_ranks`).
 """
 
 from __future__ import annotations
@@ -14,6 +25,7 @@ import base64
 import io
 import json
 import math
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -25,8 +37,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from dcee.campaign.runner import SNAPSHOT_TIMES
-from dcee.errors import DceeInputError
+from dcee.analysis.results import describe_folder, load_config, load_summaries
 from dcee.io import write_atomic
 
 Z95 = 1.959963984540054
@@ -54,38 +65,53 @@ def mean_ci(x: np.ndarray) -> tuple[float, float, float]:
     return (m, m - half, m + half)
 
 
-def median_ci(x: np.ndarray, n_boot: int = 2000) -> tuple[float, float, float]:
+def median_ci(x: np.ndarray) -> tuple[float, float, float]:
+    """(median, low, high): the sample median with its distribution-free 95% interval from
+    order statistics (``scipy.stats.quantile_test``); NaN bounds below 6 values, where no pair of
+    order statistics covers the median with 95% probability."""
     x = np.asarray(x, dtype=float)
     x = x[np.isfinite(x)]
     if len(x) == 0:
         return (math.nan, math.nan, math.nan)
-    rng = np.random.default_rng(0)
-    boots = np.median(rng.choice(x, size=(n_boot, len(x)), replace=True), axis=1)
-    lo, hi = np.percentile(boots, [2.5, 97.5])
-    return (float(np.median(x)), float(lo), float(hi))
+    med = float(np.median(x))
+    ci = stats.quantile_test(x, q=med, p=0.5).confidence_interval(0.95)
+    lo, hi = float(ci.low), float(ci.high)
+    return (med, lo if np.isfinite(lo) else math.nan, hi if np.isfinite(hi) else math.nan)
 
 
-def load_campaign(campaign_dir: Path) -> tuple[dict[str, Any], pd.DataFrame]:
-    """(campaign.json, one row per finished search)."""
-    meta_path = campaign_dir / "campaign.json"
-    if not meta_path.is_file():
-        raise DceeInputError(
-            "campaign", f"{campaign_dir} is not a campaign folder (no campaign.json)"
-        )
-    meta = json.loads(meta_path.read_text())
-    rows = []
-    for path in sorted((campaign_dir / "runs").glob("*/*/seed-*.json")):
-        if path.name.endswith(".error.json"):
-            continue
-        try:
-            s = json.loads(path.read_text())
-        except json.JSONDecodeError:
-            continue  # a corrupt summary is not a finished search
-        s["_stem"] = str(path.with_suffix(""))
-        rows.append(s)
-    if not rows:
-        raise DceeInputError("campaign", f"{campaign_dir} holds no finished searches yet")
-    return meta, pd.DataFrame(rows)
+def censored_median_time(times: np.ndarray, budgets: np.ndarray) -> tuple[float, float, float]:
+    """(median, low, high) time to an event that some searches never reach (NaN in ``times``):
+    those are right-censored at their budget. Kaplan–Meier via ``scipy.stats.ecdf``; the
+    interval is where the 95% log-log band of the CDF crosses 1/2. ``inf`` means "later than
+    the budget" (fewer than half, or for the bound too few, got there)."""
+    t = np.asarray(times, dtype=float)
+    b = np.asarray(budgets, dtype=float)
+    reached = np.isfinite(t)
+    if len(t) == 0:
+        return (math.nan, math.nan, math.nan)
+    if not reached.any():
+        return (math.inf, math.inf, math.inf)
+    data = stats.CensoredData(uncensored=t[reached], right=b[~reached])
+    cdf = stats.ecdf(data).cdf
+    grid = cdf.quantiles
+    with warnings.catch_warnings():  # undefined at CDF 0 and 1 (NaN there): expected
+        warnings.simplefilter("ignore", RuntimeWarning)
+        lo_band, hi_band = cdf.confidence_interval(0.95, method="log-log")
+
+    def crossing(values: np.ndarray) -> float:
+        hit = np.flatnonzero(np.nan_to_num(values, nan=0.0) >= 0.5 - 1e-12)
+        return float(grid[hit[0]]) if len(hit) and grid[hit[0]] < b.max() else math.inf
+
+    return (
+        crossing(cdf.evaluate(grid)),
+        crossing(hi_band.evaluate(grid)),
+        crossing(lo_band.evaluate(grid)),
+    )
+
+
+def load_campaign(folder: Path) -> tuple[dict[str, Any], pd.DataFrame]:
+    """(campaign.json or a description of the loose searches, one row per finished search)."""
+    return describe_folder(folder), load_summaries(folder)
 
 
 def metrics_table(runs: pd.DataFrame) -> pd.DataFrame:
@@ -93,7 +119,11 @@ def metrics_table(runs: pd.DataFrame) -> pd.DataFrame:
     out = []
     for strategy, g in runs.groupby("strategy", sort=True):
         n = len(g)
-        row: dict[str, Any] = {"strategy": strategy, "searches": n}
+        row: dict[str, Any] = {
+            "strategy": strategy,
+            "searches": n,
+            "budget": float(g["budget"].max()),
+        }
         for key, col in (
             ("source_acquired", "source_acquired"),
             ("plume_acquired", "plume_acquired"),
@@ -111,7 +141,7 @@ def metrics_table(runs: pd.DataFrame) -> pd.DataFrame:
             )
         for level, col in (("1m", "time_to_rmse_1m"), ("0_5m", "time_to_rmse_0_5m")):
             t = pd.to_numeric(g[col], errors="coerce").to_numpy()
-            v, lo, hi = mean_ci(t)
+            v, lo, hi = censored_median_time(t, g["budget"].to_numpy(dtype=float))
             row.update(
                 {
                     f"time_to_{level}": v,
@@ -150,6 +180,19 @@ def per_configuration_markdown(table: pd.DataFrame) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _fmt_time(v: float, lo: float, hi: float, budget: float) -> str:
+    """A censored median time: "> 900" where it lies beyond the budget."""
+
+    def one(x: float) -> str:
+        if math.isnan(x):
+            return "—"
+        return f"> {budget:.0f}" if math.isinf(x) else f"{x:.0f}"
+
+    if math.isnan(v):
+        return "—"
+    return one(v) if math.isinf(v) else f"{one(v)} [{one(lo)}, {one(hi)}]"
+
+
 def _fmt(v: float, lo: float, hi: float, digits: int = 2, pct: bool = False) -> str:
     if not np.isfinite(v):
         return "—"
@@ -163,19 +206,20 @@ def _fmt(v: float, lo: float, hi: float, digits: int = 2, pct: bool = False) -> 
 def markdown_table(table: pd.DataFrame) -> str:
     head = (
         "| strategy | n | source acquired | plume acquired | mean final RMSE (m) | "
-        "median final RMSE (m) | time to RMSE < 1 m (s) | time to < 0.5 m (s) | "
+        "median final RMSE (m) | median time to RMSE < 1 m (s) | to < 0.5 m (s) | "
         "path (m) | decision (ms) | truth in 95% region |"
     )
     lines = [head, "|" + "---|" * 11]
     for _, r in table.iterrows():
         src = _fmt(r.source_acquired_rate, r.source_acquired_lo, r.source_acquired_hi, pct=True)
         plume = _fmt(r.plume_acquired_rate, r.plume_acquired_lo, r.plume_acquired_hi, pct=True)
-        t05 = _fmt(r.time_to_0_5m, r.time_to_0_5m_lo, r.time_to_0_5m_hi, 0)
+        t1 = _fmt_time(r.time_to_1m, r.time_to_1m_lo, r.time_to_1m_hi, r.budget)
+        t05 = _fmt_time(r.time_to_0_5m, r.time_to_0_5m_lo, r.time_to_0_5m_hi, r.budget)
         lines.append(
             f"| {r.strategy} | {r.searches} | {src} | {plume} "
             f"| {_fmt(r.mean_final_rmse, r.mean_final_rmse_lo, r.mean_final_rmse_hi)} "
             f"| {_fmt(r.median_final_rmse, r.median_final_rmse_lo, r.median_final_rmse_hi)} "
-            f"| {_fmt(r.time_to_1m, r.time_to_1m_lo, r.time_to_1m_hi, 0)} ({r.reached_1m:.0%}) "
+            f"| {t1} ({r.reached_1m:.0%} got there) "
             f"| {t05} ({r.reached_0_5m:.0%}) "
             f"| {_fmt(r.path_length, r.path_length_lo, r.path_length_hi, 0)} "
             f"| {_fmt(r.decision_ms, r.decision_ms_lo, r.decision_ms_hi, 1)} "
@@ -213,8 +257,8 @@ def rmse_over_time(runs: pd.DataFrame, step: float = 10.0) -> dict[str, pd.DataF
     out = {}
     for strategy, g in runs.groupby("strategy", sort=True):
         curves = []
-        for stem in g["_stem"]:
-            steps = pd.read_parquet(f"{stem}.parquet", columns=["time", "rmse"])
+        for run_dir in g["run_dir"]:
+            steps = pd.read_parquet(Path(run_dir) / "steps.parquet", columns=["time", "rmse"])
             t, r = steps["time"].to_numpy(), steps["rmse"].to_numpy()
             idx = np.clip(np.searchsorted(t, grid, side="right") - 1, 0, len(t) - 1)
             curves.append(r[idx])
@@ -284,56 +328,142 @@ def figure_acquisition(table: pd.DataFrame) -> bytes:
     return _png(fig)
 
 
-def figure_grid(runs: pd.DataFrame, meta: dict[str, Any]) -> bytes | None:
-    """One representative search per strategy (first configuration, repeat 0) at the snapshot
-    times: particles, trajectory so far, true source."""
+def grid_configuration(runs: pd.DataFrame) -> str | None:
+    """The configuration the comparison grid shows: among those with a repeat-0 search of
+    every strategy, the one where the strategies differ most at repeat 0: most mixed success
+    (some acquire the source, some do not), then the widest spread of log final RMSE. A
+    configuration where every strategy succeeds says nothing about the differences."""
+    reps = runs[runs["seed"] == 0]
+    n_strategies = runs["strategy"].nunique()
+    best, best_key = None, None
+    for config, g in reps.groupby("scenario"):
+        if g["strategy"].nunique() < n_strategies:
+            continue
+        ok = g["source_acquired"].astype(bool)
+        mixed = min(int(ok.sum()), int((~ok).sum()))
+        log_rmse = np.log(np.maximum(g["final_rmse"].to_numpy(dtype=float), 1e-6))
+        key = (mixed, float(log_rmse.max() - log_rmse.min()))
+        if best_key is None or key > best_key:
+            best, best_key = str(config), key
+    return best
+
+
+def figure_grid(runs: pd.DataFrame) -> tuple[bytes, str] | None:
+    """Repeat 0 of every strategy on :func:`grid_configuration` at its saved snapshot times
+    (fractions of the budget, :data:`dcee.simulation.episode.SNAPSHOT_FRACTIONS`): particles,
+    trajectory so far, true source; returns (PNG, configuration)."""
     from dcee.scenarios import Scenario
 
-    reps = runs[runs["seed"] == 0].sort_values(["scenario", "strategy"])
-    if reps.empty:
+    config = grid_configuration(runs)
+    if config is None:
         return None
-    config = sorted(reps["scenario"].unique(), key=_config_key)[0]
-    reps = reps[reps["scenario"] == config]
-    scenario = Scenario.model_validate(meta["settings"]["scenarios"][config])
+    reps = runs[(runs["seed"] == 0) & (runs["scenario"] == config)].sort_values("strategy")
+    reps = reps.drop_duplicates("strategy")
+    scenario = Scenario.model_validate(load_config(reps["run_dir"].iloc[0])["scenario"])
     truth = scenario.truth_theta()
     lo, hi = scenario.volume.low, scenario.volume.high
+    snaps = []
+    for run_dir in reps["run_dir"]:
+        with np.load(Path(run_dir) / "posterior.npz") as z:
+            if "snapshot_times" in z:
+                snaps.append((z["snapshot_times"].copy(), z["snapshot_particles"].copy()))
+            else:
+                snaps.append((np.array([]), None))
+    columns = max((len(t) for t, _ in snaps), default=0)
+    if columns == 0:
+        return None
     # Panels are drawn to scale (equal aspect), so size the figure by the area's aspect ratio
     # and let constrained layout place the title: a fixed square cell left wide gaps.
     aspect = (hi[1] - lo[1]) / (hi[0] - lo[0])
     fig, axes = plt.subplots(
         len(reps),
-        len(SNAPSHOT_TIMES),
-        figsize=(2.8 * len(SNAPSHOT_TIMES), 2.8 * aspect * len(reps) + 0.5),
+        columns,
+        figsize=(2.8 * columns, 2.8 * aspect * len(reps) + 0.5),
         squeeze=False,
         layout="constrained",
     )
-    for row, (_, r) in enumerate(reps.iterrows()):
-        steps = pd.read_parquet(f"{r['_stem']}.parquet", columns=["time", "x", "y"])
-        with np.load(f"{r['_stem']}.npz") as z:
-            times = z["snapshot_times"] if "snapshot_times" in z else np.array([])
-            parts = z["snapshot_particles"] if "snapshot_particles" in z else None
-        for col, t_snap in enumerate(SNAPSHOT_TIMES):
+    for row, ((_, r), (times, parts)) in enumerate(zip(reps.iterrows(), snaps, strict=True)):
+        steps = pd.read_parquet(Path(r["run_dir"]) / "steps.parquet", columns=["time", "x", "y"])
+        for col in range(columns):
             ax = axes[row, col]
-            if parts is not None and len(times):
-                k = int(np.argmin(np.abs(times - t_snap)))
-                ax.scatter(parts[k][:, 0], parts[k][:, 1], s=1, alpha=0.3, color="tab:blue")
-            path = steps[steps["time"] <= t_snap]
-            ax.plot(path["x"], path["y"], color="tab:red", lw=1)
+            if col < len(times):
+                ax.scatter(parts[col][:, 0], parts[col][:, 1], s=1, alpha=0.3, color="tab:blue")
+                path = steps[steps["time"] <= times[col] + 1e-9]
+                ax.plot(path["x"], path["y"], color="tab:red", lw=1)
+                ax.set_title(f"t = {times[col]:.0f} s", fontsize=9)
             ax.plot(truth[0], truth[1], marker="*", color="gold", mec="k", ms=12)
             ax.set_xlim(lo[0], hi[0])
             ax.set_ylim(lo[1], hi[1])
             ax.set_aspect("equal")
             ax.set_xticks([])
             ax.set_yticks([])
-            if row == 0:
-                ax.set_title(f"t = {t_snap:.0f} s")
             if col == 0:
-                ax.set_ylabel(r["strategy"])
-    fig.suptitle(f"{config}, repeat 0: particles (blue), path (red), source (star)")
-    return _png(fig)
+                verdict = "acquired" if r["source_acquired"] else "FAILED"
+                ax.set_ylabel(f"{r['strategy']}\n{verdict}, RMSE {r['final_rmse']:.2g} m")
+    fig.suptitle(
+        f"{config}, repeat 0 (where the strategies differ most): particles (blue), path (red), "
+        "source (star)"
+    )
+    return _png(fig), config
 
 
-def figure_posteriors(runs: pd.DataFrame, meta: dict[str, Any]) -> bytes:
+def pairwise_table(runs: pd.DataFrame) -> pd.DataFrame:
+    """Every pair of strategies on their common (configuration, seed) searches: source acquired
+    by A only / by B only with the exact McNemar p-value, and the median paired difference of
+    final RMSE (A − B) with the Wilcoxon signed-rank p-value."""
+    keyed = runs.drop_duplicates(["scenario", "seed", "strategy"]).set_index(
+        ["scenario", "seed", "strategy"]
+    )
+    strategies = sorted(runs["strategy"].unique())
+    out = []
+    for i, a in enumerate(strategies):
+        for b in strategies[i + 1 :]:
+            ka = keyed.xs(a, level="strategy")
+            kb = keyed.xs(b, level="strategy")
+            common = ka.index.intersection(kb.index)
+            if len(common) == 0:
+                continue
+            sa = ka.loc[common, "source_acquired"].astype(bool).to_numpy()
+            sb = kb.loc[common, "source_acquired"].astype(bool).to_numpy()
+            only_a, only_b = int((sa & ~sb).sum()), int((~sa & sb).sum())
+            mcnemar = (
+                stats.binomtest(only_a, only_a + only_b, 0.5).pvalue if only_a + only_b else 1.0
+            )
+            diff = ka.loc[common, "final_rmse"].to_numpy(float) - kb.loc[common, "final_rmse"]
+            diff = np.asarray(diff, dtype=float)
+            wilcoxon = (
+                float(stats.wilcoxon(diff).pvalue) if np.any(diff != 0) and len(diff) > 1 else 1.0
+            )
+            out.append(
+                {
+                    "a": a,
+                    "b": b,
+                    "pairs": len(common),
+                    "acquired_a_only": only_a,
+                    "acquired_b_only": only_b,
+                    "mcnemar_p": float(mcnemar),
+                    "median_rmse_difference": float(np.median(diff)),
+                    "wilcoxon_p": wilcoxon,
+                }
+            )
+    return pd.DataFrame(out)
+
+
+def pairwise_markdown(table: pd.DataFrame) -> str:
+    lines = [
+        "| A | B | paired searches | acquired by A only | by B only | McNemar p (exact) "
+        "| median final RMSE A − B (m) | Wilcoxon p |",
+        "|" + "---|" * 8,
+    ]
+    for _, r in table.iterrows():
+        lines.append(
+            f"| {r.a} | {r.b} | {r.pairs} | {r.acquired_a_only} | {r.acquired_b_only} "
+            f"| {r.mcnemar_p:.2g} | {r.median_rmse_difference:+.3f} | {r.wilcoxon_p:.2g} |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def figure_posteriors(runs: pd.DataFrame) -> bytes:
     """Histograms of the final posterior's error (particle − truth) per unknown parameter,
     pooled over the searches of each strategy. Every strategy shares one robust range per
     parameter (see `_robust_range`), so that a few lost searches ~20 m away do not squeeze the
@@ -343,17 +473,14 @@ def figure_posteriors(runs: pd.DataFrame, meta: dict[str, Any]) -> bytes:
 
     names = list(runs["parameter_names"].iloc[0])
     idx = [PARAMETER_NAMES.index(n) for n in names]
-    truths = {
-        k: Scenario.model_validate(v).truth_theta()
-        for k, v in meta["settings"]["scenarios"].items()
-    }
     errors: dict[str, np.ndarray] = {}
     for strategy, g in runs.groupby("strategy", sort=True):
         errs = []
-        for _, r in g.iterrows():
-            with np.load(f"{r['_stem']}.npz") as z:
+        for run_dir in g["run_dir"]:
+            truth = Scenario.model_validate(load_config(run_dir)["scenario"]).truth_theta()
+            with np.load(Path(run_dir) / "posterior.npz") as z:
                 p = z["final_particles"].astype(float)
-            errs.append(p[:, idx] - truths[r["scenario"]][idx])
+            errs.append(p[:, idx] - truth[idx])
         errors[str(strategy)] = np.concatenate(errs)
     pooled = np.concatenate(list(errors.values()))
     ncols = min(4, len(names))
@@ -400,57 +527,78 @@ def _config_key(name: str) -> tuple:
     return (head, int(tail) if tail.isdigit() else tail)
 
 
-def write_report(campaign_dir: Path, out_dir: Path) -> list[Path]:
-    """Write report.html, metrics.csv/.md, per_configuration.csv/.md and the figures; returns
-    the paths."""
-    meta, runs = load_campaign(Path(campaign_dir))
+def write_report(results_dir: Path, out_dir: Path) -> list[Path]:
+    """Write report.html, metrics.csv/.md, pairwise.csv/.md, per_configuration.csv/.md and the
+    figures for a campaign or any folder of saved searches; returns the paths. The output
+    folder is checked before any work."""
+    from dcee.io import check_writable_dir
+    from dcee.provenance import describe
+
+    results_dir = Path(results_dir)
+    meta, runs = load_campaign(results_dir)
+    check_writable_dir(out_dir, "out")
     table = metrics_table(runs)
     md = markdown_table(table)
+    pairs = pairwise_table(runs)
+    pairs_md = pairwise_markdown(pairs)
     figures = {
         "rmse_over_time.png": figure_rmse(rmse_over_time(runs)),
         "acquisition.png": figure_acquisition(table),
-        "posteriors.png": figure_posteriors(runs, meta),
+        "posteriors.png": figure_posteriors(runs),
     }
-    grid = figure_grid(runs, meta)
+    grid = figure_grid(runs)
+    grid_config = None
     if grid is not None:
-        figures["comparison_grid.png"] = grid
-    out_dir.mkdir(parents=True, exist_ok=True)
+        figures["comparison_grid.png"], grid_config = grid
     paths = []
     for name, data in figures.items():
         write_atomic(out_dir / name, lambda p, d=data: p.write_bytes(d))
         paths.append(out_dir / name)
-    write_atomic(out_dir / "metrics.csv", lambda p: table.to_csv(p, index=False))
-    write_atomic(out_dir / "metrics.md", lambda p: p.write_text(md))
     per_config = per_configuration_table(runs)
     per_config_md = per_configuration_markdown(per_config)
-    write_atomic(out_dir / "per_configuration.csv", lambda p: per_config.to_csv(p))
-    write_atomic(out_dir / "per_configuration.md", lambda p: p.write_text(per_config_md))
-    failed = len(list((Path(campaign_dir) / "runs").glob("*/*/seed-*.error.json")))
+    tables = {
+        "metrics.csv": lambda p: table.to_csv(p, index=False),
+        "metrics.md": lambda p: p.write_text(md),
+        "pairwise.csv": lambda p: pairs.to_csv(p, index=False),
+        "pairwise.md": lambda p: p.write_text(pairs_md),
+        "per_configuration.csv": lambda p: per_config.to_csv(p),
+        "per_configuration.md": lambda p: p.write_text(per_config_md),
+    }
+    for name, writer in tables.items():
+        write_atomic(out_dir / name, writer)
+    failed = len(list(results_dir.rglob("error.json")))
     s = meta["settings"]
     truths = sorted(runs["truth_model"].unique()) if "truth_model" in runs else ["isotropic"]
+    codes = meta.get("code_versions") or list(
+        {json.dumps(c, sort_keys=True): c for c in runs.get("code", []) if c}.values()
+    )
+    code_text = "; ".join(describe(c) for c in codes) or "unknown"
     html = [
-        "<!doctype html><html><head><meta charset='utf-8'><title>dcee campaign report</title>",
+        "<!doctype html><html><head><meta charset='utf-8'><title>dcee report</title>",
         "<style>body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
         "collapse}td,th{border:1px solid #ccc;padding:4px 8px;font-size:13px}</style></head><body>",
-        f"<h1>Campaign report: {s['suite']} suite</h1>",
+        f"<h1>Report: {s['suite']}</h1>",
         f"<p>{len(runs)} finished searches ({failed} failed), {runs['scenario'].nunique()} "
         f"configurations, strategies: {', '.join(sorted(runs['strategy'].unique()))}; unknowns: "
-        f"{s['unknown'] or 'as configured'}; ground truth: {', '.join(truths)} (the estimator "
-        f"always assumes the isotropic plume); dcee {meta.get('version', '?')}. "
-        "Intervals are 95%.</p>",
+        f"{s.get('unknown') or 'as configured'}; ground truth: {', '.join(truths)}; code: "
+        f"dcee {code_text}. Intervals are 95%; times to an RMSE level are Kaplan–Meier "
+        "medians with searches that never got there censored at the budget.</p>",
         _md_to_html(md),
+        "<h2>paired comparisons (common configurations and seeds)</h2>",
+        _md_to_html(pairs_md) if len(pairs) else "<p>fewer than two strategies</p>",
         "<h2>source acquired per configuration</h2>",
         _md_to_html(per_config_md),
     ]
     for name, data in figures.items():
         b64 = base64.b64encode(data).decode()
+        title = name[:-4].replace("_", " ")
+        if name == "comparison_grid.png":
+            title += f" ({grid_config}, repeat 0)"
         html.append(
-            f"<h2>{name[:-4].replace('_', ' ')}</h2>"
-            f"<img src='data:image/png;base64,{b64}' style='max-width:100%'>"
+            f"<h2>{title}</h2><img src='data:image/png;base64,{b64}' style='max-width:100%'>"
         )
     html.append("</body></html>")
     write_atomic(out_dir / "report.html", lambda p: p.write_text("\n".join(html)))
-    tables = ("metrics.csv", "metrics.md", "per_configuration.csv", "per_configuration.md")
     return [out_dir / "report.html", *(out_dir / t for t in tables), *paths]
 
 

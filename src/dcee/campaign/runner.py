@@ -1,12 +1,21 @@
 """Run every (configuration, repeat, strategy) search of a campaign, resumably.
 
-Layout of a campaign folder::
+Layout of a campaign folder (hive-style partitions, values URI-encoded: ``paper:1`` is
+``paper%3A1``)::
 
-    campaign.json                      settings, resolved scenarios, package version
-    runs/<config>/<strategy>/seed-<k>.parquet   per-step record of one search
-    runs/<config>/<strategy>/seed-<k>.npz       final posterior sample (+ snapshots, repeat 0)
-    runs/<config>/<strategy>/seed-<k>.json      summary, written last: marks the search done
-    runs/<config>/<strategy>/seed-<k>.error.json  why a search failed (retried on the next run)
+    campaign.json                       settings, resolved scenarios, strategies, code versions
+    runs/config=<config>/strategy=<strategy>/seed=<k>/
+        summary.json                    written last: marks the search done
+        config.json                     resolved scenario, strategy, seed, planner options, code
+        steps.parquet                   per-step record
+        posterior.npz                   final posterior sample (+ snapshots, repeat 0)
+        error.json                      why a search failed (retried on the next run)
+
+Every search folder is the one :meth:`dcee.simulation.EpisodeResult.save` writes (``dcee run``
+writes the same), so one reader serves both: :func:`dcee.analysis.results.load_summaries` and
+``load_steps`` load a whole study in one call, and ``pyarrow.dataset.dataset(DIR / "runs",
+format="parquet", partitioning="hive", exclude_invalid_files=True)`` reads every record with
+config, strategy and seed columns.
 
 Every file is written atomically by the worker that ran the search, so an interrupted or
 killed driver loses only the searches in flight; the searches of a killed local worker are rerun
@@ -14,6 +23,10 @@ killed driver loses only the searches in flight; the searches of a killed local 
 and names record and posterior files that exist with the recorded row count; anything else is
 redone. Common random numbers: the seed of a search is its repeat index, and the seed alone
 drives the truth's noise, so one (configuration, repeat) gives every strategy the same truth.
+
+Code versions: ``campaign.json`` records the code (version, commit, dirty flag, source hash) of
+every session that ran searches in it; resuming with different code is refused unless asked for
+(``allow_code_change``), because a study that mixes code versions silently is not one study.
 """
 
 from __future__ import annotations
@@ -26,15 +39,17 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
-
-import numpy as np
+from urllib.parse import quote
 
 from dcee.errors import DceeInputError
-from dcee.io import write_atomic, write_json
+from dcee.io import write_json
+from dcee.provenance import code_version, describe, same_code
 
-# Snapshot times (s) of repeat 0 for the report's comparison grid (the paper's figure).
-SNAPSHOT_TIMES = (90.0, 270.0, 450.0, 900.0)
-FINAL_SAMPLE = 2000  # particles kept from each final posterior (for the histograms)
+
+def partition(key: str, value: object) -> str:
+    """A hive partition folder name, ``key=value`` with the value URI-encoded (pyarrow's
+    default ``segment_encoding="uri"`` decodes it)."""
+    return f"{key}={quote(str(value), safe='')}"
 
 
 @dataclass(frozen=True)
@@ -48,84 +63,49 @@ class SearchTask:
     scenario: dict[str, Any]
 
     @property
-    def stem(self) -> Path:
-        safe = self.config.replace(":", "-").replace("/", "_")
-        # a planner spec (dcee-cl:reach=6) names its folder with '+' for ':' (portable names)
-        strategy = self.strategy.replace(":", "+").replace("/", "_")
-        return Path(self.out_dir) / "runs" / safe / strategy / f"seed-{self.seed}"
+    def folder(self) -> Path:
+        return (
+            Path(self.out_dir)
+            / "runs"
+            / partition("config", self.config)
+            / partition("strategy", self.strategy)
+            / partition("seed", self.seed)
+        )
 
 
 def is_done(task: SearchTask) -> bool:
     """True when the search's summary, record and posterior sample are complete and consistent."""
-    stem = task.stem
-    try:
-        summary = json.loads(stem.with_suffix(".json").read_text())
-        import pyarrow.parquet as pq
+    from dcee.simulation.episode import EpisodeResult
 
-        rows = pq.ParquetFile(stem.with_suffix(".parquet")).metadata.num_rows
-        with np.load(stem.with_suffix(".npz")) as z:
-            n_final = z["final_particles"].shape[0]
-    except Exception:  # missing, truncated or corrupt: redo
-        return False
-    return rows == summary.get("record_rows") and n_final == summary.get("final_sample")
+    return EpisodeResult.is_complete(task.folder)
 
 
 def run_search(task: SearchTask) -> dict[str, Any]:
-    """Run one search and write its files; returns {"status": "done"|"failed", ...}.
+    """Run one search and write its folder; returns {"status": "done"|"failed", ...}.
 
-    Never raises for a failing search: the error is recorded next to where the result would be.
+    Never raises for a failing search: the error is recorded where the result would be.
     """
-    import pandas as pd
-
-    from dcee import __version__
     from dcee.scenarios import Scenario
     from dcee.simulation import make_truth, run_episode
+    from dcee.simulation.episode import snapshot_times
 
-    stem = task.stem
+    folder = task.folder
     t0 = time.perf_counter()
-    # A worker killed while writing (SIGKILL, power loss) leaves its temporary file behind;
-    # only this task writes files with this stem, so they are safe to remove on the redo.
-    for leftover in stem.parent.glob(f".{stem.name}.*"):
-        leftover.unlink(missing_ok=True)
     try:
         scenario = Scenario.model_validate(task.scenario)
         truth = make_truth(scenario, task.seed)
-        snapshots_wanted = task.seed == 0
+        keep_snapshots = task.seed == 0  # repeat 0 feeds the report's comparison grid
         result = run_episode(
             scenario,
             task.strategy,
             task.seed,
             truth=truth,
-            snapshot_every=SNAPSHOT_TIMES[0] if snapshots_wanted else None,
+            snapshot_at=snapshot_times(scenario.search.budget) if keep_snapshots else None,
         )
-        records = pd.DataFrame.from_records(result.records)
-        rng = np.random.default_rng(task.seed)
-        w = result.final_weights / result.final_weights.sum()
-        idx = rng.choice(len(w), size=min(FINAL_SAMPLE, len(w)), p=w)
-        final = result.final_theta[idx].astype(np.float32)  # (n, 8), every parameter
-        arrays: dict[str, np.ndarray] = {"final_particles": final}
-        step = scenario.make_agent().step_time
-        last = result.snapshots[-1][0] if result.snapshots else None
-        snaps = [(t, p) for t, p in result.snapshots if _near_snapshot_time(t, step) or t == last]
-        if snaps:
-            arrays["snapshot_times"] = np.array([t for t, _ in snaps])
-            arrays["snapshot_particles"] = np.stack([p[:1000].astype(np.float32) for _, p in snaps])
-        write_atomic(stem.with_suffix(".parquet"), lambda p: records.to_parquet(p, index=False))
-        write_atomic(stem.with_suffix(".npz"), lambda p: _savez(p, arrays))
-        summary = dict(result.summary)
-        summary.update(
-            config=task.config,
-            strategy=task.strategy,
-            seed=task.seed,
-            version=__version__,
-            record_rows=len(records),
-            final_sample=len(final),
-            parameter_names=list(scenario.unknown_names),
-            wall_seconds=time.perf_counter() - t0,
-        )
-        write_json(stem.with_suffix(".json"), summary)  # last: marks the search done
-        stem.with_suffix(".error.json").unlink(missing_ok=True)
-        return {"status": "done", "task": task, "seconds": summary["wall_seconds"]}
+        result.summary.update(config=task.config, wall_seconds=time.perf_counter() - t0)
+        result.save(folder, keep_snapshots=keep_snapshots)
+        (folder / "error.json").unlink(missing_ok=True)
+        return {"status": "done", "task": task, "seconds": result.summary["wall_seconds"]}
     except Exception as exc:  # recorded, the campaign goes on
         error = {
             "config": task.config,
@@ -134,20 +114,8 @@ def run_search(task: SearchTask) -> dict[str, Any]:
             "error": f"{type(exc).__name__}: {exc}",
             "traceback": traceback.format_exc(),
         }
-        write_json(stem.with_suffix(".error.json"), error)
+        write_json(folder / "error.json", error)
         return {"status": "failed", "task": task, "error": error["error"]}
-
-
-def _near_snapshot_time(t: float, step_time: float) -> bool:
-    """The snapshot taken for one of SNAPSHOT_TIMES (the first reading at or after it, so
-    within one move of it) or at the end."""
-    tol = max(1.01, step_time + 0.01)
-    return any(0 <= t - s < tol for s in SNAPSHOT_TIMES) or t >= SNAPSHOT_TIMES[-1]
-
-
-def _savez(path: Path, arrays: dict[str, np.ndarray]) -> None:
-    with open(path, "wb") as fh:
-        np.savez_compressed(fh, **arrays)
 
 
 @dataclass
@@ -163,6 +131,8 @@ class Campaign:
     truth: str | dict[str, str] | None = None
     overrides: dict[str, Any] = field(default_factory=dict)
     """dotted scenario settings applied to every scenario (``--likelihood``, ``--set``)"""
+    allow_code_change: bool = False
+    """resume a campaign that earlier code started (the versions used are all recorded)"""
 
     def __post_init__(self) -> None:
         from dcee.campaign.suites import suite_scenarios
@@ -201,15 +171,18 @@ class Campaign:
         return settings
 
     def prepare(self) -> None:
-        """Create the folder or check that it holds this campaign's results (else refuse)."""
-        from dcee import __version__
-
+        """Create the folder or check that it holds this campaign's results, made by this code
+        (else refuse), and record the code that runs now."""
         path = self.out_dir / "campaign.json"
         settings = self.settings()
+        code = code_version()
+        codes: list[dict[str, Any]] = []
         if path.exists():
             try:
                 stored = json.loads(path.read_text())
-            except (OSError, json.JSONDecodeError):
+                if not isinstance(stored, dict):
+                    raise ValueError("not a JSON object")
+            except (OSError, ValueError):
                 raise DceeInputError(
                     "out", f"{path} is unreadable; move the folder aside or choose another --out"
                 ) from None
@@ -220,17 +193,30 @@ class Campaign:
                     f"{self.out_dir} holds results of a different configuration ({changed}); "
                     "use a new --out folder instead of mixing results",
                 )
+            codes = list(stored.get("code_versions", []))
+            if not any(same_code(c, code) for c in codes):
+                if not self.allow_code_change:
+                    earlier = describe(codes[-1]) if codes else "unknown (older dcee)"
+                    raise DceeInputError(
+                        "out",
+                        f"{self.out_dir} was started by other code ({earlier}; now "
+                        f"{describe(code)}); use a new --out folder, or --allow-code-change "
+                        "to resume anyway (every version used is recorded)",
+                    )
             strategies = sorted(set(stored.get("strategies", [])) | set(self.strategies))
             repeats = max(int(stored.get("repeats", 0)), self.repeats)
         else:
             strategies, repeats = sorted(self.strategies), self.repeats
+        if not any(same_code(c, code) for c in codes):
+            codes.append(code)
         write_json(
             path,
             {
                 "settings": settings,
                 "strategies": strategies,
                 "repeats": repeats,
-                "version": __version__,
+                "version": codes[0].get("version"),
+                "code_versions": codes,
             },
         )
 
@@ -255,14 +241,20 @@ def _first_difference(a: Any, b: Any, path: str = "") -> str:
 _STARTED: Any = None  # in a local worker: shared flags, set when a search starts
 
 
-def _init_worker(started: Any = None) -> None:
+def _init_worker(started: Any = None, own_process: bool = False) -> None:
     """Worker processes: one numba thread each (parallel kernels degrade badly when several
-    searches share the cores; one search per core is the efficient layout)."""
+    searches share the cores; one search per core is the efficient layout). The local workers
+    are processes this module started, so their allocator is tuned too
+    (:mod:`dcee.allocator`); a Dask cluster's workers are not ours to retune."""
     import numba
 
     global _STARTED
     _STARTED = started
     numba.set_num_threads(1)
+    if own_process:
+        from dcee.allocator import tune_allocator
+
+        tune_allocator()
 
 
 def _run_marked(index: int, task: SearchTask, search: Callable[[SearchTask], dict]) -> dict:
@@ -275,7 +267,7 @@ def _run_marked(index: int, task: SearchTask, search: Callable[[SearchTask], dic
 def _worker_lost(task: SearchTask) -> dict[str, Any]:
     error = "its worker process died while running it alone (out of memory? killed?)"
     write_json(
-        task.stem.with_suffix(".error.json"),
+        task.folder / "error.json",
         {"config": task.config, "strategy": task.strategy, "seed": task.seed, "error": error},
     )
     return {"status": "failed", "task": task, "error": f"worker lost: {error}"}
@@ -314,7 +306,7 @@ def _local_results(
             max_workers=min(workers, len(batch)),
             mp_context=ctx,
             initializer=_init_worker,
-            initargs=(started,),
+            initargs=(started, True),
         )
         futures = {pool.submit(_run_marked, i, tasks[i], search): i for i in batch}
         lost: list[int] = []

@@ -1,11 +1,22 @@
 """Planners: one shared predicted-posterior machinery, one module per cost.
 
 Choose by name: ``dcee.planners.get("dcee")``. Register a new one with
-``@dcee.planners.register("name")`` on a :class:`Planner` subclass; nothing else changes.
+``@dcee.planners.register("name")`` on a :class:`Planner` subclass; nothing else changes. A
+planner in another package appears everywhere through the ``dcee.planners`` entry-point group
+(see :data:`dcee.planning.base.ENTRY_POINT_GROUP`).
 """
 
 from dcee.planning import dcee, dcee_closed_loop, entrotaxis, infotaxis, mpc  # noqa: F401
-from dcee.planning.base import Belief, Decision, Planner, get, names, planner_class, register
+from dcee.planning.base import (
+    Belief,
+    Decision,
+    Planner,
+    get,
+    names,
+    planner_class,
+    register,
+    unregister,
+)
 from dcee.planning.hypothesis import HypothesisPlanner
 from dcee.planning.predicted import EXPECTATIONS, PredictionContext, SequenceStats
 
@@ -21,4 +32,5 @@ __all__ = [
     "names",
     "planner_class",
     "register",
+    "unregister",
 ]

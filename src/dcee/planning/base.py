@@ -103,6 +103,11 @@ class Planner(ABC):
 
 
 _REGISTRY: dict[str, type[Planner]] = {}
+ENTRY_POINT_GROUP = "dcee.planners"
+"""Entry-point group through which other packages add planners: an entry point ``NAME =
+"package.module:PlannerClass"`` registers ``PlannerClass`` as ``NAME`` (loaded on first use of
+the registry; a built-in name wins)."""
+_entry_points_loaded = False
 
 
 def register(name: str) -> Callable[[type[Planner]], type[Planner]]:
@@ -116,6 +121,33 @@ def register(name: str) -> Callable[[type[Planner]], type[Planner]]:
         return cls
 
     return wrap
+
+
+def unregister(name: str) -> None:
+    """Remove a registered planner (for tests and notebooks that register their own)."""
+    _REGISTRY.pop(name, None)
+
+
+def _load_entry_points() -> None:
+    """Register the planners other packages declare in :data:`ENTRY_POINT_GROUP` (once)."""
+    global _entry_points_loaded
+    if _entry_points_loaded:
+        return
+    _entry_points_loaded = True
+    from importlib.metadata import entry_points
+
+    for ep in entry_points(group=ENTRY_POINT_GROUP):
+        if ep.name in _REGISTRY:
+            continue
+        try:
+            cls = ep.load()
+        except Exception as exc:  # a broken plug-in must not break the built-in planners
+            import warnings
+
+            warnings.warn(f"planner entry point {ep.name!r} failed to load: {exc}", stacklevel=2)
+            continue
+        if isinstance(cls, type) and issubclass(cls, Planner):
+            register(ep.name)(cls)
 
 
 def check_count(field: str, value: object) -> int:
@@ -172,6 +204,7 @@ def _option_value(text: str) -> Any:
 def planner_class(spec: str) -> type[Planner]:
     """The registered planner class of a name or spec; unknown names are a user error."""
     name = parse_spec(spec)[0]
+    _load_entry_points()
     try:
         return _REGISTRY[name]
     except KeyError:
@@ -192,5 +225,6 @@ def get(spec: str, **defaults: Any) -> Planner:
 
 
 def names() -> list[str]:
-    """Registered planner names."""
+    """Registered planner names (built-in and from the ``dcee.planners`` entry points)."""
+    _load_entry_points()
     return sorted(_REGISTRY)

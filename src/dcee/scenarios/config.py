@@ -64,9 +64,10 @@ Normal priors are truncated to physical values (u ≥ 0, ζ1 > 0, ζ2 > 0) autom
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, get_args
 
 import numpy as np
 from pydantic import (
@@ -246,6 +247,8 @@ class SensorSpec(BaseModel):
 
 
 Likelihood = Literal["paper", "fluctuation"]
+LIKELIHOODS: tuple[str, ...] = get_args(Likelihood)
+"""The reading models of the filter and the planners, by name (`--likelihood`)."""
 
 OUTLIER_DEFAULT: dict[str, float] = {"paper": 0.0, "fluctuation": 0.01}
 """Outlier weight per likelihood when ``estimator.outlier`` is not given: the paper's model has
@@ -548,3 +551,50 @@ def validate_scenario(data: dict[str, Any]) -> Scenario:
         elif "input" in err and err["type"] != "value_error":
             msg = f"{msg} (got {err['input']!r})"
         raise DceeInputError(loc, msg) from None
+
+
+def to_toml(scenario: Scenario) -> str:
+    """The scenario as a TOML file that :func:`dcee.scenarios.load_scenario` reads back to an
+    equal scenario (``dcee show NAME --format toml > my.toml``): every resolved setting, so the
+    file is a complete record; unset optional values (None) are left out."""
+    data = scenario.model_dump(mode="json", exclude_none=True)
+    lines = [f"# dcee scenario {scenario.name}"]
+    tables = []
+    for key, value in data.items():
+        if isinstance(value, dict):
+            tables.append((key, value))
+        else:
+            lines.append(f"{key} = {_toml_value(value)}")
+    for key, table in tables:
+        lines.append("")
+        lines.append(f"[{key}]")
+        for k, v in table.items():
+            lines.append(f"{_toml_key(k)} = {_toml_value(v)}")
+    return "\n".join(lines) + "\n"
+
+
+def _toml_key(key: str) -> str:
+    return key if key.replace("_", "").replace("-", "").isalnum() else json.dumps(key)
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "nan"
+        if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        return repr(value)
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)  # a JSON string is a TOML basic string
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        inner = ", ".join(
+            f"{_toml_key(k)} = {_toml_value(v)}" for k, v in value.items() if v is not None
+        )
+        return "{ " + inner + " }" if inner else "{}"
+    raise TypeError(f"cannot write {type(value).__name__} as TOML")

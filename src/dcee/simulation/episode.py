@@ -10,21 +10,40 @@ identical truth noise (common random numbers).
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import json
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from dcee.allocator import tune_allocator
-from dcee.analysis.metrics import summarise
 from dcee.estimation.particle_filter import ParticleFilter
+from dcee.io import write_atomic, write_json
 from dcee.models.sensor import Sensor
 from dcee.planning import get as get_planner
 from dcee.planning.base import planner_class
+from dcee.provenance import code_version
 from dcee.scenarios.config import Scenario
 from dcee.searcher import Searcher
+from dcee.simulation.metrics import summarise
 from dcee.simulation.truth import TruthModel, make_truth
+
+SNAPSHOT_FRACTIONS = (0.1, 0.3, 0.5, 1.0)
+"""When a saved search keeps particle snapshots, as fractions of its budget (the paper's figure 4
+shows 90, 270, 450 and 900 s of a 900 s search). Derived from the budget, so a 60 s search has
+snapshots too."""
+FINAL_SAMPLE = 2000
+"""Particles kept from a saved search's final posterior (drawn by weight, every parameter)."""
+SNAPSHOT_SAMPLE = 1000
+"""Particles kept per saved snapshot (source locations only)."""
+RESULT_FILES = ("summary.json", "config.json", "steps.parquet", "posterior.npz")
+"""The files of a saved search. ``summary.json`` is written last and marks it complete."""
+
+
+def snapshot_times(budget: float) -> tuple[float, ...]:
+    """The snapshot times (s) of a search with this budget: :data:`SNAPSHOT_FRACTIONS` of it."""
+    return tuple(round(f * budget, 6) for f in SNAPSHOT_FRACTIONS)
 
 
 @dataclass
@@ -38,6 +57,96 @@ class EpisodeResult:
     final_theta: np.ndarray
     final_weights: np.ndarray
     snapshots: list[tuple[float, np.ndarray]] = field(default_factory=list)
+    config: dict[str, Any] | None = None
+    """What made it: ``{"scenario": resolved scenario, "strategy", "seed", "planner_options",
+    "code"}`` (set by :func:`run_episode` and by :meth:`load`)."""
+
+    def save(self, folder: str | Path, keep_snapshots: bool = True) -> Path:
+        """Write the search to ``folder`` (created): ``steps.parquet`` (one row per reading),
+        ``posterior.npz`` (``final_particles`` (n, 8) float32, :data:`FINAL_SAMPLE` draws by
+        weight from the final posterior with every parameter; with ``keep_snapshots``,
+        ``snapshot_times`` (k,) s and ``snapshot_particles`` (k, m, 3) source locations),
+        ``config.json`` and ``summary.json`` (last: its presence marks a complete result).
+        Every file is written atomically. The same layout serves ``dcee run`` and every search
+        of a campaign; :meth:`load` reads it back."""
+        import pandas as pd
+
+        folder = Path(folder)
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "summary.json").unlink(missing_ok=True)  # incomplete until rewritten
+        for leftover in folder.glob(".*.*"):  # temporaries of a writer killed mid-file
+            leftover.unlink(missing_ok=True)
+        config = self.config or {}
+        seed = int(self.summary.get("seed", 0))
+        records = pd.DataFrame.from_records(self.records)
+        w = self.final_weights / self.final_weights.sum()
+        idx = np.random.default_rng(seed).choice(len(w), size=min(FINAL_SAMPLE, len(w)), p=w)
+        arrays: dict[str, np.ndarray] = {
+            "final_particles": self.final_theta[idx].astype(np.float32)
+        }
+        if keep_snapshots and self.snapshots:
+            arrays["snapshot_times"] = np.array([t for t, _ in self.snapshots])
+            arrays["snapshot_particles"] = np.stack(
+                [p[:SNAPSHOT_SAMPLE].astype(np.float32) for _, p in self.snapshots]
+            )
+        write_atomic(folder / "steps.parquet", lambda p: records.to_parquet(p, index=False))
+        write_atomic(folder / "posterior.npz", lambda p: _savez(p, arrays))
+        write_json(folder / "config.json", config)
+        summary = dict(self.summary)
+        summary.update(
+            code=config.get("code") or code_version(),
+            record_rows=len(records),
+            final_sample=len(idx),
+        )
+        write_json(folder / "summary.json", summary)
+        return folder
+
+    @staticmethod
+    def is_complete(folder: str | Path) -> bool:
+        """True when ``folder`` holds a complete saved search: the summary parses, and the record
+        and posterior files exist with the row and particle counts it names."""
+        folder = Path(folder)
+        try:
+            summary = json.loads((folder / "summary.json").read_text())
+            import pyarrow.parquet as pq
+
+            rows = pq.ParquetFile(folder / "steps.parquet").metadata.num_rows
+            with np.load(folder / "posterior.npz") as z:
+                n_final = z["final_particles"].shape[0]
+            json.loads((folder / "config.json").read_text())
+        except Exception:  # missing, truncated or corrupt
+            return False
+        return rows == summary.get("record_rows") and n_final == summary.get("final_sample")
+
+    @classmethod
+    def load(cls, folder: str | Path) -> EpisodeResult:
+        """Read a search written by :meth:`save`. ``final_theta`` is the saved sample of the
+        final posterior (equal weights); ``records`` one dict per reading."""
+        import pandas as pd
+
+        from dcee.errors import DceeInputError
+
+        folder = Path(folder)
+        if not cls.is_complete(folder):
+            raise DceeInputError("results", f"{folder} holds no complete dcee search result")
+        summary = json.loads((folder / "summary.json").read_text())
+        config = json.loads((folder / "config.json").read_text())
+        records = pd.read_parquet(folder / "steps.parquet").to_dict("records")
+        with np.load(folder / "posterior.npz") as z:
+            final = z["final_particles"].astype(np.float64)
+            snaps = []
+            if "snapshot_times" in z:
+                snaps = [
+                    (float(t), p.astype(np.float64))
+                    for t, p in zip(z["snapshot_times"], z["snapshot_particles"], strict=True)
+                ]
+        weights = np.full(len(final), 1.0 / len(final))
+        return cls(records, summary, final, weights, snaps, config)
+
+
+def _savez(path: Path, arrays: dict[str, np.ndarray]) -> None:
+    with open(path, "wb") as f:  # a file object: np.savez would append .npz to a path
+        np.savez_compressed(f, **arrays)
 
 
 def streams(seed: int) -> tuple[np.random.Generator, ...]:
@@ -55,11 +164,16 @@ def run_episode(
     planner_options: dict[str, Any] | None = None,
     truth: TruthModel | None = None,
     progress: Callable[[float, dict[str, Any]], None] | None = None,
-    snapshot_every: float | None = None,
+    snapshot_at: Sequence[float] | None = None,
     snapshot_particles: int = 2000,
 ) -> EpisodeResult:
-    """Fly one search until the budget is spent (or the posterior spread < ``stop_spread``)."""
-    tune_allocator()
+    """Fly one search until the budget is spent (or the posterior spread < ``stop_spread``).
+
+    ``snapshot_at``: times (s) at which to keep a weighted subsample of ``snapshot_particles``
+    source locations (at the first reading at or after each time; the last reading always, when
+    any are asked for), e.g. :func:`snapshot_times` of the budget, or a dense grid for an
+    animation. The subsamples come from their own random stream: they never change the search.
+    """
     search = scenario.search
     planner = get_planner(strategy, **_planner_defaults(strategy, scenario, planner_options))
     truth_rng, filter_rng, planner_rng, figure_rng = streams(seed)
@@ -85,7 +199,7 @@ def run_episode(
     average = scenario.average
     records: list[dict[str, Any]] = []
     snapshots: list[tuple[float, np.ndarray]] = []
-    next_snapshot = 0.0
+    pending = sorted(snapshot_at) if snapshot_at is not None else []
     path_length = 0.0
     while True:
         noise = sensor.draw_noise(truth_rng, ())  # the same count per step, whatever the position
@@ -123,9 +237,10 @@ def run_episode(
             "rejected": info.rejected,
             "update_seconds": searcher.last_update_seconds,
         }
-        if snapshot_every is not None and t >= next_snapshot:
+        if pending and t >= pending[0] - 1e-9:
             snapshots.append((t, _subsample(pf, snapshot_particles, figure_rng)))
-            next_snapshot += snapshot_every
+            while pending and t >= pending[0] - 1e-9:
+                pending.pop(0)
         stop = t + agent.step_time > search.budget + 1e-9 or (
             search.stop_spread > 0 and est.spread < search.stop_spread
         )
@@ -147,9 +262,20 @@ def run_episode(
     summary["truth_in_95"] = pf.in_credible_region(true_location, 0.95)
     summary.update(scenario.resolved_settings())
     summary["resamples"] = pf.n_resamples
-    if snapshot_every is not None and snapshots[-1][0] != records[-1]["time"]:
+    summary["config"] = scenario.name
+    summary["parameter_names"] = list(scenario.unknown_names)
+    if snapshot_at is not None and (not snapshots or snapshots[-1][0] != records[-1]["time"]):
         snapshots.append((records[-1]["time"], _subsample(pf, snapshot_particles, figure_rng)))
-    return EpisodeResult(records, summary, pf.theta.copy(), pf.weights.copy(), snapshots)
+    config = {
+        "scenario": scenario.model_dump(mode="json"),
+        "strategy": strategy,
+        "seed": seed,
+        "planner_options": summary["planner_options"],
+        "code": code_version(),
+    }
+    summary["code"] = config["code"]
+    summary["version"] = config["code"]["version"]
+    return EpisodeResult(records, summary, pf.theta.copy(), pf.weights.copy(), snapshots, config)
 
 
 def _subsample(pf: ParticleFilter, n: int, rng: np.random.Generator) -> np.ndarray:
@@ -168,4 +294,12 @@ def _planner_defaults(
     return opts
 
 
-__all__ = ["EpisodeResult", "run_episode", "streams"]
+__all__ = [
+    "FINAL_SAMPLE",
+    "RESULT_FILES",
+    "SNAPSHOT_FRACTIONS",
+    "EpisodeResult",
+    "run_episode",
+    "snapshot_times",
+    "streams",
+]

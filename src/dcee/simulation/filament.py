@@ -42,10 +42,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from dcee.simulation.truth import TruthModel
+from dcee.simulation.truth import TruthModel, plume_stream, register_truth
 
 if TYPE_CHECKING:
-    from dcee.scenarios.config import FilamentSpec
+    from dcee.scenarios.config import FilamentSpec, Scenario
 
 DECAY_CUTOFF = 1e-6
 """A puff is dropped once its mass has decayed below this fraction (age > ζ2 · ln 1e6)."""
@@ -207,6 +207,14 @@ class FilamentTruth(TruthModel):
     @property
     def time_step(self) -> float:
         return self.dt
+
+
+@register_truth("filament")
+def filament_truth(scenario: Scenario, seed: int) -> FilamentTruth:
+    """The filament truth of ``truth.model`` for episode ``seed`` (its own random stream)."""
+    low, high = np.array(scenario.volume.low), np.array(scenario.volume.high)
+    spec = scenario.truth.model
+    return FilamentTruth(scenario.truth_theta(), spec, plume_stream(seed), low, high)
 
 
 __all__ = ["FilamentTruth"]

@@ -21,11 +21,15 @@ from __future__ import annotations
 import json
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.simulation.truth import TruthModel
+from dcee.simulation.truth import TruthModel, register_truth
+
+if TYPE_CHECKING:
+    from dcee.scenarios.config import Scenario
 
 FIELD = "truth.model.file"
 
@@ -206,8 +210,7 @@ def load_recording(
         if not isinstance(meta, dict):
             raise _fail(f"{meta_path.name} must hold a JSON object")
     elif suffix in (".h5", ".hdf5"):
-        import h5py
-
+        h5py = _h5py(_fail)
         try:
             with h5py.File(path, "r") as h5:
                 if "concentration" not in h5:
@@ -255,8 +258,7 @@ def save_recording(
             doc["source"] = np.asarray(source, dtype=np.float64).tolist()
         path.with_suffix(".json").write_text(json.dumps(doc), encoding="utf-8")
     elif path.suffix.lower() in (".h5", ".hdf5"):
-        import h5py
-
+        h5py = _h5py(lambda msg: DceeInputError("recording", msg))
         with h5py.File(path, "w") as h5:
             h5.create_dataset("concentration", data=np.asarray(concentration, dtype=np.float64))
             for k, v in meta.items():
@@ -265,6 +267,40 @@ def save_recording(
                 h5.attrs["source"] = np.asarray(source, dtype=np.float64)
     else:
         raise ValueError(f"unsupported recording suffix {path.suffix!r}: use .npy or .h5")
+
+
+def _h5py(fail: Any) -> Any:
+    """h5py, an optional dependency (extra ``hdf5``): only HDF5 recordings need it."""
+    try:
+        import h5py
+    except ImportError:
+        raise fail("HDF5 recordings need h5py: pip install 'dcee[hdf5]' (or use .npy)") from None
+    return h5py
+
+
+@register_truth("playback")
+def playback_truth(scenario: Scenario, seed: int) -> PlaybackTruth:
+    """The recording named by ``truth.model.file``, checked against the scenario: it must cover
+    the search area, agree on the source and last the budget (unless looped)."""
+    spec = scenario.truth.model
+    theta = scenario.truth_theta()
+    low, high = np.array(scenario.volume.low), np.array(scenario.volume.high)
+    truth, source = load_recording(spec.file, spec.time_interpolation, spec.loop)
+    problem = truth.covers(low, high)
+    if problem:
+        raise _fail(problem)
+    if source is not None and not np.allclose(source, theta[:3], atol=1e-6):
+        raise _fail(
+            f"the recording's source {tuple(source)} differs from the scenario's truth "
+            f"x, y, z {tuple(theta[:3])}"
+        )
+    budget = scenario.search.budget
+    if not spec.loop and budget > truth.duration + 1e-9 and len(truth.t) > 1:
+        raise _fail(
+            f"the recording lasts {truth.duration:g} s but search.budget is {budget:g} s "
+            "(set loop = true or shorten the budget)"
+        )
+    return truth
 
 
 __all__ = ["PlaybackTruth", "load_recording", "save_recording"]

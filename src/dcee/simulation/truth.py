@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -127,36 +128,43 @@ def plume_stream(seed: int) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(PLUME_STREAM,)))
 
 
-def make_truth(scenario: Scenario, seed: int) -> TruthModel:
-    """The scenario's ``truth.model`` for episode ``seed``: isotropic, filament or playback."""
-    from dcee.scenarios.config import FilamentSpec, PlaybackSpec
-    from dcee.simulation.filament import FilamentTruth
-    from dcee.simulation.playback import load_recording
+TruthFactory = Callable[["Scenario", int], TruthModel]
+TRUTH_KINDS: dict[str, TruthFactory] = {}
+"""Truth models by the ``kind`` of the scenario's ``truth.model`` (``"isotropic"`` for the plain
+string): each module registers its own factory ``(scenario, seed) -> TruthModel`` with
+:func:`register_truth`, so adding a truth edits no dispatcher."""
 
-    spec = scenario.truth.model
-    theta = scenario.truth_theta()
-    low, high = np.array(scenario.volume.low), np.array(scenario.volume.high)
-    if spec == "isotropic":
-        return IsotropicTruth(theta)
-    if isinstance(spec, FilamentSpec):
-        return FilamentTruth(theta, spec, plume_stream(seed), low, high)
-    if isinstance(spec, PlaybackSpec):
-        truth, source = load_recording(spec.file, spec.time_interpolation, spec.loop)
-        problem = truth.covers(low, high)
-        if problem:
-            raise DceeInputError("truth.model.file", problem)
-        if source is not None and not np.allclose(source, theta[:3], atol=1e-6):
-            raise DceeInputError(
-                "truth.model.file",
-                f"the recording's source {tuple(source)} differs from the scenario's truth "
-                f"x, y, z {tuple(theta[:3])}",
-            )
-        budget = scenario.search.budget
-        if not spec.loop and budget > truth.duration + 1e-9 and len(truth.t) > 1:
-            raise DceeInputError(
-                "truth.model.file",
-                f"the recording lasts {truth.duration:g} s but search.budget is {budget:g} s "
-                "(set loop = true or shorten the budget)",
-            )
-        return truth
-    raise ValueError(f"unknown truth model {spec!r}")
+
+def register_truth(kind: str) -> Callable[[TruthFactory], TruthFactory]:
+    """Decorator: make ``factory(scenario, seed)`` build the truth of ``truth.model`` kind
+    ``kind``."""
+
+    def add(factory: TruthFactory) -> TruthFactory:
+        if kind in TRUTH_KINDS and TRUTH_KINDS[kind] is not factory:
+            raise ValueError(f"truth kind {kind!r} is already registered")
+        TRUTH_KINDS[kind] = factory
+        return factory
+
+    return add
+
+
+def truth_kind(spec: object) -> str:
+    """The registry key of a ``truth.model`` value: the string itself or the table's kind."""
+    return spec if isinstance(spec, str) else str(getattr(spec, "kind", ""))
+
+
+def make_truth(scenario: Scenario, seed: int) -> TruthModel:
+    """The scenario's ``truth.model`` for episode ``seed``, built by the factory registered for
+    its kind (isotropic here; filament and playback in their modules)."""
+    kind = truth_kind(scenario.truth.model)
+    factory = TRUTH_KINDS.get(kind)
+    if factory is None:
+        raise DceeInputError(
+            "truth.model", f"unknown truth kind {kind!r}; choose one of {', '.join(TRUTH_KINDS)}"
+        )
+    return factory(scenario, seed)
+
+
+@register_truth("isotropic")
+def _isotropic(scenario: Scenario, seed: int) -> TruthModel:
+    return IsotropicTruth(scenario.truth_theta())
