@@ -312,7 +312,7 @@ def test_resume_with_other_code_is_refused_unless_allowed(finished, monkeypatch)
     out, _ = finished
     other = {**code_version(), "source_hash": "0123456789abcdef", "commit": "f" * 40}
     monkeypatch.setattr(runner, "code_version", lambda: other)
-    with pytest.raises(DceeInputError, match="other code.*--allow-code-change"):
+    with pytest.raises(DceeInputError, match=r"other code.*--allow-code-change"):
         run_campaign(_campaign(out), workers=1)
     campaign = _campaign(out)
     campaign.allow_code_change = True

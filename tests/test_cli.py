@@ -129,7 +129,8 @@ def test_help_does_not_import_the_numerical_stack():
         "import sys\n"
         "from dcee.cli import main\n"
         "try:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
-        "heavy = [m for m in ('numpy', 'scipy', 'numba', 'pandas', 'pydantic') if m in sys.modules]\n"
+        "names = ('numpy', 'scipy', 'numba', 'pandas', 'pydantic')\n"
+        "heavy = [m for m in names if m in sys.modules]\n"
         "print(heavy)"
     )
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
@@ -175,11 +176,9 @@ def test_a_planner_spec_runs_and_is_recorded(tmp_path, capsys):
 
 
 def _tiny(scenario="paper:1", strategy="mpc"):
-    return ["run", "--scenario", scenario, "--strategy", strategy, "--particles", "300"] + [
-        "--budget",
-        "10",
-        "-q",
-        "--no-figure",
+    return [
+        *("run", "--scenario", scenario, "--strategy", strategy, "--particles", "300"),
+        *("--budget", "10", "-q", "--no-figure"),
     ]
 
 

@@ -38,10 +38,45 @@ def test_new_planner_registers_without_editing_a_dispatcher():
         def costs(self, belief, position, candidates, agent, rng):
             return candidates[:, 0], {}
 
-    d = planners.get("test-stay-west").decide(
-        _belief([(20, 20)]), START, AGENT, np.random.default_rng(0)
+    try:
+        d = planners.get("test-stay-west").decide(
+            _belief([(20, 20)]), START, AGENT, np.random.default_rng(0)
+        )
+        assert d.heading == 4  # 180°: west
+        assert "test-stay-west" in planners.names()
+    finally:
+        planners.unregister("test-stay-west")  # the registry is process-wide
+    assert "test-stay-west" not in planners.names()
+
+
+class PluginPlanner(planners.Planner):
+    """A planner as another package would ship it (west, always)."""
+
+    def costs(self, belief, position, candidates, agent, rng):
+        return candidates[:, 0], {}
+
+
+def test_planners_from_other_packages_come_through_entry_points(monkeypatch):
+    """A package declaring ``[project.entry-points."dcee.planners"]`` appears in the registry
+    (and so in ``dcee strategies`` and every --strategy option) without editing dcee."""
+    from importlib.metadata import EntryPoint
+
+    import dcee.planning.base as base
+
+    ep = EntryPoint("test-plugin-mpc", "tests.test_planners:PluginPlanner", base.ENTRY_POINT_GROUP)
+    monkeypatch.setattr(base, "_entry_points_loaded", False)
+    monkeypatch.setattr(
+        "importlib.metadata.entry_points",
+        lambda group=None: [ep] if group == base.ENTRY_POINT_GROUP else [],
     )
-    assert d.heading == 4  # 180°: west
+    try:
+        assert "test-plugin-mpc" in planners.names()
+        d = planners.get("test-plugin-mpc").decide(
+            _belief([(20, 20)]), START, AGENT, np.random.default_rng(0)
+        )
+        assert d.heading == 4
+    finally:
+        planners.unregister("test-plugin-mpc")
 
 
 def test_mpc_moves_towards_the_posterior_mean_with_hand_computed_costs():

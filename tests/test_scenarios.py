@@ -79,3 +79,57 @@ def test_toml_file_errors(tmp_path):
     full.write_text('unknown = "full"\n' + good.read_text())
     with pytest.raises(DceeInputError, match="phi"):
         load_scenario(str(full))
+
+
+BASE_TOML = """
+unknown = "full"
+[volume]
+low = [0, 0, 0]
+high = [50, 50, 5]
+[truth]
+x = 25
+y = 5
+z = 1
+q = 2
+u = 3
+phi = 90
+zeta1 = 1
+zeta2 = 8
+[agent]
+start = [1, 1, 2]
+{agent}
+[prior]
+q = {q}
+u = {u}
+phi = {{ kind = "normal", mean = 90.0, sd = 3.0 }}
+zeta1 = {{ kind = "normal", mean = 1.0, sd = 1.4 }}
+zeta2 = {{ kind = "normal", mean = 8.0, sd = 1.4 }}
+"""
+GOOD_Q = '{ kind = "gamma", shape = 2.0, scale = 5.0 }'
+GOOD_U = '{ kind = "normal", mean = 4.0, sd = 1.4 }'
+
+
+@pytest.mark.parametrize(
+    "changes, field, needle",
+    [
+        ({"u": '{ kind = "normal", mean = 4.0, sd = 1.4, low = nan }'}, "prior.u.low", "nan"),
+        ({"q": '{ kind = "uniform", low = 0.0, high = inf }'}, "prior.q", "finite low and high"),
+        ({"q": '{ kind = "uniform", low = 5.0, high = 1.0 }'}, "prior.q", "high > low"),
+        ({"agent": "step = 80.0"}, "agent.step", "every heading"),
+        ({"agent": "step = 2.0\nspeed = 0.001"}, "search.budget", "shorter than one move"),
+    ],
+)
+def test_cross_field_errors_name_the_field_and_say_why(tmp_path, changes, field, needle):
+    """Each names the field at fault (not the model or the distribution class) and says why."""
+    values = {"agent": "", "q": GOOD_Q, "u": GOOD_U, **changes}
+    path = tmp_path / "s.toml"
+    path.write_text(BASE_TOML.format(**values))
+    with pytest.raises(DceeInputError) as exc:
+        load_scenario(str(path))
+    assert exc.value.field == field and needle in exc.value.message
+
+
+def test_the_base_of_those_cases_is_valid(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text(BASE_TOML.format(agent="", q=GOOD_Q, u=GOOD_U))
+    assert load_scenario(str(path)).unknown == "full"

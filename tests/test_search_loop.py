@@ -25,7 +25,9 @@ def test_closed_loop_finds_the_lab_source():
 def test_closed_loop_finds_a_paper_source_from_afar():
     res = run_episode(_small("paper:1", **{"search.budget": 400.0}), "dcee", seed=1)
     assert res.summary["source_acquired"], res.summary["final_rmse"]
-    assert res.summary["time_to_rmse_1m"] is None or res.summary["time_to_rmse_1m"] <= 400
+    # measured 103 s (seed 1, 2,000 particles); an estimator or planner regression that slows
+    # convergence by more than 2x fails here
+    assert res.summary["time_to_rmse_1m"] is not None and res.summary["time_to_rmse_1m"] < 250
 
 
 def test_same_seed_same_run_and_common_truth_noise_across_strategies():

@@ -109,16 +109,6 @@ def test_meander_has_the_configured_standard_deviation():
     np.testing.assert_allclose(sd, 0.25 * THETA[4], rtol=0.25)
 
 
-def test_a_900_s_episode_of_readings_costs_well_under_a_few_seconds():
-    import time
-
-    t0 = time.perf_counter()
-    truth = filament(0)
-    for t in np.arange(1.0, 900.0, 2.0):
-        truth.concentration(np.array([20.0, 12.5, 4.0]), t)
-    assert time.perf_counter() - t0 < 5.0
-
-
 # --- configuration ----------------------------------------------------------------------------
 
 

@@ -175,7 +175,20 @@ class SourcePrior:
                 return out
             k = int(bad.sum())
             out[bad] = np.column_stack([d.sample(rng, k) for d in self.distributions])
-        raise DceeInputError("prior", "puts (almost) no mass on physically valid parameters")
+        culprits = []
+        for i in self.unknown:
+            name = PARAMETER_NAMES[i]
+            col = self.distributions[i].sample(rng, 1000)
+            low, strict = PHYSICAL_LOWER.get(name, (-np.inf, False))
+            valid = np.isfinite(self.distributions[i].log_pdf(col)) & (
+                col > low if strict else col >= low
+            )
+            if valid.mean() < 0.5:
+                culprits.append(f"{name}: {1 - valid.mean():.0%} of its draws are invalid")
+        why = "; ".join(culprits) or "the parameters' draws are rarely valid together"
+        raise DceeInputError(
+            "prior", f"puts (almost) no mass on physically valid parameters ({why})"
+        )
 
     def log_density(self, theta: np.ndarray) -> np.ndarray:
         """(N,) log prior density over the unknown columns; −inf outside the support."""

@@ -205,12 +205,26 @@ class PriorSpec(BaseModel):
     mean: Finite | None = None
     sd: Positive | None = None
 
+    @field_validator("low", "high")
+    @classmethod
+    def _not_nan(cls, value: float | None) -> float | None:
+        if value is not None and math.isnan(value):
+            raise ValueError("must be a number or ±inf, got nan")
+        return value
+
     @model_validator(mode="after")
     def _complete(self) -> PriorSpec:
         need = {"uniform": ("low", "high"), "gamma": ("shape", "scale"), "normal": ("mean", "sd")}
         missing = [f for f in need[self.kind] if getattr(self, f) is None]
         if missing:
             raise ValueError(f"a {self.kind} prior needs {', '.join(missing)}")
+        if self.kind == "uniform" and not (math.isfinite(self.low) and math.isfinite(self.high)):
+            raise ValueError(
+                f"a uniform prior needs finite low and high (got [{self.low}, {self.high}]): "
+                "no uniform density spans an infinite range; use a normal or gamma prior"
+            )
+        if self.low is not None and self.high is not None and not self.high > self.low:
+            raise ValueError(f"needs high > low, got [{self.low}, {self.high}]")
         return self
 
 
@@ -343,11 +357,13 @@ class Scenario(BaseModel):
         if np.any(src < lo) or np.any(src > hi):
             raise ValueError(
                 f"truth: source ({src[0]}, {src[1]}, {src[2]}) is outside the search volume "
-                f"{tuple(lo)}..{tuple(hi)}"
+                f"{tuple(self.volume.low)}..{tuple(self.volume.high)}"
             )
         start = np.array(self.agent.start)
         if np.any(start < lo) or np.any(start > hi):
-            raise ValueError(f"agent.start {tuple(start)} is outside the search volume")
+            raise ValueError(
+                f"{FIELD_MARK}agent.start: {tuple(self.agent.start)} is outside the search volume"
+            )
         if self.dimensions == 3 and not hi[2] > lo[2]:
             raise ValueError("volume: a 3-D scenario needs high z > low z")
         for k in (0, 1):
@@ -360,8 +376,24 @@ class Scenario(BaseModel):
         extra = [p for p in self.prior if p not in PARAMETER_NAMES]
         if extra:
             raise ValueError(f"prior: unknown parameter name(s) {extra}; allowed {PARAMETER_NAMES}")
+        agent = GridAgent(
+            SearchVolume(tuple(lo), tuple(hi)),
+            self.agent.step,
+            self.agent.speed,
+            self.dwell,
+            self.agent.headings,
+        )
+        if len(agent.candidates(start)[0]) == 0:
+            raise ValueError(
+                f"{FIELD_MARK}agent.step: {self.agent.step:g} m leaves the search area from "
+                f"agent.start {tuple(self.agent.start)} in every heading (the area is "
+                f"{hi[0] - lo[0]:g} m × {hi[1] - lo[1]:g} m); use a shorter step"
+            )
         if self.search.budget < self.agent.step / self.agent.speed + self.dwell:
-            raise ValueError("search.budget is shorter than one move")
+            raise ValueError(
+                f"{FIELD_MARK}search.budget: {self.search.budget:g} s is shorter than one move "
+                f"({self.agent.step / self.agent.speed + self.dwell:g} s: step / speed + dwell)"
+            )
         if self.sensor.average is not None and self.sensor.average > self.dwell + 1e-9:
             raise ValueError(
                 f"sensor.average = {self.sensor.average:g} s is longer than the hold "
@@ -530,6 +562,11 @@ def parse_setting(text: str) -> tuple[str, Any]:
     return path, value
 
 
+FIELD_MARK = "@field "
+"""Prefix of a cross-field check's message that names the field at fault (``@field
+agent.step: …``): :func:`validate_scenario` reports that field instead of the model's."""
+
+
 def validate_scenario(data: dict[str, Any]) -> Scenario:
     """Validate a raw mapping; errors become one-line :class:`DceeInputError`."""
     try:
@@ -546,6 +583,8 @@ def validate_scenario(data: dict[str, Any]) -> Scenario:
             del parts[2]  # the union's tag, not a field the user wrote
         loc = ".".join(parts) or "scenario"
         msg = err["msg"].removeprefix("Value error, ")
+        if msg.startswith(FIELD_MARK):  # a cross-field check that names its own field
+            loc, _, msg = msg.removeprefix(FIELD_MARK).partition(": ")
         if err["type"] == "extra_forbidden":
             msg = "unknown field"
         elif "input" in err and err["type"] != "value_error":
