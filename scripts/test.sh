@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# Set up, then lint (ruff) and run the test suite (pytest).
+# Set up, then lint (ruff), run the test suite (pytest) and build the documentation site with
+# its executed examples (mkdocs --strict: any warning fails).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-.venv/bin/ruff check src tests
-.venv/bin/ruff format --check src tests
+.venv/bin/ruff check src tests examples scripts/docs_hooks.py
+.venv/bin/ruff format --check src tests examples scripts/docs_hooks.py
 .venv/bin/python -m pytest -q "$@"
+DOCS_OUT=${DOCS_OUT:-$(mktemp -d)/site} bash scripts/docs.sh

@@ -85,7 +85,7 @@ from dcee.models.agent import GridAgent, SearchVolume
 from dcee.models.plume import PARAMETER_NAMES, IsotropicPlume
 from dcee.models.sensor import Sensor
 
-_FROZEN = ConfigDict(frozen=True, extra="forbid")
+_FROZEN = ConfigDict(frozen=True, extra="forbid", use_attribute_docstrings=True)
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 
@@ -101,9 +101,13 @@ truth, full unknown, 12 × 3, 10,000 particles): hold 2 / 3 / 4 / 5 / 7 s acquir
 
 
 class Volume(BaseModel):
+    """The search volume (m); the source-location prior is uniform over it."""
+
     model_config = _FROZEN
     low: tuple[Finite, Finite, Finite]
+    """lower corner (x, y, z), m"""
     high: tuple[Finite, Finite, Finite]
+    """upper corner (x, y, z), m; moves that leave the volume are inadmissible"""
 
     @model_validator(mode="after")
     def _ordered(self) -> Volume:
@@ -161,15 +165,24 @@ TruthModelSpec = Annotated[FilamentSpec | PlaybackSpec, Field(discriminator="kin
 
 
 class Truth(BaseModel):
+    """The true source term (what the search must find) and what the sensor sees."""
+
     model_config = _FROZEN
     x: Finite
+    """source x, m"""
     y: Finite
+    """source y, m"""
     z: Finite
+    """source height, m"""
     q: Positive
+    """release rate, g/s"""
     u: Annotated[float, Field(ge=0, allow_inf_nan=False)]
+    """mean wind speed, m/s"""
     phi: Finite = Field(description="wind direction in degrees (wind comes from it)")
     zeta1: Positive
+    """diffusivity ζ1 of the isotropic plume model, m²/s"""
     zeta2: Positive
+    """lifetime ζ2 of the released particles, s"""
     model: Literal["isotropic"] | TruthModelSpec = "isotropic"
     """what the sensor really sees: "isotropic" (the estimator's own model, the paper's
     simulation), "filament" (or a table with kind = "filament" and parameters), or a table
@@ -196,14 +209,25 @@ class Truth(BaseModel):
 
 
 class PriorSpec(BaseModel):
+    """The prior of one unknown parameter (``[prior] q = { kind = "gamma", shape = 2.0,
+    scale = 5.0 }``); degrees for phi. x, y, z default to uniform over the volume."""
+
     model_config = _FROZEN
     kind: Literal["uniform", "gamma", "normal"]
+    """distribution family"""
     low: float | None = None
+    """uniform: lower bound (finite); normal: truncation below (default: the physical bound,
+    0 for u, ζ1, ζ2)"""
     high: float | None = None
+    """uniform: upper bound (finite); normal: truncation above (default none)"""
     shape: Positive | None = None
+    """gamma: shape k"""
     scale: Positive | None = None
+    """gamma: scale θ"""
     mean: Finite | None = None
+    """normal: mean"""
     sd: Positive | None = None
+    """normal: standard deviation (the paper's N(m, δ) has variance δ, so sd = √δ)"""
 
     @field_validator("low", "high")
     @classmethod
@@ -245,11 +269,17 @@ class SensorSpec(BaseModel):
 
     model_config = _FROZEN
     threshold: Positive = 5e-4
+    """g/m³: readings below it are non-detections"""
     pd: Annotated[float, Field(gt=0, le=1)] = 0.7
+    """probability that a concentration above the threshold is detected (the paper's 0.7)"""
     sigma_min: Positive = 1e-4
+    """g/m³: least standard deviation of a reading's noise"""
     sigma_frac: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.5
+    """reading noise standard deviation as a share of the concentration (the paper's 0.5)"""
     false_alarm: Annotated[float, Field(ge=0, lt=1)] = 0.0
+    """probability of a spurious detection where the concentration is below the threshold"""
     false_alarm_scale: Positive = 5e-4
+    """g/m³: scale of the exponential distribution of false-alarm readings"""
     max_reading: Positive = 1e4
     """g/m³: physical maximum; a told reading above it is refused (a fault, not a measurement)"""
     average: Annotated[float | None, Field(ge=0, le=600, allow_inf_nan=False)] = None
@@ -305,24 +335,40 @@ class EstimatorSpec(BaseModel):
 
 
 class AgentSpec(BaseModel):
+    """The mobile sensor: where it starts and how it moves (one step along one of
+    ``headings`` directions per decision, at the start altitude)."""
+
     model_config = _FROZEN
     start: tuple[Finite, Finite, Finite]
+    """start position (x, y, z), m; inside the volume"""
     step: Positive = 2.0
+    """m per move; at least one heading from the start must stay inside the volume"""
     speed: Positive = 2.0
+    """m/s; a move takes step / speed + dwell seconds"""
     dwell: Annotated[float | None, Field(ge=0, le=600, allow_inf_nan=False)] = None
     """s held at each waypoint to take a reading; None: 1 s for the isotropic truth,
     :data:`TURBULENT_HOLD` for a time-varying one"""
     headings: Annotated[int, Field(ge=1, le=64)] = 8
+    """number of equally spaced move directions (0°, 45°, … for 8)"""
 
 
 class SearchSpec(BaseModel):
+    """The estimator's and planners' scale, the flight budget and the success criterion."""
+
     model_config = _FROZEN
     particles: Annotated[int, Field(ge=2, le=10_000_000)] = 20_000
+    """particles of the filter (the paper's 20,000)"""
     hypotheses: Annotated[int, Field(ge=1, le=10_000)] = 40
+    """hypothesised readings per candidate move (the paper's 40); a planner spec's own
+    ``hypotheses=`` overrides it"""
     budget: Positive = 900.0
+    """s of flight (the paper's 900)"""
     acquired_rmse: Positive = 3.0
+    """m: "source acquired" when the final RMSE is below it"""
     stop_spread: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
+    """m: > 0 stops the search once the posterior spread is below it"""
     resample_threshold: Annotated[float, Field(gt=0, le=1)] = 0.5
+    """resample when the effective sample size falls below this share of the particles"""
     mcmc_steps: Annotated[int, Field(ge=0, le=100)] = 1
     """least Metropolis-Hastings sweeps after a resampling"""
     global_share: Annotated[float, Field(ge=0, le=1)] = 0.2
@@ -339,16 +385,28 @@ class Scenario(BaseModel):
 
     model_config = _FROZEN
     name: str = "custom"
+    """shown in results; a file's name defaults to its stem"""
     description: str = ""
+    """free text"""
     dimensions: Literal[2, 3] = 3
+    """3: the source height is unknown in "source"; 2: it is known (planar search)"""
     unknown: Literal["source", "full"] = "source"
+    """"source": x, y, (z), q unknown; "full": wind and dispersion (u, phi, zeta1, zeta2) too"""
     volume: Volume
+    """the search volume, see [volume]"""
     truth: Truth
+    """the true source term and the truth model, see [truth]"""
     prior: dict[str, PriorSpec] = Field(default_factory=_default_priors)
+    """priors of the unknown parameters by name (q, u, phi, zeta1, zeta2; x, y, z uniform over
+    the volume unless given); defaults: the paper's table 1 (phi has none)"""
     sensor: SensorSpec = SensorSpec()
+    """the instrument, see [sensor]"""
     estimator: EstimatorSpec = EstimatorSpec()
+    """the reading model of the filter and the planners, see [estimator]"""
     agent: AgentSpec
+    """the mobile sensor, see [agent]"""
     search: SearchSpec = SearchSpec()
+    """scale, budget and success criterion, see [search]"""
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario:

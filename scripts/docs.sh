@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Set up (with the documentation tools), then build the documentation site into $DOCS_OUT
+# (default: site/). Warnings are errors (mkdocs strict mode); the examples are executed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+MPLBACKEND=Agg .venv/bin/mkdocs build --strict --clean --site-dir "${DOCS_OUT:-site}"
+echo "documentation: ${DOCS_OUT:-site}/index.html"

@@ -1,0 +1,122 @@
+"""MkDocs hooks: reference pages generated from the code at build time, so they cannot drift.
+
+* ``reference/cli.md``: the ``--help`` of every ``dcee`` command (from the click objects).
+* ``reference/scenario.md``: every scenario field with its type, default, allowed range and
+  description (from the pydantic models; the descriptions are the attribute docstrings).
+"""
+
+from __future__ import annotations
+
+import types
+import typing
+from typing import Any
+
+import click
+from mkdocs.structure.files import File, Files
+
+
+def on_files(files: Files, config: Any) -> Files:
+    files.append(File.generated(config, "reference/cli.md", content=cli_reference()))
+    files.append(File.generated(config, "reference/scenario.md", content=scenario_reference()))
+    return files
+
+
+def cli_reference() -> str:
+    from dcee.cli import cli
+
+    out = [
+        "# Command reference",
+        "",
+        "Generated from the command line's own definitions when the documentation is built. "
+        "How to use them: [the command line](../guide/command-line.md).",
+        "",
+    ]
+    root = click.Context(cli, info_name="dcee")
+    out += ["## `dcee`", "", "```text", cli.get_help(root), "```", ""]
+    for name in sorted(cli.commands):
+        cmd = cli.commands[name]
+        ctx = click.Context(cmd, info_name=f"dcee {name}", parent=root)
+        out += [f"## `dcee {name}`", "", "```text", cmd.get_help(ctx), "```", ""]
+    return "\n".join(out)
+
+
+def scenario_reference() -> str:
+    from pydantic import BaseModel
+
+    from dcee.scenarios import config
+
+    sections = [
+        ("top level", config.Scenario),
+        ("[volume]", config.Volume),
+        ("[truth]", config.Truth),
+        ('[truth] model = { kind = "filament", … }', config.FilamentSpec),
+        ("[truth] model = { file = … } (playback)", config.PlaybackSpec),
+        ("[prior] NAME = { … }", config.PriorSpec),
+        ("[sensor]", config.SensorSpec),
+        ("[estimator]", config.EstimatorSpec),
+        ("[agent]", config.AgentSpec),
+        ("[search]", config.SearchSpec),
+    ]
+    out = [
+        "# Scenario reference",
+        "",
+        "Generated from the validating models (`dcee.scenarios.config`) when the documentation "
+        "is built. A scenario is a TOML file; `dcee show paper:1` prints a complete one, and "
+        "`dcee schema` the JSON Schema of the same models (for editors). Why each default is "
+        "what it is: [scenarios](../scenarios.md).",
+        "",
+    ]
+    for title, model in sections:
+        out += [f"## {title}", ""]
+        doc = (model.__doc__ or "").strip()
+        if doc and not doc.startswith("!!!"):
+            out += [" ".join(doc.split()), ""]
+        out += ["| field | type | default | allowed | description |", "|---|---|---|---|---|"]
+        for name, field in model.model_fields.items():
+            default = "required" if field.is_required() else _fmt_default(field)
+            if isinstance(field.default, BaseModel):
+                default = "see its section"
+            out.append(
+                f"| `{name}` | {_fmt_type(field.annotation)} | {default} "
+                f"| {_fmt_constraints(field.metadata)} | {_cell(field.description or '')} |"
+            )
+        out.append("")
+    return "\n".join(out)
+
+
+def _fmt_default(field: Any) -> str:
+    if field.default_factory is not None:
+        return "(computed)"
+    value = field.default
+    return "unset" if value is None else f"`{value!r}`"
+
+
+def _fmt_type(annotation: Any) -> str:
+    origin = typing.get_origin(annotation)
+    if origin is typing.Literal:
+        return " \\| ".join(f"`{a!r}`" for a in typing.get_args(annotation))
+    if origin in (typing.Union, types.UnionType):
+        return " or ".join(_fmt_type(a) for a in typing.get_args(annotation))
+    if origin is typing.Annotated:
+        return _fmt_type(typing.get_args(annotation)[0])
+    if origin in (list, tuple, dict):
+        args = ", ".join(_fmt_type(a) for a in typing.get_args(annotation) if a is not Ellipsis)
+        return f"{origin.__name__}[{args}]"
+    if annotation is type(None):
+        return "none"
+    return getattr(annotation, "__name__", str(annotation)).replace("|", "\\|")
+
+
+def _fmt_constraints(metadata: list[Any]) -> str:
+    parts = []
+    for m in metadata:
+        for attr, sym in (("gt", ">"), ("ge", "≥"), ("lt", "<"), ("le", "≤")):
+            if getattr(m, attr, None) is not None:
+                parts.append(f"{sym} {getattr(m, attr)}")
+        if getattr(m, "allow_inf_nan", None) is False:
+            parts.append("finite")
+    return ", ".join(parts)
+
+
+def _cell(text: str) -> str:
+    return " ".join(text.split()).replace("|", "\\|")
