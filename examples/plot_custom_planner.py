@@ -11,6 +11,7 @@ see the same truth noise, and compare their RMSE over time.
 """
 
 import matplotlib.pyplot as plt
+
 from dcee.planning import HypothesisPlanner, register, unregister
 from dcee.scenarios import load_scenario
 from dcee.simulation import run_episode
