@@ -247,3 +247,23 @@ def test_unwritable_json_and_report_out_are_exit_2(tmp_path, capsys):
 def test_empty_truth_is_an_error_not_ignored(tmp_path, capsys):
     code, _, err = run_cli([*_tiny(), "--out", str(tmp_path / "o"), "--truth", ""], capsys)
     assert code == 2 and "truth" in err and err.count("\n") == 1
+
+
+def test_smoke_bench_with_four_strategies_then_report(tmp_path, capsys):
+    """Issue 14's reproduction: every rate is 0/6 or 6/6 somewhere here, which crashed the
+    report (Wilson bounds 1e-17 inside [0, 1] made negative error bars)."""
+    out = tmp_path / "smoke"
+    bench = ["bench", "--suite", "smoke", "--strategies", "mpc,infotaxis,dcee,entrotaxis"]
+    code, _, err = run_cli(
+        [*bench, "--repeats", "3", "--particles", "300", "--out", str(out)], capsys
+    )
+    assert code == 0, err
+    code, stdout, err = run_cli(["report", str(out)], capsys)
+    assert code == 0, err
+    table = pd.read_csv(out / "report/metrics.csv")
+    assert (table["searches"] == 6).all() and len(table) == 4
+    for key in ("source_acquired", "plume_acquired"):
+        assert (table[f"{key}_lo"] <= table[f"{key}_rate"]).all()
+        assert (table[f"{key}_rate"] <= table[f"{key}_hi"]).all()
+    assert len(pd.read_csv(out / "report/pairwise.csv")) == 6  # every pair of 4
+    assert "comparison_grid.png" in stdout

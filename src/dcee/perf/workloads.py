@@ -195,6 +195,37 @@ def _search(strategy: str, target: float | None) -> Timing:
     )
 
 
+FULL_IMPORT = (
+    "import dcee.cli, dcee.simulation, dcee.campaign, dcee.analysis.report, "
+    "dcee.analysis.figures, dcee.planning"
+)
+"""What ``dcee run`` ends up importing: the reference for the start-up of ``dcee --help``."""
+
+
+def _startup(repeats: int) -> list[Timing]:
+    """Wall time of ``dcee --help`` and of importing the whole package, each a fresh Python
+    process, alternated so that both see the same machine load (issue 14: help under 1 s and
+    under 0.35 of the full import)."""
+    import subprocess
+    import sys
+
+    def once(code: str) -> float:
+        t0 = time.perf_counter()
+        subprocess.run([sys.executable, "-c", code], check=True, capture_output=True)
+        return 1e3 * (time.perf_counter() - t0)
+
+    help_code = "import sys; from dcee.cli import main; sys.argv = ['dcee', '--help']; main()"
+    helps, imports = [], []
+    for _ in range(repeats):
+        helps.append(once(help_code))
+        imports.append(once(FULL_IMPORT))
+    help_t = Timing("cli-help-startup", "`dcee --help` in a fresh process", 1000.0, helps)
+    full_t = Timing("full-import", "importing every dcee subpackage, fresh process", None, imports)
+    ratio = help_t.median / full_t.median
+    help_t.note = f"{ratio:.2f}× the full import in this run (target ≤ 0.35)"
+    return [help_t, full_t]
+
+
 def run_workloads(quick: bool = False, progress: Callable[[str], None] | None = None) -> list:
     """Run the standard workloads; ``quick`` uses fewer repeats and skips whole searches."""
     tune_allocator()
@@ -246,6 +277,8 @@ def run_workloads(quick: bool = False, progress: Callable[[str], None] | None = 
     if not quick:
         plan.append(("search-900s-dcee", lambda: _search("dcee", 10_000.0)))
     out = []
+    say("cli-help-startup")
+    out.extend(_startup(3 if quick else 7))
     for name, make in plan:
         say(name)
         out.append(make())
