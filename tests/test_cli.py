@@ -267,3 +267,8 @@ def test_smoke_bench_with_four_strategies_then_report(tmp_path, capsys):
         assert (table[f"{key}_rate"] <= table[f"{key}_hi"]).all()
     assert len(pd.read_csv(out / "report/pairwise.csv")) == 6  # every pair of 4
     assert "comparison_grid.png" in stdout
+
+
+def test_perf_refuses_an_unwritable_json_before_timing(capsys):
+    code, _, err = run_cli(["perf", "--quick", "--json", "/proc/dcee-perf/x.json"], capsys)
+    assert code == 2 and err.startswith("dcee: error: json:") and err.count("\n") == 1

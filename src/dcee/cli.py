@@ -410,6 +410,8 @@ def perf(json_path: str | None, quick: bool, compare_stonesoup: bool, decisions:
     from rich.console import Console
     from rich.table import Table
 
+    if json_path:
+        check_writable_file(Path(json_path), "json")  # before minutes of timing, not after
     console = Console(width=None if sys.stdout.isatty() else 120)
     machine = {
         "cpus": os.cpu_count(),
