@@ -84,6 +84,21 @@ def test_changed_configuration_in_the_same_folder_is_refused(finished):
         run_campaign(_campaign(out, particles=400), workers=1)
 
 
+def test_a_reworded_description_does_not_orphan_a_campaign(finished, tmp_path):
+    """Free text changes no result: a campaign whose stored scenario descriptions differ from
+    today's still resumes (it refused before, a whole chain of studies once stopped on it)."""
+    import shutil
+
+    out, _ = finished
+    copy = tmp_path / "copy"
+    shutil.copytree(out, copy)
+    meta = json.loads((copy / "campaign.json").read_text())
+    for scenario in meta["settings"]["scenarios"].values():
+        scenario["description"] = "worded differently"
+    (copy / "campaign.json").write_text(json.dumps(meta))
+    assert run_campaign(_campaign(copy), workers=1)["skipped"] == 8
+
+
 def test_planner_specs_are_campaign_strategies(tmp_path):
     spec = "dcee-cl:reach=4:hypotheses=8"
     campaign = Campaign(tmp_path, "smoke", (spec,), 1, particles=200)

@@ -186,8 +186,10 @@ class Campaign:
                 raise DceeInputError(
                     "out", f"{path} is unreadable; move the folder aside or choose another --out"
                 ) from None
-            if stored.get("settings") != settings:
-                changed = _first_difference(stored.get("settings", {}), settings)
+            if _identity(stored.get("settings", {})) != _identity(settings):
+                changed = _first_difference(
+                    _identity(stored.get("settings", {})), _identity(settings)
+                )
                 raise DceeInputError(
                     "out",
                     f"{self.out_dir} holds results of a different configuration ({changed}); "
@@ -228,6 +230,21 @@ class Campaign:
                 for strategy in self.strategies:
                     out.append(SearchTask(str(self.out_dir), name, strategy, seed, dump))
         return out
+
+
+def _identity(settings: dict[str, Any]) -> dict[str, Any]:
+    """What must match for results to belong together: the settings without the scenarios'
+    free-text descriptions (rewording one must not orphan a campaign; it changes no result)."""
+    out = dict(settings)
+    scenarios = out.get("scenarios")
+    if isinstance(scenarios, dict):
+        out["scenarios"] = {
+            name: {k: v for k, v in sc.items() if k != "description"}
+            if isinstance(sc, dict)
+            else sc
+            for name, sc in scenarios.items()
+        }
+    return out
 
 
 def _first_difference(a: Any, b: Any, path: str = "") -> str:
