@@ -2,6 +2,9 @@
 # The closed-loop DCEE studies (issue 13). Resumable: rerun to finish; each command skips the
 # searches already done. Results land in results/ (not versioned); tables are in the README and
 # docs/dual-control.md.
+# Folders written before 2026-11-22 use the old result layout: convert them with
+# `scripts/migrate_results.py DIR` (then resuming needs --allow-code-change, and the campaign
+# records both code versions) or give a new --out.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 D=.venv/bin/dcee
