@@ -49,7 +49,7 @@ def scenario_reference() -> str:
         ("top level", config.Scenario),
         ("[volume]", config.Volume),
         ("[truth]", config.Truth),
-        ("[truth] model: a filament table (kind = \"filament\")", config.FilamentSpec),
+        ('[truth] model: a filament table (kind = "filament")', config.FilamentSpec),
         ("[truth] model: a recording (file = …)", config.PlaybackSpec),
         ("[prior] NAME: one parameter's prior", config.PriorSpec),
         ("[sensor]", config.SensorSpec),
