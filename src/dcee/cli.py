@@ -174,7 +174,9 @@ def run(
         **_overrides(likelihood, settings),
     }
     scenario = base.with_overrides(**changes)
-    out_dir = out_dir or Path("results") / _default_run_folder(scenario, base, strategy, seed)
+    out_dir = out_dir or Path("results") / _default_run_folder(
+        scenario, base, changes, strategy, seed
+    )
     check_writable_dir(out_dir, "out")
     _check_same_run(out_dir, scenario, strategy, seed)
     if json_file is not None:
@@ -218,11 +220,17 @@ def run(
     _print_summary(result.summary, out_dir)
 
 
-def _default_run_folder(scenario: Any, base: Any, strategy: str, seed: int) -> str:
+NAMED_CHANGES = ("search.particles", "search.hypotheses", "search.budget", "unknown", "truth.model")
+"""Overrides that the default run folder names in words; any other change adds a hash."""
+
+
+def _default_run_folder(
+    scenario: Any, base: Any, changes: dict[str, Any], strategy: str, seed: int
+) -> str:
     """``paper-1_dcee_seed0``, plus what differs from the built-in: ``_n10000`` particles,
     ``_j20`` hypotheses, ``_b300`` budget, ``_full`` unknowns, ``_filament`` truth, and a short
-    hash of any other change (``--likelihood``, ``--set``), so two different runs never share
-    a default folder."""
+    hash of the resolved scenario when anything else changed (``--likelihood``, ``--set``), so
+    two different runs never share a default folder."""
     import hashlib
 
     parts = [scenario.name.replace(":", "-"), strategy.replace(":", "+"), f"seed{seed}"]
@@ -237,20 +245,13 @@ def _default_run_folder(scenario: Any, base: Any, strategy: str, seed: int) -> s
         parts.append(scenario.unknown)
     if scenario.truth.model != base.truth.model:
         parts.append(scenario.truth.model_name)
-    rest_now = scenario.model_dump(mode="json", exclude={"search", "unknown", "truth"})
-    rest_base = base.model_dump(mode="json", exclude={"search", "unknown", "truth"})
-    other = {
-        k: v for k, v in scenario.search.model_dump().items() if k not in _NAMED_SEARCH_FIELDS
-    } != {k: v for k, v in base.search.model_dump().items() if k not in _NAMED_SEARCH_FIELDS}
-    if rest_now != rest_base or other or scenario.truth.model_dump() != base.truth.model_dump():
+    named_only = base.with_overrides(**{k: v for k, v in changes.items() if k in NAMED_CHANGES})
+    if scenario != named_only:
         digest = hashlib.sha256(
             json.dumps(scenario.model_dump(mode="json"), sort_keys=True).encode()
         ).hexdigest()[:8]
         parts.append(digest)
     return "_".join(parts)
-
-
-_NAMED_SEARCH_FIELDS = ("particles", "hypotheses", "budget")
 
 
 def _check_same_run(out_dir: Path, scenario: Any, strategy: str, seed: int) -> None:
