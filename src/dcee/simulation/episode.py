@@ -74,8 +74,9 @@ class EpisodeResult:
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
         (folder / "summary.json").unlink(missing_ok=True)  # incomplete until rewritten
-        for leftover in folder.glob(".*.*"):  # temporaries of a writer killed mid-file
-            leftover.unlink(missing_ok=True)
+        for name in RESULT_FILES:  # temporaries of a writer killed mid-file (dcee.io)
+            for leftover in folder.glob(f".{name}.*"):
+                leftover.unlink(missing_ok=True)
         config = self.config or {}
         seed = int(self.summary.get("seed", 0))
         records = pd.DataFrame.from_records(self.records)
