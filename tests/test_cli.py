@@ -38,6 +38,13 @@ def test_animation(tmp_path, capsys):
     )
     assert code == 0
     assert (out / "animation.gif").read_bytes()[:3] == b"GIF"
+    # the animation's 41 frames are not saved: the result keeps the standard snapshots only
+    # (10/30/50/100 % of the 30 s budget), so the report's grid has its usual four columns
+    import numpy as np
+
+    with np.load(out / "posterior.npz") as z:
+        times = z["snapshot_times"]
+    assert len(times) == 4 and times[-1] <= 30.0 and times[0] >= 3.0
 
 
 BAD = [

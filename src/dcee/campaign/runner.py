@@ -186,25 +186,23 @@ class Campaign:
                 raise DceeInputError(
                     "out", f"{path} is unreadable; move the folder aside or choose another --out"
                 ) from None
-            if _identity(stored.get("settings", {})) != _identity(settings):
-                changed = _first_difference(
-                    _identity(stored.get("settings", {})), _identity(settings)
-                )
+            before, now = _identity(stored.get("settings", {})), _identity(settings)
+            if before != now:
+                changed = _first_difference(before, now)
                 raise DceeInputError(
                     "out",
                     f"{self.out_dir} holds results of a different configuration ({changed}); "
                     "use a new --out folder instead of mixing results",
                 )
             codes = list(stored.get("code_versions", []))
-            if not any(same_code(c, code) for c in codes):
-                if not self.allow_code_change:
-                    earlier = describe(codes[-1]) if codes else "unknown (older dcee)"
-                    raise DceeInputError(
-                        "out",
-                        f"{self.out_dir} was started by other code ({earlier}; now "
-                        f"{describe(code)}); use a new --out folder, or --allow-code-change "
-                        "to resume anyway (every version used is recorded)",
-                    )
+            if not any(same_code(c, code) for c in codes) and not self.allow_code_change:
+                earlier = describe(codes[-1]) if codes else "unknown (older dcee)"
+                raise DceeInputError(
+                    "out",
+                    f"{self.out_dir} was started by other code ({earlier}; now "
+                    f"{describe(code)}); use a new --out folder, or --allow-code-change "
+                    "to resume anyway (every version used is recorded)",
+                )
             strategies = sorted(set(stored.get("strategies", [])) | set(self.strategies))
             repeats = max(int(stored.get("repeats", 0)), self.repeats)
         else:

@@ -85,22 +85,33 @@ class EpisodeResult:
         arrays: dict[str, np.ndarray] = {
             "final_particles": self.final_theta[idx].astype(np.float32)
         }
-        if keep_snapshots and self.snapshots:
-            arrays["snapshot_times"] = np.array([t for t, _ in self.snapshots])
+        snapshots = self._standard_snapshots() if keep_snapshots else []
+        if snapshots:
+            arrays["snapshot_times"] = np.array([t for t, _ in snapshots])
             arrays["snapshot_particles"] = np.stack(
-                [p[:SNAPSHOT_SAMPLE].astype(np.float32) for _, p in self.snapshots]
+                [p[:SNAPSHOT_SAMPLE].astype(np.float32) for _, p in snapshots]
             )
         write_atomic(folder / "steps.parquet", lambda p: records.to_parquet(p, index=False))
         write_atomic(folder / "posterior.npz", lambda p: _savez(p, arrays))
         write_json(folder / "config.json", config)
-        summary = dict(self.summary)
-        summary.update(
-            code=config.get("code") or code_version(),
-            record_rows=len(records),
-            final_sample=len(idx),
-        )
+        summary = {"code": code_version(), **self.summary}  # run_episode already set it
+        summary.update(record_rows=len(records), final_sample=len(idx))
         write_json(folder / "summary.json", summary)
         return folder
+
+    def _standard_snapshots(self) -> list[tuple[float, np.ndarray]]:
+        """The snapshots at :func:`snapshot_times` of the budget (the first taken at or after
+        each) and the last one: what a saved search keeps, whatever else was taken (an
+        animation takes 41), so every saved search has the same comparison-grid columns."""
+        if not self.snapshots:
+            return []
+        budget = float(self.summary.get("budget", self.snapshots[-1][0]))
+        keep = {len(self.snapshots) - 1}
+        for target in snapshot_times(budget):
+            k = next((i for i, (t, _) in enumerate(self.snapshots) if t >= target - 1e-9), None)
+            if k is not None:
+                keep.add(k)
+        return [self.snapshots[i] for i in sorted(keep)]
 
     @staticmethod
     def is_complete(folder: str | Path) -> bool:
