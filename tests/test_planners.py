@@ -250,8 +250,11 @@ def test_stratified_expectation_has_lower_variance_when_detections_are_rare():
 def test_closed_loop_dcee_limits():
     belief = _spread_belief()
     rng = np.random.default_rng
-    # reach 0: the open-loop DCEE loss, hypothesis by hypothesis
-    cl = planners.get("dcee-cl", reach=0.0, n_hypotheses=200).decide(belief, START, AGENT, rng(3))
+    # reach 0 and the location variance as the uncertainty: the open-loop DCEE loss,
+    # hypothesis by hypothesis
+    cl = planners.get("dcee-cl:info_share=0", reach=0.0, n_hypotheses=200).decide(
+        belief, START, AGENT, rng(3)
+    )
     op = planners.get("dcee", expectation="stratified", n_hypotheses=200).decide(
         belief, START, AGENT, rng(3)
     )
@@ -373,3 +376,41 @@ def test_spread_reach_scales_the_free_disk_with_the_belief():
     assert planners.get("dcee-cl:reach=8:spread_reach=1").effective_reach(belief) == 8.0
     with pytest.raises(DceeInputError, match="spread_reach"):
         planners.get("dcee-cl:spread_reach=-1")
+
+
+def test_info_share_charges_the_information_equivalent_location_variance():
+    # Beyond every predicted mean (reach 100 m) the loss is the uncertainty term alone:
+    # info_share=1 gives tr P · E_z[exp(−KL(w'(z) ‖ w))], checked here against the NumPy
+    # reference posterior of each stratified hypothesis (independent of the compiled kernel).
+    belief = _two_point_belief(200)
+    planner = planners.get("dcee-cl:reach=100:info_share=1:hypotheses=12")
+    assert planner.needs_kl and not planners.get("dcee-cl:info_share=0").needs_kl
+    costs = planner.decide(belief, START, AGENT, np.random.default_rng(5)).costs
+    ctx = PredictionContext(belief, 12, 1, np.random.default_rng(5), "stratified")
+    candidates, _ = AGENT.candidates(START)
+    d = belief.source - belief.source_mean()
+    trace_p = float(belief.weights @ np.einsum("ij,ij->i", d, d))
+    expected = []
+    for p in candidates:
+        idx = ctx.position_index(p[None, :])
+        z, prob = ctx.readings(idx)
+        conc, dist = ctx.terms[0], ctx.terms[1]
+        _, _, _, kl = predicted_posterior_stats_reference(
+            conc, belief.source, belief.weights, np.repeat(idx[None, :], len(z), 0), z,
+            belief.sensor, dist,
+        )  # fmt: skip
+        expected.append(trace_p * prob @ np.exp(-kl))
+    np.testing.assert_allclose(costs, expected, rtol=1e-9)
+    # the term lies between "nothing learnt" (tr P) and "everything learnt" (0), and the move
+    # whose reading discriminates between the two hypotheses (east) is preferred
+    assert np.all((costs > 0) & (costs <= trace_p * (1 + 1e-12)))
+    assert int(np.argmin(costs)) == 0
+    # info_share interpolates linearly between the two uncertainty measures
+    half = planners.get("dcee-cl:reach=100:info_share=0.5:hypotheses=12")
+    zero = planners.get("dcee-cl:reach=100:info_share=0:hypotheses=12")
+    c_half, c_zero = (
+        pl.decide(belief, START, AGENT, np.random.default_rng(5)).costs for pl in (half, zero)
+    )
+    np.testing.assert_allclose(c_half, 0.5 * (c_zero + costs), rtol=1e-9)
+    with pytest.raises(DceeInputError, match="info_share"):
+        planners.get("dcee-cl:info_share=1.5")

@@ -37,6 +37,10 @@ from dcee.planning.predicted import PredictionContext, SequenceStats
 DEFAULT_REACH = 8.0
 """m: four 2 m steps of the paper's agent; chosen by measurement (docs/dual-control.md)."""
 
+DEFAULT_INFO_SHARE = 0.5
+"""Share of the uncertainty term measured by information about every parameter rather than by
+the location variance (:meth:`ClosedLoopDCEEPlanner.uncertainty`); under study."""
+
 
 @register("dcee-cl")
 class ClosedLoopDCEEPlanner(HypothesisPlanner):
@@ -48,19 +52,35 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
     default_expectation = "stratified"
 
     def __init__(
-        self, reach: float = DEFAULT_REACH, spread_reach: float = 0.0, **options: Any
+        self,
+        reach: float = DEFAULT_REACH,
+        spread_reach: float = 0.0,
+        info_share: float = DEFAULT_INFO_SHARE,
+        **options: Any,
     ) -> None:
         super().__init__(**options)
-        for name, value, high in (("reach", reach, 1e3), ("spread_reach", spread_reach, 10.0)):
+        for name, value, high in (
+            ("reach", reach, 1e3),
+            ("spread_reach", spread_reach, 10.0),
+            ("info_share", info_share, 1.0),
+        ):
             if isinstance(value, bool) or not (
                 isinstance(value, int | float) and math.isfinite(value) and 0 <= value <= high
             ):
                 raise DceeInputError(name, f"must be a number in [0, {high:g}], got {value!r}")
         self.reach = float(reach)
         self.spread_reach = float(spread_reach)
+        self.info_share = float(info_share)
+        # the KL divergence costs one more accumulation in the kernel: only when it is used
+        self.needs_kl = self.info_share > 0.0
 
     def options(self) -> dict[str, Any]:
-        return {"reach": self.reach, "spread_reach": self.spread_reach, **super().options()}
+        return {
+            "reach": self.reach,
+            "spread_reach": self.spread_reach,
+            "info_share": self.info_share,
+            **super().options(),
+        }
 
     def effective_reach(self, belief: Belief) -> float:
         """R = max(``reach``, ``spread_reach`` · σ_xy) m, σ_xy the belief's horizontal spread
@@ -74,11 +94,27 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
         spread = math.sqrt(float(belief.weights @ np.einsum("ij,ij->i", centred, centred)))
         return max(self.reach, self.spread_reach * spread)
 
+    def uncertainty(self, stats: SequenceStats, belief: Belief) -> np.ndarray:
+        """(S, J) the uncertainty left after each hypothesised reading, in m²:
+        (1 − a) tr P'_j + a tr P e^{−KL_j}, a = ``info_share``.
+
+        tr P'_j counts only what the reading tells about the source location. tr P e^{−KL_j}
+        is the location variance that the same amount of information, KL_j nats about all the
+        parameters (wind and dispersion included), would leave if it were information about
+        the 2-D location of a Gaussian belief (its variance shrinks by e^{−I} per I nats). It
+        values readings that resolve the environment, which later narrow the location."""
+        if self.info_share == 0.0:
+            return stats.trace_cov
+        centred = belief.source - belief.source_mean()
+        total = float(belief.weights @ np.einsum("ij,ij->i", centred, centred))  # tr P
+        a = self.info_share
+        return (1.0 - a) * stats.trace_cov + a * total * np.exp(-stats.kl)
+
     def loss(self, final_positions: np.ndarray, stats: SequenceStats, belief: Belief) -> np.ndarray:
         d = stats.mean - final_positions[:, None, :]
         horizontal = np.hypot(d[..., 0], d[..., 1])
         beyond = np.maximum(horizontal - self.effective_reach(belief), 0.0)
-        return beyond * beyond + d[..., 2] * d[..., 2] + stats.trace_cov
+        return beyond * beyond + d[..., 2] * d[..., 2] + self.uncertainty(stats, belief)
 
 
 @register("dcee-cl-tree")
