@@ -1,10 +1,11 @@
 """Which code made a result: the package version, the git commit, a dirty flag and a hash of the
 source files, recorded in every summary and campaign.
 
-``__version__`` alone is not enough: an editable install freezes the version at install time, so
-every result would claim the same version whatever the code. The commit and dirty flag come from
-git when the package runs from a work tree (read once per process); the source hash (SHA-256 of
-the package's ``.py`` files, paths and contents) identifies the code even without git or with
+The installed version alone is not enough: an editable install freezes it at install time, so
+every result would claim the same version whatever the code. In a git work tree the version is
+therefore recomputed from ``git describe`` with setuptools-scm's default scheme (read once per
+process), and the commit and dirty flag come from git too; the source hash (SHA-256 of the
+package's ``.py`` files, paths and contents) identifies the code even without git or with
 uncommitted edits, and is what a resumed campaign compares.
 """
 
@@ -12,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import re
 import subprocess
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
@@ -34,12 +36,36 @@ def code_version() -> dict[str, Any]:
     """``{"version", "commit", "dirty", "source_hash"}`` of the running code. ``commit`` and
     ``dirty`` are None outside a git work tree (an installed wheel). ``dirty`` is True when the
     package's own files differ from the commit (edits elsewhere in the repository do not count)."""
+    dirty = _dirty()
+    described = (
+        _git("describe", "--tags", "--long", "--match", "v[0-9]*") if dirty is not None else None
+    )
     return {
-        "version": package_version(),
+        "version": version_from_describe(described, bool(dirty)) or package_version(),
         "commit": _git("rev-parse", "HEAD"),
-        "dirty": _dirty(),
+        "dirty": dirty,
         "source_hash": source_hash(),
     }
+
+
+_DESCRIBE = re.compile(r"^v(?P<tag>\d+(?:\.\d+)*)-(?P<distance>\d+)-g(?P<sha>[0-9a-f]+)$")
+
+
+def version_from_describe(described: str | None, dirty: bool) -> str | None:
+    """The version setuptools-scm would give a work tree, from ``git describe --tags --long``
+    output such as ``v0.1.0-26-g80ab722``: the tag itself on a clean tagged commit, else the
+    next patch version with ``.dev<distance>+g<sha>`` (``.dirty`` appended for uncommitted
+    edits). None when the output is not of that form (no tag: the installed version is used)."""
+    m = _DESCRIBE.match(described or "")
+    if m is None:
+        return None
+    tag, distance, sha = m["tag"], int(m["distance"]), m["sha"]
+    if distance == 0 and not dirty:
+        return tag
+    parts = tag.split(".")
+    parts[-1] = str(int(parts[-1]) + 1)
+    local = f"g{sha}" + (".dirty" if dirty else "")
+    return f"{'.'.join(parts)}.dev{distance}+{local}"
 
 
 def source_hash() -> str:

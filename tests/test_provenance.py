@@ -1,0 +1,36 @@
+import subprocess
+
+import pytest
+
+from dcee.provenance import code_version, describe, version_from_describe
+
+
+@pytest.mark.parametrize(
+    ("described", "dirty", "expected"),
+    [
+        ("v0.1.0-0-gabc1234", False, "0.1.0"),  # a clean tagged commit is the tag
+        ("v0.1.0-0-gabc1234", True, "0.1.1.dev0+gabc1234.dirty"),
+        ("v0.1.0-26-g80ab722", False, "0.1.1.dev26+g80ab722"),
+        ("v1.2-3-gdeadbee", False, "1.3.dev3+gdeadbee"),
+        ("release-1-gabc", False, None),  # not a version tag: the installed version is used
+        (None, False, None),
+    ],
+)
+def test_version_follows_setuptools_scm_default_scheme(described, dirty, expected):
+    assert version_from_describe(described, dirty) == expected
+
+
+def test_code_version_names_the_commit_that_runs():
+    code = code_version()
+    head = subprocess.run(
+        ["git", "rev-parse", "HEAD"], capture_output=True, text=True, check=False
+    ).stdout.strip()
+    if code["commit"] is None or not head:
+        pytest.skip("not running from a git work tree")
+    assert code["commit"] == head
+    # the version is recomputed from git, not frozen at install time: it names this commit
+    # unless the commit carries the tag itself
+    assert code["version"].split("+")[0] and (
+        f"+g{head[:7]}" in code["version"] or "+" not in code["version"]
+    )
+    assert head[:7] in describe(code)
