@@ -42,7 +42,7 @@ class Searcher:
     def __init__(
         self,
         particle_filter: ParticleFilter,
-        planner: Planner,
+        planner: Planner | None,
         agent: GridAgent,
         rng: np.random.Generator,
     ) -> None:
@@ -80,6 +80,8 @@ class Searcher:
         """Next waypoint (3,) in m, chosen by the planner from the last told position."""
         if self.position is None:
             raise DceeInputError("ask", "tell() at least one reading before ask()")
+        if self.planner is None:
+            raise DceeInputError("planner", "this searcher has no planner to ask")
         t0 = _time.perf_counter()
         self.last_decision = self.planner.decide(self.belief(), self.position, self.agent, self.rng)
         self.last_decision_seconds = _time.perf_counter() - t0

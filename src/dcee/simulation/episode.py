@@ -22,7 +22,7 @@ from dcee.estimation.particle_filter import ParticleFilter
 from dcee.io import write_atomic, write_json
 from dcee.models.sensor import Sensor
 from dcee.planning import get as get_planner
-from dcee.planning.base import planner_class
+from dcee.planning.base import Planner, planner_class
 from dcee.provenance import code_version
 from dcee.scenarios.config import Scenario
 from dcee.searcher import Searcher
@@ -169,6 +169,131 @@ def streams(seed: int) -> tuple[np.random.Generator, ...]:
     return tuple(np.random.default_rng(s) for s in (truth_ss, filter_ss, planner_ss, figure_ss))
 
 
+class SearchSimulation:
+    """One simulated search, a reading at a time: the world (truth, instrument, agent model)
+    and the filter, without a planner. :func:`run_episode` drives it with a planner; the
+    Gymnasium environment (:mod:`dcee.gym`) with a policy's actions. Both therefore make the
+    same readings and the same records for the same seed and moves.
+
+    ``sense()`` takes the reading at the current position and time, assimilates it and appends
+    the step's record (:attr:`records`); ``move(waypoint)`` flies to the next waypoint, one
+    ``agent.step_time`` later; ``finished`` says when no further move fits the budget (or the
+    scenario's ``stop_spread`` is reached).
+    """
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        seed: int,
+        planner: Planner | None = None,
+        truth: TruthModel | None = None,
+    ) -> None:
+        search = scenario.search
+        self.scenario = scenario
+        self.seed = int(seed)
+        truth_rng, filter_rng, planner_rng, self.figure_rng = streams(seed)
+        self._truth_rng = truth_rng
+        self.sensor: Sensor = scenario.make_sensor()  # the instrument: makes the real readings
+        self.agent = scenario.make_agent()
+        self.truth = truth or make_truth(scenario, seed)
+        self.true_location = scenario.truth_theta()[:3]
+        self.filter = ParticleFilter(
+            scenario.make_prior(),
+            scenario.make_estimator_sensor(),  # the reading model of the filter and planners
+            scenario.make_plume(),
+            n_particles=search.particles,
+            seed=filter_rng,
+            resample_threshold=search.resample_threshold,
+            mcmc_steps=search.mcmc_steps,
+            global_share=search.global_share,
+            diversify=search.diversify,
+            max_sweeps=search.max_sweeps,
+        )
+        self.searcher = Searcher(self.filter, planner, self.agent, planner_rng)
+        self.position = np.array(scenario.agent.start, dtype=np.float64)
+        self.time = self.agent.dwell  # the first reading is taken at the start after one dwell
+        self.records: list[dict[str, Any]] = []
+        self.path_length = 0.0
+
+    def sense(self) -> dict[str, Any]:
+        """Take, assimilate and record the reading at the current position and time."""
+        scenario, pf, position, t = self.scenario, self.filter, self.position, self.time
+        # the same count of noise draws per step, whatever the position
+        noise = self.sensor.draw_noise(self._truth_rng, ())
+        conc = self.truth.sensed(position, t, scenario.average, scenario.sensor.response_time)
+        reading = float(self.sensor.simulate_from(conc, noise))
+        info = self.searcher.tell(position, reading, t)
+        est = self.searcher.estimate()
+        rec: dict[str, Any] = {
+            "step": len(self.records),
+            "time": t,
+            "x": position[0],
+            "y": position[1],
+            "z": position[2],
+            "true_concentration": conc,
+            "reading": reading,
+            "detection": bool(self.sensor.is_detection(reading)),
+            "mean_x": est.mean[0],
+            "mean_y": est.mean[1],
+            "mean_z": est.mean[2],
+            **{
+                f"cov_{a}{b}": est.cov[i, j]
+                for i, a in enumerate("xyz")
+                for j, b in enumerate("xyz")
+                if j >= i
+            },
+            "spread": est.spread,
+            "rmse": pf.rmse(self.true_location),
+            "mean_error": float(np.linalg.norm(est.mean - self.true_location)),
+            "ess": info.ess,
+            "resampled": info.resampled,
+            "tempering_stages": info.tempering_stages,
+            "acceptance": info.acceptance,
+            "move_sweeps": info.move_sweeps,
+            "distinct": info.distinct,
+            "rejected": info.rejected,
+            "update_seconds": self.searcher.last_update_seconds,
+            "decision_seconds": 0.0,
+        }
+        self.records.append(rec)
+        return rec
+
+    @property
+    def finished(self) -> bool:
+        """True when no further move fits the budget, or the posterior spread fell below the
+        scenario's ``stop_spread``."""
+        search = self.scenario.search
+        return self.time + self.agent.step_time > search.budget + 1e-9 or (
+            search.stop_spread > 0
+            and bool(self.records)
+            and self.records[-1]["spread"] < search.stop_spread
+        )
+
+    def move(self, waypoint: np.ndarray) -> None:
+        """Fly to ``waypoint`` (3,) m; the next reading is one step time later."""
+        waypoint = np.asarray(waypoint, dtype=np.float64)
+        self.path_length += float(np.linalg.norm(waypoint - self.position))
+        self.position = waypoint
+        self.time += self.agent.step_time
+
+    def summary(self, strategy: str) -> dict[str, Any]:
+        """The search's summary (:func:`dcee.simulation.metrics.summarise` and the filter's
+        diagnostics) under the name ``strategy``."""
+        scenario, pf = self.scenario, self.filter
+        out = summarise(self.records, scenario, strategy, self.seed, self.path_length)
+        planner = self.searcher.planner
+        out["planner_options"] = planner.options() if planner is not None else {}
+        out["recoveries"] = len(pf.recoveries)
+        out["tempering_events"] = sum(r["kind"] == "tempering" for r in pf.recoveries)
+        out["rejected_readings"] = sum(r["kind"] == "rejected" for r in pf.recoveries)
+        out["truth_in_95"] = pf.in_credible_region(self.true_location, 0.95)
+        out.update(scenario.resolved_settings())
+        out["resamples"] = pf.n_resamples
+        out["config"] = scenario.name
+        out["parameter_names"] = list(scenario.unknown_names)
+        return out
+
+
 def run_episode(
     scenario: Scenario,
     strategy: str,
@@ -186,98 +311,30 @@ def run_episode(
     any are asked for), e.g. :func:`snapshot_times` of the budget, or a dense grid for an
     animation. The subsamples come from their own random stream: they never change the search.
     """
-    search = scenario.search
     planner = get_planner(strategy, **_planner_defaults(strategy, scenario, planner_options))
-    truth_rng, filter_rng, planner_rng, figure_rng = streams(seed)
-    sensor: Sensor = scenario.make_sensor()  # the instrument: makes the real readings
-    agent = scenario.make_agent()
-    truth = truth or make_truth(scenario, seed)
-    true_location = scenario.truth_theta()[:3]
-    pf = ParticleFilter(
-        scenario.make_prior(),
-        scenario.make_estimator_sensor(),  # the reading model of the filter and the planners
-        scenario.make_plume(),
-        n_particles=search.particles,
-        seed=filter_rng,
-        resample_threshold=search.resample_threshold,
-        mcmc_steps=search.mcmc_steps,
-        global_share=search.global_share,
-        diversify=search.diversify,
-        max_sweeps=search.max_sweeps,
-    )
-    searcher = Searcher(pf, planner, agent, planner_rng)
-    position = np.array(scenario.agent.start, dtype=np.float64)
-    t = agent.dwell  # the first reading is taken at the start after one dwell
-    average = scenario.average
-    records: list[dict[str, Any]] = []
+    sim = SearchSimulation(scenario, seed, planner, truth)
+    pf, searcher = sim.filter, sim.searcher
     snapshots: list[tuple[float, np.ndarray]] = []
     pending = sorted(snapshot_at) if snapshot_at is not None else []
-    path_length = 0.0
     while True:
-        noise = sensor.draw_noise(truth_rng, ())  # the same count per step, whatever the position
-        conc = truth.sensed(position, t, average, scenario.sensor.response_time)
-        reading = float(sensor.simulate_from(conc, noise))
-        info = searcher.tell(position, reading, t)
-        est = searcher.estimate()
-        rec: dict[str, Any] = {
-            "step": len(records),
-            "time": t,
-            "x": position[0],
-            "y": position[1],
-            "z": position[2],
-            "true_concentration": conc,
-            "reading": reading,
-            "detection": bool(sensor.is_detection(reading)),
-            "mean_x": est.mean[0],
-            "mean_y": est.mean[1],
-            "mean_z": est.mean[2],
-            **{
-                f"cov_{a}{b}": est.cov[i, j]
-                for i, a in enumerate("xyz")
-                for j, b in enumerate("xyz")
-                if j >= i
-            },
-            "spread": est.spread,
-            "rmse": pf.rmse(true_location),
-            "mean_error": float(np.linalg.norm(est.mean - true_location)),
-            "ess": info.ess,
-            "resampled": info.resampled,
-            "tempering_stages": info.tempering_stages,
-            "acceptance": info.acceptance,
-            "move_sweeps": info.move_sweeps,
-            "distinct": info.distinct,
-            "rejected": info.rejected,
-            "update_seconds": searcher.last_update_seconds,
-        }
+        rec = sim.sense()
+        t = sim.time
         if pending and t >= pending[0] - 1e-9:
-            snapshots.append((t, _subsample(pf, snapshot_particles, figure_rng)))
+            snapshots.append((t, _subsample(pf, snapshot_particles, sim.figure_rng)))
             while pending and t >= pending[0] - 1e-9:
                 pending.pop(0)
-        stop = t + agent.step_time > search.budget + 1e-9 or (
-            search.stop_spread > 0 and est.spread < search.stop_spread
-        )
-        waypoint = None if stop else searcher.ask()
-        rec["decision_seconds"] = 0.0 if stop else searcher.last_decision_seconds
-        records.append(rec)
+        waypoint = None if sim.finished else searcher.ask()
+        if waypoint is not None:
+            rec["decision_seconds"] = searcher.last_decision_seconds
         if progress:
             progress(t, rec)
         if waypoint is None:
             break
-        path_length += float(np.linalg.norm(waypoint - position))
-        position = waypoint
-        t += agent.step_time
-    summary = summarise(records, scenario, strategy, seed, path_length)
-    summary["planner_options"] = planner.options()
-    summary["recoveries"] = len(pf.recoveries)
-    summary["tempering_events"] = sum(r["kind"] == "tempering" for r in pf.recoveries)
-    summary["rejected_readings"] = sum(r["kind"] == "rejected" for r in pf.recoveries)
-    summary["truth_in_95"] = pf.in_credible_region(true_location, 0.95)
-    summary.update(scenario.resolved_settings())
-    summary["resamples"] = pf.n_resamples
-    summary["config"] = scenario.name
-    summary["parameter_names"] = list(scenario.unknown_names)
+        sim.move(waypoint)
+    records = sim.records
+    summary = sim.summary(strategy)
     if snapshot_at is not None and (not snapshots or snapshots[-1][0] != records[-1]["time"]):
-        snapshots.append((records[-1]["time"], _subsample(pf, snapshot_particles, figure_rng)))
+        snapshots.append((records[-1]["time"], _subsample(pf, snapshot_particles, sim.figure_rng)))
     config = {
         "scenario": scenario.model_dump(mode="json"),
         "strategy": strategy,
@@ -311,6 +368,7 @@ __all__ = [
     "RESULT_FILES",
     "SNAPSHOT_FRACTIONS",
     "EpisodeResult",
+    "SearchSimulation",
     "run_episode",
     "snapshot_times",
     "streams",
