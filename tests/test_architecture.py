@@ -29,6 +29,7 @@ LAYERS = {
     "dcee.analysis": 7,
     "dcee.cli": 8,
     "dcee.perf": 8,
+    "dcee.gym": 8,  # the Gymnasium interface
 }
 
 

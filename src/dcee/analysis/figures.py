@@ -13,6 +13,8 @@ import numpy as np
 from matplotlib.colors import LogNorm
 
 if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
     from dcee.scenarios.config import Scenario
     from dcee.simulation.episode import EpisodeResult
     from dcee.simulation.truth import TruthModel
@@ -120,10 +122,9 @@ def _draw_rmse(ax: plt.Axes, result: EpisodeResult, scenario: Scenario, until: f
     ax.grid(alpha=0.3, which="both")
 
 
-def search_figure(
-    result: EpisodeResult, scenario: Scenario, truth: TruthModel, path: str | Path
-) -> None:
-    """Write the summary figure of one search (PNG) to ``path``."""
+def draw_search_figure(result: EpisodeResult, scenario: Scenario, truth: TruthModel) -> Figure:
+    """The summary figure of one search (map with trajectory and particles, RMSE over time);
+    the caller saves or renders it and closes it."""
     s = result.summary
     fig, (ax_map, ax_rmse) = plt.subplots(1, 2, figsize=(13, 6.4), width_ratios=[1.15, 1])
     idx = np.random.default_rng(0).choice(
@@ -145,6 +146,14 @@ def search_figure(
         fontsize=11,
     )
     fig.tight_layout(rect=(0, 0, 1, 0.95))
+    return fig
+
+
+def search_figure(
+    result: EpisodeResult, scenario: Scenario, truth: TruthModel, path: str | Path
+) -> None:
+    """Write the summary figure of one search (PNG) to ``path``."""
+    fig = draw_search_figure(result, scenario, truth)
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
 

@@ -311,7 +311,7 @@ def run_episode(
     any are asked for), e.g. :func:`snapshot_times` of the budget, or a dense grid for an
     animation. The subsamples come from their own random stream: they never change the search.
     """
-    planner = get_planner(strategy, **_planner_defaults(strategy, scenario, planner_options))
+    planner = get_planner(strategy, **planner_defaults(strategy, scenario, planner_options))
     sim = SearchSimulation(scenario, seed, planner, truth)
     pf, searcher = sim.filter, sim.searcher
     snapshots: list[tuple[float, np.ndarray]] = []
@@ -352,7 +352,7 @@ def _subsample(pf: ParticleFilter, n: int, rng: np.random.Generator) -> np.ndarr
     return pf.source_locations[idx].copy()
 
 
-def _planner_defaults(
+def planner_defaults(
     strategy: str, scenario: Scenario, options: dict[str, Any] | None
 ) -> dict[str, Any]:
     """Constructor defaults: the scenario's hypothesis count (a spec's own, ``dcee:hypotheses=25``,
@@ -369,6 +369,7 @@ __all__ = [
     "SNAPSHOT_FRACTIONS",
     "EpisodeResult",
     "SearchSimulation",
+    "planner_defaults",
     "run_episode",
     "snapshot_times",
     "streams",

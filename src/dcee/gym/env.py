@@ -1,0 +1,263 @@
+"""``dcee/SourceSearch-v0``: one robot, one particle filter, a simulated release."""
+
+from __future__ import annotations
+
+import math
+from typing import Any, ClassVar, SupportsFloat
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+
+from dcee.errors import DceeInputError
+from dcee.planning.base import Belief
+from dcee.scenarios.config import Scenario, truth_choice
+from dcee.simulation.episode import EpisodeResult, SearchSimulation
+
+REWARDS = ("spread", "rmse")
+"""``spread``: the drop of the posterior spread √tr P over the step (m; what the robot itself
+can compute); ``rmse``: the drop of the particles' RMSE about the true source (m; privileged
+information, only in simulation)."""
+
+MAX_LOG_READING = 20.0
+"""The observation's log(1 + reading) is clipped here (a reading of 4.9e8 g/m³): a finite
+bound for learning code, far above any plausible reading."""
+
+OBSERVATION_FIELDS = (
+    "x",
+    "y",
+    "z",
+    "log_reading",
+    "detection",
+    "mean_x",
+    "mean_y",
+    "mean_z",
+    "sd_x",
+    "sd_y",
+    "sd_z",
+    "ess",
+    "time",
+)
+"""Names of the observation's entries, in order (see :class:`SourceSearchEnv`)."""
+
+
+class SourceSearchEnv(gymnasium.Env):
+    """Source search as a Gymnasium environment.
+
+    One episode is one simulated search (:class:`~dcee.simulation.episode.SearchSimulation`):
+    the robot starts where the scenario says, takes a reading, and each action moves it one
+    step along a heading, after which it takes the next reading and the particle filter
+    assimilates it. With the same seed and the same moves it makes exactly the readings that
+    ``dcee run`` makes.
+
+    **Actions**: ``Discrete(H)``, H = the scenario's ``agent.n_headings`` (8 in the paper: 0 = +x,
+    then counter-clockwise in 45° steps). ``info["action_mask"]`` (H,) int8 marks the headings
+    that stay inside the search area; an inadmissible action keeps the robot in place (time
+    passes, a reading is taken there) and sets ``info["inadmissible"]``.
+
+    **Observation**: a belief summary, not raw particles; ``Box`` float32 (13,), names in
+    :data:`OBSERVATION_FIELDS`: position (x, y, z) as fractions of the area; log(1 + reading in
+    g/m³); detection flag; posterior mean of the source (x, y, z) as fractions of the area;
+    posterior standard deviations (x, y, z) as fractions of the area's sides; effective
+    sample size / particles; elapsed time / budget. Everything lies in [0, 1] except the log
+    reading (in [0, :data:`MAX_LOG_READING`]); a flat axis (z in a 2-D area) reads 0.
+
+    **Reward** (keywords): ``reward`` is one of :data:`REWARDS` (default ``spread``: the drop of
+    the posterior spread over the step, in m), minus ``time_penalty`` per step, plus
+    ``success_bonus`` when the episode terminates.
+
+    **End**: *terminated* when the posterior spread √tr P falls below ``converged_spread`` m
+    (default 0.5 m: the belief has converged; whether it converged on the truth is in
+    ``info["rmse"]``); *truncated* when no further move fits the scenario's budget.
+
+    **Keywords**: ``scenario`` (a built-in name or a TOML path, default ``paper:1``),
+    ``particles`` (default 2,000: 10× fewer than the paper, for training speed; pass 20,000 for
+    paper scale), ``unknown`` (``source`` | ``full``), ``truth`` (``isotropic`` | ``filament`` |
+    a recording's path), ``likelihood`` (the filter's reading model), ``budget`` (s), and
+    ``render_mode`` ``"rgb_array"`` (the ``dcee run`` figure as an (H, W, 3) uint8 array).
+
+    Not in the observation but available to reference policies: :attr:`belief`,
+    :attr:`position`, :attr:`agent` (see :class:`dcee.gym.PlannerPolicy`).
+    """
+
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array"], "render_fps": 4}
+
+    def __init__(
+        self,
+        scenario: str | Scenario = "paper:1",
+        particles: int | None = 2000,
+        unknown: str | None = None,
+        truth: str | None = None,
+        likelihood: str | None = None,
+        budget: float | None = None,
+        reward: str = "spread",
+        time_penalty: float = 0.0,
+        success_bonus: float = 0.0,
+        converged_spread: float = 0.5,
+        render_mode: str | None = None,
+    ) -> None:
+        from dcee.scenarios import load_scenario
+
+        if reward not in REWARDS:
+            raise DceeInputError("reward", f"must be one of {', '.join(REWARDS)}, got {reward!r}")
+        for name, value in (
+            ("time_penalty", time_penalty),
+            ("success_bonus", success_bonus),
+            ("converged_spread", converged_spread),
+        ):
+            if isinstance(value, bool) or not (
+                isinstance(value, int | float) and math.isfinite(value) and value >= 0
+            ):
+                raise DceeInputError(name, f"must be a finite number >= 0, got {value!r}")
+        if render_mode not in (None, "rgb_array"):
+            raise DceeInputError("render_mode", f"must be None or 'rgb_array', got {render_mode!r}")
+        base = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+        self.scenario = base.with_overrides(
+            **{
+                "search.particles": particles,
+                "search.budget": budget,
+                "unknown": unknown,
+                "truth.model": truth_choice(truth) if truth is not None else None,
+                "estimator.likelihood": likelihood,
+            }
+        )
+        self.reward_kind = reward
+        self.time_penalty = float(time_penalty)
+        self.success_bonus = float(success_bonus)
+        self.converged_spread = float(converged_spread)
+        self.render_mode = render_mode
+        agent = self.scenario.make_agent()
+        self.action_space = spaces.Discrete(agent.n_headings)
+        high = np.ones(len(OBSERVATION_FIELDS), dtype=np.float32)
+        high[OBSERVATION_FIELDS.index("log_reading")] = MAX_LOG_READING
+        self.observation_space = spaces.Box(
+            np.zeros(len(OBSERVATION_FIELDS), np.float32), high, dtype=np.float32
+        )
+        volume = self.scenario.volume
+        self._low = np.asarray(volume.low, dtype=np.float64)
+        self._size = np.asarray(volume.high, dtype=np.float64) - self._low
+        self.simulation: SearchSimulation | None = None
+
+    # -- what reference policies may see ------------------------------------------------------
+    def _sim(self) -> SearchSimulation:
+        if self.simulation is None:
+            raise DceeInputError("reset", "call reset() before step() or render()")
+        return self.simulation
+
+    @property
+    def belief(self) -> Belief:
+        """The particle filter's current belief (particles, weights, models)."""
+        return self._sim().searcher.belief()
+
+    @property
+    def position(self) -> np.ndarray:
+        """(3,) the robot's position in m."""
+        return self._sim().position.copy()
+
+    @property
+    def agent(self) -> Any:
+        """The robot's move model (:class:`dcee.models.agent.GridAgent`)."""
+        return self._sim().agent
+
+    def action_mask(self) -> np.ndarray:
+        """(H,) int8: 1 for the headings that keep the robot inside the area."""
+        sim = self._sim()
+        mask = np.zeros(self.action_space.n, dtype=np.int8)
+        mask[sim.agent.candidates(sim.position)[1]] = 1
+        return mask
+
+    # -- Gymnasium API --------------------------------------------------------------------------
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Start a new search. ``seed`` is the search's seed (as in ``dcee run --seed``); without
+        one, a seed is drawn from the environment's own generator."""
+        super().reset(seed=seed)
+        run_seed = int(seed) if seed is not None else int(self.np_random.integers(2**31))
+        self.simulation = SearchSimulation(self.scenario, run_seed)
+        self._done = False
+        rec = self.simulation.sense()
+        return self._observation(rec), self._info(rec, inadmissible=False)
+
+    def step(self, action: Any) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
+        sim = self._sim()
+        if not self.action_space.contains(action):
+            raise DceeInputError(
+                "action", f"must be a heading index in [0, {self.action_space.n}), got {action!r}"
+            )
+        if self._done:
+            raise DceeInputError("step", "the episode has ended; call reset()")
+        before = sim.records[-1]
+        candidates, headings = sim.agent.candidates(sim.position)
+        hit = np.flatnonzero(headings == int(action))
+        inadmissible = len(hit) == 0
+        # an inadmissible heading keeps the robot where it is for one step (time still passes)
+        sim.move(sim.position if inadmissible else candidates[hit[0]])
+        rec = sim.sense()
+        key = "spread" if self.reward_kind == "spread" else "rmse"
+        reward = float(before[key] - rec[key]) - self.time_penalty
+        terminated = bool(rec["spread"] < self.converged_spread)
+        truncated = bool(not terminated and sim.finished)
+        if terminated:
+            reward += self.success_bonus
+        self._done = terminated or truncated
+        return self._observation(rec), reward, terminated, truncated, self._info(rec, inadmissible)
+
+    def render(self) -> np.ndarray | None:  # type: ignore[override]
+        if self.render_mode != "rgb_array":
+            return None
+        from dcee.analysis.figures import draw_search_figure
+
+        fig = draw_search_figure(self.result("policy"), self.scenario, self._sim().truth)
+        fig.canvas.draw()
+        image = np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()
+        import matplotlib.pyplot as plt
+
+        plt.close(fig)
+        return image
+
+    # -- results --------------------------------------------------------------------------------
+    def result(self, strategy: str) -> EpisodeResult:
+        """The search so far as a saved-search object (records, summary under the name
+        ``strategy``, final posterior), with the same metrics as ``dcee run``."""
+        sim = self._sim()
+        summary = sim.summary(strategy)
+        config = {"scenario": self.scenario.model_dump(mode="json"), "strategy": strategy}
+        pf = sim.filter
+        return EpisodeResult(sim.records, summary, pf.theta.copy(), pf.weights.copy(), [], config)
+
+    # -- helpers --------------------------------------------------------------------------------
+    _done = False
+
+    def _fraction(self, values: np.ndarray) -> np.ndarray:
+        out = np.zeros(3)
+        flat = self._size <= 0
+        out[~flat] = (values[~flat] - self._low[~flat]) / self._size[~flat]
+        return out
+
+    def _observation(self, rec: dict[str, Any]) -> np.ndarray:
+        sim = self._sim()
+        sd = np.sqrt(np.maximum([rec["cov_xx"], rec["cov_yy"], rec["cov_zz"]], 0.0))
+        scale = np.where(self._size > 0, self._size, np.inf)
+        obs = np.concatenate(
+            [
+                self._fraction(sim.position),
+                [math.log1p(max(rec["reading"], 0.0)), float(rec["detection"])],
+                self._fraction(np.array([rec["mean_x"], rec["mean_y"], rec["mean_z"]])),
+                sd / scale,
+                [rec["ess"] / sim.filter.n, rec["time"] / self.scenario.search.budget],
+            ]
+        )
+        low, high = self.observation_space.low, self.observation_space.high
+        return np.clip(obs, low, high).astype(np.float32)
+
+    def _info(self, rec: dict[str, Any], inadmissible: bool) -> dict[str, Any]:
+        return {
+            "action_mask": self.action_mask(),
+            "inadmissible": inadmissible,
+            "time": rec["time"],
+            "spread": rec["spread"],
+            "rmse": rec["rmse"],
+            "mean_error": rec["mean_error"],
+            "detection": rec["detection"],
+        }

@@ -1,0 +1,134 @@
+"""The Gymnasium environment: the standard API checks, determinism, and that a planner acting in
+it makes exactly the search `dcee run` makes."""
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import dcee.gym
+from dcee import DceeInputError
+from dcee.scenarios import load_scenario
+from dcee.simulation import run_episode
+
+SMALL = {"scenario": "paper:1", "particles": 300, "budget": 60.0}
+
+
+def test_registered_env_passes_the_gymnasium_checker():
+    env = gymnasium.make(dcee.gym.ENV_ID, render_mode="rgb_array", **SMALL)
+    check_env(env.unwrapped, skip_render_check=False)
+    obs, info = env.reset(seed=1)
+    assert env.observation_space.contains(obs)
+    assert info["action_mask"].dtype == np.int8 and info["action_mask"].shape == (8,)
+    frame = env.render()
+    assert frame.dtype == np.uint8 and frame.ndim == 3 and frame.shape[2] == 3
+
+
+def test_same_seed_same_episode_and_observation_fields():
+    def roll(seed):
+        env = dcee.gym.SourceSearchEnv(**SMALL)
+        obs, _ = env.reset(seed=seed)
+        out = [obs]
+        for k in range(10):
+            obs, *_ = env.step(k % 8)
+            out.append(obs)
+        return np.array(out)
+
+    a, b, c = roll(3), roll(3), roll(4)
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(a, c)
+    assert a.shape == (11, len(dcee.gym.env.OBSERVATION_FIELDS))
+    # the start of paper:1 is (2, 2, 4) m in a 50 × 50 × 5 m area
+    np.testing.assert_allclose(a[0, :3], [2 / 50, 2 / 50, 4 / 5], rtol=1e-6)
+    np.testing.assert_allclose(a[:, -1] * 60.0, 1.0 + 2.0 * np.arange(11), rtol=1e-6)
+
+
+def test_inadmissible_moves_keep_the_robot_in_place_and_are_masked():
+    env = dcee.gym.SourceSearchEnv(**SMALL)
+    _, info = env.reset(seed=0)
+    assert info["action_mask"].all()  # from (2, 2) every 2 m step stays in [0, 50]²
+    _, _, _, _, info = env.step(4)  # −x, to (0, 2): on the edge
+    # a further −x step would leave the area: masked, and the robot stays
+    assert info["action_mask"][4] == 0 and info["action_mask"][0] == 1
+    before = env.position
+    np.testing.assert_allclose(before[:2], [0.0, 2.0])
+    _, _, _, _, info = env.step(4)
+    assert info["inadmissible"] and np.array_equal(env.position, before)
+    _, _, _, _, info = env.step(0)
+    assert not info["inadmissible"]
+    np.testing.assert_allclose(env.position, before + np.array([2.0, 0.0, 0.0]))
+
+
+def test_episode_ends_by_budget_or_convergence_with_documented_rewards():
+    env = dcee.gym.SourceSearchEnv(**SMALL, time_penalty=0.1)
+    _, info = env.reset(seed=2)
+    spreads, rewards, truncated, steps = [info["spread"]], [], False, 0
+    while not truncated:
+        _, r, terminated, truncated, info = env.step(0 if info["action_mask"][0] else 2)
+        assert not terminated  # 300 particles and 60 s do not converge to 0.5 m
+        rewards.append(r)
+        spreads.append(info["spread"])
+        steps += 1
+    # 60 s budget, first reading at 1 s, 2 s per move: 29 moves fit
+    assert steps == 29
+    np.testing.assert_allclose(rewards, -np.diff(spreads) - 0.1, rtol=1e-12)
+    with pytest.raises(DceeInputError, match="step"):
+        env.step(0)
+    # a loose convergence criterion ends the episode with the bonus
+    env = dcee.gym.SourceSearchEnv(**SMALL, converged_spread=1e3, success_bonus=5.0)
+    env.reset(seed=2)
+    _, r, terminated, truncated, _ = env.step(0)
+    assert terminated and not truncated and r > 4.0
+
+
+@pytest.mark.parametrize("strategy", ["infotaxis", "dcee-cl"])
+def test_a_planner_policy_reproduces_dcee_run(strategy):
+    scenario = load_scenario("paper:5").with_overrides(
+        **{"search.particles": 400, "search.budget": 40.0}
+    )
+    reference = run_episode(scenario, strategy, 7)
+    table = dcee.gym.evaluate(
+        [dcee.gym.PlannerPolicy(strategy)], [7], scenario=scenario, particles=None
+    )
+    row = table.iloc[0]
+    assert row["strategy"] == strategy
+    for key in ("final_rmse", "final_spread", "detections", "steps", "path_length"):
+        assert row[key] == reference.summary[key], key
+
+
+def test_evaluate_scores_policies_on_common_seeds():
+    table = dcee.gym.evaluate(
+        [dcee.gym.RandomPolicy(), dcee.gym.PlannerPolicy("mpc")], [0, 1], **SMALL
+    )
+    assert list(table["strategy"]) == ["random", "random", "mpc", "mpc"]
+    assert {"final_rmse", "source_acquired", "time_to_rmse_1m", "return"} <= set(table.columns)
+    # both policies saw the same first reading (same truth noise)
+    again = dcee.gym.evaluate([dcee.gym.RandomPolicy()], [0, 1], **SMALL)
+    np.testing.assert_array_equal(again["final_rmse"], table["final_rmse"][:2])
+
+
+def test_vectorised_envs_step_together():
+    envs = gymnasium.make_vec(dcee.gym.ENV_ID, num_envs=2, vectorization_mode="sync", **SMALL)
+    obs, _ = envs.reset(seed=[0, 1])
+    assert obs.shape == (2, len(dcee.gym.env.OBSERVATION_FIELDS))
+    obs, reward, terminated, truncated, _ = envs.step(np.array([0, 1]))
+    assert reward.shape == terminated.shape == truncated.shape == (2,)
+    assert obs.dtype == np.float32
+    envs.close()
+
+
+def test_bad_keywords_are_user_errors():
+    for kwargs, field in [
+        ({"reward": "fun"}, "reward"),
+        ({"time_penalty": -1.0}, "time_penalty"),
+        ({"render_mode": "human"}, "render_mode"),
+        ({"particles": 0}, "particles"),
+    ]:
+        with pytest.raises(DceeInputError, match=field):
+            dcee.gym.SourceSearchEnv(**{**SMALL, **kwargs})
+    env = dcee.gym.SourceSearchEnv(**SMALL)
+    with pytest.raises(DceeInputError, match="reset"):
+        env.step(0)
+    env.reset(seed=0)
+    with pytest.raises(DceeInputError, match="action"):
+        env.step(8)
