@@ -114,6 +114,11 @@ def cli(ctx: click.Context) -> None:
 @click.option("--budget", type=float, help="Override search.budget (seconds of flight).")
 @click.option("--unknown", type=click.Choice(["source", "full"]), help="Override unknown set.")
 @click.option(
+    "--agents",
+    type=int,
+    help="Robots searching together with one shared belief (override agent.count) [default: 1].",
+)
+@click.option(
     "--out",
     "out_dir",
     type=click.Path(file_okay=False, path_type=Path),
@@ -140,6 +145,7 @@ def run(
     hypotheses: int | None,
     budget: float | None,
     unknown: str | None,
+    agents: int | None,
     out_dir: Path | None,
     json_file: Path | None,
     truth: str | None,
@@ -171,9 +177,14 @@ def run(
         "search.budget": budget,
         "unknown": unknown,
         "truth.model": truth,
+        "agent.count": agents,
         **_overrides(likelihood, settings),
     }
     scenario = base.with_overrides(**changes)
+    if scenario.agent.count > 1:
+        from dcee.planning import check_team_planner
+
+        check_team_planner(get_planner(strategy))
     out_dir = out_dir or Path("results") / _default_run_folder(
         scenario, base, changes, strategy, seed
     )
@@ -220,7 +231,14 @@ def run(
     _print_summary(result.summary, out_dir)
 
 
-NAMED_CHANGES = ("search.particles", "search.hypotheses", "search.budget", "unknown", "truth.model")
+NAMED_CHANGES = (
+    "search.particles",
+    "search.hypotheses",
+    "search.budget",
+    "unknown",
+    "truth.model",
+    "agent.count",
+)
 """Overrides that the default run folder names in words; any other change adds a hash."""
 
 
@@ -228,7 +246,8 @@ def _default_run_folder(
     scenario: Any, base: Any, changes: dict[str, Any], strategy: str, seed: int
 ) -> str:
     """``paper-1_dcee_seed0``, plus what differs from the built-in: ``_n10000`` particles,
-    ``_j20`` hypotheses, ``_b300`` budget, ``_full`` unknowns, ``_filament`` truth, and a short
+    ``_j20`` hypotheses, ``_b300`` budget, ``_full`` unknowns, ``_filament`` truth, ``_a3``
+    robots, and a short
     hash of the resolved scenario when anything else changed (``--likelihood``, ``--set``), so
     two different runs never share a default folder."""
     import hashlib
@@ -245,6 +264,8 @@ def _default_run_folder(
         parts.append(scenario.unknown)
     if scenario.truth.model != base.truth.model:
         parts.append(scenario.truth.model_name)
+    if scenario.agent.count != base.agent.count:
+        parts.append(f"a{scenario.agent.count}")
     named_only = base.with_overrides(**{k: v for k, v in changes.items() if k in NAMED_CHANGES})
     if scenario != named_only:
         digest = hashlib.sha256(
@@ -501,6 +522,11 @@ def _numba_threads() -> int:
 @click.option("--scheduler", help="Address of a running Dask scheduler, e.g. tcp://host:8786.")
 @click.option("--unknown", type=click.Choice(["source", "full"]), help="Override unknown set.")
 @click.option("--particles", type=int, help="Override the particle count.")
+@click.option(
+    "--agents",
+    type=int,
+    help="Robots searching together with one shared belief (override agent.count) [default: 1].",
+)
 @TRUTH_OPTION
 @LIKELIHOOD_OPTION
 @SET_OPTION
@@ -518,6 +544,7 @@ def bench(
     scheduler: str | None,
     unknown: str | None,
     particles: int | None,
+    agents: int | None,
     truth: str | None,
     likelihood: str | None,
     settings: tuple[str, ...],
@@ -537,6 +564,9 @@ def bench(
     from dcee.scenarios.config import truth_choice
 
     names = tuple(s.strip() for s in strategies.split(",") if s.strip())
+    overrides = _overrides(likelihood, settings)
+    if agents is not None:
+        overrides["agent.count"] = agents
     campaign = Campaign(
         out_dir,
         suite,
@@ -545,7 +575,7 @@ def bench(
         unknown,
         particles,
         truth_choice(truth) if truth is not None else None,
-        _overrides(likelihood, settings),
+        overrides,
         allow_code_change,
     )
     check_writable_dir(out_dir, "out")

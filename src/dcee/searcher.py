@@ -13,6 +13,7 @@ from dcee.errors import DceeInputError
 from dcee.estimation.particle_filter import ParticleFilter, UpdateInfo
 from dcee.models.agent import GridAgent
 from dcee.planning.base import Belief, Decision, Planner
+from dcee.planning.team import decide_team
 
 
 @dataclass(frozen=True)
@@ -55,6 +56,7 @@ class Searcher:
         self.time = 0.0
         self.last_update: UpdateInfo | None = None
         self.last_decision: Decision | None = None
+        self.last_team_decisions: list[Decision | None] = []
         self.last_update_seconds = 0.0
         self.last_decision_seconds = 0.0
 
@@ -87,6 +89,27 @@ class Searcher:
         self.last_decision_seconds = _time.perf_counter() - t0
         return self.last_decision.position.copy()
 
+    def ask_team(self, positions: np.ndarray) -> np.ndarray:
+        """Next waypoints (K, 3) m of K robots at ``positions`` (K, 3) that share this
+        searcher's belief (every robot's readings told to this searcher), chosen jointly by
+        sequential greedy planning (:func:`dcee.planning.team.decide_team`); a robot with no
+        admissible, collision-free move keeps its position. :attr:`last_team_decisions` holds
+        the per-robot decisions."""
+        if self.position is None:
+            raise DceeInputError("ask", "tell() at least one reading before ask_team()")
+        if self.planner is None:
+            raise DceeInputError("planner", "this searcher has no planner to ask")
+        arr = np.asarray(positions, dtype=np.float64) if _is_numeric(positions) else None
+        if arr is None or arr.ndim != 2 or arr.shape[1] != 3 or not np.all(np.isfinite(arr)):
+            raise DceeInputError("positions", "must be a finite (K, 3) array of positions in m")
+        t0 = _time.perf_counter()
+        decisions = decide_team(self.planner, self.belief(), arr, self.agent, self.rng)
+        self.last_decision_seconds = _time.perf_counter() - t0
+        self.last_team_decisions = decisions
+        return np.array(
+            [d.position if d is not None else p for d, p in zip(decisions, arr, strict=True)]
+        )
+
     def belief(self) -> Belief:
         f = self.filter
         return Belief(f.theta, f.weights, f.sensor, f.plume)
@@ -94,3 +117,10 @@ class Searcher:
     def estimate(self) -> SourceEstimate:
         """Posterior mean and covariance of the source location."""
         return SourceEstimate(self.filter.source_mean(), self.filter.source_cov())
+
+
+def _is_numeric(value: object) -> bool:
+    try:
+        return np.asarray(value).dtype.kind in "iuf"
+    except (TypeError, ValueError):
+        return False

@@ -66,7 +66,15 @@ def _draw_map(
     )
     px = np.array([r["x"] for r in recs])
     py = np.array([r["y"] for r in recs])
-    ax.plot(px, py, "-", color="tab:red", lw=0.8, alpha=0.8, label="trajectory")
+    robot = np.array([r.get("robot", 0) for r in recs])
+    robots = np.unique(robot)
+    colours = ["tab:red", "tab:purple", "tab:orange", "tab:brown", "tab:pink", "tab:olive"]
+    for k in robots:
+        on = robot == k
+        label = "trajectory" if len(robots) == 1 else f"robot {k} trajectory"
+        ax.plot(
+            px[on], py[on], "-", color=colours[k % len(colours)], lw=0.8, alpha=0.8, label=label
+        )
     det = np.array([r["detection"] for r in recs])
     z = np.array([r["reading"] for r in recs])
     ax.scatter(px[~det], py[~det], s=4, c="0.35", lw=0, label="non-detection")
@@ -87,7 +95,8 @@ def _draw_map(
     ax.plot(
         last["mean_x"], last["mean_y"], "P", ms=9, mec="k", mfc="tab:cyan", label="posterior mean"
     )
-    ax.plot(*scenario.agent.start[:2], "x", ms=9, color="k", mew=2, label="start")
+    starts = scenario.starts()
+    ax.plot(starts[:, 0], starts[:, 1], "x", ms=9, color="k", mew=2, ls="none", label="start")
     ax.set_xlim(scenario.volume.low[0], scenario.volume.high[0])
     ax.set_ylim(scenario.volume.low[1], scenario.volume.high[1])
     ax.set_aspect("equal")

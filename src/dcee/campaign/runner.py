@@ -150,6 +150,11 @@ class Campaign:
                 self.suite, self.unknown, self.particles, self.truth, self.overrides
             )
         }
+        if any(sc.agent.count > 1 for sc in self.scenarios.values()):
+            from dcee.planning import check_team_planner
+
+            for s in self.strategies:
+                check_team_planner(get_planner(s))  # e.g. dcee-ms plans for one robot only
         if self.truth is not None:
             from dcee.simulation import make_truth
 

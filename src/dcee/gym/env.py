@@ -121,6 +121,10 @@ class SourceSearchEnv(gymnasium.Env):
                 "estimator.likelihood": likelihood,
             }
         )
+        if self.scenario.agent.count != 1:
+            raise DceeInputError(
+                "agent.count", "SourceSearchEnv flies one robot; use dcee.gym.multi_search_env"
+            )
         self.reward_kind = reward
         self.time_penalty = float(time_penalty)
         self.success_bonus = float(success_bonus)
@@ -176,7 +180,7 @@ class SourceSearchEnv(gymnasium.Env):
         run_seed = int(seed) if seed is not None else int(self.np_random.integers(2**31))
         self.simulation = SearchSimulation(self.scenario, run_seed)
         self._done = False
-        rec = self.simulation.sense()
+        rec = self.simulation.sense()[0]
         return self._observation(rec), self._info(rec, inadmissible=False)
 
     def step(self, action: Any) -> tuple[np.ndarray, SupportsFloat, bool, bool, dict[str, Any]]:
@@ -193,7 +197,7 @@ class SourceSearchEnv(gymnasium.Env):
         inadmissible = len(hit) == 0
         # an inadmissible heading keeps the robot where it is for one step (time still passes)
         sim.move(sim.position if inadmissible else candidates[hit[0]])
-        rec = sim.sense()
+        rec = sim.sense()[0]
         key = "spread" if self.reward_kind == "spread" else "rmse"
         reward = float(before[key] - rec[key]) - self.time_penalty
         terminated = bool(rec["spread"] < self.converged_spread)

@@ -19,6 +19,7 @@ from dcee.planning.base import (
 )
 from dcee.planning.hypothesis import HypothesisPlanner
 from dcee.planning.predicted import EXPECTATIONS, PredictionContext, SequenceStats
+from dcee.planning.team import check_team_planner, decide_team
 
 __all__ = [
     "EXPECTATIONS",
@@ -28,6 +29,8 @@ __all__ = [
     "Planner",
     "PredictionContext",
     "SequenceStats",
+    "check_team_planner",
+    "decide_team",
     "get",
     "names",
     "planner_class",

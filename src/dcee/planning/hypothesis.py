@@ -97,6 +97,21 @@ class HypothesisPlanner(Planner):
         stats = ctx.stats(sequences, moments=self.needs_moments, kl=self.needs_kl)
         return stats.expect(self.loss(sequences[:, -1], stats, belief))
 
+    def context(
+        self, belief: Belief, rng: np.random.Generator, stages: int
+    ) -> tuple[Belief, PredictionContext]:
+        """The belief the predictions use (a systematic resample of it with ``subsample`` < 1)
+        and one decision's :class:`PredictionContext` for sequences of up to ``stages``
+        readings, drawing every random number from ``rng``."""
+        if self.subsample < 1.0:
+            n = max(1, round(self.subsample * len(belief.weights)))
+            idx = systematic_resample(belief.weights, rng, n)
+            belief = Belief(belief.theta[idx], np.full(n, 1.0 / n), belief.sensor, belief.plume)
+        ctx = PredictionContext(
+            belief, self.n_hypotheses, stages, rng, self.expectation, self.noise, self.readings
+        )
+        return belief, ctx
+
     def costs(
         self,
         belief: Belief,
@@ -105,19 +120,7 @@ class HypothesisPlanner(Planner):
         agent: GridAgent,
         rng: np.random.Generator,
     ) -> tuple[np.ndarray, dict[str, Any]]:
-        if self.subsample < 1.0:
-            n = max(1, round(self.subsample * len(belief.weights)))
-            idx = systematic_resample(belief.weights, rng, n)
-            belief = Belief(belief.theta[idx], np.full(n, 1.0 / n), belief.sensor, belief.plume)
-        ctx = PredictionContext(
-            belief,
-            self.n_hypotheses,
-            self.horizon,
-            rng,
-            self.expectation,
-            self.noise,
-            self.readings,
-        )
+        belief, ctx = self.context(belief, rng, self.horizon)
         seqs = candidates[:, None, :]
         cost = self.sequence_costs(seqs, ctx, belief)
         if self.horizon == 1:

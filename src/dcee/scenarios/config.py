@@ -334,6 +334,19 @@ class EstimatorSpec(BaseModel):
     likelihood's default, :data:`OUTLIER_DEFAULT`"""
 
 
+def team_starts(
+    start: np.ndarray, step: float, count: int, low: np.ndarray, high: np.ndarray
+) -> np.ndarray | None:
+    """(count, 3) start positions: robot k at ``start`` + k · step along +y, or along −y where
+    the row would leave [low, high]; None when neither fits."""
+    for sign in (1.0, -1.0):
+        rows = np.repeat(np.asarray(start, dtype=np.float64)[None, :], count, axis=0)
+        rows[:, 1] += sign * step * np.arange(count)
+        if np.all(rows >= low - 1e-9) and np.all(rows <= high + 1e-9):
+            return rows
+    return None
+
+
 class AgentSpec(BaseModel):
     """The mobile sensor: where it starts and how it moves (one step along one of
     ``headings`` directions per decision, at the start altitude)."""
@@ -350,6 +363,9 @@ class AgentSpec(BaseModel):
     :data:`TURBULENT_HOLD` for a time-varying one"""
     headings: Annotated[int, Field(ge=1, le=64)] = 8
     """number of equally spaced move directions (0°, 45°, … for 8)"""
+    count: Annotated[int, Field(ge=1, le=16)] = 1
+    """robots searching together with one shared belief; robot k starts k · step metres from
+    ``start`` along +y (along −y where +y would leave the area)"""
 
 
 class SearchSpec(BaseModel):
@@ -441,6 +457,12 @@ class Scenario(BaseModel):
             self.dwell,
             self.agent.headings,
         )
+        starts = team_starts(start, self.agent.step, self.agent.count, lo, hi)
+        if starts is None:
+            raise ValueError(
+                f"{FIELD_MARK}agent.count: {self.agent.count} robots {self.agent.step:g} m apart "
+                f"along y from agent.start {tuple(self.agent.start)} do not fit in the area"
+            )
         if len(agent.candidates(start)[0]) == 0:
             raise ValueError(
                 f"{FIELD_MARK}agent.step: {self.agent.step:g} m leaves the search area from "
@@ -529,6 +551,14 @@ class Scenario(BaseModel):
     def make_plume(self) -> IsotropicPlume:
         """The dispersion model of the filter and the planners."""
         return IsotropicPlume(meander=self.meander)
+
+    def starts(self) -> np.ndarray:
+        """(count, 3) start positions of the robots, m (row 0 is ``agent.start``)."""
+        lo, hi = np.array(self.volume.low), np.array(self.volume.high)
+        a = self.agent
+        out = team_starts(np.array(a.start, dtype=np.float64), a.step, a.count, lo, hi)
+        assert out is not None  # checked at validation
+        return out
 
     def make_agent(self) -> GridAgent:
         a = self.agent

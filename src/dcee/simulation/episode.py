@@ -23,6 +23,7 @@ from dcee.io import write_atomic, write_json
 from dcee.models.sensor import Sensor
 from dcee.planning import get as get_planner
 from dcee.planning.base import Planner, planner_class
+from dcee.planning.team import check_team_planner
 from dcee.provenance import code_version
 from dcee.scenarios.config import Scenario
 from dcee.searcher import Searcher
@@ -170,15 +171,17 @@ def streams(seed: int) -> tuple[np.random.Generator, ...]:
 
 
 class SearchSimulation:
-    """One simulated search, a reading at a time: the world (truth, instrument, agent model)
-    and the filter, without a planner. :func:`run_episode` drives it with a planner; the
-    Gymnasium environment (:mod:`dcee.gym`) with a policy's actions. Both therefore make the
-    same readings and the same records for the same seed and moves.
+    """One simulated search, a step at a time: the world (truth, instrument, robots' move
+    model) and the filter, without a planner. :func:`run_episode` drives it with a planner; the
+    Gymnasium and PettingZoo environments (:mod:`dcee.gym`) with a policy's actions. All
+    therefore make the same readings and the same records for the same seed and moves.
 
-    ``sense()`` takes the reading at the current position and time, assimilates it and appends
-    the step's record (:attr:`records`); ``move(waypoint)`` flies to the next waypoint, one
-    ``agent.step_time`` later; ``finished`` says when no further move fits the budget (or the
-    scenario's ``stop_spread`` is reached).
+    ``sense()`` takes every robot's reading at its current position and the current time,
+    assimilates them into the one shared filter (robot 0 first) and appends one record per
+    reading (:attr:`records`, with its ``robot``); ``move(waypoints)`` flies the robots to their
+    next waypoints, one ``agent.step_time`` later; ``finished`` says when no further move fits
+    the budget (or the scenario's ``stop_spread`` is reached). The scenario's ``agent.count``
+    sets the number of robots (:meth:`~dcee.scenarios.config.Scenario.starts`).
     """
 
     def __init__(
@@ -210,22 +213,33 @@ class SearchSimulation:
             max_sweeps=search.max_sweeps,
         )
         self.searcher = Searcher(self.filter, planner, self.agent, planner_rng)
-        self.position = np.array(scenario.agent.start, dtype=np.float64)
+        self.positions = scenario.starts()  # (K, 3)
         self.time = self.agent.dwell  # the first reading is taken at the start after one dwell
         self.records: list[dict[str, Any]] = []
         self.path_length = 0.0
 
-    def sense(self) -> dict[str, Any]:
-        """Take, assimilate and record the reading at the current position and time."""
-        scenario, pf, position, t = self.scenario, self.filter, self.position, self.time
-        # the same count of noise draws per step, whatever the position
+    @property
+    def position(self) -> np.ndarray:
+        """(3,) robot 0's position, m (the only robot's, in a single-robot search)."""
+        return self.positions[0]
+
+    def sense(self) -> list[dict[str, Any]]:
+        """Take, assimilate and record every robot's reading at the current time; returns the
+        step's records, one per robot."""
+        return [self._sense_one(k) for k in range(len(self.positions))]
+
+    def _sense_one(self, robot: int) -> dict[str, Any]:
+        scenario, pf, t = self.scenario, self.filter, self.time
+        position = self.positions[robot].copy()
+        # the same count of noise draws per step, whatever the positions
         noise = self.sensor.draw_noise(self._truth_rng, ())
         conc = self.truth.sensed(position, t, scenario.average, scenario.sensor.response_time)
         reading = float(self.sensor.simulate_from(conc, noise))
         info = self.searcher.tell(position, reading, t)
         est = self.searcher.estimate()
         rec: dict[str, Any] = {
-            "step": len(self.records),
+            "step": len(self.records) // len(self.positions),
+            "robot": robot,
             "time": t,
             "x": position[0],
             "y": position[1],
@@ -269,11 +283,12 @@ class SearchSimulation:
             and self.records[-1]["spread"] < search.stop_spread
         )
 
-    def move(self, waypoint: np.ndarray) -> None:
-        """Fly to ``waypoint`` (3,) m; the next reading is one step time later."""
-        waypoint = np.asarray(waypoint, dtype=np.float64)
-        self.path_length += float(np.linalg.norm(waypoint - self.position))
-        self.position = waypoint
+    def move(self, waypoints: np.ndarray) -> None:
+        """Fly the robots to ``waypoints`` (K, 3) m (a (3,) waypoint for one robot); the next
+        readings are one step time later."""
+        waypoints = np.asarray(waypoints, dtype=np.float64).reshape(self.positions.shape)
+        self.path_length += float(np.linalg.norm(waypoints - self.positions, axis=1).sum())
+        self.positions = waypoints.copy()
         self.time += self.agent.step_time
 
     def summary(self, strategy: str) -> dict[str, Any]:
@@ -316,14 +331,20 @@ def run_episode(
     pf, searcher = sim.filter, sim.searcher
     snapshots: list[tuple[float, np.ndarray]] = []
     pending = sorted(snapshot_at) if snapshot_at is not None else []
+    team = scenario.agent.count > 1
+    if team:
+        check_team_planner(planner)
     while True:
-        rec = sim.sense()
+        rec = sim.sense()[-1]
         t = sim.time
         if pending and t >= pending[0] - 1e-9:
             snapshots.append((t, _subsample(pf, snapshot_particles, sim.figure_rng)))
             while pending and t >= pending[0] - 1e-9:
                 pending.pop(0)
-        waypoint = None if sim.finished else searcher.ask()
+        if sim.finished:
+            waypoint = None
+        else:
+            waypoint = searcher.ask_team(sim.positions) if team else searcher.ask()
         if waypoint is not None:
             rec["decision_seconds"] = searcher.last_decision_seconds
         if progress:

@@ -34,6 +34,7 @@ def summarise(
     decision = np.array([r["decision_seconds"] for r in records])
     update = np.array([r["update_seconds"] for r in records])
     final = records[-1]
+    steps = len(np.unique(times)) - 1  # moves: every robot reads once per step
     return {
         "scenario": scenario.name,
         "strategy": strategy,
@@ -53,11 +54,12 @@ def summarise(
         "detections": int(sum(r["detection"] for r in records)),
         "time_to_rmse_1m": first_time_below(times, rmse, 1.0),
         "time_to_rmse_0_5m": first_time_below(times, rmse, 0.5),
-        "steps": len(records) - 1,
+        "steps": steps,
         "readings": len(records),
+        "agents": int(scenario.agent.count),
         "path_length": float(path_length),
         "decision_seconds_total": float(decision.sum()),
-        "decision_seconds_mean": float(decision[:-1].mean()) if len(records) > 1 else 0.0,
+        "decision_seconds_mean": float(decision.sum() / steps) if steps else 0.0,
         "update_seconds_total": float(update.sum()),
         "compute_seconds_total": float(decision.sum() + update.sum()),
     }
