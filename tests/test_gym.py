@@ -132,3 +132,32 @@ def test_bad_keywords_are_user_errors():
     env.reset(seed=0)
     with pytest.raises(DceeInputError, match="action"):
         env.step(8)
+
+
+def test_multi_robot_env_passes_the_pettingzoo_tests():
+    from pettingzoo.test import parallel_api_test, parallel_seed_test
+
+    parallel_api_test(dcee.gym.multi_search_env(agents=3, **SMALL), num_cycles=40)
+    parallel_seed_test(lambda: dcee.gym.multi_search_env(agents=2, **SMALL), num_cycles=40)
+
+
+def test_multi_robot_env_shares_one_belief_and_blocks_collisions():
+    env = dcee.gym.multi_search_env(agents=2, **SMALL)
+    obs, infos = env.reset(seed=5)
+    np.testing.assert_allclose(env.simulation.positions[:, :2], [[2, 2], [2, 4]])
+    # both step +y: robot 0 onto (2, 4), which robot 1 leaves for (2, 6) -- allowed
+    obs, rewards, _, _, infos = env.step({"robot_0": 2, "robot_1": 2})
+    assert not any(i["blocked"] for i in infos.values())
+    np.testing.assert_allclose(env.simulation.positions[:, :2], [[2, 4], [2, 6]])
+    # the shared belief: the same belief summary in both observations, their own positions
+    np.testing.assert_array_equal(obs["robot_0"][5:], obs["robot_1"][5:])
+    np.testing.assert_allclose(obs["robot_1"][:2] * 50, [2, 6], rtol=1e-6)
+    assert rewards["robot_0"] == rewards["robot_1"]
+    # robots 4 m apart both step onto the cell between them: the later one is blocked
+    env.simulation.positions = np.array([[2.0, 0.0, 4.0], [2.0, 4.0, 4.0]])
+    _, _, _, _, infos = env.step({"robot_0": 2, "robot_1": 6})
+    assert not infos["robot_0"]["blocked"] and infos["robot_1"]["blocked"]
+    np.testing.assert_allclose(env.simulation.positions[:, :2], [[2, 2], [2, 4]])
+    # one record per robot and step, every reading in the one filter
+    assert len(env.simulation.records) == 2 * 3
+    assert env.simulation.filter.n_readings == 6

@@ -96,31 +96,8 @@ class SourceSearchEnv(gymnasium.Env):
         converged_spread: float = 0.5,
         render_mode: str | None = None,
     ) -> None:
-        from dcee.scenarios import load_scenario
-
-        if reward not in REWARDS:
-            raise DceeInputError("reward", f"must be one of {', '.join(REWARDS)}, got {reward!r}")
-        for name, value in (
-            ("time_penalty", time_penalty),
-            ("success_bonus", success_bonus),
-            ("converged_spread", converged_spread),
-        ):
-            if isinstance(value, bool) or not (
-                isinstance(value, int | float) and math.isfinite(value) and value >= 0
-            ):
-                raise DceeInputError(name, f"must be a finite number >= 0, got {value!r}")
-        if render_mode not in (None, "rgb_array"):
-            raise DceeInputError("render_mode", f"must be None or 'rgb_array', got {render_mode!r}")
-        base = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
-        self.scenario = base.with_overrides(
-            **{
-                "search.particles": particles,
-                "search.budget": budget,
-                "unknown": unknown,
-                "truth.model": truth_choice(truth) if truth is not None else None,
-                "estimator.likelihood": likelihood,
-            }
-        )
+        self.scenario = make_scenario(scenario, particles, unknown, truth, likelihood, budget)
+        check_options(reward, time_penalty, success_bonus, converged_spread, render_mode)
         if self.scenario.agent.count != 1:
             raise DceeInputError(
                 "agent.count", "SourceSearchEnv flies one robot; use dcee.gym.multi_search_env"
@@ -130,16 +107,8 @@ class SourceSearchEnv(gymnasium.Env):
         self.success_bonus = float(success_bonus)
         self.converged_spread = float(converged_spread)
         self.render_mode = render_mode
-        agent = self.scenario.make_agent()
-        self.action_space = spaces.Discrete(agent.n_headings)
-        high = np.ones(len(OBSERVATION_FIELDS), dtype=np.float32)
-        high[OBSERVATION_FIELDS.index("log_reading")] = MAX_LOG_READING
-        self.observation_space = spaces.Box(
-            np.zeros(len(OBSERVATION_FIELDS), np.float32), high, dtype=np.float32
-        )
-        volume = self.scenario.volume
-        self._low = np.asarray(volume.low, dtype=np.float64)
-        self._size = np.asarray(volume.high, dtype=np.float64) - self._low
+        self.action_space = spaces.Discrete(self.scenario.agent.headings)
+        self.observation_space = observation_space()
         self.simulation: SearchSimulation | None = None
 
     # -- what reference policies may see ------------------------------------------------------
@@ -166,9 +135,7 @@ class SourceSearchEnv(gymnasium.Env):
     def action_mask(self) -> np.ndarray:
         """(H,) int8: 1 for the headings that keep the robot inside the area."""
         sim = self._sim()
-        mask = np.zeros(self.action_space.n, dtype=np.int8)
-        mask[sim.agent.candidates(sim.position)[1]] = 1
-        return mask
+        return action_mask(sim, sim.position)
 
     # -- Gymnasium API --------------------------------------------------------------------------
     def reset(
@@ -192,11 +159,10 @@ class SourceSearchEnv(gymnasium.Env):
         if self._done:
             raise DceeInputError("step", "the episode has ended; call reset()")
         before = sim.records[-1]
-        candidates, headings = sim.agent.candidates(sim.position)
-        hit = np.flatnonzero(headings == int(action))
-        inadmissible = len(hit) == 0
+        target = heading_target(sim, sim.position, int(action))
+        inadmissible = target is None
         # an inadmissible heading keeps the robot where it is for one step (time still passes)
-        sim.move(sim.position if inadmissible else candidates[hit[0]])
+        sim.move(sim.position if target is None else target)
         rec = sim.sense()[0]
         key = "spread" if self.reward_kind == "spread" else "rmse"
         reward = float(before[key] - rec[key]) - self.time_penalty
@@ -233,27 +199,8 @@ class SourceSearchEnv(gymnasium.Env):
     # -- helpers --------------------------------------------------------------------------------
     _done = False
 
-    def _fraction(self, values: np.ndarray) -> np.ndarray:
-        out = np.zeros(3)
-        flat = self._size <= 0
-        out[~flat] = (values[~flat] - self._low[~flat]) / self._size[~flat]
-        return out
-
     def _observation(self, rec: dict[str, Any]) -> np.ndarray:
-        sim = self._sim()
-        sd = np.sqrt(np.maximum([rec["cov_xx"], rec["cov_yy"], rec["cov_zz"]], 0.0))
-        scale = np.where(self._size > 0, self._size, np.inf)
-        obs = np.concatenate(
-            [
-                self._fraction(sim.position),
-                [math.log1p(max(rec["reading"], 0.0)), float(rec["detection"])],
-                self._fraction(np.array([rec["mean_x"], rec["mean_y"], rec["mean_z"]])),
-                sd / scale,
-                [rec["ess"] / sim.filter.n, rec["time"] / self.scenario.search.budget],
-            ]
-        )
-        low, high = self.observation_space.low, self.observation_space.high
-        return np.clip(obs, low, high).astype(np.float32)
+        return observe(self._sim(), rec, self._sim().position)
 
     def _info(self, rec: dict[str, Any], inadmissible: bool) -> dict[str, Any]:
         return {
@@ -265,3 +212,103 @@ class SourceSearchEnv(gymnasium.Env):
             "mean_error": rec["mean_error"],
             "detection": rec["detection"],
         }
+
+
+# -- shared with the multi-robot environment ---------------------------------------------------
+def make_scenario(
+    scenario: str | Scenario,
+    particles: int | None,
+    unknown: str | None,
+    truth: str | None,
+    likelihood: str | None,
+    budget: float | None,
+    count: int | None = None,
+) -> Scenario:
+    """The environment's scenario: a built-in name, a TOML path or a :class:`Scenario`, with
+    the keyword overrides applied (None keeps the scenario's value)."""
+    from dcee.scenarios import load_scenario
+
+    base = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+    return base.with_overrides(
+        **{
+            "search.particles": particles,
+            "search.budget": budget,
+            "unknown": unknown,
+            "truth.model": truth_choice(truth) if truth is not None else None,
+            "estimator.likelihood": likelihood,
+            "agent.count": count,
+        }
+    )
+
+
+def check_options(
+    reward: str,
+    time_penalty: float,
+    success_bonus: float,
+    converged_spread: float,
+    render_mode: str | None,
+) -> None:
+    """:class:`DceeInputError` naming the first keyword that is not allowed."""
+    if reward not in REWARDS:
+        raise DceeInputError("reward", f"must be one of {', '.join(REWARDS)}, got {reward!r}")
+    for name, value in (
+        ("time_penalty", time_penalty),
+        ("success_bonus", success_bonus),
+        ("converged_spread", converged_spread),
+    ):
+        if isinstance(value, bool) or not (
+            isinstance(value, int | float) and math.isfinite(value) and value >= 0
+        ):
+            raise DceeInputError(name, f"must be a finite number >= 0, got {value!r}")
+    if render_mode not in (None, "rgb_array"):
+        raise DceeInputError("render_mode", f"must be None or 'rgb_array', got {render_mode!r}")
+
+
+def observation_space() -> spaces.Box:
+    """The per-robot observation space (see :data:`OBSERVATION_FIELDS`)."""
+    high = np.ones(len(OBSERVATION_FIELDS), dtype=np.float32)
+    high[OBSERVATION_FIELDS.index("log_reading")] = MAX_LOG_READING
+    return spaces.Box(np.zeros(len(OBSERVATION_FIELDS), np.float32), high, dtype=np.float32)
+
+
+def action_mask(sim: SearchSimulation, position: np.ndarray) -> np.ndarray:
+    """(H,) int8: 1 for the headings from ``position`` that stay inside the area."""
+    mask = np.zeros(sim.agent.n_headings, dtype=np.int8)
+    mask[sim.agent.candidates(position)[1]] = 1
+    return mask
+
+
+def heading_target(sim: SearchSimulation, position: np.ndarray, heading: int) -> np.ndarray | None:
+    """(3,) the position one step from ``position`` along ``heading``; None if it leaves the
+    area."""
+    candidates, headings = sim.agent.candidates(position)
+    hit = np.flatnonzero(headings == heading)
+    return candidates[hit[0]] if len(hit) else None
+
+
+def observe(sim: SearchSimulation, rec: dict[str, Any], position: np.ndarray) -> np.ndarray:
+    """One robot's observation: its ``position`` and the reading of its record ``rec``, and the
+    shared belief after the step's readings (the simulation's last record)."""
+    volume = sim.scenario.volume
+    low = np.asarray(volume.low, dtype=np.float64)
+    size = np.asarray(volume.high, dtype=np.float64) - low
+
+    def fraction(values: np.ndarray) -> np.ndarray:
+        out = np.zeros(3)
+        flat = size <= 0
+        out[~flat] = (values[~flat] - low[~flat]) / size[~flat]
+        return out
+
+    shared = sim.records[-1]
+    sd = np.sqrt(np.maximum([shared["cov_xx"], shared["cov_yy"], shared["cov_zz"]], 0.0))
+    obs = np.concatenate(
+        [
+            fraction(np.asarray(position, dtype=np.float64)),
+            [math.log1p(max(rec["reading"], 0.0)), float(rec["detection"])],
+            fraction(np.array([shared["mean_x"], shared["mean_y"], shared["mean_z"]])),
+            sd / np.where(size > 0, size, np.inf),
+            [shared["ess"] / sim.filter.n, shared["time"] / sim.scenario.search.budget],
+        ]
+    )
+    space = observation_space()
+    return np.clip(obs, space.low, space.high).astype(np.float32)
