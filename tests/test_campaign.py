@@ -451,3 +451,15 @@ def test_plain_progress_lines_for_logs(capsys):
     assert len(lines) == 20
     assert lines[0] == "paper: 2/40 searches, failed 1, elapsed 0:00:06, ETA 0:01:54"
     assert lines[-1] == "paper: 40/40 searches, failed 1, elapsed 0:02:00, ETA 0:00:00"
+
+
+def test_campaigns_stored_before_a_setting_existed_still_resume():
+    # agent.count came later: a stored scenario without it ran with the default (1 robot)
+    from dcee.campaign.runner import scenario_identity
+    from dcee.scenarios import load_scenario
+
+    now = load_scenario("paper:1").model_dump(mode="json")
+    before = {**now, "agent": {k: v for k, v in now["agent"].items() if k != "count"}}
+    assert scenario_identity(before) == scenario_identity(now)
+    two = {**now, "agent": {**now["agent"], "count": 2}}
+    assert scenario_identity(two) != scenario_identity(before)

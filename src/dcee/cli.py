@@ -282,9 +282,13 @@ def _check_same_run(out_dir: Path, scenario: Any, strategy: str, seed: int) -> N
     if not entries:
         return
     try:
+        from dcee.campaign.runner import scenario_identity
+
         config = json.loads((out_dir / "config.json").read_text())
         same = (
-            config.get("scenario") == scenario.model_dump(mode="json")
+            isinstance(config.get("scenario"), dict)
+            and scenario_identity(config["scenario"])
+            == scenario_identity(scenario.model_dump(mode="json"))
             and config.get("strategy") == strategy
             and config.get("seed") == seed
         )

@@ -31,6 +31,7 @@ every session that ran searches in it; resuming with different code is refused u
 
 from __future__ import annotations
 
+import copy
 import json
 import os
 import time
@@ -235,18 +236,35 @@ class Campaign:
         return out
 
 
+LATER_DEFAULTS: dict[tuple[str, ...], Any] = {("agent", "count"): 1}
+"""Scenario settings added after campaigns were first stored, with their defaults: a stored
+scenario without one ran with the default, so the two must compare equal."""
+
+
 def _identity(settings: dict[str, Any]) -> dict[str, Any]:
     """What must match for results to belong together: the settings without the scenarios'
-    free-text descriptions (rewording one must not orphan a campaign; it changes no result)."""
+    free-text descriptions (rewording one must not orphan a campaign; it changes no result) and
+    without later-added settings at their defaults (:data:`LATER_DEFAULTS`)."""
     out = dict(settings)
     scenarios = out.get("scenarios")
     if isinstance(scenarios, dict):
         out["scenarios"] = {
-            name: {k: v for k, v in sc.items() if k != "description"}
-            if isinstance(sc, dict)
-            else sc
+            name: scenario_identity(sc) if isinstance(sc, dict) else sc
             for name, sc in scenarios.items()
         }
+    return out
+
+
+def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
+    """A stored scenario (its JSON dump) reduced to what decides the results: without its
+    free-text description and without later-added settings at their defaults."""
+    out = copy.deepcopy({k: v for k, v in scenario.items() if k != "description"})
+    for path, default in LATER_DEFAULTS.items():
+        node = out
+        for key in path[:-1]:
+            node = node.get(key) if isinstance(node, dict) else None
+        if isinstance(node, dict) and node.get(path[-1], default) == default:
+            node.pop(path[-1], None)
     return out
 
 
