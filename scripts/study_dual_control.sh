@@ -33,3 +33,31 @@ $D bench --suite paper --repeats 10 --unknown full --strategies dcee,mpc --out r
 # the two-move scenario tree against dcee-cl (small: 5,000 particles, 10 + 5 hypotheses, 1 repeat)
 $D bench --suite hard-easy --repeats 1 --particles 5000 --out results/dual-tree \
     --strategies dcee-cl:hypotheses=10,dcee-cl-tree:hypotheses=10:branch_hypotheses=5
+# the 21-search full-unknown pilot of docs/dual-control.md §6b-6c (paired with paper-full-cl by seed)
+for spec in dcee-cl:reach=4 dcee-cl:spread_reach=1 dcee-cl:hypotheses=80 dcee-cl:info_share=0.5 \
+    dcee-cl:info_share=1; do
+    dir=results/pilot-full/$(echo "$spec" | sed 's/:/+/g; s/=/-/g')
+    for K in 1 5 6 7 8 10 12; do for S in 0 1 2; do
+        [ -f "$dir/paper-$K-seed$S.json" ] && continue
+        $D run --scenario paper:$K --strategy "$spec" --seed $S --particles 20000 --unknown full \
+            --out "$dir/paper-$K-seed$S" --json "$dir/paper-$K-seed$S.json" --no-figure -q
+    done; done
+done
+# 2026-11-22: dcee-cl's uncertainty term values every parameter (info_share = 0.5, docs/dual-control.md
+# §6c). The 120-search studies again, dcee-cl beside the other planners' searches of the same seeds:
+# copies of the folders above (hard links) without their old dcee-cl searches, then the new dcee-cl.
+for s in source full; do
+    if [ ! -d results/paper-$s-cl2 ]; then
+        cp -al results/paper-$s-cl results/paper-$s-cl2
+        rm results/paper-$s-cl2/campaign.json && cp results/paper-$s-cl/campaign.json results/paper-$s-cl2/
+        rm -rf results/paper-$s-cl2/runs/config=*/strategy=dcee-cl
+    fi
+done
+$D bench --suite paper --repeats 10 --strategies dcee-cl --out results/paper-source-cl2 --allow-code-change
+$D bench --suite paper --repeats 10 --unknown full --strategies dcee-cl --out results/paper-full-cl2 \
+    --allow-code-change
+# the new term in the ablation and in the 75 m area (the old `dcee-cl` rows there are info_share = 0)
+$D bench --suite hard-easy --repeats 5 --particles 10000 --out results/dual-ablation --allow-code-change \
+    --strategies dcee-cl:info_share=0.5,dcee-cl:info_share=1
+$D bench --suite hard-easy75 --repeats 5 --particles 10000 --out results/dual-ablation-75 \
+    --allow-code-change --strategies dcee-cl:info_share=0.5
