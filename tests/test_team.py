@@ -103,3 +103,27 @@ def test_cli_run_and_bench_take_agents(tmp_path, capsys):
     assert json.loads((bench / "campaign.json").read_text())["settings"]["overrides"] == {
         "agent.count": 2
     }
+
+
+def test_searcher_asks_for_a_team_and_rejects_bad_positions():
+    from dcee import ParticleFilter, Searcher
+
+    sc = load_scenario("lab:downwind")
+    pf = ParticleFilter(sc.make_prior(), sc.make_sensor(), n_particles=500, seed=0)
+    s = Searcher(pf, planners.get("infotaxis"), sc.make_agent(), np.random.default_rng(0))
+    starts = np.array(sc.agent.start) + np.array([[0.0, 0.0, 0.0], [0.0, 0.3, 0.0]])
+    with pytest.raises(DceeInputError, match="ask"):
+        s.ask_team(starts)
+    for p in starts:
+        s.tell(p, 0.0, time=3.0)
+    nxt = s.ask_team(starts)
+    assert nxt.shape == (2, 3) and len(s.last_team_decisions) == 2
+    np.testing.assert_allclose(np.linalg.norm(nxt - starts, axis=1), 0.3)
+    assert not np.allclose(nxt[0], nxt[1])
+    for bad in (starts[0], [[1.0, 2.0]], [[np.nan, 0.0, 0.0]], "here"):
+        with pytest.raises(DceeInputError, match="positions"):
+            s.ask_team(bad)
+    bare = Searcher(pf, None, sc.make_agent(), np.random.default_rng(0))
+    bare.tell(starts[0], 0.0, time=4.0)
+    with pytest.raises(DceeInputError, match="planner"):
+        bare.ask_team(starts)
