@@ -158,6 +158,23 @@ def draw_search_figure(result: EpisodeResult, scenario: Scenario, truth: TruthMo
     return fig
 
 
+def render_search(
+    result: EpisodeResult, scenario: Scenario, truth: TruthModel, dpi: int = 80
+) -> np.ndarray:
+    """The summary figure of one search as an (H, W, 3) uint8 RGB image (environments'
+    ``render``)."""
+    from io import BytesIO
+
+    from PIL import Image
+
+    fig = draw_search_figure(result, scenario, truth)
+    buffer = BytesIO()
+    fig.savefig(buffer, format="png", dpi=dpi, bbox_inches="tight")
+    plt.close(fig)
+    buffer.seek(0)
+    return np.asarray(Image.open(buffer).convert("RGB"))
+
+
 def search_figure(
     result: EpisodeResult, scenario: Scenario, truth: TruthModel, path: str | Path
 ) -> None:

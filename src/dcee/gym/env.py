@@ -176,15 +176,9 @@ class SourceSearchEnv(gymnasium.Env):
     def render(self) -> np.ndarray | None:  # type: ignore[override]
         if self.render_mode != "rgb_array":
             return None
-        from dcee.analysis.figures import draw_search_figure
+        from dcee.analysis.figures import render_search
 
-        fig = draw_search_figure(self.result("policy"), self.scenario, self._sim().truth)
-        fig.canvas.draw()
-        image = np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()
-        import matplotlib.pyplot as plt
-
-        plt.close(fig)
-        return image
+        return render_search(self.result("policy"), self.scenario, self._sim().truth)
 
     # -- results --------------------------------------------------------------------------------
     def result(self, strategy: str) -> EpisodeResult:

@@ -146,20 +146,14 @@ class MultiSearchEnv(ParallelEnv):
     def render(self) -> np.ndarray | None:
         if self.render_mode != "rgb_array":
             return None
-        import matplotlib.pyplot as plt
-
-        from dcee.analysis.figures import draw_search_figure
+        from dcee.analysis.figures import render_search
         from dcee.simulation.episode import EpisodeResult
 
         sim = self._sim()
         result = EpisodeResult(
             sim.records, sim.summary("policy"), sim.filter.theta, sim.filter.weights, [], {}
         )
-        fig = draw_search_figure(result, self.scenario, sim.truth)
-        fig.canvas.draw()
-        image = np.asarray(fig.canvas.buffer_rgba())[..., :3].copy()
-        plt.close(fig)
-        return image
+        return render_search(result, self.scenario, sim.truth)
 
     def close(self) -> None:
         pass
