@@ -154,7 +154,9 @@ def draw_search_figure(result: EpisodeResult, scenario: Scenario, truth: TruthMo
         f" · source {'acquired' if s['source_acquired'] else 'not acquired'}",
         fontsize=11,
     )
-    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    # room below the map for its legend (placed under the axes), also when the figure is shown
+    # or saved without bbox_inches="tight"
+    fig.tight_layout(rect=(0, 0.07, 1, 0.95))
     return fig
 
 
