@@ -99,8 +99,11 @@ class Searcher:
             raise DceeInputError("ask", "tell() at least one reading before ask_team()")
         if self.planner is None:
             raise DceeInputError("planner", "this searcher has no planner to ask")
-        arr = np.asarray(positions, dtype=np.float64) if _is_numeric(positions) else None
-        if arr is None or arr.ndim != 2 or arr.shape[1] != 3 or not np.all(np.isfinite(arr)):
+        try:
+            arr = np.asarray(positions, dtype=np.float64)
+        except (TypeError, ValueError):
+            arr = np.empty(0)
+        if arr.ndim != 2 or arr.shape[1] != 3 or not np.all(np.isfinite(arr)):
             raise DceeInputError("positions", "must be a finite (K, 3) array of positions in m")
         t0 = _time.perf_counter()
         decisions = decide_team(self.planner, self.belief(), arr, self.agent, self.rng)
@@ -117,10 +120,3 @@ class Searcher:
     def estimate(self) -> SourceEstimate:
         """Posterior mean and covariance of the source location."""
         return SourceEstimate(self.filter.source_mean(), self.filter.source_cov())
-
-
-def _is_numeric(value: object) -> bool:
-    try:
-        return np.asarray(value).dtype.kind in "iuf"
-    except (TypeError, ValueError):
-        return False

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Any, ClassVar, SupportsFloat
 
 import gymnasium
@@ -97,15 +98,12 @@ class SourceSearchEnv(gymnasium.Env):
         render_mode: str | None = None,
     ) -> None:
         self.scenario = make_scenario(scenario, particles, unknown, truth, likelihood, budget)
-        check_options(reward, time_penalty, success_bonus, converged_spread, render_mode)
+        self.rules = EpisodeRules.checked(reward, time_penalty, success_bonus, converged_spread)
+        check_render_mode(render_mode)
         if self.scenario.agent.count != 1:
             raise DceeInputError(
                 "agent.count", "SourceSearchEnv flies one robot; use dcee.gym.multi_search_env"
             )
-        self.reward_kind = reward
-        self.time_penalty = float(time_penalty)
-        self.success_bonus = float(success_bonus)
-        self.converged_spread = float(converged_spread)
         self.render_mode = render_mode
         self.action_space = spaces.Discrete(self.scenario.agent.headings)
         self.observation_space = observation_space()
@@ -164,12 +162,7 @@ class SourceSearchEnv(gymnasium.Env):
         # an inadmissible heading keeps the robot where it is for one step (time still passes)
         sim.move(sim.position if target is None else target)
         rec = sim.sense()[0]
-        key = "spread" if self.reward_kind == "spread" else "rmse"
-        reward = float(before[key] - rec[key]) - self.time_penalty
-        terminated = bool(rec["spread"] < self.converged_spread)
-        truncated = bool(not terminated and sim.finished)
-        if terminated:
-            reward += self.success_bonus
+        reward, terminated, truncated = self.rules.outcome(before, rec, sim.finished)
         self._done = terminated or truncated
         return self._observation(rec), reward, terminated, truncated, self._info(rec, inadmissible)
 
@@ -235,25 +228,47 @@ def make_scenario(
     )
 
 
-def check_options(
-    reward: str,
-    time_penalty: float,
-    success_bonus: float,
-    converged_spread: float,
-    render_mode: str | None,
-) -> None:
-    """:class:`DceeInputError` naming the first keyword that is not allowed."""
-    if reward not in REWARDS:
-        raise DceeInputError("reward", f"must be one of {', '.join(REWARDS)}, got {reward!r}")
-    for name, value in (
-        ("time_penalty", time_penalty),
-        ("success_bonus", success_bonus),
-        ("converged_spread", converged_spread),
-    ):
-        if isinstance(value, bool) or not (
-            isinstance(value, int | float) and math.isfinite(value) and value >= 0
+@dataclass(frozen=True)
+class EpisodeRules:
+    """Reward and episode end, shared by the single- and multi-robot environments (see
+    :class:`SourceSearchEnv`); built with :meth:`checked`, which names a bad keyword."""
+
+    reward: str = "spread"
+    time_penalty: float = 0.0
+    success_bonus: float = 0.0
+    converged_spread: float = 0.5
+
+    @classmethod
+    def checked(
+        cls, reward: str, time_penalty: float, success_bonus: float, converged_spread: float
+    ) -> EpisodeRules:
+        if reward not in REWARDS:
+            raise DceeInputError("reward", f"must be one of {', '.join(REWARDS)}, got {reward!r}")
+        for name, value in (
+            ("time_penalty", time_penalty),
+            ("success_bonus", success_bonus),
+            ("converged_spread", converged_spread),
         ):
-            raise DceeInputError(name, f"must be a finite number >= 0, got {value!r}")
+            if isinstance(value, bool) or not (
+                isinstance(value, int | float) and math.isfinite(value) and value >= 0
+            ):
+                raise DceeInputError(name, f"must be a finite number >= 0, got {value!r}")
+        return cls(reward, float(time_penalty), float(success_bonus), float(converged_spread))
+
+    def outcome(
+        self, before: dict[str, Any], after: dict[str, Any], finished: bool
+    ) -> tuple[float, bool, bool]:
+        """(reward, terminated, truncated) of a step from the belief records before and after
+        it; ``finished``: no further move fits the budget."""
+        reward = float(before[self.reward] - after[self.reward]) - self.time_penalty
+        terminated = bool(after["spread"] < self.converged_spread)
+        if terminated:
+            reward += self.success_bonus
+        return reward, terminated, bool(not terminated and finished)
+
+
+def check_render_mode(render_mode: str | None) -> None:
+    """:class:`DceeInputError` unless ``render_mode`` is None or ``"rgb_array"``."""
     if render_mode not in (None, "rgb_array"):
         raise DceeInputError("render_mode", f"must be None or 'rgb_array', got {render_mode!r}")
 

@@ -11,8 +11,9 @@ from pettingzoo import ParallelEnv
 
 from dcee.errors import DceeInputError
 from dcee.gym.env import (
+    EpisodeRules,
     action_mask,
-    check_options,
+    check_render_mode,
     heading_target,
     make_scenario,
     observation_space,
@@ -65,11 +66,8 @@ class MultiSearchEnv(ParallelEnv):
         self.scenario = make_scenario(
             scenario, particles, unknown, truth, likelihood, budget, agents
         )
-        check_options(reward, time_penalty, success_bonus, converged_spread, render_mode)
-        self.reward_kind = reward
-        self.time_penalty = float(time_penalty)
-        self.success_bonus = float(success_bonus)
-        self.converged_spread = float(converged_spread)
+        self.rules = EpisodeRules.checked(reward, time_penalty, success_bonus, converged_spread)
+        check_render_mode(render_mode)
         self.render_mode = render_mode
         self.possible_agents = [f"robot_{k}" for k in range(agents)]
         self.agents: list[str] = []
@@ -124,13 +122,7 @@ class MultiSearchEnv(ParallelEnv):
             targets.append(sim.positions[k].copy() if blocked[agent] else target)
         sim.move(np.array(targets))
         records = sim.sense()
-        after = records[-1]
-        key = "spread" if self.reward_kind == "spread" else "rmse"
-        reward = float(before[key] - after[key]) - self.time_penalty
-        terminated = bool(after["spread"] < self.converged_spread)
-        truncated = bool(not terminated and sim.finished)
-        if terminated:
-            reward += self.success_bonus
+        reward, terminated, truncated = self.rules.outcome(before, records[-1], sim.finished)
         agents = list(self.agents)
         obs, infos = self._observations(records), self._infos(records, blocked)
         if terminated or truncated:

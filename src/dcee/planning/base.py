@@ -36,6 +36,13 @@ class Belief:
     def source_mean(self) -> np.ndarray:
         return self.weights @ self.source
 
+    def location_variance(self, dims: int = 3) -> float:
+        """Σ of the posterior variances of the first ``dims`` source coordinates, m² (3: tr P of
+        the location; 2: the horizontal part)."""
+        loc = self.source[:, :dims]
+        centred = loc - self.weights @ loc
+        return float(self.weights @ np.einsum("ij,ij->i", centred, centred))
+
 
 @dataclass
 class Decision:

@@ -100,9 +100,7 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
         as the belief narrows (an option under study, docs/dual-control.md)."""
         if self.spread_reach == 0.0:
             return self.reach
-        xy = belief.source[:, :2]
-        centred = xy - belief.weights @ xy
-        spread = math.sqrt(float(belief.weights @ np.einsum("ij,ij->i", centred, centred)))
+        spread = math.sqrt(belief.location_variance(2))
         return max(self.reach, self.spread_reach * spread)
 
     def uncertainty(self, stats: SequenceStats, belief: Belief) -> np.ndarray:
@@ -116,10 +114,8 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
         values readings that resolve the environment, which later narrow the location."""
         if self.info_share == 0.0:
             return stats.trace_cov
-        centred = belief.source - belief.source_mean()
-        total = float(belief.weights @ np.einsum("ij,ij->i", centred, centred))  # tr P
         a = self.info_share
-        return (1.0 - a) * stats.trace_cov + a * total * np.exp(-stats.kl)
+        return (1.0 - a) * stats.trace_cov + a * belief.location_variance() * np.exp(-stats.kl)
 
     def loss(self, final_positions: np.ndarray, stats: SequenceStats, belief: Belief) -> np.ndarray:
         d = stats.mean - final_positions[:, None, :]
