@@ -21,7 +21,10 @@ import numpy as np
 from dcee.allocator import tune_allocator
 from dcee.estimation import ParticleFilter
 from dcee.models import isotropic_concentration
+from dcee.models.plume import isotropic_concentration_reference
+from dcee.perf.floor import floor_decision
 from dcee.planning import get as get_planner
+from dcee.planning.predicted import PredictionContext, predicted_posterior_stats_reference
 from dcee.scenarios import load_scenario
 from dcee.searcher import Searcher
 from dcee.simulation import run_episode, streams
@@ -37,6 +40,9 @@ class Timing:
     values: list[float] = field(default_factory=list)
     unit: str = "ms"
     note: str = ""
+    ratio_to: dict[str, float] = field(default_factory=dict)
+    """Median of this workload over the median of each named reference timed in the same run
+    (``floor``: the plain compiled loop, ``numpy``: the NumPy reference, ``stonesoup``)."""
 
     @property
     def median(self) -> float:
@@ -61,6 +67,7 @@ class Timing:
             "passed": self.passed,
             "repeats": len(self.values),
             "note": self.note,
+            "ratio_to": dict(self.ratio_to),
         }
         if self.unit == "ms":
             out["median_ms"] = out["median"]
@@ -128,6 +135,39 @@ def stall_filter(n_particles: int, seed: int = 1) -> ParticleFilter:
     return pf
 
 
+def _reference_inputs(searcher: Searcher, n_hypotheses: int = 40):
+    """What a decision of ``searcher`` computes, as inputs to the references: its belief, its
+    admissible candidates (M, 3) and J hypothesised readings per candidate (M, J) drawn by the
+    planners' own machinery (sampled expectation)."""
+    belief = searcher.belief()
+    candidates, _ = searcher.agent.candidates(searcher.position)
+    ctx = PredictionContext(belief, n_hypotheses, 1, np.random.default_rng(0))
+    idx = ctx.position_index(candidates)
+    readings = np.stack([ctx.readings(idx[k : k + 1])[0][:, 0] for k in range(len(idx))])
+    return belief, candidates, readings
+
+
+def _numpy_decision(belief, candidates: np.ndarray, readings: np.ndarray) -> None:
+    """The NumPy reference of the same statistics: the plume and the predicted posteriors
+    (:func:`~dcee.planning.predicted.predicted_posterior_stats_reference`)."""
+    plume = belief.plume
+    conc = isotropic_concentration_reference(
+        belief.theta, candidates, plume.min_distance, plume.meander
+    ).T
+    dist = np.linalg.norm(belief.source[None, :, :] - candidates[:, None, :], axis=2)
+    m_count, j_count = readings.shape
+    task_pos = np.repeat(np.arange(m_count), j_count)[:, None]
+    predicted_posterior_stats_reference(
+        conc,
+        belief.source,
+        belief.weights,
+        task_pos,
+        readings.reshape(-1, 1),
+        belief.sensor,
+        np.maximum(dist, plume.min_distance),
+    )
+
+
 def _decisions_interleaved(
     items: list[tuple[str, str, float | None]],
     n: int,
@@ -135,24 +175,45 @@ def _decisions_interleaved(
     make_filter: Callable[[int], ParticleFilter] = posterior_filter,
     where: str = "",
     position: tuple[float, float, float] | None = None,
+    references: bool = False,
 ) -> list[Timing]:
     """Decisions of several planners timed in alternation (one decision of each per round,
     each planner with its own searcher and filter), so that the ratios between them are
     measured under the same machine load: on this shared machine blocks timed one after the
-    other drift apart by 2x and more."""
+    other drift apart by 2x and more.
+
+    ``references``: each round also times the plain compiled loop (:mod:`dcee.perf.floor`) and,
+    in the first three rounds, the NumPy reference, both on the first searcher's belief,
+    candidates and 40 hypothesised readings per candidate; every decision then gets its
+    ``ratio_to`` them."""
     searchers = [_searcher(make_filter(n), strategy) for _, strategy, _ in items]
     if position is not None:
         for searcher in searchers:
             searcher.position = np.array(position)
     for searcher in searchers:
         searcher.ask()  # warm-up: compilation caches, allocator
-    times: list[list[float]] = [[] for _ in items]
-    for _ in range(repeats):
-        for k, searcher in enumerate(searchers):
+    calls: list[Callable[[], object]] = [s.ask for s in searchers]
+    if references:
+        belief, cands, readings = _reference_inputs(searchers[0])
+        out = np.empty((*readings.shape, 6))
+        calls.append(
+            lambda: floor_decision(
+                belief.theta, belief.weights, cands, readings, belief.sensor, belief.plume, out
+            )
+        )
+        calls[-1]()  # warm-up
+    times: list[list[float]] = [[] for _ in calls]
+    numpy_times: list[float] = []
+    for round_ in range(repeats):
+        for k, call in enumerate(calls):
             t0 = time.perf_counter()
-            searcher.ask()
+            call()
             times[k].append(1e3 * (time.perf_counter() - t0))
-    return [
+        if references and round_ < 3:
+            t0 = time.perf_counter()
+            _numpy_decision(belief, cands, readings)
+            numpy_times.append(1e3 * (time.perf_counter() - t0))
+    out_timings = [
         Timing(
             name,
             f"one {strategy} decision, {n:,} particles, 8 moves × 40 readings{where} "
@@ -160,8 +221,30 @@ def _decisions_interleaved(
             target,
             t,
         )
-        for (name, strategy, target), t in zip(items, times, strict=True)
+        for (name, strategy, target), t in zip(items, times, strict=False)
     ]
+    if references:
+        floor = Timing(
+            f"floor-decision-{n // 1000}k",
+            f"the plain compiled loop (dcee.perf.floor): the same statistics of "
+            f"{readings.size} (move, reading) tasks, {n:,} particles, nothing shared",
+            None,
+            times[-1],
+        )
+        numpy_ref = Timing(
+            f"numpy-decision-{n // 1000}k",
+            "the NumPy reference of the same statistics (3 rounds)",
+            None,
+            numpy_times,
+        )
+        for t in out_timings:
+            t.ratio_to = {"floor": t.median / floor.median, "numpy": t.median / numpy_ref.median}
+            t.note = (
+                f"{t.ratio_to['floor']:.2f}× the plain compiled loop, "
+                f"{t.ratio_to['numpy']:.3f}× the NumPy reference (same run)"
+            )
+        out_timings += [floor, numpy_ref]
+    return out_timings
 
 
 def _filter_update(repeats: int) -> Timing:
@@ -292,6 +375,7 @@ def run_workloads(quick: bool = False, progress: Callable[[str], None] | None = 
                 ],
                 20_000,
                 max(r, 9),
+                references=True,
             ),
         ),
         (
