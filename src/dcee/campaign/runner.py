@@ -282,8 +282,9 @@ _STARTED: Any = None  # in a local worker: shared flags, set when a search start
 def _init_worker(started: Any = None, own_process: bool = False) -> None:
     """Worker processes: one numba thread each (parallel kernels degrade badly when several
     searches share the cores; one search per core is the efficient layout). The local workers
-    are processes this module started, so their allocator is tuned too
-    (:mod:`dcee.allocator`); a Dask cluster's workers are not ours to retune."""
+    are processes this module started, so their allocator is tuned and BLAS limited to one
+    thread too (:mod:`dcee.allocator`, :mod:`dcee.blas`); a Dask cluster's workers are not ours
+    to retune (their searches still limit BLAS inside each update and decision)."""
     import numba
 
     global _STARTED
@@ -291,8 +292,10 @@ def _init_worker(started: Any = None, own_process: bool = False) -> None:
     numba.set_num_threads(1)
     if own_process:
         from dcee.allocator import tune_allocator
+        from dcee.blas import limit_process_blas
 
         tune_allocator()
+        limit_process_blas()  # spinning OpenBLAS threads would take the other worker's core
 
 
 def _run_marked(index: int, task: SearchTask, search: Callable[[SearchTask], dict]) -> dict:

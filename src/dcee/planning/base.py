@@ -5,7 +5,7 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
@@ -14,19 +14,25 @@ from dcee.models.agent import GridAgent
 from dcee.models.plume import IsotropicPlume
 from dcee.models.sensor import Sensor
 
+if TYPE_CHECKING:
+    from dcee.planning.particle_terms import ParticleTerms
+
 
 @dataclass(frozen=True)
 class Belief:
     """A weighted particle approximation of p(Θ | Z_k), as planners see it (no copies made).
 
     theta: (N, 8) source terms; weights: (N,) normalised; sensor and plume: the models used to
-    predict readings.
+    predict readings; cache: a :class:`~dcee.planning.particle_terms.ParticleTerms` kept by the
+    caller across decisions (a :class:`~dcee.searcher.Searcher` keeps one), or None for a
+    fresh one per decision.
     """
 
     theta: np.ndarray
     weights: np.ndarray
     sensor: Sensor
     plume: IsotropicPlume
+    cache: ParticleTerms | None = field(default=None, compare=False, repr=False)
 
     @property
     def source(self) -> np.ndarray:

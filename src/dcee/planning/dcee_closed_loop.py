@@ -166,7 +166,7 @@ class ScenarioTreeDCEEPlanner(ClosedLoopDCEEPlanner):
         conc, dist = ctx.terms[0], ctx.terms[1]
         branch_seed = int(rng.integers(2**63))
         with np.errstate(divide="ignore"):
-            log_w = np.log(belief.weights)
+            log_w = np.log(ctx.belief.weights)  # over the context's (merged) particles
         cost = np.zeros(len(candidates))
         branches = 0
         for m, p_idx in enumerate(first_idx):

@@ -100,9 +100,9 @@ class HypothesisPlanner(Planner):
     def context(
         self, belief: Belief, rng: np.random.Generator, stages: int
     ) -> tuple[Belief, PredictionContext]:
-        """The belief the predictions use (a systematic resample of it with ``subsample`` < 1)
-        and one decision's :class:`PredictionContext` for sequences of up to ``stages``
-        readings, drawing every random number from ``rng``."""
+        """The belief the predictions use (its identical particles merged; a systematic
+        resample of it with ``subsample`` < 1) and one decision's :class:`PredictionContext`
+        for sequences of up to ``stages`` readings, drawing every random number from ``rng``."""
         if self.subsample < 1.0:
             n = max(1, round(self.subsample * len(belief.weights)))
             idx = systematic_resample(belief.weights, rng, n)
@@ -110,7 +110,7 @@ class HypothesisPlanner(Planner):
         ctx = PredictionContext(
             belief, self.n_hypotheses, stages, rng, self.expectation, self.noise, self.readings
         )
-        return belief, ctx
+        return ctx.belief, ctx
 
     def costs(
         self,

@@ -26,10 +26,9 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.estimation.particle_filter import systematic_resample
-from dcee.models.plume_kernels import concentration_distance_grid
 from dcee.models.sensor import Sensor
-from dcee.models.sensor_kernels import position_terms
 from dcee.planning.base import Belief
+from dcee.planning.particle_terms import ParticleTerms
 from dcee.planning.predicted_kernels import predicted_posterior_stats
 
 
@@ -87,6 +86,25 @@ def predicted_posterior_stats_reference(
         pos = w_post > 0
         kl[s] = np.sum(w_post[pos] * (np.log(w_post[pos]) - np.log(weights[pos])))
     return log_ev, mean, trace, kl
+
+
+def unique_per_sequence(readings: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The distinct reading sequences of each candidate: readings (S, J, T) →
+    (task readings (Q, T), the candidate of each task (Q,), inverse (S, J) task of each
+    hypothesis). Tasks are ordered by candidate, then lexicographically by reading (the order
+    ``np.unique(readings[s], axis=0)`` gives), so identical hypotheses of one candidate
+    (in practice every non-detection) are evaluated once."""
+    s_count, j_count, t_count = readings.shape
+    flat = readings.reshape(s_count * j_count, t_count)
+    seq = np.repeat(np.arange(s_count), j_count)
+    order = np.lexsort((*flat.T[::-1], seq))  # the last key is the primary one
+    fs, ss = flat[order], seq[order]
+    new = np.ones(len(order), dtype=bool)
+    new[1:] = (ss[1:] != ss[:-1]) | np.any(fs[1:] != fs[:-1], axis=1)
+    task = np.cumsum(new) - 1
+    inverse = np.empty(len(order), dtype=np.int64)
+    inverse[order] = task
+    return np.ascontiguousarray(fs[new]), ss[new], inverse.reshape(s_count, j_count)
 
 
 EXPECTATIONS = ("sampled", "stratified")
@@ -150,6 +168,13 @@ class PredictionContext:
         readings: str = "model",
     ) -> None:
         check_hypothesis_options(expectation, noise, readings)
+        self._pt = belief.cache if belief.cache is not None else ParticleTerms()
+        self._pt.sync(belief.theta, belief.sensor, belief.plume)
+        self._pt.begin()
+        # the merged particles (see dcee.planning.particle_terms): same statistics, less work
+        belief = Belief(
+            self._pt.theta, self._pt.weights(belief.weights), belief.sensor, belief.plume
+        )
         self.belief = belief
         self.sensor = belief.sensor
         self.expectation = expectation
@@ -160,12 +185,8 @@ class PredictionContext:
         self._fresh = noise == "fresh"
         self._simplify = readings
         self._draw()
-        self._theta = np.ascontiguousarray(belief.theta)
         self._source = np.ascontiguousarray(belief.source)
         self._center = belief.source_mean()
-        self._rows: list[tuple[np.ndarray, ...]] = []
-        self._index: dict[tuple[float, ...], int] = {}
-        self._terms: tuple[np.ndarray, ...] | None = None
 
     def _draw(self) -> None:
         """Every random number one set of hypotheses needs (see the class docstring)."""
@@ -187,22 +208,20 @@ class PredictionContext:
     def branch(
         self, weights: np.ndarray, n_hypotheses: int, rng: np.random.Generator
     ) -> PredictionContext:
-        """A one-stage context for the belief reweighted to ``weights`` (N,) — the predicted
-        posterior after a hypothesised reading — that reuses this context's per-position terms
-        (they depend on Θ, not on the weights) and draws its own hypotheses from ``rng``.
+        """A one-stage context for the belief reweighted to ``weights`` (M,) (over this
+        context's particles, :attr:`belief`) — the predicted posterior after a hypothesised
+        reading — that reuses this context's per-position terms (they depend on Θ, not on the
+        weights) and draws its own hypotheses from ``rng``.
 
         Particles below 1e-12 of the largest weight are dropped (their total share is below
         N · 1e-12): after a detection the branch keeps only the few particles that explain it.
         """
         keep = weights > 1e-12 * weights.max()
         other = copy.copy(self)
-        other._rows, other._index = list(self._rows), dict(self._index)  # never shared
         theta = self.belief.theta
         if keep.mean() < 0.9:
             theta, weights = theta[keep], weights[keep] / weights[keep].sum()
-            other._rows = [tuple(np.ascontiguousarray(a[:, keep]) for a in self.terms)]
-            other._terms = None
-            other._theta = np.ascontiguousarray(theta)
+            other._pt = self._pt.subset(keep)
             other._source = np.ascontiguousarray(theta[:, :3])
         other.belief = Belief(theta, weights, self.sensor, self.belief.plume)
         other._n, other._horizon, other._rng = int(n_hypotheses), 1, rng
@@ -217,44 +236,20 @@ class PredictionContext:
         return self._n if self.expectation == "sampled" else self._n + 1
 
     def position_index(self, positions: np.ndarray) -> np.ndarray:
-        """Indices of (K, 3) positions in the concentration cache, computing new ones."""
-        out = np.empty(len(positions), dtype=np.int64)
-        new: list[np.ndarray] = []
-        for k, p in enumerate(positions):
-            key = tuple(np.round(p, 9).tolist())
-            if key not in self._index:
-                self._index[key] = len(self._index)
-                new.append(p)
-            out[k] = self._index[key]
-        if new:
-            pts = np.ascontiguousarray(np.array(new, dtype=np.float64))
-            shape = (len(pts), self._theta.shape[0])
-            conc, dist, loc, log_nd, inv_sigma, det_offset = (np.empty(shape) for _ in range(6))
-            plume = self.belief.plume
-            concentration_distance_grid(
-                self._theta, pts, plume.min_distance, plume.meander, conc, dist
-            )
-            position_terms(conc, dist, self._sp, loc, log_nd, inv_sigma, det_offset)
-            self._rows.append((conc, dist, loc, log_nd, inv_sigma, det_offset))
-            self._terms = None
-        return out
+        """Rows of (K, 3) positions in :attr:`terms`, computing new ones."""
+        return self._pt.rows(positions)
 
     @property
     def terms(self) -> tuple[np.ndarray, ...]:
-        """(conc, dist, loc, log_nd, inv_sigma, det_offset), each (P, N), at every cached
-        position (see :func:`dcee.models.sensor_kernels.position_terms`)."""
-        if self._terms is None and len(self._rows) == 1:
-            self._terms = self._rows[0]
-        elif self._terms is None:
-            self._terms = tuple(
-                np.ascontiguousarray(np.concatenate([r[k] for r in self._rows], axis=0))
-                for k in range(6)
-            )
-        return self._terms
+        """(conc, dist, loc, log_nd, inv_sigma, det_offset), each (R, M) over this context's
+        particles, rows as :meth:`position_index` gives them (see
+        :func:`dcee.models.sensor_kernels.position_terms`). Read it after the last
+        :meth:`position_index` call: new rows may move the buffers."""
+        return self._pt.terms
 
     @property
     def conc(self) -> np.ndarray:
-        """(P, N) concentrations of every particle at every cached position."""
+        """(R, M) concentrations of every particle at every cached position."""
         return self.terms[0]
 
     def readings(self, pos_idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -269,6 +264,14 @@ class PredictionContext:
         r = self.terms[1][pos_idx][:, self.indices].T
         z = self.sensor.simulate_from(c, self.noise[:, :t_count], r)
         return z, np.full(self._n, 1.0 / self._n)
+
+    def _sampled_readings(self, pos_idx: np.ndarray) -> np.ndarray:
+        """(S, J, T) sampled hypothesised readings along (S, T) sequences of cached positions;
+        the same as :meth:`readings` for each sequence (shared noise), in one NumPy pass."""
+        t_count = pos_idx.shape[1]
+        c = self.conc[:, self.indices][pos_idx].transpose(0, 2, 1)  # (S, J, T)
+        r = self.terms[1][:, self.indices][pos_idx].transpose(0, 2, 1)
+        return self.sensor.simulate_from(c, self.noise[None, :, :t_count], r)
 
     def _stratified_readings(self, pos_idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         t_count = len(pos_idx)
@@ -315,22 +318,17 @@ class PredictionContext:
         s_count, t_count, _ = sequences.shape
         j_count = self.n_hypotheses
         pos_idx = self.position_index(sequences.reshape(-1, 3)).reshape(s_count, t_count)
-        readings = np.empty((s_count, j_count, t_count))
-        probability = np.empty((s_count, j_count))
-        task_pos: list[np.ndarray] = []
-        task_z: list[np.ndarray] = []
-        inverse = np.empty((s_count, j_count), dtype=np.int64)
-        n_tasks = 0
-        for s in range(s_count):
-            z, probability[s] = self.readings(pos_idx[s])
-            readings[s] = z
-            uniq, inv = np.unique(z, axis=0, return_inverse=True)
-            task_z.append(uniq)
-            task_pos.append(np.broadcast_to(pos_idx[s], uniq.shape))
-            inverse[s] = n_tasks + inv.ravel()
-            n_tasks += len(uniq)
-        tz = np.ascontiguousarray(np.concatenate(task_z))
-        tp = np.ascontiguousarray(np.concatenate(task_pos))
+        if self.expectation == "sampled" and not self._fresh:
+            readings = self._sampled_readings(pos_idx)  # every sequence at once
+            probability = np.full((s_count, j_count), 1.0 / j_count)
+        else:
+            readings = np.empty((s_count, j_count, t_count))
+            probability = np.empty((s_count, j_count))
+            for s in range(s_count):
+                readings[s], probability[s] = self.readings(pos_idx[s])
+        tz, seq_of_task, inverse = unique_per_sequence(readings)
+        n_tasks = len(tz)
+        tp = np.ascontiguousarray(pos_idx[seq_of_task])
         log_ev = np.empty(n_tasks)
         mean = np.empty((n_tasks, 3))
         trace = np.empty(n_tasks)

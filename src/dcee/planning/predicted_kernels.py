@@ -16,11 +16,66 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from dcee.models.sensor_kernels import SensorParams
+from dcee.models.plume_kernels import plume_at, plume_terms
+from dcee.models.sensor_kernels import (
+    SensorParams,
+    log_detection_probability,
+    log_likelihood,
+    transform,
+)
 from dcee.numeric import HALF_LOG_2PI, _vexp, logaddexp, vlogaddexp
 
 _BLOCK = 512  # particles per work item; fixed, so the summation order never depends on threads
 _N_ACC = 6  # accumulated sums per task: Σe, Σe·dx, Σe·dy, Σe·dz, Σe·|d|², Σe·ll
+
+
+@njit(cache=True)
+def probe_sums(flat: np.ndarray, probe: np.ndarray) -> tuple[float, float]:
+    """(Σ flat·probe[:n], Σ flat·probe[n:2n]) for flat (n,): a fingerprint of an array's
+    contents. Compiled and sequential, not a BLAS dot: OpenBLAS threads that spin after a call
+    take the cores from the numba threads of the kernels that follow."""
+    n = flat.shape[0]
+    a = 0.0
+    b = 0.0
+    for i in range(n):
+        a += flat[i] * probe[i]
+        b += flat[i] * probe[n + i]
+    return a, b
+
+
+@njit(cache=True, parallel=True)
+def position_rows(
+    theta: np.ndarray,
+    positions: np.ndarray,
+    rows: np.ndarray,
+    rmin: float,
+    meander: float,
+    sp: SensorParams,
+    conc: np.ndarray,
+    dist: np.ndarray,
+    loc: np.ndarray,
+    log_nd: np.ndarray,
+    inv_sigma: np.ndarray,
+    det_offset: np.ndarray,
+) -> None:
+    """Row rows[k] of each (R, N) output = the terms of every particle at positions[k]:
+    concentration and clamped source distance
+    (:func:`~dcee.models.plume_kernels.concentration_distance_grid`), then the reading-free
+    likelihood terms (:func:`~dcee.models.sensor_kernels.position_terms`), in one pass.
+    theta (N, 8); positions (K, 3); rows (K,) distinct."""
+    n = theta.shape[0]
+    for i in prange(n):
+        terms = plume_terms(theta, i)
+        for k in range(positions.shape[0]):
+            c, r = plume_at(terms, positions[k, 0], positions[k, 1], positions[k, 2], rmin, meander)
+            row = rows[k]
+            m, sigma = transform(c, sp)
+            conc[row, i] = c
+            dist[row, i] = r
+            loc[row, i] = m
+            log_nd[row, i] = log_likelihood(0.0, c, r, sp)
+            inv_sigma[row, i] = 1.0 / sigma
+            det_offset[row, i] = log_detection_probability(r, sp) - math.log(sigma)
 
 
 @njit(cache=True, inline="always")
@@ -321,8 +376,11 @@ def predicted_posterior_stats(
     new_group[1:] = np.any(task_positions[1:] != task_positions[:-1], axis=1)
     group_start = np.append(np.flatnonzero(new_group), s_count).astype(np.int64)
     live = weights > 0.0
-    max_log_nd = np.where(live, log_nd, -np.inf).max(axis=1)
-    max_det_offset = np.where(live, det_offset, -np.inf).max(axis=1)
+    used = np.unique(task_positions)  # rows of the position terms the tasks read
+    max_log_nd = np.full(log_nd.shape[0], -np.inf)
+    max_det_offset = np.full(log_nd.shape[0], -np.inf)
+    max_log_nd[used] = np.where(live, log_nd[used], -np.inf).max(axis=1)
+    max_det_offset[used] = np.where(live, det_offset[used], -np.inf).max(axis=1)
     bound = np.empty(s_count)
     _task_bounds(task_positions, task_v, task_fa, task_out, max_log_nd, max_det_offset, sp, bound)
     n_blocks = (source.shape[0] + _BLOCK - 1) // _BLOCK

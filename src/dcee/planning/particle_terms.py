@@ -1,0 +1,217 @@
+"""The particle set as the planners compute on it, and its per-position likelihood terms, kept
+across decisions (issue 17).
+
+Two exact savings:
+
+* **Merged copies.** Resampling leaves runs of identical particles next to each other (about a
+  quarter of a 20,000-particle posterior, until the MCMC move has moved them). Every
+  predicted-posterior statistic is a weighted sum over particles, so a run merged into one
+  particle carrying the run's total weight gives the same statistics (to rounding) for less
+  work.
+* **Terms kept across decisions.** A particle's terms at a position (concentration, source
+  distance, transformed location, 1/σ, log P(non-detection), log Pd − log σ) depend on its
+  source term and the position, not on its weight. While the particle set is unchanged (most
+  readings only reweight it), the rows of positions already evaluated by an earlier decision are
+  reused, and new rows go into the same buffers (no fresh allocation, no page faults).
+
+A :class:`ParticleTerms` recognises "the same particle set" by the array's identity, shape and
+two random projections of its contents, so an edit in place is noticed as well.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from dcee.models.plume import IsotropicPlume
+from dcee.models.sensor import Sensor
+from dcee.planning.predicted_kernels import position_rows, probe_sums
+
+N_TERMS = 6
+"""conc, dist, loc, log_nd, inv_sigma, det_offset (see :attr:`ParticleTerms.terms`)."""
+
+DEFAULT_MAX_BYTES = 32 * 2**20
+"""Rows kept across decisions are capped at this many bytes (a decision's own rows always fit)."""
+
+
+def merge_runs(theta: np.ndarray) -> np.ndarray:
+    """(M,) start index of each run of identical consecutive rows of theta (N, 8)."""
+    if len(theta) == 0:
+        return np.zeros(0, dtype=np.int64)
+    differs = np.any(theta[1:] != theta[:-1], axis=1)
+    return np.concatenate([[0], np.flatnonzero(differs) + 1]).astype(np.int64)
+
+
+class ParticleTerms:
+    """Merged particles and a cache of their per-position terms, for one particle set at a time.
+
+    :meth:`sync` binds it to the current particles; :meth:`weights` merges a weight vector the
+    same way; :meth:`rows` returns the rows of (K, 3) positions in :attr:`terms`, computing the
+    missing ones. Rows used since the last :meth:`begin` are never evicted, so every row a
+    decision asked for stays valid for that decision.
+    """
+
+    def __init__(self, merge: bool = True, max_bytes: int = DEFAULT_MAX_BYTES) -> None:
+        self.merge = bool(merge)
+        self.max_bytes = int(max_bytes)
+        self._key: tuple | None = None
+        self._probe: np.ndarray | None = None
+        self.theta = np.zeros((0, 8))
+        self.starts = np.zeros(0, dtype=np.int64)
+        self._flat: np.ndarray | None = None  # (N_TERMS, capacity · M) buffer
+        self._index: dict[tuple[float, ...], int] = {}
+        self._stamp = np.zeros(0, dtype=np.int64)
+        self._clock = 0
+        self._terms: tuple[np.ndarray, ...] | None = None
+        self._plume: tuple[float, float] | None = None
+        self._sensor_params: tuple | None = None
+
+    # --- binding ----------------------------------------------------------------------------
+
+    def _fingerprint(self, theta: np.ndarray) -> tuple:
+        flat = np.ascontiguousarray(theta).reshape(-1)
+        if self._probe is None or len(self._probe) < 2 * flat.size:
+            self._probe = np.random.default_rng(20261122).standard_normal(2 * flat.size)
+        return (id(theta), theta.shape, *probe_sums(flat, self._probe))
+
+    def sync(self, theta: np.ndarray, sensor: Sensor, plume: IsotropicPlume) -> None:
+        """Bind to the particles theta (N, 8) and the models; keeps the cached rows only if
+        nothing changed."""
+        theta = np.asarray(theta, dtype=np.float64)
+        key = self._fingerprint(theta)
+        models = (plume.min_distance, plume.meander), tuple(sensor.params)
+        if key == self._key and models == (self._plume, self._sensor_params):
+            return
+        self._key = key
+        self._plume, self._sensor_params = models
+        self.sp = sensor.params
+        self.min_distance, self.meander = plume.min_distance, plume.meander
+        if self.merge:
+            self.starts = merge_runs(theta)
+            self.theta = np.ascontiguousarray(theta[self.starts])
+        else:
+            self.starts = np.arange(len(theta), dtype=np.int64)
+            self.theta = np.ascontiguousarray(theta)
+        self._index.clear()
+        self._terms = None  # the buffers stay; their (capacity, M) views follow M
+        self._stamp = np.zeros(self.capacity, dtype=np.int64)
+
+    def weights(self, weights: np.ndarray) -> np.ndarray:
+        """(M,) merged weights: the sum over each run."""
+        if len(self.starts) == len(weights):
+            return np.asarray(weights, dtype=np.float64)
+        return np.add.reduceat(np.asarray(weights, dtype=np.float64), self.starts)
+
+    @property
+    def n(self) -> int:
+        """Particles after merging."""
+        return len(self.theta)
+
+    # --- rows -------------------------------------------------------------------------------
+
+    def begin(self) -> None:
+        """Start a decision: rows used from now on stay valid until the next call."""
+        self._clock += 1
+
+    @property
+    def capacity(self) -> int:
+        """Rows the buffers hold for the current particle count."""
+        return 0 if self._flat is None else self._flat.shape[1] // max(self.n, 1)
+
+    @property
+    def terms(self) -> tuple[np.ndarray, ...]:
+        """(conc, dist, loc, log_nd, inv_sigma, det_offset), each (capacity, M) C-contiguous;
+        row r holds the terms at the position :meth:`rows` mapped to r (see
+        :func:`dcee.models.sensor_kernels.position_terms`)."""
+        if self._terms is None:
+            m, cap = max(self.n, 1), self.capacity
+            self._terms = tuple(self._flat[k, : cap * m].reshape(cap, m) for k in range(N_TERMS))
+        return self._terms
+
+    def _grow(self, rows: int) -> None:
+        """Buffers for at least ``rows`` rows, keeping the rows cached so far."""
+        m = max(self.n, 1)
+        old = self.terms if self._flat is not None else None
+        used = min(self.capacity, len(self._stamp))
+        flat = np.empty((N_TERMS, rows * m))
+        self._flat, self._terms = flat, None
+        if old is not None and used:
+            for k in range(N_TERMS):
+                self.terms[k][:used] = old[k][:used]
+        stamp = np.zeros(self.capacity, dtype=np.int64)
+        stamp[:used] = self._stamp[:used]
+        self._stamp = stamp
+
+    def _free_rows(self, count: int) -> list[int]:
+        """``count`` rows to overwrite: unused ones first, then the least recently used rows
+        of earlier decisions once the byte cap is reached; grows the buffers otherwise (and
+        always when the current decision itself needs more rows)."""
+        used = set(self._index.values())
+        free = [r for r in range(self.capacity) if r not in used]
+        if len(free) >= count:
+            return free[:count]
+        cap_rows = max(self.max_bytes // bytes_per_row(max(self.n, 1)), 1)
+        if len(used) + count > cap_rows:
+            old = sorted((int(self._stamp[r]), r) for r in used if self._stamp[r] < self._clock)
+            evict = [r for _, r in old[: count - len(free)]]
+            if len(free) + len(evict) >= count:
+                drop = set(evict)
+                self._index = {k: r for k, r in self._index.items() if r not in drop}
+                return (free + evict)[:count]
+        self._grow(max(len(used) + count, min(2 * self.capacity, cap_rows), 8))
+        free = [r for r in range(self.capacity) if r not in used]
+        return free[:count]
+
+    def rows(self, positions: np.ndarray) -> np.ndarray:
+        """(K,) rows of (K, 3) positions in :attr:`terms`, computing the missing ones."""
+        positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+        out = np.empty(len(positions), dtype=np.int64)
+        missing: list[int] = []
+        keys = [tuple(np.round(p, 9).tolist()) for p in positions]
+        pending: dict[tuple[float, ...], int] = {}
+        for k, key in enumerate(keys):
+            row = self._index.get(key)
+            if row is None and key not in pending:
+                pending[key] = len(missing)
+                missing.append(k)
+            out[k] = -1 if row is None else row
+        if missing:
+            free = self._free_rows(len(missing))
+            new_rows = np.array(free, dtype=np.int64)
+            pts = np.ascontiguousarray(positions[missing])
+            position_rows(
+                self.theta, pts, new_rows, self.min_distance, self.meander, self.sp, *self.terms
+            )
+            for key, j in pending.items():
+                self._index[key] = int(new_rows[j])
+            for k, key in enumerate(keys):
+                if out[k] < 0:
+                    out[k] = self._index[key]
+        self._stamp[out] = self._clock
+        return out
+
+    def subset(self, keep: np.ndarray) -> ParticleTerms:
+        """A new :class:`ParticleTerms` of the particles where ``keep`` (M,) is True, with the
+        rows cached so far (copied, same row numbers)."""
+        other = ParticleTerms(merge=False, max_bytes=self.max_bytes)
+        other.sp, other.min_distance, other.meander = self.sp, self.min_distance, self.meander
+        other._plume, other._sensor_params = self._plume, self._sensor_params
+        other.theta = np.ascontiguousarray(self.theta[keep])
+        other.starts = np.arange(other.n, dtype=np.int64)
+        other._key = ("subset", id(other))
+        other._grow(max(self.capacity, 8))
+        rows = sorted(set(self._index.values()))
+        for k, src in enumerate(self.terms):
+            other.terms[k][rows] = src[rows][:, keep]
+        other._index = dict(self._index)
+        other._clock = self._clock
+        other._stamp[: len(self._stamp)] = self._stamp
+        return other
+
+    def nbytes(self) -> int:
+        """Bytes held by the row buffers."""
+        return 0 if self._flat is None else int(self._flat.nbytes)
+
+
+def bytes_per_row(n: int) -> int:
+    """Bytes of one cached position row for n particles."""
+    return N_TERMS * 8 * n
