@@ -84,13 +84,19 @@ def compiled_predicted_stats(conc, source, weights, task_pos, task_z, sensor, di
     """The compiled predicted-posterior statistics with the reference's arguments:
     (log_evidence, mean, trace_cov, kl) for raw concentrations (P, N), distances (P, N; None:
     far) and readings (S, T)."""
-    from dcee.models.sensor_kernels import position_terms
     from dcee.planning.predicted_kernels import predicted_posterior_stats
 
     conc = np.ascontiguousarray(conc)
     dist = np.full_like(conc, np.inf) if dist is None else np.ascontiguousarray(dist)
-    terms = [np.empty_like(conc) for _ in range(4)]
-    position_terms(conc, dist, sensor.params, *terms)
+    # the reading-free terms, from the NumPy sensor model (position_rows computes them from
+    # source terms; these tests feed raw concentrations)
+    loc, sigma = sensor._loc_sigma(conc)
+    with np.errstate(divide="ignore"):
+        det_offset = np.log(sensor.detect_prob(dist)) - np.log(sigma)
+    terms = [
+        np.ascontiguousarray(a)
+        for a in (loc, sensor.log_likelihood(0.0, conc, dist), 1.0 / sigma, det_offset)
+    ]
     s = len(task_pos)
     out = [np.empty(s), np.empty((s, 3)), np.empty(s), np.empty(s)]
     predicted_posterior_stats(

@@ -26,7 +26,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from dcee.numeric import HALF_LOG_2PI, log_ndtr, logaddexp, ndtr_upper
 
@@ -123,31 +123,3 @@ def log_likelihood(z: float, c: float, r: float, sp: SensorParams) -> float:
     if sp.log_outlier > -np.inf:
         ld = logaddexp(ld, sp.log_outlier - math.log(z))
     return ld
-
-
-@njit(cache=True, parallel=True)
-def position_terms(
-    conc: np.ndarray,
-    dist: np.ndarray,
-    sp: SensorParams,
-    loc: np.ndarray,
-    log_nd: np.ndarray,
-    inv_sigma: np.ndarray,
-    det_offset: np.ndarray,
-):
-    """Per (position, particle) terms of the likelihood that do not depend on the reading.
-
-    conc, dist (P, N) → the transformed location, log p(non-detection | C, r), 1/σ and the
-    detection's log normaliser log Pd(r) − log σ, each (P, N). With them a hypothesised reading
-    costs a lookup (non-detection) or a few flops (detection).
-    """
-    p_count, n = conc.shape
-    for i in prange(n):
-        for p in range(p_count):
-            c = conc[p, i]
-            r = dist[p, i]
-            m, sigma = transform(c, sp)
-            loc[p, i] = m
-            log_nd[p, i] = log_likelihood(0.0, c, r, sp)
-            inv_sigma[p, i] = 1.0 / sigma
-            det_offset[p, i] = log_detection_probability(r, sp) - math.log(sigma)

@@ -24,7 +24,12 @@ import numpy as np
 
 from dcee.models.plume import IsotropicPlume
 from dcee.models.sensor import Sensor
-from dcee.planning.predicted_kernels import position_rows, probe_sums
+from dcee.planning.predicted_kernels import (
+    N_PLUME_CONSTANTS,
+    plume_constants,
+    position_rows,
+    probe_sums,
+)
 
 N_TERMS = 6
 """conc, dist, loc, log_nd, inv_sigma, det_offset (see :attr:`ParticleTerms.terms`)."""
@@ -91,9 +96,17 @@ class ParticleTerms:
         else:
             self.starts = np.arange(len(theta), dtype=np.int64)
             self.theta = np.ascontiguousarray(theta)
+        self._plume_constants = np.empty((N_PLUME_CONSTANTS, self.n))
+        plume_constants(self.theta, self._plume_constants)
         self._index.clear()
         self._terms = None  # the buffers stay; their (capacity, M) views follow M
         self._stamp = np.zeros(self.capacity, dtype=np.int64)
+
+    def forget(self) -> None:
+        """Drop every cached row and the binding (the buffers stay): the next decision computes
+        all its terms, as one at a new position after the particles changed would."""
+        self._key = None
+        self._index.clear()
 
     def weights(self, weights: np.ndarray) -> np.ndarray:
         """(M,) merged weights: the sum over each run."""
@@ -121,7 +134,7 @@ class ParticleTerms:
     def terms(self) -> tuple[np.ndarray, ...]:
         """(conc, dist, loc, log_nd, inv_sigma, det_offset), each (capacity, M) C-contiguous;
         row r holds the terms at the position :meth:`rows` mapped to r (see
-        :func:`dcee.models.sensor_kernels.position_terms`)."""
+        :func:`~dcee.planning.predicted_kernels.position_rows`)."""
         if self._terms is None:
             m, cap = max(self.n, 1), self.capacity
             self._terms = tuple(self._flat[k, : cap * m].reshape(cap, m) for k in range(N_TERMS))
@@ -179,7 +192,13 @@ class ParticleTerms:
             new_rows = np.array(free, dtype=np.int64)
             pts = np.ascontiguousarray(positions[missing])
             position_rows(
-                self.theta, pts, new_rows, self.min_distance, self.meander, self.sp, *self.terms
+                self._plume_constants,
+                pts,
+                new_rows,
+                self.min_distance,
+                self.meander,
+                self.sp,
+                *self.terms,
             )
             for key, j in pending.items():
                 self._index[key] = int(new_rows[j])
@@ -196,6 +215,7 @@ class ParticleTerms:
         other.sp, other.min_distance, other.meander = self.sp, self.min_distance, self.meander
         other._plume, other._sensor_params = self._plume, self._sensor_params
         other.theta = np.ascontiguousarray(self.theta[keep])
+        other._plume_constants = np.ascontiguousarray(self._plume_constants[:, keep])
         other.starts = np.arange(other.n, dtype=np.int64)
         other._key = ("subset", id(other))
         other._grow(max(self.capacity, 8))

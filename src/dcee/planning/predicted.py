@@ -243,7 +243,7 @@ class PredictionContext:
     def terms(self) -> tuple[np.ndarray, ...]:
         """(conc, dist, loc, log_nd, inv_sigma, det_offset), each (R, M) over this context's
         particles, rows as :meth:`position_index` gives them (see
-        :func:`dcee.models.sensor_kernels.position_terms`). Read it after the last
+        :func:`~dcee.planning.predicted_kernels.position_rows`). Read it after the last
         :meth:`position_index` call: new rows may move the buffers."""
         return self._pt.terms
 

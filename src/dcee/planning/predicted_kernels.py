@@ -23,7 +23,15 @@ from dcee.models.sensor_kernels import (
     log_likelihood,
     transform,
 )
-from dcee.numeric import HALF_LOG_2PI, _vexp, logaddexp, vlogaddexp
+from dcee.numeric import (
+    HALF_LOG_2PI,
+    _vexp,
+    _vlog_moderate,
+    logaddexp,
+    vlog1m,
+    vlogaddexp,
+    vndtr_upper,
+)
 
 _BLOCK = 512  # particles per work item; fixed, so the summation order never depends on threads
 _N_ACC = 6  # accumulated sums per task: Σe, Σe·dx, Σe·dy, Σe·dz, Σe·|d|², Σe·ll
@@ -43,9 +51,73 @@ def probe_sums(flat: np.ndarray, probe: np.ndarray) -> tuple[float, float]:
     return a, b
 
 
+N_PLUME_CONSTANTS = 10
+"""Per-particle plume constants (:func:`~dcee.models.plume_kernels.plume_terms`)."""
+
+
+@njit(cache=True, parallel=True)
+def plume_constants(theta: np.ndarray, out: np.ndarray) -> None:
+    """out[:, i] = :func:`~dcee.models.plume_kernels.plume_terms` of particle i (the source
+    location, q/(4π ζ1), 1/λ, u cosφ/(2ζ1), u sinφ/(2ζ1), cos φ, sin φ, u/(2ζ1)): the square
+    root, cosine and sine of a particle, computed once per particle set instead of at every
+    new position. theta (N, 8); out (10, N)."""
+    for i in prange(theta.shape[0]):
+        terms = plume_terms(theta, i)
+        for k in range(N_PLUME_CONSTANTS):
+            out[k, i] = terms[k]
+
+
+_ROW_BLOCK = 256  # particles per work item of position_rows
+
+
+@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+def _rows_gaussian(
+    plume: np.ndarray,
+    i0: int,
+    i1: int,
+    px: float,
+    py: float,
+    pz: float,
+    rmin: float,
+    sp: SensorParams,
+    conc: np.ndarray,
+    dist: np.ndarray,
+    loc: np.ndarray,
+    log_nd: np.ndarray,
+    inv_sigma: np.ndarray,
+    det_offset: np.ndarray,
+) -> None:
+    """:func:`position_rows` for particles i0..i1−1 at one position, into 1-D rows, in the
+    common case (Gaussian family, constant Pd < 1, no meander): one loop without branches
+    (selects only), so that LLVM vectorises it, exp, log and erfc included."""
+    missed_offset = sp.log_not_false_alarm + sp.log_keep
+    for j in range(i1 - i0):
+        # an unsigned index: numba then emits no negative-index wraparound, which would keep
+        # LLVM from vectorising the loop
+        i = np.uint64(i0 + j)
+        dx = px - plume[0, i]
+        dy = py - plume[1, i]
+        dz = pz - plume[2, i]
+        r = max(math.sqrt(dx * dx + dy * dy + dz * dz), rmin)
+        # the exponent is ≤ 0 (1/λ ≥ u/(2ζ1)); min() guards against rounding
+        arg = min(-r * plume[4, i] - dx * plume[5, i] - dy * plume[6, i], 0.0)
+        value = plume[3, i] / r * _vexp(arg)
+        c = value if arg > -700.0 else 0.0
+        sigma = sp.sigma_frac * c + sp.sigma_min
+        inv_s = 1.0 / sigma
+        missed = vlog1m(sp.pd * vndtr_upper((sp.v_threshold - c) * inv_s))  # log(1 − Pd Φ(−x))
+        lin = sp.lin0 + sp.lin1 * c
+        conc[i] = c
+        dist[i] = r
+        loc[i] = c
+        inv_sigma[i] = inv_s
+        log_nd[i] = (lin if c < sp.c_lin else missed) + missed_offset
+        det_offset[i] = sp.log_pd - _vlog_moderate(sigma)
+
+
 @njit(cache=True, parallel=True)
 def position_rows(
-    theta: np.ndarray,
+    plume: np.ndarray,
     positions: np.ndarray,
     rows: np.ndarray,
     rmin: float,
@@ -58,24 +130,77 @@ def position_rows(
     inv_sigma: np.ndarray,
     det_offset: np.ndarray,
 ) -> None:
-    """Row rows[k] of each (R, N) output = the terms of every particle at positions[k]:
-    concentration and clamped source distance
-    (:func:`~dcee.models.plume_kernels.concentration_distance_grid`), then the reading-free
-    likelihood terms (:func:`~dcee.models.sensor_kernels.position_terms`), in one pass.
-    theta (N, 8); positions (K, 3); rows (K,) distinct."""
-    n = theta.shape[0]
-    for i in prange(n):
-        terms = plume_terms(theta, i)
+    """Row rows[k] of each (R, N) output = the terms of every particle at positions[k] that do
+    not depend on the reading: the concentration C and the clamped source distance r (as
+    :func:`~dcee.models.plume_kernels.concentration_distance_grid`), the transformed location,
+    log p(non-detection | C, r), 1/σ and log Pd(r) − log σ (see
+    :mod:`dcee.models.sensor_kernels`). With them a hypothesised reading costs a lookup
+    (non-detection) or a few flops (detection). plume (10, N) from :func:`plume_constants`;
+    positions (K, 3); rows (K,) distinct. NumPy references:
+    :func:`~dcee.models.plume.isotropic_concentration_reference`,
+    :meth:`~dcee.models.sensor.Sensor.log_likelihood`.
+
+    Blocks of particles run in parallel. The paper's sensor (Gaussian family, constant Pd < 1)
+    without meander takes :func:`_rows_gaussian`, vectorised with the ``exp``, ``log`` and
+    ``erfc`` of :mod:`dcee.numeric`; every other case the scalar formulas with libm (with
+    Pd = 1, log Φ needs relative accuracy far in the tail).
+    """
+    n = plume.shape[1]
+    n_blocks = (n + _ROW_BLOCK - 1) // _ROW_BLOCK
+    fast = (
+        sp.lognormal == 0.0
+        and sp.pd < 1.0
+        and sp.near_length == 0.0
+        and meander == 0.0
+        and sp.sigma_min >= 2.0**-60  # σ within the short log ladder's range
+    )
+    for b in prange(n_blocks):
+        i0 = b * _ROW_BLOCK
+        i1 = min(n, i0 + _ROW_BLOCK)
         for k in range(positions.shape[0]):
-            c, r = plume_at(terms, positions[k, 0], positions[k, 1], positions[k, 2], rmin, meander)
+            px = positions[k, 0]
+            py = positions[k, 1]
+            pz = positions[k, 2]
             row = rows[k]
-            m, sigma = transform(c, sp)
-            conc[row, i] = c
-            dist[row, i] = r
-            loc[row, i] = m
-            log_nd[row, i] = log_likelihood(0.0, c, r, sp)
-            inv_sigma[row, i] = 1.0 / sigma
-            det_offset[row, i] = log_detection_probability(r, sp) - math.log(sigma)
+            if fast:
+                _rows_gaussian(
+                    plume,
+                    i0,
+                    i1,
+                    px,
+                    py,
+                    pz,
+                    rmin,
+                    sp,
+                    conc[row],
+                    dist[row],
+                    loc[row],
+                    log_nd[row],
+                    inv_sigma[row],
+                    det_offset[row],
+                )
+                continue
+            for i in range(i0, i1):
+                terms = (
+                    plume[0, i],
+                    plume[1, i],
+                    plume[2, i],
+                    plume[3, i],
+                    plume[4, i],
+                    plume[5, i],
+                    plume[6, i],
+                    plume[7, i],
+                    plume[8, i],
+                    plume[9, i],
+                )
+                c, r = plume_at(terms, px, py, pz, rmin, meander)
+                m, sigma = transform(c, sp)
+                conc[row, i] = c
+                dist[row, i] = r
+                loc[row, i] = m
+                inv_sigma[row, i] = 1.0 / sigma
+                log_nd[row, i] = log_likelihood(0.0, c, r, sp)
+                det_offset[row, i] = log_detection_probability(r, sp) - math.log(sigma)
 
 
 @njit(cache=True, inline="always")
@@ -89,7 +214,7 @@ def _loglik_cached(
     det_off: float,
     sp: SensorParams,
 ) -> float:
-    """log p(z | C) less the log Jacobian, from :func:`position_terms` and the transformed
+    """log p(z | C) less the log Jacobian, from :func:`position_rows` and the transformed
     reading terms; equals :func:`dcee.models.sensor_kernels.log_likelihood` minus the Jacobian."""
     if v < sp.v_threshold:
         return lnd
@@ -354,7 +479,7 @@ def predicted_posterior_stats(
 ) -> None:
     """Statistics of the predicted posterior for each task (a hypothesised reading sequence).
 
-    loc, log_nd, inv_sigma, det_offset (P, N): :func:`~dcee.models.sensor_kernels.position_terms`
+    loc, log_nd, inv_sigma, det_offset (P, N): :func:`position_rows`
     of every particle at P distinct positions; source (N, 3): source locations; weights (N,)
     normalised; center (3,): a reference point subtracted before the second moments are formed
     (keeps trace_cov accurate); task_positions (S, T) int indices into the position terms;
