@@ -4,7 +4,10 @@
 that call them into SIMD code (numba's ``math.exp``/``math.log``/``math.erfc`` are scalar libm
 calls; this llvmlite wheel has no SVML). Kernels that divide must be compiled with
 ``error_model="numpy"``: numba's default Python error model checks every division for zero,
-and that branch alone keeps LLVM from vectorising the loop (measured: erfc 21 → 2.9 ns). They sit at the bottom of the layering: every kernel module may use them.
+and that branch alone keeps LLVM from vectorising the loop (measured: erfc 21 → 2.9 ns); so
+does indexing with a signed integer that numba cannot prove non-negative (its wraparound
+check), so such loops index with ``np.uint64``. These helpers sit at the bottom of the
+layering: every kernel module may use them.
 """
 
 from __future__ import annotations
