@@ -280,7 +280,7 @@ def _task_bounds(
         )
 
 
-@njit(cache=True, parallel=True, fastmath={"contract"})
+@njit(cache=True, parallel=True, fastmath={"contract"}, error_model="numpy")
 def _grouped_stats(
     loc: np.ndarray,
     log_nd: np.ndarray,
@@ -318,6 +318,7 @@ def _grouped_stats(
     log_keep = sp.log_keep
     with_false_alarms = sp.false_alarm > 0.0
     with_outliers = sp.log_outlier > -np.inf
+    single_stage = t_count == 1 and not with_false_alarms
     for item in prange(n_groups * n_blocks):
         g = item // n_blocks
         b = item % n_blocks
@@ -339,7 +340,9 @@ def _grouped_stats(
         a3 = np.zeros(k)
         a4 = np.zeros(k)
         a5 = np.zeros(k)
-        for i in range(b * _BLOCK, min(n, (b + 1) * _BLOCK)):
+        i_start = b * _BLOCK
+        for q in range(min(n, i_start + _BLOCK) - i_start):
+            i = np.uint64(i_start + q)  # unsigned: no wraparound checks on the loads
             wi = weights[i]
             if wi <= 0.0:
                 continue
@@ -347,6 +350,31 @@ def _grouped_stats(
             dy = source[i, 1] - center[1]
             dz = source[i, 2] - center[2]
             d2 = dx * dx + dy * dy + dz * dz
+            if single_stage and k < 8:
+                # few readings of one stage (too few to vectorise over them): the likelihood
+                # and the weight in one pass over j
+                p = task_positions[s0, 0]
+                m = loc[p, i]
+                lnd = log_nd[p, i]
+                inv_s = inv_sigma[p, i]
+                det_const = det_offset[p, i] - HALF_LOG_2PI + log_keep
+                for j in range(k):
+                    zj = z[0, j]
+                    r = (zj - m) * inv_s
+                    d = det_const - 0.5 * r * r
+                    if with_outliers:
+                        d = vlogaddexp(d, out[0, j])
+                    llj = d if zj >= v_thr else lnd
+                    e = wi * _vexp(llj - bnd[j])
+                    a0[j] += e
+                    if want_moments:
+                        a1[j] += e * dx
+                        a2[j] += e * dy
+                        a3[j] += e * dz
+                        a4[j] += e * d2
+                    if want_kl:
+                        a5[j] += e * llj
+                continue
             ll[:] = 0.0
             for t in range(t_count):
                 p = task_positions[s0, t]
