@@ -42,6 +42,7 @@ about 10 kg/m³, so a larger reading is a fault, not a measurement.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Literal
@@ -97,9 +98,10 @@ class Sensor:
     def lognormal(self) -> bool:
         return self.family == "lognormal"
 
-    @property
+    @functools.cached_property
     def params(self) -> SensorParams:
-        """The model as the compiled kernels read it (:class:`SensorParams`).
+        """The model as the compiled kernels read it (:class:`SensorParams`); computed once
+        per (immutable) sensor.
 
         Below ``c_lin`` the kernels use log P(missed | C) ≈ lin0 + lin1·C instead of an erfc.
         Gaussian family: c_lin = 1e-6 σ_min, lin0 = log P(missed | 0), lin1 its derivative at

@@ -179,7 +179,7 @@ class ParticleTerms:
         positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
         out = np.empty(len(positions), dtype=np.int64)
         missing: list[int] = []
-        keys = [tuple(np.round(p, 9).tolist()) for p in positions]
+        keys = [tuple(p) for p in np.round(positions, 9).tolist()]
         pending: dict[tuple[float, ...], int] = {}
         for k, key in enumerate(keys):
             row = self._index.get(key)

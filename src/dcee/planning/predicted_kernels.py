@@ -264,6 +264,28 @@ def _task_bound(
 
 
 @njit(cache=True)
+def _live_row_max(
+    log_nd: np.ndarray,
+    det_offset: np.ndarray,
+    rows: np.ndarray,
+    weights: np.ndarray,
+    max_log_nd: np.ndarray,
+    max_det_offset: np.ndarray,
+) -> None:
+    """For each row r in ``rows``: the largest log_nd[r, i] and det_offset[r, i] over the
+    particles with weight > 0 (the inputs of :func:`_task_bound`)."""
+    for r in rows:
+        a = -np.inf
+        b = -np.inf
+        for i in range(weights.shape[0]):
+            if weights[i] > 0.0:
+                a = max(a, log_nd[r, i])
+                b = max(b, det_offset[r, i])
+        max_log_nd[r] = a
+        max_det_offset[r] = b
+
+
+@njit(cache=True)
 def _task_bounds(
     task_positions: np.ndarray,
     task_v: np.ndarray,
@@ -528,12 +550,10 @@ def predicted_posterior_stats(
     new_group = np.ones(s_count, dtype=bool)
     new_group[1:] = np.any(task_positions[1:] != task_positions[:-1], axis=1)
     group_start = np.append(np.flatnonzero(new_group), s_count).astype(np.int64)
-    live = weights > 0.0
     used = np.unique(task_positions)  # rows of the position terms the tasks read
     max_log_nd = np.full(log_nd.shape[0], -np.inf)
     max_det_offset = np.full(log_nd.shape[0], -np.inf)
-    max_log_nd[used] = np.where(live, log_nd[used], -np.inf).max(axis=1)
-    max_det_offset[used] = np.where(live, det_offset[used], -np.inf).max(axis=1)
+    _live_row_max(log_nd, det_offset, used, weights, max_log_nd, max_det_offset)
     bound = np.empty(s_count)
     _task_bounds(task_positions, task_v, task_fa, task_out, max_log_nd, max_det_offset, sp, bound)
     n_blocks = (source.shape[0] + _BLOCK - 1) // _BLOCK
