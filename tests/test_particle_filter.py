@@ -162,3 +162,83 @@ def test_nan_reading_is_rejected(sensor, bad):
         pf.update(np.array([1.0, 1.0]), 0.0)
     with pytest.raises(DceeInputError, match="particles"):
         ParticleFilter(planar_prior(), sensor, n_particles=-5)
+
+
+# --- the history likelihood kernel and its exact early rejection (issue 17) ---
+
+
+@pytest.mark.parametrize(
+    "sensor",
+    [
+        Sensor(),  # the paper's: vectorised non-detections
+        Sensor(pd=1.0),
+        Sensor(false_alarm=0.02, outlier=0.01),
+        Sensor(family="lognormal", pd=0.6, log_sd=1.3, outlier=0.01),
+    ],
+    ids=["paper", "pd1", "fa+outlier", "lognormal"],
+)
+def test_history_likelihood_and_reading_bounds_against_numpy(sensor):
+    from dcee.estimation.filter_kernels import history_log_likelihood, reading_upper_bounds
+    from dcee.estimation.particle_filter import history_log_likelihood_reference
+    from dcee.models import IsotropicPlume
+    from tests.helpers import random_theta
+
+    rng = np.random.default_rng(3)
+    theta = random_theta(700, rng)  # 700: two full blocks and a partial one
+    pos = np.column_stack([rng.uniform(0, 50, (60, 2)), np.full(60, 4.0)])
+    z = np.where(rng.random(60) < 0.6, 0.0, rng.gamma(1.0, 5e-3, 60) + 5e-4)
+    mult = rng.integers(1, 4, 60).astype(float)
+    plume = IsotropicPlume()
+    out = np.empty(700)
+    active = rng.random(700) < 0.9
+    history_log_likelihood(theta, active, pos, z, mult, 1e-3, 0.0, sensor.params, out)
+    ref = history_log_likelihood_reference(theta, pos, z, mult, sensor, plume)
+    np.testing.assert_allclose(out[active], ref[active], rtol=1e-9)
+    assert np.all(out[~active] == -np.inf)
+    # every reading's bound lies above its log-likelihood for every particle
+    from dcee.models.plume import isotropic_concentration_reference
+
+    conc = isotropic_concentration_reference(theta, pos)
+    dist = np.linalg.norm(theta[:, None, :3] - pos[None], axis=2)
+    per = sensor.log_likelihood(z[None, :], conc, dist)
+    bounds = reading_upper_bounds(z, sensor)
+    assert np.all(per <= bounds[None, :] + 1e-12)
+    # early rejection: exactly the particles whose full sum lies below their threshold are
+    # abandoned, never one above it; the others keep their full sums
+    threshold = ref + rng.normal(0.0, 30.0, 700)
+    early = np.empty(700)
+    history_log_likelihood(
+        theta, active, pos, z, mult, 1e-3, 0.0, sensor.params, early, threshold, bounds
+    )
+    kept = np.isfinite(early)
+    np.testing.assert_array_equal(early[kept], out[kept])
+    assert np.all(ref[~kept & active] < threshold[~kept & active])
+    assert np.all(kept[active & (ref > threshold)])
+    assert (~kept & active).sum() > 50  # it does abandon hopeless ones
+
+
+def test_mcmc_move_is_unchanged_by_early_rejection(monkeypatch):
+    """The same filter run with and without the early exit gives identical particles."""
+    import dcee.estimation.particle_filter as pfm
+    from dcee.scenarios import load_scenario
+
+    scenario = load_scenario("paper:1")
+    truth = scenario.truth_theta()[None]
+
+    def run() -> np.ndarray:
+        pf = ParticleFilter(scenario.make_prior(), scenario.make_sensor(), n_particles=3000, seed=2)
+        rng = np.random.default_rng(9)
+        for k in range(40):
+            p = np.array([5.0 + k, 12.0 + (k % 5), 4.0])
+            c = isotropic_concentration_reference(truth, p[None])[0, 0]
+            pf.update(p, float(pf.sensor.simulate(c, rng)))
+        return pf.theta.copy()
+
+    with_exit = run()
+    plain = pfm.history_log_likelihood
+
+    def no_exit(*args):
+        return plain(*args[:9])
+
+    monkeypatch.setattr(pfm, "history_log_likelihood", no_exit)
+    np.testing.assert_array_equal(run(), with_exit)

@@ -1,16 +1,202 @@
 """Compiled (numba) filter kernel; NumPy reference:
-:func:`dcee.estimation.particle_filter.history_log_likelihood_reference`."""
+:func:`dcee.estimation.particle_filter.history_log_likelihood_reference`.
+
+The history likelihood Σ_k m_k log p(z_k | Θ_i) is the cost of the filter's MCMC move (every
+proposal against every reading so far) and of each update (one reading). Particles are taken
+in blocks; for each reading the plume is evaluated for the whole block in a branch-free loop
+that LLVM vectorises (:func:`dcee.numeric._vexp`), then the likelihood: far from a hypothesised source the concentration is below the sensor's
+linearisation point and a non-detection costs a multiply-add; the other non-detections are
+gathered and evaluated in one vectorised pass (the paper's sensor; libm otherwise), detections
+in a scalar loop. Each particle's sum runs
+over the readings in their order, as in a plain loop.
+
+**Early rejection (exact).** The MCMC move accepts proposal i only if its history
+log-likelihood exceeds a threshold T_i fixed by its uniform draw, the prior and the current
+particle. Every reading's log-likelihood has an upper bound over all source terms
+(:func:`reading_upper_bounds`), so once the partial sum plus the bounds of the readings still
+to come falls below T_i, the proposal cannot be accepted and its sum is abandoned (returned as
+−inf, which the move rejects as it would have). Accepted proposals are summed in full, in the
+same order, so the filter's particles and cached likelihoods are what the full sums give.
+"""
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from numba import njit, prange
 
 from dcee.models.plume_kernels import plume_at, plume_terms
+from dcee.models.sensor import Sensor
 from dcee.models.sensor_kernels import SensorParams, log_likelihood
+from dcee.numeric import HALF_LOG_2PI, _vexp, vlog1m, vndtr_upper
+
+_BLOCK = 256  # particles per work item
+_CHECK_EVERY = 8  # readings between early-rejection checks
+# Early rejection needs the partial sum to lie this far below the threshold (nats, relative
+# to 1 + |T|): the final comparison is made in another order of floating-point operations.
+_MARGIN = 1e-9
+
+
+@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+def _plume_block(
+    pc: np.ndarray,
+    nb: int,
+    px: float,
+    py: float,
+    pz: float,
+    rmin: float,
+    conc: np.ndarray,
+    dist: np.ndarray,
+) -> None:
+    """conc[q], dist[q] for the block's particles q < nb from their plume constants pc (10, nb)
+    (see :func:`~dcee.models.plume_kernels.plume_terms`), without meander; branch-free."""
+    for q in range(nb):
+        dx = px - pc[0, q]
+        dy = py - pc[1, q]
+        dz = pz - pc[2, q]
+        r = max(math.sqrt(dx * dx + dy * dy + dz * dz), rmin)
+        # the exponent is ≤ 0 (1/λ ≥ u/(2ζ1)); min() guards against rounding
+        arg = min(-r * pc[4, q] - dx * pc[5, q] - dy * pc[6, q], 0.0)
+        value = pc[3, q] / r * _vexp(arg)
+        conc[q] = value if arg > -700.0 else 0.0
+        dist[q] = r
+
+
+@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+def _log_missed_gaussian(conc: np.ndarray, count: int, sp: SensorParams, out: np.ndarray) -> None:
+    """out[j] = log P(no detection | conc[j]) − log(1 − false alarm) − log(1 − outlier) for
+    j < count: log(1 − Pd Φ(−x)), x = (threshold − C)/σ(C), for the Gaussian family with a
+    constant Pd < 1; branch-free, vectorised (erfc and log of :mod:`dcee.numeric`)."""
+    for j in range(count):
+        c = conc[j]
+        x = (sp.v_threshold - c) / (sp.sigma_frac * c + sp.sigma_min)
+        out[j] = vlog1m(sp.pd * vndtr_upper(x))
 
 
 @njit(cache=True, parallel=True)
+def _history_kernel(
+    theta: np.ndarray,
+    active: np.ndarray,
+    positions: np.ndarray,
+    readings: np.ndarray,
+    multiplicity: np.ndarray,
+    rmin: float,
+    meander: float,
+    sp: SensorParams,
+    threshold: np.ndarray,
+    remaining_bound: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    n = theta.shape[0]
+    k_count = readings.shape[0]
+    n_blocks = (n + _BLOCK - 1) // _BLOCK
+    # log P(miss) vectorised for the paper's sensor (Gaussian, constant Pd < 1; with Pd = 1 the
+    # log Φ form needs relative accuracy far in the tail, and Pd(r) needs expm1)
+    vector_missed = sp.lognormal == 0.0 and sp.pd < 1.0 and sp.near_length == 0.0
+    missed_offset = sp.log_not_false_alarm + sp.log_keep
+    for b in prange(n_blocks):
+        i0 = b * _BLOCK
+        nb = min(n, i0 + _BLOCK) - i0
+        pc = np.empty((10, nb))
+        for q in range(nb):
+            terms = plume_terms(theta, i0 + q)
+            for c in range(10):
+                pc[c, q] = terms[c]
+        acc = np.zeros(nb)
+        alive = np.empty(nb, dtype=np.bool_)
+        n_alive = 0
+        for q in range(nb):
+            alive[q] = active[i0 + q]
+            n_alive += alive[q]
+        conc = np.empty(nb)
+        dist = np.empty(nb)
+        gathered = np.empty(nb)
+        missed = np.empty(nb)
+        which = np.empty(nb, dtype=np.int64)
+        for k in range(k_count):
+            if n_alive == 0:
+                break
+            px = positions[k, 0]
+            py = positions[k, 1]
+            pz = positions[k, 2]
+            if meander > 0.0:
+                for q in range(nb):
+                    terms = (
+                        pc[0, q],
+                        pc[1, q],
+                        pc[2, q],
+                        pc[3, q],
+                        pc[4, q],
+                        pc[5, q],
+                        pc[6, q],
+                        pc[7, q],
+                        pc[8, q],
+                        pc[9, q],
+                    )
+                    conc[q], dist[q] = plume_at(terms, px, py, pz, rmin, meander)
+            else:
+                _plume_block(pc, nb, px, py, pz, rmin, conc, dist)
+            zk = readings[k]
+            mk = multiplicity[k]
+            if zk < sp.threshold and vector_missed:
+                # a non-detection: linear below c_lin; the others gathered and evaluated in
+                # one vectorised pass
+                count = 0
+                for q in range(nb):
+                    if alive[q]:
+                        cq = conc[q]
+                        if cq < sp.c_lin:
+                            acc[q] += mk * (sp.lin0 + sp.lin1 * cq + missed_offset)
+                        else:
+                            gathered[count] = cq
+                            which[count] = q
+                            count += 1
+                if count > 0:
+                    _log_missed_gaussian(gathered, count, sp, missed)
+                    for j in range(count):
+                        acc[which[j]] += mk * (missed[j] + missed_offset)
+            else:
+                for q in range(nb):
+                    if alive[q]:
+                        acc[q] += mk * log_likelihood(zk, conc[q], dist[q], sp)
+            if (k + 1) % _CHECK_EVERY == 0 and k + 1 < k_count:
+                rest = remaining_bound[k + 1]
+                for q in range(nb):
+                    t = threshold[i0 + q]
+                    if alive[q] and acc[q] + rest < t - _MARGIN * (1.0 + abs(t)):
+                        alive[q] = False
+                        n_alive -= 1
+        for q in range(nb):
+            out[i0 + q] = acc[q] if alive[q] else -np.inf
+
+
+def reading_upper_bounds(readings: np.ndarray, sensor: Sensor) -> np.ndarray:
+    """(K,) an upper bound of log p(z_k | C, r) over every concentration C ≥ 0 and source
+    distance r, for readings (K,) g/m³ (below the threshold: a non-detection).
+
+    Non-detection: log P(miss) ≤ 0, so log(1 − false alarm) + log(1 − outlier). Detection:
+    Pd(r) ≤ Pd, σ(C) ≥ σ_min (Gaussian) or = s (log-normal), the squared residual ≥ 0; a false
+    alarm's density is at most its exponential's at P(miss) = 1; the outlier term is exact.
+    """
+    sp = sensor.params
+    z = np.asarray(readings, dtype=np.float64)
+    det = z >= sensor.threshold
+    zd = np.where(det, z, sensor.threshold)
+    if sensor.lognormal:
+        density = sp.log_pd - math.log(sensor.log_sd) - HALF_LOG_2PI - np.log(zd)
+    else:
+        density = np.full(z.shape, sp.log_pd - math.log(sensor.sigma_min) - HALF_LOG_2PI)
+    if sensor.false_alarm > 0:
+        fas = sensor.false_alarm_scale
+        fa = sp.log_false_alarm - (zd - sensor.threshold) / fas - math.log(fas)
+        density = np.logaddexp(density, fa)
+    density = density + sp.log_keep
+    if sp.log_outlier > -np.inf:
+        density = np.logaddexp(density, sp.log_outlier - np.log(zd))
+    return np.where(det, density, sp.log_not_false_alarm + sp.log_keep)
+
+
 def history_log_likelihood(
     theta: np.ndarray,
     active: np.ndarray,
@@ -21,21 +207,35 @@ def history_log_likelihood(
     meander: float,
     sp: SensorParams,
     out: np.ndarray,
-):
+    threshold: np.ndarray | None = None,
+    bounds: np.ndarray | None = None,
+) -> None:
     """out[i] = Σ_k multiplicity[k] · log p(readings[k] | C(positions[k]; theta[i])).
 
     Particles with ``active[i]`` False get −inf (used for proposals outside the prior's support).
-    theta (N, 8); positions (K, 3); readings, multiplicity (K,); out (N,).
+    theta (N, 8); positions (K, 3); readings, multiplicity (K,); out (N,). With ``threshold``
+    (N,) and ``bounds`` (K,) (:func:`reading_upper_bounds`), a particle whose sum provably ends
+    at or below threshold[i] gets −inf instead (exact early rejection, see the module doc).
     """
     n = theta.shape[0]
-    k_count = readings.shape[0]
-    for i in prange(n):
-        if not active[i]:
-            out[i] = -np.inf
-            continue
-        terms = plume_terms(theta, i)
-        acc = 0.0
-        for k in range(k_count):
-            c, r = plume_at(terms, positions[k, 0], positions[k, 1], positions[k, 2], rmin, meander)
-            acc += multiplicity[k] * log_likelihood(readings[k], c, r, sp)
-        out[i] = acc
+    multiplicity = np.ascontiguousarray(multiplicity, dtype=np.float64)
+    if threshold is None or bounds is None:
+        threshold = np.full(n, -np.inf)
+        remaining = np.zeros(len(readings) + 1)
+    else:
+        # remaining[k] = Σ_{k' ≥ k} m_k' · bound_k'
+        weighted = np.asarray(bounds, dtype=np.float64) * multiplicity
+        remaining = np.append(np.cumsum(weighted[::-1])[::-1], 0.0)
+    _history_kernel(
+        np.ascontiguousarray(theta, dtype=np.float64),
+        np.ascontiguousarray(active, dtype=np.bool_),
+        np.ascontiguousarray(positions, dtype=np.float64),
+        np.ascontiguousarray(readings, dtype=np.float64),
+        multiplicity,
+        rmin,
+        meander,
+        sp,
+        np.ascontiguousarray(threshold, dtype=np.float64),
+        remaining,
+        out,
+    )

@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.estimation.filter_kernels import history_log_likelihood
+from dcee.estimation.filter_kernels import history_log_likelihood, reading_upper_bounds
 from dcee.estimation.priors import SourcePrior
 from dcee.models.plume import IsotropicPlume, isotropic_concentration_reference
 from dcee.models.sensor import Sensor
@@ -395,6 +395,10 @@ class ParticleFilter:
         active = np.isfinite(lp_prop)
         ll_prop = np.empty(self.n)
         pos, z, mult = self.history()
+        log_u = np.log(self.rng.random(self.n))
+        # accepted iff ll_prop > threshold: lets the kernel abandon hopeless proposals early
+        with np.errstate(invalid="ignore"):
+            threshold = log_u - lp_prop + self._hist_loglik + lp_cur - log_q_ratio
         history_log_likelihood(
             proposal,
             active,
@@ -405,8 +409,9 @@ class ParticleFilter:
             self.plume.meander,
             self._sp,
             ll_prop,
+            np.nan_to_num(threshold, nan=-np.inf, posinf=np.inf),
+            reading_upper_bounds(z, self.sensor),
         )
-        log_u = np.log(self.rng.random(self.n))
         with np.errstate(invalid="ignore"):
             log_ratio = (ll_prop + lp_prop) - (self._hist_loglik + lp_cur) + log_q_ratio
             accept = active & (log_u < log_ratio)
