@@ -4,11 +4,11 @@
 The history likelihood Σ_k m_k log p(z_k | Θ_i) is the cost of the filter's MCMC move (every
 proposal against every reading so far) and of each update (one reading). Particles are taken
 in blocks; for each reading the plume is evaluated for the whole block in a branch-free loop
-that LLVM vectorises (:func:`dcee.numeric._vexp`), then the likelihood: far from a hypothesised source the concentration is below the sensor's
-linearisation point and a non-detection costs a multiply-add; the other non-detections are
-gathered and evaluated in one vectorised pass (the paper's sensor; libm otherwise), detections
-in a scalar loop. Each particle's sum runs
-over the readings in their order, as in a plain loop.
+that LLVM vectorises (:func:`dcee.numeric._vexp`), then the likelihood: far from a
+hypothesised source the concentration is below the sensor's linearisation point and a
+non-detection costs a multiply-add; the other non-detections are gathered and evaluated in one
+vectorised pass (the paper's sensor; libm otherwise), detections in a scalar loop. Each
+particle's sum runs over the readings in their order, as in a plain loop.
 
 **Early rejection (exact).** The MCMC move accepts proposal i only if its history
 log-likelihood exceeds a threshold T_i fixed by its uniform draw, the prior and the current
