@@ -32,6 +32,18 @@ def test_perf_quick_writes_every_standard_workload(tmp_path, capsys):
     cl = by_name["dcee-cl-decision-20k"]
     ratio = cl["median_ms"] / by_name["dcee-decision-20k"]["median_ms"]
     assert cl["note"] == f"{ratio:.2f}× the dcee decision in this run"
+    # issue 17: decisions as ratios to the plain compiled loop and the NumPy reference, and the
+    # move as a ratio to the update, each from medians timed in the same run
+    floor, numpy_ref = by_name["floor-decision-20k"], by_name["numpy-decision-20k"]
+    for name in ("dcee-decision-20k", "infotaxis-decision-20k"):
+        w = by_name[name]
+        assert w["ratio_to"]["floor"] == w["median_ms"] / floor["median_ms"]
+        assert w["ratio_to"]["numpy"] == w["median_ms"] / numpy_ref["median_ms"]
+        assert "the plain compiled loop" in w["note"]
+    move = by_name["resample-mcmc-500-readings-20k"]
+    assert move["ratio_to"]["filter-update"] == (
+        move["median_ms"] / by_name["filter-update-20k"]["median_ms"]
+    )
     mem = by_name["memory-dcee-decision-100k"]
     assert mem["unit"] == "MB" and 0 < mem["median"] < 200
     assert data["machine"]["cpus"] >= 1

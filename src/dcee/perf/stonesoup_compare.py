@@ -221,5 +221,6 @@ def compare(n_decisions: int = 10) -> dict:
         "stonesoup_median_ms": ss_med,
         "dcee_infotaxis_median_ms": our_med,
         "speedup": ss_med / our_med,
+        "ratio_to": {"stonesoup": our_med / ss_med},
         "target_speedup": 20.0,
     }

@@ -135,6 +135,8 @@ class ParticleTerms:
         """(conc, dist, loc, log_nd, inv_sigma, det_offset), each (capacity, M) C-contiguous;
         row r holds the terms at the position :meth:`rows` mapped to r (see
         :func:`~dcee.planning.predicted_kernels.position_rows`)."""
+        if self._flat is None:
+            self._grow(8)
         if self._terms is None:
             m, cap = max(self.n, 1), self.capacity
             self._terms = tuple(self._flat[k, : cap * m].reshape(cap, m) for k in range(N_TERMS))

@@ -1,0 +1,119 @@
+"""ParticleTerms (issue 17): merged particle copies and per-position terms kept across decisions
+give the statistics of the plain computation, never stale ones."""
+
+import numpy as np
+import pytest
+
+from dcee.models import IsotropicPlume, Sensor
+from dcee.planning.base import Belief
+from dcee.planning.particle_terms import ParticleTerms, merge_runs
+from dcee.planning.predicted import PredictionContext
+from tests.helpers import random_theta
+
+SENSOR = Sensor()
+PLUME = IsotropicPlume()
+
+
+def _resampled(n=3000, seed=0):
+    rng = np.random.default_rng(seed)
+    base = random_theta(n // 3, rng)
+    idx = np.sort(rng.integers(0, len(base), n))  # runs of copies, as resampling leaves them
+    theta = np.ascontiguousarray(base[idx])
+    w = rng.random(n)
+    return theta, w / w.sum()
+
+
+def test_merge_runs_keeps_one_particle_per_run_with_the_runs_weight():
+    theta, w = _resampled()
+    pt = ParticleTerms()
+    pt.sync(theta, SENSOR, PLUME)
+    starts = merge_runs(theta)
+    assert pt.n == len(starts) < len(theta)
+    np.testing.assert_array_equal(pt.theta, theta[starts])
+    merged = pt.weights(w)
+    ends = np.append(starts[1:], len(theta))
+    np.testing.assert_allclose(merged, [w[a:b].sum() for a, b in zip(starts, ends, strict=True)])
+    assert np.all(np.any(pt.theta[1:] != pt.theta[:-1], axis=1))  # no run left
+
+
+def test_merged_statistics_equal_the_unmerged_ones():
+    theta, w = _resampled()
+    positions = np.array([[[20.0, 20.0, 2.0]], [[24.0, 20.0, 2.0]], [[20.0, 26.0, 2.0]]])
+    out = []
+    for merge in (True, False):
+        belief = Belief(theta, w, SENSOR, PLUME, ParticleTerms(merge=merge))
+        ctx = PredictionContext(belief, 30, 1, np.random.default_rng(3))
+        out.append(ctx.stats(positions))
+    fast, plain = out
+    np.testing.assert_array_equal(fast.readings, plain.readings)  # the same hypotheses
+    for a, b in [
+        (fast.log_evidence, plain.log_evidence),
+        (fast.mean, plain.mean),
+        (fast.trace_cov, plain.trace_cov),
+        (fast.kl, plain.kl),
+    ]:
+        np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-12)
+
+
+def test_rows_are_reused_across_decisions_and_recomputed_when_the_particles_change():
+    theta, w = _resampled()
+    cache = ParticleTerms()
+    a = np.array([[10.0, 10.0, 2.0], [12.0, 10.0, 2.0]])
+    ctx = PredictionContext(Belief(theta, w, SENSOR, PLUME, cache), 5, 1, np.random.default_rng(0))
+    rows = ctx.position_index(a)
+    first = [t[rows].copy() for t in ctx.terms]
+    # a second decision on the same particles (new weights) finds the rows
+    PredictionContext(Belief(theta, w[::-1].copy(), SENSOR, PLUME, cache), 5, 1,
+                      np.random.default_rng(1))  # fmt: skip
+    assert cache.rows(a).tolist() == rows.tolist()
+    # an edit in place is noticed: the terms are those of the new particles
+    theta[:, 0] += 1.0
+    ctx = PredictionContext(Belief(theta, w, SENSOR, PLUME, cache), 5, 1, np.random.default_rng(0))
+    new = [t[ctx.position_index(a)] for t in ctx.terms]
+    fresh = PredictionContext(Belief(theta, w, SENSOR, PLUME), 5, 1, np.random.default_rng(0))
+    ref = [t[fresh.position_index(a)] for t in fresh.terms]
+    for x, y in zip(new, ref, strict=True):
+        np.testing.assert_array_equal(x, y)
+    assert not np.array_equal(new[0], first[0])
+
+
+def test_the_byte_cap_evicts_old_rows_never_the_current_decisions():
+    theta, w = _resampled(900)
+    cache = ParticleTerms(max_bytes=6 * 8 * 300 * 10)  # 10 rows of 300 merged particles or more
+    cache.sync(theta, SENSOR, PLUME)
+    rng = np.random.default_rng(0)
+    for decision in range(6):
+        cache.begin()
+        pts = np.column_stack([rng.uniform(0, 50, (8, 2)), np.full(8, 2.0)])
+        rows = cache.rows(pts)
+        assert len(set(rows.tolist())) == 8
+        # every row asked for in this decision still holds its position's terms
+        fresh = ParticleTerms()
+        fresh.sync(theta, SENSOR, PLUME)
+        fresh.begin()
+        ref = fresh.rows(pts)
+        np.testing.assert_array_equal(cache.terms[2][rows], fresh.terms[2][ref])
+        assert cache.capacity <= max(16, 8 * (decision + 1))
+    # one decision needing more rows than the cap grows the buffers instead of evicting its own
+    cache.begin()
+    many = np.column_stack([rng.uniform(0, 50, (30, 2)), np.full(30, 2.0)])
+    rows = cache.rows(many)
+    assert len(set(rows.tolist())) == 30 and cache.capacity >= 30
+
+
+@pytest.mark.parametrize("expectation", ["sampled", "stratified"])
+def test_a_branch_on_a_subset_sees_the_same_terms(expectation):
+    theta, w = _resampled()
+    ctx = PredictionContext(Belief(theta, w, SENSOR, PLUME), 6, 1, np.random.default_rng(0),
+                            expectation)  # fmt: skip
+    pts = np.array([[10.0, 10.0, 2.0], [30.0, 12.0, 2.0]])
+    rows = ctx.position_index(pts)
+    bw = ctx.belief.weights.copy()
+    bw[::3] = 0.0  # a third cannot explain the hypothesised reading: the branch drops them
+    bw /= bw.sum()
+    branch = ctx.branch(bw, 4, np.random.default_rng(1))
+    keep = bw > 1e-12 * bw.max()
+    assert branch.belief.theta.shape[0] == keep.sum()
+    brow = branch.position_index(pts)
+    for full, sub in zip(ctx.terms, branch.terms, strict=True):
+        np.testing.assert_array_equal(sub[brow], full[rows][:, keep])
