@@ -78,7 +78,7 @@ def test_rows_are_reused_across_decisions_and_recomputed_when_the_particles_chan
 
 
 def test_the_byte_cap_evicts_old_rows_never_the_current_decisions():
-    theta, w = _resampled(900)
+    theta, _ = _resampled(900)
     cache = ParticleTerms(max_bytes=6 * 8 * 300 * 10)  # 10 rows of 300 merged particles or more
     cache.sync(theta, SENSOR, PLUME)
     rng = np.random.default_rng(0)
