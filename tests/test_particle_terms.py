@@ -94,6 +94,17 @@ def test_the_byte_cap_evicts_old_rows_never_the_current_decisions():
         ref = fresh.rows(pts)
         np.testing.assert_array_equal(cache.terms[2][rows], fresh.terms[2][ref])
         assert cache.capacity <= max(16, 8 * (decision + 1))
+    # a call that mixes rows cached by earlier decisions with new positions under the cap's
+    # pressure keeps the old rows it asks for (they are this decision's now)
+    cache.begin()
+    old_pts = pts[:3]
+    mixed = np.vstack([old_pts, np.column_stack([rng.uniform(0, 50, (9, 2)), np.full(9, 2.0)])])
+    rows = cache.rows(mixed)
+    fresh = ParticleTerms()
+    fresh.sync(theta, SENSOR, PLUME)
+    fresh.begin()
+    fresh_rows = fresh.rows(mixed)
+    np.testing.assert_array_equal(cache.terms[2][rows], fresh.terms[2][fresh_rows])
     # one decision needing more rows than the cap grows the buffers instead of evicting its own
     cache.begin()
     many = np.column_stack([rng.uniform(0, 50, (30, 2)), np.full(30, 2.0)])
@@ -117,3 +128,22 @@ def test_a_branch_on_a_subset_sees_the_same_terms(expectation):
     brow = branch.position_index(pts)
     for full, sub in zip(ctx.terms, branch.terms, strict=True):
         np.testing.assert_array_equal(sub[brow], full[rows][:, keep])
+
+
+def test_a_cached_row_asked_for_again_is_not_evicted_for_the_new_ones_of_the_same_call():
+    theta, _ = _resampled(900)
+    cache = ParticleTerms(max_bytes=1)  # the cap in force at once: evict whatever is old
+    cache.sync(theta, SENSOR, PLUME)
+    cache.begin()
+    first = np.array([[float(x), 10.0, 2.0] for x in range(8)])
+    cache.rows(first)
+    cache.begin()  # next decision: the first position again, and seven new ones
+    mixed = np.vstack([first[:1], [[float(x), 30.0, 2.0] for x in range(7)]])
+    rows = cache.rows(mixed)
+    assert len(set(rows.tolist())) == 8
+    fresh = ParticleTerms()
+    fresh.sync(theta, SENSOR, PLUME)
+    fresh.begin()
+    fresh_rows = fresh.rows(mixed)
+    for a, b in zip(cache.terms, fresh.terms, strict=True):
+        np.testing.assert_array_equal(a[rows], b[fresh_rows])

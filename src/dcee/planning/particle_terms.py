@@ -189,6 +189,8 @@ class ParticleTerms:
                 pending[key] = len(missing)
                 missing.append(k)
             out[k] = -1 if row is None else row
+        found = out[out >= 0]
+        self._stamp[found] = self._clock  # in use by this decision: never evicted below
         if missing:
             free = self._free_rows(len(missing))
             new_rows = np.array(free, dtype=np.int64)
