@@ -147,7 +147,7 @@ def vlog1p(x: np.ndarray, out: np.ndarray) -> None:
 # erfc(y) = e^(−y²) · erfcx(y) for y ≥ 0, with (y + K) · erfcx(y) a Chebyshev series in
 # t = (y − K)/(y + K) ∈ [−1, 1) (K = 3; coefficients from scripts/fit_erfcx.py, relative error
 # < 1e-14 against scipy.special.erfcx on [0, 1e6]). log(x) = m ln 2 + log1p(x 2^−m − 1) with m
-# found by a ladder of compares (no frexp, which numba only has as a scalar call).
+# (|m| ≤ 63) found by a ladder of compares (no frexp, which numba only has as a scalar call).
 _ERFCX_K = 3.0
 _ERFCX_CHEB = (
     1.4134382239808718,
@@ -228,77 +228,7 @@ def vndtr_upper(x: float) -> float:
 
 @njit(cache=True, inline="always")
 def _vlog(x: float) -> float:
-    """log(x) for a positive normal float, vectorisable; relative error < 2e-16."""
-    m = 0.0
-    # x ≥ 2^k → x · 2^−k, k = 512, 256, ..., 1: leaves x < 2
-    up = x >= 1.3407807929942597e154
-    x = x * 7.458340731200207e-155 if up else x
-    m = m + 512.0 if up else m
-    up = x >= 1.157920892373162e77
-    x = x * 8.636168555094445e-78 if up else x
-    m = m + 256.0 if up else m
-    up = x >= 3.402823669209385e38
-    x = x * 2.938735877055719e-39 if up else x
-    m = m + 128.0 if up else m
-    up = x >= 1.8446744073709552e19
-    x = x * 5.421010862427522e-20 if up else x
-    m = m + 64.0 if up else m
-    up = x >= 4294967296.0
-    x = x * 2.3283064365386963e-10 if up else x
-    m = m + 32.0 if up else m
-    up = x >= 65536.0
-    x = x * 1.52587890625e-05 if up else x
-    m = m + 16.0 if up else m
-    up = x >= 256.0
-    x = x * 0.00390625 if up else x
-    m = m + 8.0 if up else m
-    up = x >= 16.0
-    x = x * 0.0625 if up else x
-    m = m + 4.0 if up else m
-    up = x >= 4.0
-    x = x * 0.25 if up else x
-    m = m + 2.0 if up else m
-    up = x >= 2.0
-    x = x * 0.5 if up else x
-    m = m + 1.0 if up else m
-    # x < 2^(1−k) → x · 2^k: leaves 1 ≤ x < 2
-    down = x < 1.4916681462400413e-154
-    x = x * 1.3407807929942597e154 if down else x
-    m = m - 512.0 if down else m
-    down = x < 1.727233711018889e-77
-    x = x * 1.157920892373162e77 if down else x
-    m = m - 256.0 if down else m
-    down = x < 5.877471754111438e-39
-    x = x * 3.402823669209385e38 if down else x
-    m = m - 128.0 if down else m
-    down = x < 1.0842021724855044e-19
-    x = x * 1.8446744073709552e19 if down else x
-    m = m - 64.0 if down else m
-    down = x < 4.656612873077393e-10
-    x = x * 4294967296.0 if down else x
-    m = m - 32.0 if down else m
-    down = x < 3.0517578125e-05
-    x = x * 65536.0 if down else x
-    m = m - 16.0 if down else m
-    down = x < 0.0078125
-    x = x * 256.0 if down else x
-    m = m - 8.0 if down else m
-    down = x < 0.125
-    x = x * 16.0 if down else x
-    m = m - 4.0 if down else m
-    down = x < 0.5
-    x = x * 4.0 if down else x
-    m = m - 2.0 if down else m
-    down = x < 1.0
-    x = x * 2.0 if down else x
-    m = m - 1.0 if down else m
-    return m * _LN2_HI + (m * _LN2_LO + _vlog1p(x - 1.0))
-
-
-@njit(cache=True, inline="always")
-def _vlog_moderate(x: float) -> float:
-    """log(x) for 2^−63 ≤ x < 2^64, vectorisable; relative error < 2e-16 (a shorter ladder
-    than :func:`_vlog`)."""
+    """log(x) for 2^−63 ≤ x < 2^64, vectorisable; relative error < 2e-16."""
     m = 0.0
     up = x >= 4294967296.0
     x = x * 2.3283064365386963e-10 if up else x
@@ -344,7 +274,7 @@ def vlog1m(y: float) -> float:
     """log(1 − y) for 0 ≤ y ≤ 1 − 2^−63, vectorisable; absolute error < 3e-16 (a series below
     y = 1e-3, where 1 − y would round)."""
     series = -y * (1.0 + y * (0.5 + y * (1.0 / 3.0 + y * (0.25 + y * 0.2))))
-    return series if y < 1e-3 else _vlog_moderate(1.0 - y)
+    return series if y < 1e-3 else _vlog(1.0 - y)
 
 
 @njit(cache=True, fastmath={"contract"}, error_model="numpy")
@@ -355,12 +285,7 @@ def verfc(x: np.ndarray, out: np.ndarray) -> None:
 
 
 @njit(cache=True, fastmath={"contract"}, error_model="numpy")
-def vlog(x: np.ndarray, out: np.ndarray, moderate: bool = False) -> None:
-    """out[i] = log(x[i]) for positive normal x with the vectorisable ladder (``moderate``:
-    the shorter one, 2^−63 ≤ x < 2^64); exposed for tests."""
-    if moderate:
-        for i in range(x.shape[0]):
-            out[i] = _vlog_moderate(x[i])
-    else:
-        for i in range(x.shape[0]):
-            out[i] = _vlog(x[i])
+def vlog(x: np.ndarray, out: np.ndarray) -> None:
+    """out[i] = log(x[i]) for 2^−63 ≤ x < 2^64 with the vectorisable ladder (for tests)."""
+    for i in range(x.shape[0]):
+        out[i] = _vlog(x[i])

@@ -26,10 +26,10 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from dcee.models.plume_kernels import plume_at, plume_terms
+from dcee.models.plume_kernels import constants_at, plume_at, plume_from_constants, plume_terms
 from dcee.models.sensor import Sensor
 from dcee.models.sensor_kernels import SensorParams, log_likelihood
-from dcee.numeric import HALF_LOG_2PI, _vexp, vlog1m, vndtr_upper
+from dcee.numeric import HALF_LOG_2PI, vlog1m, vndtr_upper
 
 _BLOCK = 256  # particles per work item
 _CHECK_EVERY = 8  # readings between early-rejection checks
@@ -49,18 +49,10 @@ def _plume_block(
     conc: np.ndarray,
     dist: np.ndarray,
 ) -> None:
-    """conc[q], dist[q] for the block's particles q < nb from their plume constants pc (10, nb)
-    (see :func:`~dcee.models.plume_kernels.plume_terms`), without meander; branch-free."""
+    """conc[q], dist[q] for the block's particles q < nb from their plume constants pc (10, nb),
+    without meander; vectorised (:func:`~dcee.models.plume_kernels.plume_from_constants`)."""
     for q in range(nb):
-        dx = px - pc[0, q]
-        dy = py - pc[1, q]
-        dz = pz - pc[2, q]
-        r = max(math.sqrt(dx * dx + dy * dy + dz * dz), rmin)
-        # the exponent is ≤ 0 (1/λ ≥ u/(2ζ1)); min() guards against rounding
-        arg = min(-r * pc[4, q] - dx * pc[5, q] - dy * pc[6, q], 0.0)
-        value = pc[3, q] / r * _vexp(arg)
-        conc[q] = value if arg > -700.0 else 0.0
-        dist[q] = r
+        conc[q], dist[q] = plume_from_constants(pc, q, px, py, pz, rmin)
 
 
 @njit(cache=True, fastmath={"contract"}, error_model="numpy")
@@ -122,19 +114,7 @@ def _history_kernel(
             pz = positions[k, 2]
             if meander > 0.0:
                 for q in range(nb):
-                    terms = (
-                        pc[0, q],
-                        pc[1, q],
-                        pc[2, q],
-                        pc[3, q],
-                        pc[4, q],
-                        pc[5, q],
-                        pc[6, q],
-                        pc[7, q],
-                        pc[8, q],
-                        pc[9, q],
-                    )
-                    conc[q], dist[q] = plume_at(terms, px, py, pz, rmin, meander)
+                    conc[q], dist[q] = plume_at(constants_at(pc, q), px, py, pz, rmin, meander)
             else:
                 _plume_block(pc, nb, px, py, pz, rmin, conc, dist)
             zk = readings[k]

@@ -13,6 +13,8 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from dcee.numeric import _vexp
+
 _FOUR_PI = 4.0 * math.pi
 
 
@@ -67,6 +69,40 @@ def plume_at(terms, px: float, py: float, pz: float, rmin: float, meander: float
     if r0 < rmin:
         r0 = rmin
     return factor * pref / r * math.exp(-r * inv_lam - dx * ax - dy * ay), r0
+
+
+@njit(cache=True, inline="always")
+def constants_at(pc: np.ndarray, i: int):
+    """Particle i's :func:`plume_terms` from the (10, N) array of them that planners and the
+    filter keep per particle set."""
+    return (
+        pc[0, i],
+        pc[1, i],
+        pc[2, i],
+        pc[3, i],
+        pc[4, i],
+        pc[5, i],
+        pc[6, i],
+        pc[7, i],
+        pc[8, i],
+        pc[9, i],
+    )
+
+
+@njit(cache=True, inline="always")
+def plume_from_constants(pc: np.ndarray, i, px: float, py: float, pz: float, rmin: float):
+    """(concentration, clamped distance r) at (px, py, pz) for particle i of the (10, N)
+    :func:`plume_terms` array pc, without meander. Branch-free (selects only) with the
+    vectorisable exp, so the loops over particles that call it vectorise; equals
+    :func:`plume_at` with meander 0 to rounding (0 below e^−700)."""
+    dx = px - pc[0, i]
+    dy = py - pc[1, i]
+    dz = pz - pc[2, i]
+    r = max(math.sqrt(dx * dx + dy * dy + dz * dz), rmin)
+    # the exponent is ≤ 0 (1/λ ≥ u/(2ζ1)); min() guards against rounding
+    arg = min(-r * pc[4, i] - dx * pc[5, i] - dy * pc[6, i], 0.0)
+    value = pc[3, i] / r * _vexp(arg)
+    return (value if arg > -700.0 else 0.0), r
 
 
 @njit(cache=True, parallel=True)

@@ -164,7 +164,7 @@ class ParticleTerms:
         free = [r for r in range(self.capacity) if r not in used]
         if len(free) >= count:
             return free[:count]
-        cap_rows = max(self.max_bytes // bytes_per_row(max(self.n, 1)), 1)
+        cap_rows = max(self.max_bytes // (N_TERMS * 8 * max(self.n, 1)), 1)
         if len(used) + count > cap_rows:
             old = sorted((int(self._stamp[r]), r) for r in used if self._stamp[r] < self._clock)
             evict = [r for _, r in old[: count - len(free)]]
@@ -230,12 +230,3 @@ class ParticleTerms:
         other._clock = self._clock
         other._stamp[: len(self._stamp)] = self._stamp
         return other
-
-    def nbytes(self) -> int:
-        """Bytes held by the row buffers."""
-        return 0 if self._flat is None else int(self._flat.nbytes)
-
-
-def bytes_per_row(n: int) -> int:
-    """Bytes of one cached position row for n particles."""
-    return N_TERMS * 8 * n

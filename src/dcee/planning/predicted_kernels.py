@@ -16,7 +16,12 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from dcee.models.plume_kernels import plume_at, plume_terms
+from dcee.models.plume_kernels import (
+    constants_at,
+    plume_at,
+    plume_from_constants,
+    plume_terms,
+)
 from dcee.models.sensor_kernels import (
     SensorParams,
     log_detection_probability,
@@ -26,7 +31,7 @@ from dcee.models.sensor_kernels import (
 from dcee.numeric import (
     HALF_LOG_2PI,
     _vexp,
-    _vlog_moderate,
+    _vlog,
     logaddexp,
     vlog1m,
     vlogaddexp,
@@ -95,14 +100,7 @@ def _rows_gaussian(
         # an unsigned index: numba then emits no negative-index wraparound, which would keep
         # LLVM from vectorising the loop
         i = np.uint64(i0 + j)
-        dx = px - plume[0, i]
-        dy = py - plume[1, i]
-        dz = pz - plume[2, i]
-        r = max(math.sqrt(dx * dx + dy * dy + dz * dz), rmin)
-        # the exponent is ≤ 0 (1/λ ≥ u/(2ζ1)); min() guards against rounding
-        arg = min(-r * plume[4, i] - dx * plume[5, i] - dy * plume[6, i], 0.0)
-        value = plume[3, i] / r * _vexp(arg)
-        c = value if arg > -700.0 else 0.0
+        c, r = plume_from_constants(plume, i, px, py, pz, rmin)
         sigma = sp.sigma_frac * c + sp.sigma_min
         inv_s = 1.0 / sigma
         missed = vlog1m(sp.pd * vndtr_upper((sp.v_threshold - c) * inv_s))  # log(1 − Pd Φ(−x))
@@ -112,7 +110,7 @@ def _rows_gaussian(
         loc[i] = c
         inv_sigma[i] = inv_s
         log_nd[i] = (lin if c < sp.c_lin else missed) + missed_offset
-        det_offset[i] = sp.log_pd - _vlog_moderate(sigma)
+        det_offset[i] = sp.log_pd - _vlog(sigma)
 
 
 @njit(cache=True, parallel=True)
@@ -152,7 +150,7 @@ def position_rows(
         and sp.pd < 1.0
         and sp.near_length == 0.0
         and meander == 0.0
-        and sp.sigma_min >= 2.0**-60  # σ within the short log ladder's range
+        and sp.sigma_min >= 2.0**-60  # σ within the range of the vectorised log
     )
     for b in prange(n_blocks):
         i0 = b * _ROW_BLOCK
@@ -181,19 +179,7 @@ def position_rows(
                 )
                 continue
             for i in range(i0, i1):
-                terms = (
-                    plume[0, i],
-                    plume[1, i],
-                    plume[2, i],
-                    plume[3, i],
-                    plume[4, i],
-                    plume[5, i],
-                    plume[6, i],
-                    plume[7, i],
-                    plume[8, i],
-                    plume[9, i],
-                )
-                c, r = plume_at(terms, px, py, pz, rmin, meander)
+                c, r = plume_at(constants_at(plume, i), px, py, pz, rmin, meander)
                 m, sigma = transform(c, sp)
                 conc[row, i] = c
                 dist[row, i] = r
