@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import math
+import pickle
 import time as _time
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -12,6 +15,7 @@ from dcee.allocator import tune_allocator
 from dcee.blas import one_blas_thread
 from dcee.errors import DceeInputError
 from dcee.estimation.particle_filter import ParticleFilter, UpdateInfo
+from dcee.io import write_atomic
 from dcee.models.agent import GridAgent
 from dcee.planning.base import Belief, Decision, Planner
 from dcee.planning.particle_terms import ParticleTerms
@@ -29,6 +33,10 @@ class SourceEstimate:
     @property
     def spread(self) -> float:
         return float(math.sqrt(max(np.trace(self.cov), 0.0)))
+
+
+CHECKPOINT_FORMAT = "dcee-searcher-checkpoint-1"
+"""Identifies a :meth:`Searcher.save` file (and its layout version)."""
 
 
 class Searcher:
@@ -64,6 +72,8 @@ class Searcher:
         # merged particles and per-position terms kept across decisions while the particles
         # are unchanged (dcee.planning.particle_terms; exact, about a third of a decision)
         self.planning_cache = ParticleTerms()
+        self.checkpoint_code: dict[str, Any] | None = None
+        """the code version that wrote the checkpoint this searcher was loaded from"""
 
     def tell(self, position: np.ndarray, reading: float, time: float | None = None) -> UpdateInfo:
         """Assimilate a reading (g/m³) taken at ``position`` (m) at ``time`` (s)."""
@@ -122,6 +132,54 @@ class Searcher:
         return np.array(
             [d.position if d is not None else p for d, p in zip(decisions, arr, strict=True)]
         )
+
+    # --- checkpoint and restore ---------------------------------------------------------------
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        state["planning_cache"] = None  # a cache: rebuilt on demand, never changes a decision
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self.planning_cache = ParticleTerms()
+
+    def save(self, path: str | Path) -> Path:
+        """Checkpoint the whole search to ``path`` (one file, written atomically): the filter
+        (particles, weights, reading history, its random state), the planner and its options,
+        the agent, the planner's random state, the last position and time. :meth:`load` gives a
+        searcher that makes exactly the decisions this one would have made (tested). The file
+        is a Python pickle: load only checkpoints you wrote yourself."""
+        from dcee.provenance import code_version
+
+        path = Path(path)
+        state = {"format": CHECKPOINT_FORMAT, "code": code_version(), "searcher": self}
+        try:
+            write_atomic(path, lambda p: p.write_bytes(pickle.dumps(state, protocol=5)))
+        except OSError as exc:
+            raise DceeInputError("path", f"cannot write checkpoint {path}: {exc}") from None
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> Searcher:
+        """Restore a searcher from a :meth:`save` checkpoint (the code version that wrote it is
+        in :attr:`checkpoint_code`)."""
+        path = Path(path)
+        try:
+            state = pickle.loads(path.read_bytes())
+        except FileNotFoundError:
+            raise DceeInputError("path", f"no checkpoint at {path}") from None
+        except Exception as exc:
+            raise DceeInputError("path", f"{path} is not a dcee checkpoint ({exc})") from None
+        if not (
+            isinstance(state, dict)
+            and state.get("format") == CHECKPOINT_FORMAT
+            and isinstance(state.get("searcher"), cls)
+        ):
+            raise DceeInputError("path", f"{path} is not a dcee searcher checkpoint")
+        searcher: Searcher = state["searcher"]
+        searcher.checkpoint_code = state.get("code")
+        return searcher
 
     def belief(self) -> Belief:
         f = self.filter

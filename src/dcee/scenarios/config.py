@@ -82,6 +82,7 @@ from pydantic import (
 from dcee.errors import DceeInputError
 from dcee.estimation.priors import Distribution, Fixed, Gamma, Normal, SourcePrior, Uniform
 from dcee.models.agent import GridAgent, SearchVolume
+from dcee.models.motion import MotionModel, make_motion
 from dcee.models.plume import PARAMETER_NAMES, IsotropicPlume
 from dcee.models.sensor import Sensor
 
@@ -347,6 +348,29 @@ def team_starts(
     return None
 
 
+class UnicycleSpec(BaseModel):
+    """The differential-drive robot of ``agent.model = "unicycle"`` (:mod:`dcee.models.motion`).
+    Its top speed is ``agent.speed``. Defaults: a Turtlebot-2-class robot as Nav2 drives it
+    (0.5 m/s² and 60°/s, 180°/s²); a 0.3 m move then takes 1.9-4.4 s depending on the heading
+    change, against 1.5 s for the grid agent at 0.2 m/s."""
+
+    model_config = _FROZEN
+    max_accel: Positive = 0.5
+    """m/s², forward acceleration and braking"""
+    max_turn_rate: Annotated[float, Field(gt=0, le=720, allow_inf_nan=False)] = 60.0
+    """°/s"""
+    max_turn_accel: Annotated[float, Field(gt=0, le=7200, allow_inf_nan=False)] = 180.0
+    """°/s²"""
+    lookahead: Positive = 0.15
+    """m, pure-pursuit look-ahead along the segment to the waypoint"""
+    turn_in_place: Annotated[float, Field(gt=0, le=180, allow_inf_nan=False)] = 45.0
+    """°: a waypoint further off the heading is first faced by turning on the spot"""
+    goal_tolerance: Positive = 0.02
+    """m: settled within this distance of the waypoint (and nearly still)"""
+    control_dt: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.05
+    """s, control and integration period"""
+
+
 class AgentSpec(BaseModel):
     """The mobile sensor: where it starts and how it moves (one step along one of
     ``headings`` directions per decision, at the start altitude)."""
@@ -366,6 +390,17 @@ class AgentSpec(BaseModel):
     count: Annotated[int, Field(ge=1, le=16)] = 1
     """robots searching together with one shared belief; robot k starts k · step metres from
     ``start`` along +y (along −y where +y would leave the area)"""
+    model: Literal["grid", "unicycle"] = "grid"
+    """how the robot drives to a waypoint (:mod:`dcee.models.motion`): "grid", every move takes
+    step / speed s and ends on the waypoint (the paper's); "unicycle", a differential-drive
+    robot with the limits of [agent.unicycle], so the time per move comes from its dynamics"""
+    unicycle: UnicycleSpec = UnicycleSpec()
+    """the unicycle robot's limits and path follower, see [agent.unicycle]"""
+    heading: Finite = 0.0
+    """start heading, ° counter-clockwise from +x"""
+    localisation_sd: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 0.0
+    """m: standard deviation of the localisation error (per axis, horizontal) on the position
+    told to the estimator with every reading; the reading itself is taken at the true position"""
 
 
 class SearchSpec(BaseModel):
@@ -561,8 +596,27 @@ class Scenario(BaseModel):
         return out
 
     def make_agent(self) -> GridAgent:
+        """The planner's move set."""
         a = self.agent
         return GridAgent(self.search_volume(), a.step, a.speed, self.dwell, a.headings)
+
+    def make_motion(self) -> MotionModel:
+        """How the robots drive to the planner's waypoints (``agent.model``)."""
+        a = self.agent
+        if a.model == "grid":
+            return make_motion("grid", step=a.step, speed=a.speed)
+        u = a.unicycle
+        return make_motion(
+            "unicycle",
+            max_speed=a.speed,
+            max_accel=u.max_accel,
+            max_turn_rate=math.radians(u.max_turn_rate),
+            max_turn_accel=math.radians(u.max_turn_accel),
+            lookahead=u.lookahead,
+            turn_in_place=math.radians(u.turn_in_place),
+            goal_tolerance=u.goal_tolerance,
+            control_dt=u.control_dt,
+        )
 
     def truth_theta(self) -> np.ndarray:
         """(8,) true source term (φ in radians)."""

@@ -11,6 +11,7 @@ identical truth noise (common random numbers).
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -170,6 +171,16 @@ def streams(seed: int) -> tuple[np.random.Generator, ...]:
     return tuple(np.random.default_rng(s) for s in (truth_ss, filter_ss, planner_ss, figure_ss))
 
 
+MOTION_STREAM = 4
+"""Child of the seed that draws the localisation errors (children 0-2 are :func:`streams`, 3 the
+stochastic truth's), so adding localisation noise changes no other draw."""
+
+
+def motion_stream(seed: int) -> np.random.Generator:
+    """The generator of the robots' localisation errors for episode ``seed``."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(MOTION_STREAM,)))
+
+
 class SearchSimulation:
     """One simulated search, a step at a time: the world (truth, instrument, robots' move
     model) and the filter, without a planner. :func:`run_episode` drives it with a planner; the
@@ -178,9 +189,9 @@ class SearchSimulation:
 
     ``sense()`` takes every robot's reading at its current position and the current time,
     assimilates them into the one shared filter (robot 0 first) and appends one record per
-    reading (:attr:`records`, with its ``robot``); ``move(waypoints)`` flies the robots to their
-    next waypoints, one ``agent.step_time`` later; ``finished`` says when no further move fits
-    the budget (or the scenario's ``stop_spread`` is reached). The scenario's ``agent.count``
+    reading (:attr:`records`, with its ``robot``); ``move(waypoints)`` drives the robots to
+    their next waypoints (:attr:`motion`), the readings follow one hold after the slowest has
+    settled; ``finished`` says when no further move fits the budget (or the scenario's ``stop_spread`` is reached). The scenario's ``agent.count``
     sets the number of robots (:meth:`~dcee.scenarios.config.Scenario.starts`).
     """
 
@@ -213,8 +224,12 @@ class SearchSimulation:
             max_sweeps=search.max_sweeps,
         )
         self.searcher = Searcher(self.filter, planner, self.agent, planner_rng)
-        self.positions = scenario.starts()  # (K, 3)
+        self.motion = scenario.make_motion()
+        self._motion_rng = motion_stream(seed)
+        self.positions = scenario.starts()  # (K, 3) true positions
+        self.headings = np.full(len(self.positions), math.radians(scenario.agent.heading))
         self.time = self.agent.dwell  # the first reading is taken at the start after one dwell
+        self.travel_time = 0.0  # s, the last move's drive (the slowest robot's)
         self.records: list[dict[str, Any]] = []
         self.path_length = 0.0
 
@@ -235,7 +250,14 @@ class SearchSimulation:
         noise = self.sensor.draw_noise(self._truth_rng, ())
         conc = self.truth.sensed(position, t, scenario.average, scenario.sensor.response_time)
         reading = float(self.sensor.simulate_from(conc, noise))
-        info = self.searcher.tell(position, reading, t)
+        told = position.copy()  # where the robot believes it is
+        sd = self.scenario.agent.localisation_sd
+        if sd > 0:
+            told[:2] += sd * self._motion_rng.standard_normal(2)
+            told[:2] = np.clip(
+                told[:2], self.scenario.volume.low[:2], self.scenario.volume.high[:2]
+            )
+        info = self.searcher.tell(told, reading, t)
         est = self.searcher.estimate()
         rec: dict[str, Any] = {
             "step": len(self.records) // len(self.positions),
@@ -244,6 +266,10 @@ class SearchSimulation:
             "x": position[0],
             "y": position[1],
             "z": position[2],
+            "heading": math.degrees(self.headings[robot]),
+            "told_x": told[0],
+            "told_y": told[1],
+            "travel_time": self.travel_time,
             "true_concentration": conc,
             "reading": reading,
             "detection": bool(self.sensor.is_detection(reading)),
@@ -274,22 +300,38 @@ class SearchSimulation:
 
     @property
     def finished(self) -> bool:
-        """True when no further move fits the budget, or the posterior spread fell below the
-        scenario's ``stop_spread``."""
+        """True when no further move can fit the budget (the fastest possible drive plus the
+        hold), or the posterior spread fell below the scenario's ``stop_spread``."""
         search = self.scenario.search
-        return self.time + self.agent.step_time > search.budget + 1e-9 or (
+        shortest = self.motion.shortest_move_time(self.agent.step) + self.agent.dwell
+        return self.time + shortest > search.budget + 1e-9 or (
             search.stop_spread > 0
             and bool(self.records)
             and self.records[-1]["spread"] < search.stop_spread
         )
 
+    @property
+    def over_budget(self) -> bool:
+        """True when the last move ended after the budget (a drive slower than the fastest
+        possible one): its readings are not taken."""
+        return self.time > self.scenario.search.budget + 1e-9
+
     def move(self, waypoints: np.ndarray) -> None:
-        """Fly the robots to ``waypoints`` (K, 3) m (a (3,) waypoint for one robot); the next
-        readings are one step time later."""
+        """Drive the robots to ``waypoints`` (K, 3) m (a (3,) waypoint for one robot) with the
+        scenario's motion model (:mod:`dcee.models.motion`); they move together and the next
+        readings are taken when the slowest has settled and held ``agent.dwell`` s."""
         waypoints = np.asarray(waypoints, dtype=np.float64).reshape(self.positions.shape)
-        self.path_length += float(np.linalg.norm(waypoints - self.positions, axis=1).sum())
-        self.positions = waypoints.copy()
-        self.time += self.agent.step_time
+        new = waypoints.copy()
+        durations = []
+        for k, (p, goal) in enumerate(zip(self.positions, waypoints, strict=True)):
+            travel = self.motion.travel((p[0], p[1], self.headings[k]), goal)
+            new[k, 0], new[k, 1], self.headings[k] = travel.pose
+            durations.append(travel.duration)
+            steps = np.diff(travel.path[:, 1:3], axis=0)
+            self.path_length += float(np.hypot(steps[:, 0], steps[:, 1]).sum())
+        self.positions = new
+        self.travel_time = max(durations)
+        self.time += self.travel_time + self.agent.dwell
 
     def summary(self, strategy: str) -> dict[str, Any]:
         """The search's summary (:func:`dcee.simulation.metrics.summarise` and the filter's
@@ -352,6 +394,8 @@ def run_episode(
         if waypoint is None:
             break
         sim.move(waypoint)
+        if sim.over_budget:
+            break
     records = sim.records
     summary = sim.summary(strategy)
     if snapshot_at is not None and (not snapshots or snapshots[-1][0] != records[-1]["time"]):
@@ -386,10 +430,12 @@ def planner_defaults(
 
 __all__ = [
     "FINAL_SAMPLE",
+    "MOTION_STREAM",
     "RESULT_FILES",
     "SNAPSHOT_FRACTIONS",
     "EpisodeResult",
     "SearchSimulation",
+    "motion_stream",
     "planner_defaults",
     "run_episode",
     "snapshot_times",
