@@ -191,7 +191,8 @@ class SearchSimulation:
     assimilates them into the one shared filter (robot 0 first) and appends one record per
     reading (:attr:`records`, with its ``robot``); ``move(waypoints)`` drives the robots to
     their next waypoints (:attr:`motion`), the readings follow one hold after the slowest has
-    settled; ``finished`` says when no further move fits the budget (or the scenario's ``stop_spread`` is reached). The scenario's ``agent.count``
+    settled; ``finished`` says when no further move fits the budget (or the scenario's
+    ``stop_spread`` is reached). The scenario's ``agent.count``
     sets the number of robots (:meth:`~dcee.scenarios.config.Scenario.starts`).
     """
 
