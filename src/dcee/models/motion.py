@@ -41,6 +41,39 @@ class Travel:
     path: np.ndarray
 
 
+@dataclass(frozen=True)
+class UnicycleState:
+    """Pose (x, y m; heading rad) and speeds (v m/s forward, omega rad/s) of a unicycle."""
+
+    x: float
+    y: float
+    heading: float = 0.0
+    v: float = 0.0
+    omega: float = 0.0
+
+
+@dataclass(frozen=True)
+class Drive:
+    """A drive along the straight segment from (sx, sy) to the goal (gx, gy), m."""
+
+    sx: float
+    sy: float
+    gx: float
+    gy: float
+
+    @property
+    def length(self) -> float:
+        return math.hypot(self.gx - self.sx, self.gy - self.sy)
+
+    @property
+    def ux(self) -> float:
+        return (self.gx - self.sx) / self.length if self.length > 0 else 0.0
+
+    @property
+    def uy(self) -> float:
+        return (self.gy - self.sy) / self.length if self.length > 0 else 0.0
+
+
 class MotionModel:
     """How a robot drives from a pose to a waypoint (one base for every motion model)."""
 
@@ -150,66 +183,67 @@ class UnicycleMotion(MotionModel):
                 raise DceeInputError(f"agent.unicycle.{name}", f"must be > 0, got {value!r}")
 
     def travel(self, pose: tuple[float, float, float], goal: np.ndarray) -> Travel:
-        x, y, th = (float(v) for v in pose)
-        gx, gy = float(goal[0]), float(goal[1])
-        sx, sy = x, y  # the segment the follower tracks starts where the drive starts
-        seg = np.array([gx - sx, gy - sy])
-        seg_len = float(np.hypot(*seg))
-        unit = seg / seg_len if seg_len > 0 else np.zeros(2)
-        dt = self.control_dt
-        v = omega = t = 0.0
-        samples = [(0.0, x, y, th)]
-        steps = math.ceil(self.time_limit / dt)
+        state = UnicycleState(*(float(v) for v in pose))
+        drive = self.start_drive(state, goal)
+        samples = [(0.0, state.x, state.y, state.heading)]
+        t = 0.0
         arrived = False
-        for _ in range(steps):
-            dist = math.hypot(gx - x, gy - y)
-            if (
-                dist <= self.goal_tolerance
-                and abs(v) <= self.settle_speed
-                and abs(omega) <= self.settle_turn_rate
-            ):
+        for _ in range(math.ceil(self.time_limit / self.control_dt)):
+            if self.settled(state, drive):
                 arrived = True
                 break
-            v_cmd, omega_cmd = self._command(x, y, th, gx, gy, dist, sx, sy, unit, seg_len)
-            # acceleration limits, then the unicycle kinematics (exact arc for constant v, ω)
-            v += float(np.clip(v_cmd - v, -self.max_accel * dt, self.max_accel * dt))
-            omega += float(
-                np.clip(omega_cmd - omega, -self.max_turn_accel * dt, self.max_turn_accel * dt)
-            )
-            if abs(omega) > 1e-9:
-                x += v / omega * (math.sin(th + omega * dt) - math.sin(th))
-                y -= v / omega * (math.cos(th + omega * dt) - math.cos(th))
-            else:
-                x += v * math.cos(th) * dt
-                y += v * math.sin(th) * dt
-            th = wrap_angle(th + omega * dt)
-            t += dt
-            samples.append((t, x, y, th))
-        return Travel(t, (x, y, th), arrived, np.array(samples))
+            state = self.step(state, drive)
+            t += self.control_dt
+            samples.append((t, state.x, state.y, state.heading))
+        return Travel(t, (state.x, state.y, state.heading), arrived, np.array(samples))
 
-    def _command(
-        self,
-        x: float,
-        y: float,
-        th: float,
-        gx: float,
-        gy: float,
-        dist: float,
-        sx: float,
-        sy: float,
-        unit: np.ndarray,
-        seg_len: float,
-    ) -> tuple[float, float]:
+    def start_drive(self, state: UnicycleState, goal: np.ndarray) -> Drive:
+        """The drive from ``state``'s position to ``goal`` (the segment the follower tracks)."""
+        return Drive(state.x, state.y, float(goal[0]), float(goal[1]))
+
+    def settled(self, state: UnicycleState, drive: Drive) -> bool:
+        """Within the goal tolerance and nearly still (the settle criterion)."""
+        return (
+            math.hypot(drive.gx - state.x, drive.gy - state.y) <= self.goal_tolerance
+            and abs(state.v) <= self.settle_speed
+            and abs(state.omega) <= self.settle_turn_rate
+        )
+
+    def step(self, state: UnicycleState, drive: Drive | None) -> UnicycleState:
+        """One control period: the follower's command (brake to a stop without a drive), the
+        acceleration limits, then the exact unicycle arc for constant (v, ω) over ``control_dt``."""
+        dt = self.control_dt
+        x, y, th = state.x, state.y, state.heading
+        if drive is None:
+            v_cmd = omega_cmd = 0.0
+        else:
+            v_cmd, omega_cmd = self._command(x, y, th, drive)
+        v = state.v + float(np.clip(v_cmd - state.v, -self.max_accel * dt, self.max_accel * dt))
+        omega = state.omega + float(
+            np.clip(omega_cmd - state.omega, -self.max_turn_accel * dt, self.max_turn_accel * dt)
+        )
+        if abs(omega) > 1e-9:
+            x += v / omega * (math.sin(th + omega * dt) - math.sin(th))
+            y -= v / omega * (math.cos(th + omega * dt) - math.cos(th))
+        else:
+            x += v * math.cos(th) * dt
+            y += v * math.sin(th) * dt
+        return UnicycleState(x, y, wrap_angle(th + omega * dt), v, omega)
+
+    def _command(self, x: float, y: float, th: float, drive: Drive) -> tuple[float, float]:
         """(v, ω) commanded by the follower at pose (x, y, th)."""
+        gx, gy, sx, sy = drive.gx, drive.gy, drive.sx, drive.sy
+        dist = math.hypot(gx - x, gy - y)
+        seg_len, ux, uy = drive.length, drive.ux, drive.uy
         if dist <= self.goal_tolerance:
             return 0.0, 0.0  # brake and settle
         bearing = wrap_angle(math.atan2(gy - y, gx - x) - th)
         if abs(bearing) > self.turn_in_place:
             return 0.0, self._turn_rate(bearing)
         # look-ahead point on the segment, ``lookahead`` past the robot's projection on it
-        along = (x - sx) * unit[0] + (y - sy) * unit[1]
+        along = (x - sx) * ux + (y - sy) * uy
         s = min(max(along, 0.0) + self.lookahead, seg_len)
-        lx, ly = sx + s * unit[0], sy + s * unit[1]
+        lx, ly = sx + s * ux, sy + s * uy
         if math.hypot(lx - x, ly - y) < 1e-6:
             lx, ly = gx, gy
         alpha = wrap_angle(math.atan2(ly - y, lx - x) - th)
@@ -234,10 +268,12 @@ class UnicycleMotion(MotionModel):
 
 __all__ = [
     "MOTION_MODELS",
+    "Drive",
     "GridMotion",
     "MotionModel",
     "Travel",
     "UnicycleMotion",
+    "UnicycleState",
     "make_motion",
     "register_motion",
     "wrap_angle",

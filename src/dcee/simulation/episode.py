@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from dcee.estimation.particle_filter import ParticleFilter
+from dcee.estimation.particle_filter import ParticleFilter, UpdateInfo
 from dcee.io import write_atomic, write_json
 from dcee.models.sensor import Sensor
 from dcee.planning import get as get_planner
@@ -181,6 +181,97 @@ def motion_stream(seed: int) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(MOTION_STREAM,)))
 
 
+def make_searcher(
+    scenario: Scenario,
+    planner: Planner | None,
+    filter_rng: np.random.Generator,
+    planner_rng: np.random.Generator,
+) -> Searcher:
+    """The scenario's filter (prior, estimator reading model, plume model, scale) and
+    ``planner`` in a :class:`~dcee.searcher.Searcher`; the simulation, the ROS node and
+    ``dcee replay`` build theirs here (with the generators of :func:`streams`)."""
+    search = scenario.search
+    pf = ParticleFilter(
+        scenario.make_prior(),
+        scenario.make_estimator_sensor(),  # the reading model of the filter and planners
+        scenario.make_plume(),
+        n_particles=search.particles,
+        seed=filter_rng,
+        resample_threshold=search.resample_threshold,
+        mcmc_steps=search.mcmc_steps,
+        global_share=search.global_share,
+        diversify=search.diversify,
+        max_sweeps=search.max_sweeps,
+    )
+    return Searcher(pf, planner, scenario.make_agent(), planner_rng)
+
+
+def reading_record(
+    searcher: Searcher,
+    info: UpdateInfo,
+    *,
+    step: int,
+    robot: int,
+    time: float,
+    position: np.ndarray,
+    told: np.ndarray,
+    reading: float,
+    detection: bool,
+    true_location: np.ndarray | None,
+    heading: float,
+    travel_time: float,
+    true_concentration: float = math.nan,
+) -> dict[str, Any]:
+    """One row of a search's per-reading record (``steps.parquet``), made after ``searcher``
+    assimilated ``reading`` (g/m³) taken at ``position`` (3,) m (told as ``told``): the
+    posterior summary and the filter's diagnostics. ``true_location`` (3,) m gives the RMSE
+    and the error of the mean (NaN without one); ``heading`` in °; ``travel_time`` s of the
+    drive before the reading. The simulation, the ROS node and ``dcee replay`` all use it."""
+    est = searcher.estimate()
+    pf = searcher.filter
+    if true_location is None:
+        rmse = mean_error = math.nan
+    else:
+        rmse = pf.rmse(true_location)
+        mean_error = float(np.linalg.norm(est.mean - true_location))
+    return {
+        "step": step,
+        "robot": robot,
+        "time": time,
+        "x": position[0],
+        "y": position[1],
+        "z": position[2],
+        "heading": heading,
+        "told_x": told[0],
+        "told_y": told[1],
+        "travel_time": travel_time,
+        "true_concentration": true_concentration,
+        "reading": reading,
+        "detection": detection,
+        "mean_x": est.mean[0],
+        "mean_y": est.mean[1],
+        "mean_z": est.mean[2],
+        **{
+            f"cov_{a}{b}": est.cov[i, j]
+            for i, a in enumerate("xyz")
+            for j, b in enumerate("xyz")
+            if j >= i
+        },
+        "spread": est.spread,
+        "rmse": rmse,
+        "mean_error": mean_error,
+        "ess": info.ess,
+        "resampled": info.resampled,
+        "tempering_stages": info.tempering_stages,
+        "acceptance": info.acceptance,
+        "move_sweeps": info.move_sweeps,
+        "distinct": info.distinct,
+        "rejected": info.rejected,
+        "update_seconds": searcher.last_update_seconds,
+        "decision_seconds": 0.0,
+    }
+
+
 class SearchSimulation:
     """One simulated search, a step at a time: the world (truth, instrument, robots' move
     model) and the filter, without a planner. :func:`run_episode` drives it with a planner; the
@@ -203,28 +294,16 @@ class SearchSimulation:
         planner: Planner | None = None,
         truth: TruthModel | None = None,
     ) -> None:
-        search = scenario.search
         self.scenario = scenario
         self.seed = int(seed)
         truth_rng, filter_rng, planner_rng, self.figure_rng = streams(seed)
         self._truth_rng = truth_rng
         self.sensor: Sensor = scenario.make_sensor()  # the instrument: makes the real readings
-        self.agent = scenario.make_agent()
         self.truth = truth or make_truth(scenario, seed)
         self.true_location = scenario.truth_theta()[:3]
-        self.filter = ParticleFilter(
-            scenario.make_prior(),
-            scenario.make_estimator_sensor(),  # the reading model of the filter and planners
-            scenario.make_plume(),
-            n_particles=search.particles,
-            seed=filter_rng,
-            resample_threshold=search.resample_threshold,
-            mcmc_steps=search.mcmc_steps,
-            global_share=search.global_share,
-            diversify=search.diversify,
-            max_sweeps=search.max_sweeps,
-        )
-        self.searcher = Searcher(self.filter, planner, self.agent, planner_rng)
+        self.searcher = make_searcher(scenario, planner, filter_rng, planner_rng)
+        self.agent = self.searcher.agent
+        self.filter = self.searcher.filter
         self.motion = scenario.make_motion()
         self._motion_rng = motion_stream(seed)
         self.positions = scenario.starts()  # (K, 3) true positions
@@ -245,7 +324,7 @@ class SearchSimulation:
         return [self._sense_one(k) for k in range(len(self.positions))]
 
     def _sense_one(self, robot: int) -> dict[str, Any]:
-        scenario, pf, t = self.scenario, self.filter, self.time
+        scenario, t = self.scenario, self.time
         position = self.positions[robot].copy()
         # the same count of noise draws per step, whatever the positions
         noise = self.sensor.draw_noise(self._truth_rng, ())
@@ -259,43 +338,21 @@ class SearchSimulation:
                 told[:2], self.scenario.volume.low[:2], self.scenario.volume.high[:2]
             )
         info = self.searcher.tell(told, reading, t)
-        est = self.searcher.estimate()
-        rec: dict[str, Any] = {
-            "step": len(self.records) // len(self.positions),
-            "robot": robot,
-            "time": t,
-            "x": position[0],
-            "y": position[1],
-            "z": position[2],
-            "heading": math.degrees(self.headings[robot]),
-            "told_x": told[0],
-            "told_y": told[1],
-            "travel_time": self.travel_time,
-            "true_concentration": conc,
-            "reading": reading,
-            "detection": bool(self.sensor.is_detection(reading)),
-            "mean_x": est.mean[0],
-            "mean_y": est.mean[1],
-            "mean_z": est.mean[2],
-            **{
-                f"cov_{a}{b}": est.cov[i, j]
-                for i, a in enumerate("xyz")
-                for j, b in enumerate("xyz")
-                if j >= i
-            },
-            "spread": est.spread,
-            "rmse": pf.rmse(self.true_location),
-            "mean_error": float(np.linalg.norm(est.mean - self.true_location)),
-            "ess": info.ess,
-            "resampled": info.resampled,
-            "tempering_stages": info.tempering_stages,
-            "acceptance": info.acceptance,
-            "move_sweeps": info.move_sweeps,
-            "distinct": info.distinct,
-            "rejected": info.rejected,
-            "update_seconds": self.searcher.last_update_seconds,
-            "decision_seconds": 0.0,
-        }
+        rec = reading_record(
+            self.searcher,
+            info,
+            step=len(self.records) // len(self.positions),
+            robot=robot,
+            time=t,
+            position=position,
+            told=told,
+            reading=reading,
+            detection=bool(self.sensor.is_detection(reading)),
+            true_location=self.true_location,
+            heading=math.degrees(self.headings[robot]),
+            travel_time=self.travel_time,
+            true_concentration=conc,
+        )
         self.records.append(rec)
         return rec
 
@@ -437,7 +494,9 @@ __all__ = [
     "EpisodeResult",
     "SearchSimulation",
     "motion_stream",
+    "make_searcher",
     "planner_defaults",
+    "reading_record",
     "run_episode",
     "snapshot_times",
     "streams",

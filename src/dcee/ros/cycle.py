@@ -1,0 +1,218 @@
+"""The robot's search cycle without ROS: arrive → settle → hold (average the readings) → tell →
+ask → publish. The ROS 2 node (:mod:`dcee.ros.node`) feeds it the messages it receives and
+publishes what it returns; ``dcee replay`` (:mod:`dcee.ros.replay`) feeds it a recorded bag
+with the goals as recorded. Everything here is plain Python and tested without ROS.
+
+Time is the robot's clock in seconds (message stamps, simulated time in the demo); the search's
+own clock starts at the first pose, so ``search.budget`` counts from there.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from dcee.errors import DceeInputError
+from dcee.scenarios.config import Scenario
+from dcee.searcher import Searcher
+from dcee.simulation.episode import reading_record
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A pose sample: ``t`` s, position ``x``, ``y`` m, ``heading`` rad counter-clockwise from
+    +x (REP-103 ENU yaw), forward speed ``v`` m/s and turn rate ``omega`` rad/s."""
+
+    t: float
+    x: float
+    y: float
+    heading: float = 0.0
+    v: float = 0.0
+    omega: float = 0.0
+
+
+@dataclass(frozen=True)
+class CycleSettings:
+    """When a reading is taken. ``hold`` s held still on the waypoint (``agent.dwell``);
+    ``average`` s of readings averaged at the end of the hold (0: the last sample, an
+    instantaneous reading; ``sensor.average``); ``calibration`` g/m³ per sensor unit (a PID in
+    ppm: the gas's g/m³ per ppm); settled = within ``goal_tolerance`` m of the goal, slower than
+    ``settle_speed`` m/s and ``settle_turn_rate`` rad/s for ``settle_time`` s; ``altitude`` m of
+    the readings (a ground robot's sensor height, the scenario's start z); ``budget`` s of
+    search; ``step`` m and ``shortest_move`` s bound the next move (a move that cannot end in
+    the budget is not asked for)."""
+
+    hold: float
+    average: float
+    budget: float
+    altitude: float
+    shortest_move: float
+    calibration: float = 1.0
+    goal_tolerance: float = 0.05
+    settle_speed: float = 0.02
+    settle_turn_rate: float = math.radians(5.0)
+    settle_time: float = 0.2
+
+    @classmethod
+    def from_scenario(cls, scenario: Scenario, **changes: Any) -> CycleSettings:
+        """The scenario's hold, averaging, budget, altitude and move bound; ``changes``
+        (calibration, tolerances) override."""
+        motion = scenario.make_motion()
+        values: dict[str, Any] = {
+            "hold": scenario.dwell,
+            "average": scenario.average,
+            "budget": scenario.search.budget,
+            "altitude": scenario.agent.start[2],
+            "shortest_move": motion.shortest_move_time(scenario.agent.step),
+        }
+        values.update(changes)
+        for name in ("hold", "average", "budget", "calibration", "goal_tolerance", "settle_time"):
+            value = values.get(name, getattr(cls, name, 0.0))
+            if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
+                raise DceeInputError(name, f"must be a finite number >= 0, got {value!r}")
+        if values["average"] > values["hold"] + 1e-9:
+            raise DceeInputError("average", "must not be longer than the hold")
+        return cls(**values)
+
+
+@dataclass
+class CycleOutput:
+    """What one message caused: a new ``goal`` (3,) m to publish, a ``record`` of an
+    assimilated reading (the per-reading record of a search), ``finished`` when the budget
+    leaves no further move."""
+
+    goal: np.ndarray | None = None
+    record: dict[str, Any] | None = None
+    finished: bool = False
+
+
+@dataclass
+class SearchCycle:
+    """One robot's search cycle around a :class:`~dcee.searcher.Searcher`.
+
+    ``plan``: ask the searcher's planner for the next goal after each reading (the node);
+    False: the goals come from outside through :meth:`on_goal` (a replay). ``true_location``
+    (3,) m, when known, gives the records an RMSE. States: ``driving`` (to the goal; also at
+    the start, to where it stands), ``settling``, ``holding``, ``waiting`` (for a goal, replay
+    only), ``done``."""
+
+    searcher: Searcher
+    settings: CycleSettings
+    plan: bool = True
+    true_location: np.ndarray | None = None
+    state: str = "driving"
+    goal: np.ndarray | None = None
+    start_time: float | None = None
+    records: list[dict[str, Any]] = field(default_factory=list)
+    dropped_readings: int = 0
+    path_length: float = 0.0
+    _pose: Pose | None = None
+    _since: float = 0.0
+    _samples: list[tuple[float, float]] = field(default_factory=list)
+    _drive_started: float = 0.0
+    _pending_goal: np.ndarray | None = None
+
+    @property
+    def search_time(self) -> float:
+        """s since the search started (its first pose)."""
+        if self._pose is None or self.start_time is None:
+            return 0.0
+        return self._pose.t - self.start_time
+
+    def on_goal(self, goal: np.ndarray) -> None:
+        """A goal from outside (replay): drive to it."""
+        if self.state == "done":
+            return
+        goal = np.asarray(goal, dtype=np.float64)
+        if self.state == "waiting":
+            self.goal, self.state = goal, "driving"
+        else:  # published while this replay still holds (clock skew): the next goal
+            self._pending_goal = goal
+
+    def on_reading(self, t: float, value: float) -> None:
+        """A concentration sample (sensor units) received at ``t`` s; kept while holding.
+        Non-finite or negative samples are dropped and counted (:attr:`dropped_readings`)."""
+        if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
+            self.dropped_readings += 1
+            return
+        if self.state == "holding" and t >= self._since:
+            self._samples.append((float(t), float(value)))
+
+    def on_pose(self, pose: Pose) -> CycleOutput:
+        """A pose sample: advances the cycle; returns what to publish."""
+        out = CycleOutput()
+        if self._pose is not None:
+            self.path_length += math.hypot(pose.x - self._pose.x, pose.y - self._pose.y)
+        self._pose = pose
+        if self.start_time is None:
+            self.start_time = pose.t
+            self._drive_started = pose.t
+        s = self.settings
+        if self.state != "done" and self.search_time > s.budget + 1e-9:
+            self.state = "done"  # the budget ran out on the way: no reading is taken
+            return CycleOutput(finished=True)
+        still = abs(pose.v) <= s.settle_speed and abs(pose.omega) <= s.settle_turn_rate
+        if self.state == "driving":
+            near = self.goal is None or math.hypot(
+                pose.x - self.goal[0], pose.y - self.goal[1]
+            ) <= max(s.goal_tolerance, 1e-9)
+            if near and still:
+                self.state, self._since = "settling", pose.t
+        if self.state == "settling":
+            if not still:
+                self.state = "driving"
+            elif pose.t - self._since >= s.settle_time - 1e-9:
+                self.state, self._since, self._samples = "holding", pose.t, []
+        if self.state == "holding" and pose.t - self._since >= s.hold - 1e-9 and self._samples:
+            out = self._complete(pose)
+        return out
+
+    def _complete(self, pose: Pose) -> CycleOutput:
+        s = self.settings
+        if s.average > 0:
+            window = [v for t, v in self._samples if t >= pose.t - s.average - 1e-9]
+            value = float(np.mean(window)) if window else self._samples[-1][1]
+        else:
+            value = self._samples[-1][1]
+        reading = value * s.calibration
+        time = self.search_time
+        position = np.array([pose.x, pose.y, s.altitude])
+        info = self.searcher.tell(position, reading, time)
+        sensor = self.searcher.filter.sensor
+        record = reading_record(
+            self.searcher,
+            info,
+            step=len(self.records),
+            robot=0,
+            time=time,
+            position=position,
+            told=position,
+            reading=reading,
+            detection=bool(reading >= sensor.threshold),
+            true_location=self.true_location,
+            heading=math.degrees(pose.heading),
+            travel_time=self._since - self._drive_started - s.settle_time,
+        )
+        record["path_length"] = self.path_length
+        self.records.append(record)
+        out = CycleOutput(record=record)
+        if time + s.shortest_move + s.hold > s.budget + 1e-9:
+            self.state, out.finished = "done", True
+            return out
+        self._drive_started = pose.t
+        if self.plan:
+            self.goal = self.searcher.ask()
+            record["decision_seconds"] = self.searcher.last_decision_seconds
+            self.state = "driving"
+            out.goal = self.goal.copy()
+        elif self._pending_goal is not None:
+            self.goal, self.state, self._pending_goal = self._pending_goal, "driving", None
+        else:
+            self.goal, self.state = None, "waiting"
+        return out
+
+
+__all__ = ["CycleOutput", "CycleSettings", "Pose", "SearchCycle"]

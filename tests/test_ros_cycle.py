@@ -1,0 +1,106 @@
+"""The robot's search cycle without ROS: a simulated unicycle robot in continuous time, the
+cycle deciding when it has settled and which samples make a reading."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from dcee.errors import DceeInputError
+from dcee.planning import get as get_planner
+from dcee.ros.cycle import CycleSettings, Pose, SearchCycle
+from dcee.scenarios import load_scenario
+from dcee.simulation.episode import make_searcher, planner_defaults, streams
+from dcee.simulation.robot import SimulatedRobot
+
+
+def _lab(**changes):
+    base = {"search.particles": 1500, "search.hypotheses": 10, "agent.model": "unicycle"}
+    return load_scenario("lab:upwind").with_overrides(**{**base, **changes})
+
+
+def _fly(scenario, strategy="infotaxis", seed=0, max_time=None):
+    """Robot and cycle in lock step (what the ROS demo does over topics)."""
+    robot = SimulatedRobot(scenario, seed)
+    _, filter_rng, planner_rng, _ = streams(seed)
+    planner = get_planner(strategy, **planner_defaults(strategy, scenario, None))
+    searcher = make_searcher(scenario, planner, filter_rng, planner_rng)
+    cycle = SearchCycle(
+        searcher,
+        CycleSettings.from_scenario(scenario),
+        true_location=scenario.truth_theta()[:3],
+    )
+    goals = []
+    limit = max_time or scenario.search.budget + 60
+    while robot.time < limit:
+        s = robot.odometry()
+        cycle.on_reading(robot.time, robot.sample())
+        out = cycle.on_pose(Pose(robot.time, s.x, s.y, s.heading, s.v, s.omega))
+        if out.goal is not None:
+            goals.append(out.goal)
+            robot.set_goal(out.goal)
+        if out.finished:
+            break
+        robot.step()
+    return cycle, goals
+
+
+def test_cycle_finds_the_source_with_a_unicycle_robot() -> None:
+    sc = _lab()
+    cycle, goals = _fly(sc)
+    rec = cycle.records
+    assert cycle.state == "done"
+    times = np.array([r["time"] for r in rec])
+    assert np.all(np.diff(times) > 0) and times[-1] <= sc.search.budget
+    # each reading follows a drive, a settle and the whole hold
+    gaps = np.diff(times)
+    assert gaps.min() >= sc.agent.step / sc.agent.speed + sc.dwell - 0.05
+    assert 60 < len(rec) < 150  # fewer readings than the grid agent's 150
+    # readings are taken where the robot settled, on its goal
+    pos = np.array([[r["x"], r["y"]] for r in rec[1:]])
+    assert np.hypot(*(pos - np.array(goals)[: len(pos), :2]).T).max() <= 0.05
+    assert rec[-1]["rmse"] < sc.search.acquired_rmse
+
+
+def test_cycle_averages_over_the_hold_and_calibrates() -> None:
+    sc = _lab()
+    searcher = make_searcher(sc, None, *streams(0)[1:3])
+    settings = CycleSettings.from_scenario(sc, average=1.0, calibration=2.0)
+    cycle = SearchCycle(searcher, settings, plan=False)
+    t = 0.0
+    for _ in range(200):  # standing still at the start: settle 0.2 s, then hold 1.5 s
+        cycle.on_reading(t, 1e-3 if t < 1.0 else 3e-3)
+        out = cycle.on_pose(Pose(t, 0.3, 3.2))
+        if out.record is not None:
+            break
+        t = round(t + 0.05, 10)
+    assert out.record is not None
+    # hold from 0.2 s to 1.7 s; the last 1 s (0.7-1.7 s) averages 0.3 s of 1e-3 and 0.7 s of 3e-3
+    window = [1e-3 if u < 1.0 else 3e-3 for u in np.arange(0.7, 1.7 + 1e-9, 0.05).round(10)]
+    assert out.record["reading"] == pytest.approx(2.0 * np.mean(window))
+    assert out.record["time"] == pytest.approx(1.7)
+    assert cycle.state == "waiting" and out.goal is None
+    # non-finite samples are dropped, not told
+    cycle.on_reading(t, float("nan"))
+    cycle.on_reading(t, -1.0)
+    assert cycle.dropped_readings == 2
+
+
+def test_cycle_waits_for_settling() -> None:
+    sc = _lab()
+    cycle = SearchCycle(make_searcher(sc, None, *streams(0)[1:3]), CycleSettings.from_scenario(sc))
+    for k in range(100):  # still moving: never a reading
+        t = 0.05 * k
+        cycle.on_reading(t, 1e-3)
+        assert cycle.on_pose(Pose(t, 0.3 + 0.01 * k, 3.2, 0.0, 0.2, 0.0)).record is None
+    assert cycle.state == "driving"
+
+
+def test_cycle_settings_validation() -> None:
+    sc = _lab()
+    with pytest.raises(DceeInputError, match="calibration"):
+        CycleSettings.from_scenario(sc, calibration=math.nan)
+    with pytest.raises(DceeInputError, match="average"):
+        CycleSettings.from_scenario(sc, average=10.0)
