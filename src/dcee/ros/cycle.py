@@ -138,8 +138,10 @@ class SearchCycle:
         if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
             self.dropped_readings += 1
             return
-        if self.state == "holding" and t >= self._since:
-            self._samples.append((float(t), float(value)))
+        if self.state == "holding":
+            # arrived while holding: part of this hold, even when its stamp lags the pose's
+            # (a subscriber's clock behind the odometry's)
+            self._samples.append((max(float(t), self._since), float(value)))
 
     def on_pose(self, pose: Pose) -> CycleOutput:
         """A pose sample: advances the cycle; returns what to publish."""

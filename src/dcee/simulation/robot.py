@@ -46,6 +46,7 @@ class SimulatedRobot:
         self.altitude = float(start[2])
         self.state = UnicycleState(start[0], start[1], math.radians(scenario.agent.heading))
         self.time = 0.0
+        self.path_length = 0.0  # m driven
         self.drive: Drive | None = None
 
     @property
@@ -65,7 +66,9 @@ class SimulatedRobot:
         """Advance ``control_dt`` s (brake and stand once settled on the goal)."""
         if self.drive is not None and self.motion.settled(self.state, self.drive):
             self.drive = None
+        before = self.state
         self.state = self.motion.step(self.state, self.drive)
+        self.path_length += math.hypot(self.state.x - before.x, self.state.y - before.y)
         self.time += self.control_dt
 
     def odometry(self) -> UnicycleState:

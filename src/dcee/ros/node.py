@@ -1,0 +1,295 @@
+"""The dcee ROS 2 node (``dcee-ros-node``): the search cycle of :mod:`dcee.ros.cycle` on topics.
+
+Subscribes
+    ``concentration`` (std_msgs/Float32, sensor units × ``calibration`` = g/m³), stamped on
+    arrival with the node's clock (set ``use_sim_time`` to follow ``/clock``);
+    ``odom`` (nav_msgs/Odometry; or geometry_msgs/PoseWithCovarianceStamped with
+    ``pose_type:=pose_with_covariance``, speeds then from successive poses).
+Publishes
+    ``goal_pose`` (geometry_msgs/PoseStamped, what Nav2's bt_navigator accepts; its
+    orientation faces the move), ``dcee/estimate`` (geometry_msgs/PointStamped, posterior mean
+    of the source), ``dcee/estimate_covariance`` (geometry_msgs/PoseWithCovarianceStamped, the
+    same mean with the 3 × 3 location covariance in the position block), ``dcee/particles``
+    (visualization_msgs/MarkerArray, a weighted sample of source hypotheses), ``dcee/path``
+    (nav_msgs/Path, where the readings were taken).
+Parameters
+    ``scenario`` (name or TOML path), ``strategy``, ``seed``, ``particles`` (0: the
+    scenario's), ``frame_id`` ("map"), ``calibration`` (1.0), ``concentration_topic``,
+    ``pose_topic``, ``goal_topic``, ``pose_type`` ("odometry" | "pose_with_covariance"),
+    ``checkpoint`` (a file: the searcher is saved there after every reading and resumed from
+    it at start), ``marker_particles`` (500).
+
+Conventions (docs/guide/robot.md): frames are REP-103 ENU (x east, y north, yaw
+counter-clockwise from +x); dcee's wind direction φ is the direction the wind comes *from*,
+counter-clockwise from +x (meteorological direction = 90° − φ, clockwise from north);
+concentrations are g/m³.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import rclpy
+from geometry_msgs.msg import PointStamped, PoseStamped, PoseWithCovarianceStamped
+from nav_msgs.msg import Odometry
+from nav_msgs.msg import Path as PathMsg
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import QoSDurabilityPolicy, QoSProfile, QoSReliabilityPolicy
+from std_msgs.msg import Float32
+from visualization_msgs.msg import Marker, MarkerArray
+
+from dcee.errors import DceeInputError
+from dcee.ros.cycle import CycleSettings, Pose, SearchCycle
+from dcee.scenarios import load_scenario
+from dcee.scenarios.config import Scenario
+from dcee.searcher import Searcher
+from dcee.simulation.episode import make_searcher, planner_defaults, streams
+
+RELIABLE = QoSProfile(depth=50, reliability=QoSReliabilityPolicy.RELIABLE)
+LATCHED = QoSProfile(
+    depth=1,
+    reliability=QoSReliabilityPolicy.RELIABLE,
+    durability=QoSDurabilityPolicy.TRANSIENT_LOCAL,
+)
+
+PARAMETERS: dict[str, Any] = {
+    "scenario": "lab:upwind",
+    "strategy": "infotaxis",
+    "seed": 0,
+    "particles": 0,
+    "frame_id": "map",
+    "calibration": 1.0,
+    "concentration_topic": "concentration",
+    "pose_topic": "odom",
+    "goal_topic": "goal_pose",
+    "pose_type": "odometry",
+    "checkpoint": "",
+    "marker_particles": 500,
+}
+
+
+def yaw_of(q: Any) -> float:
+    """Yaw (rad, counter-clockwise from +x) of a geometry_msgs quaternion."""
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def quaternion_of(yaw: float) -> tuple[float, float, float, float]:
+    """(x, y, z, w) of a rotation by ``yaw`` rad about +z."""
+    return 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)
+
+
+def seconds(stamp: Any) -> float:
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+class SearchNode(Node):
+    """The search cycle as a ROS 2 node. ``true_location`` (3,) m, when known (a simulation),
+    gives the records an RMSE; ``scenario`` (a :class:`~dcee.scenarios.config.Scenario`)
+    replaces the ``scenario`` and ``particles`` parameters when the node is built from Python.
+    :attr:`done` is set when the budget is spent."""
+
+    def __init__(
+        self,
+        *,
+        context: Any = None,
+        parameter_overrides: list[Parameter] | None = None,
+        true_location: np.ndarray | None = None,
+        scenario: Scenario | None = None,
+        name: str = "dcee_search",
+    ) -> None:
+        super().__init__(name, context=context, parameter_overrides=parameter_overrides or [])
+        for key, default in PARAMETERS.items():
+            if not self.has_parameter(key):
+                self.declare_parameter(key, default)
+        p = {key: self.get_parameter(key).value for key in PARAMETERS}
+        self.params = p
+        if scenario is None:
+            scenario = load_scenario(str(p["scenario"]))
+        if int(p["particles"]) > 0:
+            scenario = scenario.with_overrides(**{"search.particles": int(p["particles"])})
+        if p["pose_type"] not in ("odometry", "pose_with_covariance"):
+            raise DceeInputError("pose_type", "must be odometry or pose_with_covariance")
+        self.scenario = scenario
+        self.frame_id = str(p["frame_id"])
+        checkpoint = str(p["checkpoint"])
+        self.checkpoint = Path(checkpoint) if checkpoint else None
+        if self.checkpoint is not None and self.checkpoint.exists():
+            searcher = Searcher.load(self.checkpoint)
+            self.get_logger().info(f"resumed the search from {self.checkpoint}")
+        else:
+            from dcee.planning import get as get_planner
+
+            strategy = str(p["strategy"])
+            planner = get_planner(strategy, **planner_defaults(strategy, scenario, None))
+            _, filter_rng, planner_rng, _ = streams(int(p["seed"]))
+            searcher = make_searcher(scenario, planner, filter_rng, planner_rng)
+        self.searcher = searcher
+        settings = CycleSettings.from_scenario(scenario, calibration=float(p["calibration"]))
+        self.cycle = SearchCycle(searcher, settings, true_location=true_location)
+        self.done = threading.Event()
+        self._lock = threading.Lock()
+        self._last_pose: Pose | None = None
+        self._marker_rng = np.random.default_rng(int(p["seed"]) + 1)
+
+        self.goal_pub = self.create_publisher(PoseStamped, str(p["goal_topic"]), LATCHED)
+        self.estimate_pub = self.create_publisher(PointStamped, "dcee/estimate", RELIABLE)
+        self.cov_pub = self.create_publisher(
+            PoseWithCovarianceStamped, "dcee/estimate_covariance", RELIABLE
+        )
+        self.particles_pub = self.create_publisher(MarkerArray, "dcee/particles", RELIABLE)
+        self.path_pub = self.create_publisher(PathMsg, "dcee/path", RELIABLE)
+        self.path_msg = PathMsg()
+        self.path_msg.header.frame_id = self.frame_id
+        self.create_subscription(
+            Float32, str(p["concentration_topic"]), self._on_concentration, RELIABLE
+        )
+        if p["pose_type"] == "odometry":
+            self.create_subscription(Odometry, str(p["pose_topic"]), self._on_odometry, RELIABLE)
+        else:
+            self.create_subscription(
+                PoseWithCovarianceStamped, str(p["pose_topic"]), self._on_pose_cov, RELIABLE
+            )
+
+    # --- inputs -------------------------------------------------------------------------------
+
+    def _now(self) -> float:
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def _on_concentration(self, msg: Float32) -> None:
+        with self._lock:
+            self.cycle.on_reading(self._now(), float(msg.data))
+
+    def _on_odometry(self, msg: Odometry) -> None:
+        p = msg.pose.pose
+        t = seconds(msg.header.stamp) or self._now()
+        self._step(
+            Pose(
+                t,
+                p.position.x,
+                p.position.y,
+                yaw_of(p.orientation),
+                msg.twist.twist.linear.x,
+                msg.twist.twist.angular.z,
+            )
+        )
+
+    def _on_pose_cov(self, msg: PoseWithCovarianceStamped) -> None:
+        p = msg.pose.pose
+        t = seconds(msg.header.stamp) or self._now()
+        x, y, yaw = p.position.x, p.position.y, yaw_of(p.orientation)
+        v = w = 0.0
+        last = self._last_pose
+        if last is not None and t > last.t:  # speeds from successive poses
+            v = math.hypot(x - last.x, y - last.y) / (t - last.t)
+            w = math.remainder(yaw - last.heading, 2 * math.pi) / (t - last.t)
+        self._step(Pose(t, x, y, yaw, v, w))
+
+    def _step(self, pose: Pose) -> None:
+        with self._lock:
+            self._last_pose = pose
+            if self.done.is_set():
+                return
+            out = self.cycle.on_pose(pose)
+        if out.record is not None:
+            self._publish_belief(out.record)
+            if self.checkpoint is not None:
+                self.searcher.save(self.checkpoint)
+        if out.goal is not None:
+            self._publish_goal(out.goal, pose)
+        if out.finished:
+            est = self.searcher.estimate()
+            self.get_logger().info(
+                f"search finished: {len(self.cycle.records)} readings, source estimate "
+                f"({est.mean[0]:.2f}, {est.mean[1]:.2f}) m, spread {est.spread:.2f} m"
+            )
+            self.done.set()
+
+    # --- outputs ------------------------------------------------------------------------------
+
+    def _header(self, msg: Any) -> None:
+        msg.header.frame_id = self.frame_id
+        msg.header.stamp = self.get_clock().now().to_msg()
+
+    def _publish_goal(self, goal: np.ndarray, pose: Pose) -> None:
+        msg = PoseStamped()
+        self._header(msg)
+        msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = (float(v) for v in goal)
+        yaw = math.atan2(goal[1] - pose.y, goal[0] - pose.x)
+        q = quaternion_of(yaw)
+        o = msg.pose.orientation
+        o.x, o.y, o.z, o.w = q
+        self.goal_pub.publish(msg)
+
+    def _publish_belief(self, record: dict[str, Any]) -> None:
+        est = self.searcher.estimate()
+        point = PointStamped()
+        self._header(point)
+        point.point.x, point.point.y, point.point.z = (float(v) for v in est.mean)
+        self.estimate_pub.publish(point)
+        cov = PoseWithCovarianceStamped()
+        self._header(cov)
+        pos = cov.pose.pose.position
+        pos.x, pos.y, pos.z = (float(v) for v in est.mean)
+        cov.pose.pose.orientation.w = 1.0
+        full = np.zeros((6, 6))
+        full[:3, :3] = est.cov
+        full[3:, 3:] = np.eye(3) * 1e9  # orientation unknown
+        cov.pose.covariance = [float(v) for v in full.ravel()]
+        self.cov_pub.publish(cov)
+        self.particles_pub.publish(self._particle_markers())
+        stamped = PoseStamped()
+        self._header(stamped)
+        stamped.pose.position.x = float(record["x"])
+        stamped.pose.position.y = float(record["y"])
+        stamped.pose.position.z = float(record["z"])
+        stamped.pose.orientation.w = 1.0
+        self.path_msg.header.stamp = stamped.header.stamp
+        self.path_msg.poses.append(stamped)
+        self.path_pub.publish(self.path_msg)
+
+    def _particle_markers(self) -> MarkerArray:
+        from geometry_msgs.msg import Point
+
+        pf = self.searcher.filter
+        n = min(int(self.params["marker_particles"]), pf.n)
+        idx = self._marker_rng.choice(pf.n, size=n, p=pf.weights)
+        marker = Marker()
+        self._header(marker)
+        marker.ns, marker.id = "dcee_particles", 0
+        marker.type, marker.action = Marker.POINTS, Marker.ADD
+        marker.scale.x = marker.scale.y = 0.03
+        marker.color.r, marker.color.g, marker.color.b, marker.color.a = 0.1, 0.4, 0.9, 0.8
+        marker.pose.orientation.w = 1.0
+        for x, y, z in pf.source_locations[idx]:
+            marker.points.append(Point(x=float(x), y=float(y), z=float(z)))
+        return MarkerArray(markers=[marker])
+
+
+def main(argv: list[str] | None = None) -> None:
+    """``dcee-ros-node [--ros-args -p scenario:=lab:upwind -p strategy:=infotaxis ...]``."""
+    import sys
+
+    rclpy.init(args=argv if argv is not None else sys.argv)
+    try:
+        node = SearchNode()
+    except DceeInputError as exc:
+        print(f"dcee-ros-node: error: {exc}", file=sys.stderr)
+        rclpy.shutdown()
+        raise SystemExit(2) from None
+    executor = rclpy.executors.MultiThreadedExecutor()
+    executor.add_node(node)
+    try:
+        executor.spin()
+    except KeyboardInterrupt:
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+__all__ = ["PARAMETERS", "SearchNode", "main", "quaternion_of", "yaw_of"]
