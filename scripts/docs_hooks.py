@@ -55,6 +55,7 @@ def scenario_reference() -> str:
         ("[sensor]", config.SensorSpec),
         ("[estimator]", config.EstimatorSpec),
         ("[agent]", config.AgentSpec),
+        ("[agent.unicycle]", config.UnicycleSpec),
         ("[search]", config.SearchSpec),
     ]
     out = [

@@ -6,6 +6,8 @@
   and paper:1 and 3 (every planner succeeds), at paper scale: the dual-control ablation.
 * ``paper75`` and ``hard-easy75``: the same in the 75 m × 75 m domain of the authors' example
   code (sources scaled by 1.5; ``paper75:K``).
+* ``lab`` and ``lab-robot``: the paper's indoor experiment (section 6) in simulation, its two
+  starts, with the grid agent and with the unicycle robot (``agent.model = "unicycle"``).
 * ``smoke``: two of them at toy scale (1,000 particles, 10 hypothesised readings, 60 s) so a
   campaign with every strategy finishes in well under a minute; for CI and for trying options.
 """
@@ -29,6 +31,13 @@ SUITES: dict[str, dict] = {
     "hard-easy75": {
         "configs": ["paper75:1", "paper75:3", "paper75:5", "paper75:7", "paper75:12"],
         "overrides": {},
+    },
+    # the paper's indoor experiment (section 6): two starts, seven unknowns, 0.3 m steps; "lab"
+    # with the paper's idealised grid agent, "lab-robot" with the unicycle robot (docs/robot.md)
+    "lab": {"configs": ["lab:downwind", "lab:upwind"], "overrides": {}},
+    "lab-robot": {
+        "configs": ["lab:downwind", "lab:upwind"],
+        "overrides": {"agent.model": "unicycle"},
     },
     "smoke": {
         "configs": ["paper:1", "paper:6"],

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from dcee.errors import DceeInputError
 
 DEFAULT_TOPICS = {"concentration": "concentration", "pose": "odom", "goal": "goal_pose"}
@@ -50,8 +52,78 @@ class BagWriter:
     def write(self, topic: str, stamp_ns: int, data: bytes) -> None:
         self._writer.write(self._connections[topic], int(stamp_ns), data)
 
+    def write_message(self, topic: str, stamp_ns: int, message: Any, msgtype: str) -> None:
+        """Serialise a rosbags message object (``typestore.types[msgtype](...)``) and write it."""
+        self.add_topic(topic, msgtype)
+        self.write(topic, stamp_ns, bytes(self._typestore.serialize_cdr(message, msgtype)))
+
+    def write_search_step(
+        self,
+        t: float,
+        pose: tuple[float, float, float, float, float] | None = None,
+        reading: float | None = None,
+        goal: tuple[float, float, float] | None = None,
+        topics: dict[str, str] | None = None,
+        frame_id: str = "map",
+    ) -> None:
+        """Write, at ``t`` s, a pose (x, y, heading rad, v m/s, ω rad/s) as nav_msgs/Odometry, a
+        reading as std_msgs/Float32 and/or a goal (x, y, z) as geometry_msgs/PoseStamped on
+        the search's topics (:data:`DEFAULT_TOPICS`): how a log from a robot without ROS
+        becomes a bag ``dcee replay`` reads."""
+        names = {**DEFAULT_TOPICS, **(topics or {})}
+        types = self._typestore.types
+        ns = round(t * 1e9)
+        header = types["std_msgs/msg/Header"](
+            stamp=types["builtin_interfaces/msg/Time"](
+                sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000
+            ),
+            frame_id=frame_id,
+        )
+        vec3, point = types["geometry_msgs/msg/Vector3"], types["geometry_msgs/msg/Point"]
+        quat = types["geometry_msgs/msg/Quaternion"]
+        if reading is not None:
+            msg = types["std_msgs/msg/Float32"](data=float(reading))
+            self.write_message(names["concentration"], ns, msg, "std_msgs/msg/Float32")
+        if pose is not None:
+            x, y, heading, v, omega = (float(u) for u in pose)
+            odom = types["nav_msgs/msg/Odometry"](
+                header=header,
+                child_frame_id="base_link",
+                pose=types["geometry_msgs/msg/PoseWithCovariance"](
+                    pose=types["geometry_msgs/msg/Pose"](
+                        position=point(x=x, y=y, z=0.0),
+                        orientation=quat(
+                            x=0.0, y=0.0, z=math.sin(heading / 2), w=math.cos(heading / 2)
+                        ),
+                    ),
+                    covariance=np.zeros(36),
+                ),
+                twist=types["geometry_msgs/msg/TwistWithCovariance"](
+                    twist=types["geometry_msgs/msg/Twist"](
+                        linear=vec3(x=v, y=0.0, z=0.0), angular=vec3(x=0.0, y=0.0, z=omega)
+                    ),
+                    covariance=np.zeros(36),
+                ),
+            )
+            self.write_message(names["pose"], ns, odom, "nav_msgs/msg/Odometry")
+        if goal is not None:
+            gx, gy, gz = (float(u) for u in goal)
+            msg = types["geometry_msgs/msg/PoseStamped"](
+                header=header,
+                pose=types["geometry_msgs/msg/Pose"](
+                    position=point(x=gx, y=gy, z=gz), orientation=quat(x=0.0, y=0.0, z=0.0, w=1.0)
+                ),
+            )
+            self.write_message(names["goal"], ns, msg, "geometry_msgs/msg/PoseStamped")
+
     def close(self) -> None:
         self._writer.close()
+
+    def __enter__(self) -> BagWriter:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
 @dataclass(frozen=True)
@@ -69,6 +141,11 @@ class BagEvent:
 def _yaw(q: Any) -> float:
     """Yaw (rad, counter-clockwise from +x) of a geometry_msgs quaternion."""
     return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def stamp_seconds(ns: int) -> float:
+    """Seconds of a time in integer nanoseconds, computed as ROS does (sec + nanosec · 1e-9)."""
+    return ns // 1_000_000_000 + (ns % 1_000_000_000) * 1e-9
 
 
 def _stamp(header: Any, fallback: float) -> float:
@@ -95,7 +172,7 @@ def read_events(path: str | Path, topics: dict[str, str] | None = None) -> list[
             conns = [c for c in reader.connections if c.topic in by_topic]
             for conn, log_ns, raw in reader.messages(connections=conns):
                 msg = reader.deserialize(raw, conn.msgtype)
-                events.extend(_event(by_topic[conn.topic], msg, log_ns * 1e-9))
+                events.extend(_event(by_topic[conn.topic], msg, stamp_seconds(log_ns)))
     except DceeInputError:
         raise
     except Exception as exc:
@@ -105,7 +182,9 @@ def read_events(path: str | Path, topics: dict[str, str] | None = None) -> list[
         if kind not in kinds:
             topic = names["concentration" if kind == "reading" else kind]
             raise DceeInputError("bag", f"{path} has no {kind} messages on topic {topic!r}")
-    order = {"pose": 0, "reading": 1, "goal": 2}
+    # at equal times: the reading, then the pose it completes a hold with, then the goal the
+    # node published in answer (the order the simulated robot and the node produce them)
+    order = {"reading": 0, "pose": 1, "goal": 2}
     events.sort(key=lambda e: (e.t, order[e.kind]))
     return events
 
@@ -128,4 +207,4 @@ def _event(kind: str, msg: Any, log_t: float) -> Iterator[BagEvent]:
         yield BagEvent(log_t, "goal", (p.x, p.y, p.z))
 
 
-__all__ = ["DEFAULT_TOPICS", "BagEvent", "BagWriter", "read_events"]
+__all__ = ["DEFAULT_TOPICS", "BagEvent", "BagWriter", "read_events", "stamp_seconds"]

@@ -101,13 +101,16 @@ def run_demo(
                 raise DceeInputError("timeout", f"the search did not finish in {timeout:g} s")
         wall = time.monotonic() - started
     finally:
+        for node in nodes:  # no new work: timers first, then the executor and its threads
+            for timer in list(node.timers):
+                timer.cancel()
         if executor is not None:
-            executor.shutdown(timeout_sec=2.0)
+            executor.shutdown(timeout_sec=5.0)
         if spinner is not None:
             spinner.join(timeout=5.0)
+        rclpy.try_shutdown(context=context)
         for node in nodes:
             node.destroy_node()
-        rclpy.try_shutdown(context=context)
         if writer is not None:
             writer.close()
     cycle = search.cycle
