@@ -30,6 +30,7 @@ LAYERS = {
     "dcee.cli": 8,
     "dcee.perf": 8,
     "dcee.gym": 8,  # the Gymnasium interface
+    "dcee.ros": 8,  # the robot interface (ROS 2 node, demo, bags, replay)
 }
 
 
