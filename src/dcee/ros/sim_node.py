@@ -11,6 +11,7 @@ elsewhere delays the timer, and simulated time then simply waits: the robot neve
 
 from __future__ import annotations
 
+import threading
 from typing import Any
 
 import numpy as np
@@ -58,6 +59,8 @@ class SimRobotNode(Node):
             LATCHED,
         )
         self.goals = 0
+        self._lock = threading.Lock()
+        self._stopped = False
         self._publish()
         self.timer = self.create_timer(self.robot.control_dt / speedup, self._tick)
 
@@ -67,8 +70,18 @@ class SimRobotNode(Node):
         self.goals += 1
 
     def _tick(self) -> None:
-        self.robot.step()
-        self._publish()
+        with self._lock:
+            if self._stopped:
+                return
+            self.robot.step()
+            self._publish()
+
+    def stop(self) -> None:
+        """Stop the robot's clock: after this returns no tick publishes again (so the context
+        can shut down under a spinning executor)."""
+        with self._lock:
+            self._stopped = True
+            self.timer.cancel()
 
     def _publish(self) -> None:
         r = self.robot
