@@ -108,3 +108,20 @@ def test_stamps_round_the_whole_time() -> None:
     }.items():
         s = stamp_of(t)
         assert (s.sec, s.nanosec) == (sec, ns)
+
+
+def test_node_command_line_errors_are_one_line_exit_2() -> None:
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    exe = Path(sys.executable).parent / "dcee-ros-node"
+    for args, field in ((["-p", "pose_type:=gps"], "pose_type"), (["-p", "seed:=abc"], "seed")):
+        proc = subprocess.run(
+            [str(exe), "--ros-args", *args], capture_output=True, text=True, timeout=60
+        )
+        assert proc.returncode == 2
+        lines = proc.stderr.strip().splitlines()
+        assert (
+            len(lines) == 1 and lines[0].startswith("dcee-ros-node: error:") and field in lines[0]
+        )

@@ -278,11 +278,14 @@ def main(argv: list[str] | None = None) -> None:
     import sys
 
     rclpy.init(args=argv if argv is not None else sys.argv)
+    from rclpy.exceptions import InvalidParameterTypeException, ParameterException
+
     try:
         node = SearchNode()
-    except DceeInputError as exc:
-        print(f"dcee-ros-node: error: {exc}", file=sys.stderr)
-        rclpy.shutdown()
+    except (DceeInputError, ParameterException, InvalidParameterTypeException) as exc:
+        message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        print(f"dcee-ros-node: error: {message}", file=sys.stderr)
+        rclpy.try_shutdown()
         raise SystemExit(2) from None
     executor = rclpy.executors.MultiThreadedExecutor()
     executor.add_node(node)
