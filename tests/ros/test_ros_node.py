@@ -91,7 +91,7 @@ def test_node_refuses_a_bad_pose_type() -> None:
 def test_yaw_and_quaternion_round_trip() -> None:
     from geometry_msgs.msg import Quaternion
 
-    from dcee.ros.node import quaternion_of, yaw_of
+    from dcee.ros.bag import quaternion_of, yaw_of
 
     for yaw in np.linspace(-3.1, 3.1, 13):
         x, y, z, w = quaternion_of(yaw)

@@ -92,9 +92,7 @@ class BagWriter:
                 pose=types["geometry_msgs/msg/PoseWithCovariance"](
                     pose=types["geometry_msgs/msg/Pose"](
                         position=point(x=x, y=y, z=0.0),
-                        orientation=quat(
-                            x=0.0, y=0.0, z=math.sin(heading / 2), w=math.cos(heading / 2)
-                        ),
+                        orientation=quat(*quaternion_of(heading)),
                     ),
                     covariance=np.zeros(36),
                 ),
@@ -138,9 +136,14 @@ class BagEvent:
     value: Any
 
 
-def _yaw(q: Any) -> float:
-    """Yaw (rad, counter-clockwise from +x) of a geometry_msgs quaternion."""
+def yaw_of(q: Any) -> float:
+    """Yaw (rad, counter-clockwise from +x) of a geometry_msgs quaternion (rclpy's or rosbags')."""
     return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def quaternion_of(yaw: float) -> tuple[float, float, float, float]:
+    """(x, y, z, w) of a rotation by ``yaw`` rad about +z."""
+    return 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)
 
 
 def stamp_seconds(ns: int) -> float:
@@ -200,11 +203,19 @@ def _event(kind: str, msg: Any, log_t: float) -> Iterator[BagEvent]:
         yield BagEvent(
             _stamp(msg.header, log_t),
             "pose",
-            (p.position.x, p.position.y, _yaw(p.orientation), v, w),
+            (p.position.x, p.position.y, yaw_of(p.orientation), v, w),
         )
     elif kind == "goal":
         p = msg.pose.position
         yield BagEvent(log_t, "goal", (p.x, p.y, p.z))
 
 
-__all__ = ["DEFAULT_TOPICS", "BagEvent", "BagWriter", "read_events", "stamp_seconds"]
+__all__ = [
+    "DEFAULT_TOPICS",
+    "BagEvent",
+    "BagWriter",
+    "quaternion_of",
+    "read_events",
+    "stamp_seconds",
+    "yaw_of",
+]

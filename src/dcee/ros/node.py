@@ -45,6 +45,7 @@ from std_msgs.msg import Float32
 from visualization_msgs.msg import Marker, MarkerArray
 
 from dcee.errors import DceeInputError
+from dcee.ros.bag import quaternion_of, yaw_of
 from dcee.ros.cycle import CycleSettings, Pose, SearchCycle
 from dcee.scenarios import load_scenario
 from dcee.scenarios.config import Scenario
@@ -72,16 +73,6 @@ PARAMETERS: dict[str, Any] = {
     "checkpoint": "",
     "marker_particles": 500,
 }
-
-
-def yaw_of(q: Any) -> float:
-    """Yaw (rad, counter-clockwise from +x) of a geometry_msgs quaternion."""
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-
-
-def quaternion_of(yaw: float) -> tuple[float, float, float, float]:
-    """(x, y, z, w) of a rotation by ``yaw`` rad about +z."""
-    return 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)
 
 
 def seconds(stamp: Any) -> float:
@@ -298,4 +289,4 @@ def main(argv: list[str] | None = None) -> None:
         rclpy.try_shutdown()
 
 
-__all__ = ["PARAMETERS", "SearchNode", "main", "quaternion_of", "yaw_of"]
+__all__ = ["PARAMETERS", "SearchNode", "main"]

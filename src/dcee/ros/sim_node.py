@@ -20,7 +20,8 @@ from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float32
 
-from dcee.ros.node import LATCHED, RELIABLE, quaternion_of
+from dcee.ros.bag import quaternion_of
+from dcee.ros.node import LATCHED, RELIABLE
 from dcee.scenarios.config import Scenario
 from dcee.simulation.robot import SimulatedRobot
 
