@@ -5,8 +5,13 @@ A robot drives `dcee.Searcher` directly: after every sample it *tells* the searc
 and what the sensor read, then *asks* where to sample next. Here a simulated sensor stands in
 for the robot's (`sensor.simulate_from` on the true concentration); on a robot the reading
 comes from the instrument and the position from localisation. Everything random comes from
-explicit seeded generators, so the run is reproducible.
+explicit seeded generators, so the run is reproducible. Half-way, the robot "restarts": it
+checkpoints the searcher and carries on with the restored one, which decides exactly as the
+uninterrupted one would have.
 """
+
+import tempfile
+from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -36,7 +41,12 @@ noise_rng = np.random.default_rng(3)
 position = np.array(scenario.agent.start, dtype=float)
 t, step_time = 0.0, scenario.make_agent().step_time
 path, spreads = [position.copy()], []
-for _ in range(80):
+checkpoint = Path(tempfile.mkdtemp()) / "search.ckpt"
+for k in range(80):
+    if k == 40:  # a restart mid-search: save, then carry on with the restored searcher
+        searcher.save(checkpoint)
+        searcher = dcee.Searcher.load(checkpoint)
+        pf = searcher.filter
     reading = float(
         sensor.simulate_from(truth.concentration(position, t), sensor.draw_noise(noise_rng, ()))
     )
