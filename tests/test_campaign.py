@@ -463,3 +463,12 @@ def test_campaigns_stored_before_a_setting_existed_still_resume():
     assert scenario_identity(before) == scenario_identity(now)
     two = {**now, "agent": {**now["agent"], "count": 2}}
     assert scenario_identity(two) != scenario_identity(before)
+    # the robot's motion came later still: stored without it, the grid agent ran
+    added = ("count", "model", "heading", "localisation_sd", "unicycle")
+    older = {**now, "agent": {k: v for k, v in now["agent"].items() if k not in added}}
+    assert scenario_identity(older) == scenario_identity(now)
+    robot = {**now, "agent": {**now["agent"], "model": "unicycle"}}
+    assert scenario_identity(robot) != scenario_identity(older)
+    slower = {**now, "agent": {**now["agent"], "unicycle": {**now["agent"]["unicycle"]}}}
+    slower["agent"]["unicycle"]["max_accel"] = 0.2
+    assert scenario_identity(slower) != scenario_identity(older)

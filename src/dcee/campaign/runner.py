@@ -236,7 +236,20 @@ class Campaign:
         return out
 
 
-LATER_DEFAULTS: dict[tuple[str, ...], Any] = {("agent", "count"): 1}
+def _unicycle_defaults() -> dict[str, Any]:
+    from dcee.scenarios.config import UnicycleSpec
+
+    return UnicycleSpec().model_dump(mode="json")
+
+
+LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
+    ("agent", "count"): 1,
+    # the robot's motion (issue 15); the grid agent at these defaults is the one that ran before
+    ("agent", "model"): "grid",
+    ("agent", "heading"): 0.0,
+    ("agent", "localisation_sd"): 0.0,
+    ("agent", "unicycle"): _unicycle_defaults(),
+}
 """Scenario settings added after campaigns were first stored, with their defaults: a stored
 scenario without one ran with the default, so the two must compare equal."""
 
