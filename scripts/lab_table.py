@@ -1,7 +1,10 @@
 """The lab-experiment table (issue 15): the paper's indoor search in simulation with the
 unicycle robot against the idealised grid agent, per start and planner, paired by seed.
 
-    .venv/bin/python scripts/lab_table.py results/lab-robot results/lab-grid
+    .venv/bin/python scripts/lab_table.py results/lab-robot results/lab-grid [results/lab-robot-filament]
+
+prints the per-start table (robot against grid, paired) and a compact one pooled over both
+starts with one column group per campaign given.
 
 "Source acquired" is the lab scenarios' criterion (final RMSE < 0.5 m). Rates carry Wilson 95 %
 intervals, medians distribution-free intervals, times Kaplan-Meier medians (searches that never
@@ -70,5 +73,34 @@ def table(robot_dir: str, grid_dir: str) -> str:
     return "\n".join(lines)
 
 
+def pooled(folders: list[str]) -> str:
+    """Per planner, both starts pooled (20 searches), one column group per campaign."""
+    runs = [load_summaries(f) for f in folders]
+    head = "| planner | " + " | ".join(
+        f"{f.rstrip('/').split('/')[-1]}: acquired, median RMSE (m), time to 0.5 m (s), readings"
+        for f in folders
+    )
+    lines = [head + " |", "|---|" + "---|" * len(folders)]
+    for planner in sorted(runs[0].strategy.unique()):
+        cells = []
+        for r in runs:
+            g = r[r.strategy == planner]
+            if g.empty:
+                cells.append("—")
+                continue
+            k, n = int(g.source_acquired.sum()), len(g)
+            t = censored_median_time(
+                g.time_to_rmse_0_5m.to_numpy(dtype=float), g.budget.to_numpy(dtype=float)
+            )
+            tfmt = f"{t[0]:.0f}".replace("inf", "> 450")
+            cells.append(
+                f"{k}/{n}, {np.median(g.final_rmse):.2f}, {tfmt}, {int(np.median(g.readings))}"
+            )
+        lines.append(f"| {planner} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 if __name__ == "__main__":
     print(table(sys.argv[1], sys.argv[2]))
+    print()
+    print(pooled(sys.argv[1:]))
