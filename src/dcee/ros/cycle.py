@@ -69,7 +69,16 @@ class CycleSettings:
             "shortest_move": motion.shortest_move_time(scenario.agent.step),
         }
         values.update(changes)
-        for name in ("hold", "average", "budget", "calibration", "goal_tolerance", "settle_time"):
+        for name in (
+            "hold",
+            "average",
+            "budget",
+            "calibration",
+            "goal_tolerance",
+            "settle_speed",
+            "settle_turn_rate",
+            "settle_time",
+        ):
             value = values.get(name, getattr(cls, name, 0.0))
             if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
                 raise DceeInputError(name, f"must be a finite number >= 0, got {value!r}")

@@ -17,7 +17,10 @@ Parameters
     scenario's), ``frame_id`` ("map"), ``calibration`` (1.0), ``concentration_topic``,
     ``pose_topic``, ``goal_topic``, ``pose_type`` ("odometry" | "pose_with_covariance"),
     ``checkpoint`` (a file: the searcher is saved there after every reading and resumed from
-    it at start), ``marker_particles`` (500).
+    it at start), ``marker_particles`` (500); when the robot has settled for a reading:
+    ``goal_tolerance`` (0.05 m), ``settle_speed`` (0.02 m/s), ``settle_turn_rate`` (5 °/s),
+    ``settle_time`` (0.2 s). The hold and the averaging are the scenario's (``agent.dwell``,
+    ``sensor.average``).
 
 Conventions (docs/guide/robot.md): frames are REP-103 ENU (x east, y north, yaw
 counter-clockwise from +x); dcee's wind direction φ is the direction the wind comes *from*,
@@ -72,6 +75,11 @@ PARAMETERS: dict[str, Any] = {
     "pose_type": "odometry",
     "checkpoint": "",
     "marker_particles": 500,
+    # when a reading is taken (dcee.ros.cycle.CycleSettings); hold and averaging: the scenario's
+    "goal_tolerance": 0.05,
+    "settle_speed": 0.02,
+    "settle_turn_rate": 5.0,
+    "settle_time": 0.2,
 }
 
 
@@ -121,7 +129,14 @@ class SearchNode(Node):
             _, filter_rng, planner_rng, _ = streams(int(p["seed"]))
             searcher = make_searcher(scenario, planner, filter_rng, planner_rng)
         self.searcher = searcher
-        settings = CycleSettings.from_scenario(scenario, calibration=float(p["calibration"]))
+        settings = CycleSettings.from_scenario(
+            scenario,
+            calibration=float(p["calibration"]),
+            goal_tolerance=float(p["goal_tolerance"]),
+            settle_speed=float(p["settle_speed"]),
+            settle_turn_rate=math.radians(float(p["settle_turn_rate"])),
+            settle_time=float(p["settle_time"]),
+        )
         self.cycle = SearchCycle(searcher, settings, true_location=true_location)
         self.done = threading.Event()
         self.finished = Future()  # done with the number of readings when the budget is spent
