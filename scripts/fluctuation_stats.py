@@ -9,6 +9,10 @@ share of non-detections, and the log-sd of the detected readings about ln C. It 
 fluctuation likelihood's intermittency γ(r) = γ∞ (1 − exp(−r / r_γ)) by maximum likelihood.
 
     .venv/bin/python scripts/fluctuation_stats.py [--hold 5] [--seconds 1800] [--seeds 3]
+    .venv/bin/python scripts/fluctuation_stats.py --scenario lab:upwind --hold 4
+
+Another scenario (``--scenario``) gets the same pattern of points scaled to its area (the
+distances above × area width / 50 m) at its sensor height.
 """
 
 from __future__ import annotations
@@ -29,13 +33,22 @@ def main() -> None:
     ap.add_argument("--seconds", type=float, default=1800.0)
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--meander", type=float, default=0.15, help="the model's meander intensity")
+    ap.add_argument("--scenario", default="paper:1")
     args = ap.parse_args()
-    scenario = load_scenario("paper:1").with_overrides(**{"truth.model": "filament"})
+    scenario = load_scenario(args.scenario).with_overrides(**{"truth.model": "filament"})
     theta = scenario.truth_theta()
     sensor = scenario.make_sensor()
-    down = np.array([1.0, 2.0, 3.0, 5.0, 8.0, 12.0, 20.0, 30.0])
-    cross = np.array([0.0, 1.5, 3.0])
-    pts = np.array([[theta[0] - d, theta[1] + c, 4.0] for d in down for c in cross])
+    scale = (scenario.volume.high[0] - scenario.volume.low[0]) / 50.0
+    down = scale * np.array([1.0, 2.0, 3.0, 5.0, 8.0, 12.0, 20.0, 30.0])
+    cross = scale * np.array([0.0, 1.5, 3.0])
+    height = scenario.agent.start[2]
+    wind = -np.array([np.cos(theta[5]), np.sin(theta[5])])  # where the plume goes
+    normal = np.array([-wind[1], wind[0]])
+    pts = np.array(
+        [[*(theta[:2] + d * wind + c * normal), height] for d in down for c in cross]
+    )
+    lo, hi = np.array(scenario.volume.low), np.array(scenario.volume.high)
+    pts = pts[np.all((pts >= lo) & (pts <= hi), axis=1)]  # inside the area
     mean_c = isotropic_concentration(theta, pts, meander=args.meander)[0]
     rng = np.random.default_rng(0)
     readings = []
@@ -50,7 +63,7 @@ def main() -> None:
             t += args.hold
     z = np.array(readings)  # (windows, points)
     det = z >= sensor.threshold
-    r = np.sqrt((pts[:, 0] - theta[0]) ** 2 + (pts[:, 1] - theta[1]) ** 2 + 9.0)
+    r = np.linalg.norm(pts - theta[:3], axis=1)
     print(
         f"model meander {args.meander:g}, hold {args.hold:g} s, {len(z)} readings per point, "
         f"instrument Pd {sensor.pd}"
@@ -59,8 +72,9 @@ def main() -> None:
     for k, p in enumerate(pts):
         d = det[:, k]
         lsd = np.std(np.log(z[d, k] / mean_c[k])) if d.sum() > 2 else float("nan")
+        along, across = (p[:2] - theta[:2]) @ wind, (p[:2] - theta[:2]) @ normal
         print(
-            f"{theta[0] - p[0]:4.0f} {p[1] - theta[1]:6.1f} {r[k]:6.2f} {mean_c[k]:10.3g} "
+            f"{along:5.1f} {across:6.1f} {r[k]:6.2f} {mean_c[k]:10.3g} "
             f"{z[:, k].mean() / sensor.pd / mean_c[k]:10.2f} {1 - d.mean():9.2f} {lsd:10.2f} "
             f"{float(sensor.likelihood(0.0, mean_c[k])):10.2f}"
         )
