@@ -472,3 +472,21 @@ def test_campaigns_stored_before_a_setting_existed_still_resume():
     slower = {**now, "agent": {**now["agent"], "unicycle": {**now["agent"]["unicycle"]}}}
     slower["agent"]["unicycle"]["max_accel"] = 0.2
     assert scenario_identity(slower) != scenario_identity(older)
+
+
+def test_fluctuation_only_settings_do_not_matter_under_the_paper_likelihood():
+    from dcee.campaign.runner import scenario_identity
+    from dcee.scenarios import load_scenario
+
+    lab = load_scenario("lab:upwind")
+    assert lab.estimator.log_sd == 0.72  # fitted at the room's scale
+    a = lab.model_dump(mode="json")
+    b = lab.with_overrides(**{"estimator.log_sd": 1.3}).model_dump(mode="json")
+    assert scenario_identity(a) == scenario_identity(b)  # paper likelihood: never read
+    fa, fb = (
+        lab.with_overrides(**{"estimator.likelihood": "fluctuation", **extra}).model_dump(
+            mode="json"
+        )
+        for extra in ({}, {"estimator.log_sd": 1.3})
+    )
+    assert scenario_identity(fa) != scenario_identity(fb)

@@ -254,6 +254,11 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
 scenario without one ran with the default, so the two must compare equal."""
 
 
+FLUCTUATION_ONLY = ("intermittency", "log_sd", "near_source_length")
+"""Estimator settings that only the fluctuation likelihood reads: under the paper's likelihood
+they decide nothing, so changing their defaults must not orphan a campaign."""
+
+
 def _identity(settings: dict[str, Any]) -> dict[str, Any]:
     """What must match for results to belong together: the settings without the scenarios'
     free-text descriptions (rewording one must not orphan a campaign; it changes no result) and
@@ -272,6 +277,10 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
     """A stored scenario (its JSON dump) reduced to what decides the results: without its
     free-text description and without later-added settings at their defaults."""
     out = copy.deepcopy({k: v for k, v in scenario.items() if k != "description"})
+    estimator = out.get("estimator")
+    if isinstance(estimator, dict) and estimator.get("likelihood", "paper") == "paper":
+        for key in FLUCTUATION_ONLY:  # read by the fluctuation likelihood only
+            estimator.pop(key, None)
     for path, default in LATER_DEFAULTS.items():
         node = out
         for key in path[:-1]:
