@@ -293,11 +293,13 @@ def main(argv: list[str] | None = None) -> None:
         print(f"dcee-ros-node: error: {message}", file=sys.stderr)
         rclpy.try_shutdown()
         raise SystemExit(2) from None
-    executor = rclpy.executors.MultiThreadedExecutor()
+    # one thread: the node's callbacks share one mutually exclusive group anyway, and the
+    # single-threaded executor has 3-4x the throughput (measured with the demo)
+    executor = rclpy.executors.SingleThreadedExecutor()
     executor.add_node(node)
     try:
         executor.spin()
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
         pass
     finally:
         node.destroy_node()
