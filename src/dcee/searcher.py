@@ -11,7 +11,6 @@ from typing import Any
 
 import numpy as np
 
-from dcee.allocator import tune_allocator
 from dcee.blas import one_blas_thread
 from dcee.errors import DceeInputError
 from dcee.estimation.particle_filter import ParticleFilter, UpdateInfo
@@ -46,8 +45,9 @@ class Searcher:
     >>> waypoint = searcher.ask()                # where to sample next (3,)
 
     The planner's random draws come from ``rng`` (seeded by the caller); the filter owns its own.
-    Creating a Searcher applies :func:`dcee.allocator.tune_allocator` (glibc keeps the large
-    per-decision buffers instead of unmapping them; about 20% faster decisions).
+    A Searcher changes no process-wide state: a program of its own may apply
+    :func:`dcee.allocator.tune_allocator` (the command line, campaign workers and the ROS node
+    do), and ``tell``/``ask`` limit BLAS to one thread only while they run.
     """
 
     def __init__(
@@ -57,7 +57,6 @@ class Searcher:
         agent: GridAgent,
         rng: np.random.Generator,
     ) -> None:
-        tune_allocator()
         self.filter = particle_filter
         self.planner = planner
         self.agent = agent

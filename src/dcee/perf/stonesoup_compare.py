@@ -53,7 +53,7 @@ def _candidates(position: np.ndarray) -> np.ndarray:
 def dcee_decisions(n_decisions: int, seed: int = 1990) -> Iterator[float]:
     """Milliseconds of each infotaxis decision on the example's workload (our implementation),
     one per ``next``; the first decision (loading compiled kernels) is run but not yielded."""
-    tune_allocator()  # as a Searcher would
+    tune_allocator()  # as the command line does in its own processes
     prior = SourcePrior.from_dict(
         {
             "x": Uniform(0, 50),

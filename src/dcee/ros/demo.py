@@ -218,6 +218,9 @@ def cli(
         check_writable_file(json_file, "json")
     if record is not None and record.exists():
         raise DceeInputError("record", f"{record} exists; choose a new bag folder")
+    from dcee.allocator import tune_allocator
+
+    tune_allocator()  # this process is the demo's own (see dcee.allocator)
     summary = run_demo(
         scenario_name,
         strategy,

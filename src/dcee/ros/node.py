@@ -286,6 +286,10 @@ def main(argv: list[str] | None = None) -> None:
     rclpy.init(args=argv if argv is not None else sys.argv)
     from rclpy.exceptions import InvalidParameterTypeException, ParameterException
 
+    from dcee.allocator import tune_allocator
+
+    tune_allocator()  # this process is the node's own (see dcee.allocator)
+
     try:
         node = SearchNode()
     except (DceeInputError, ParameterException, InvalidParameterTypeException) as exc:
