@@ -125,3 +125,60 @@ def test_node_command_line_errors_are_one_line_exit_2() -> None:
         assert (
             len(lines) == 1 and lines[0].startswith("dcee-ros-node: error:") and field in lines[0]
         )
+
+
+def test_node_with_pose_with_covariance_input_takes_readings_and_publishes_a_goal() -> None:
+    """A robot that reports PoseWithCovarianceStamped (AMCL-style): speeds come from successive
+    poses; standing still, it gets a reading after the hold and a goal one step away."""
+    import time
+
+    import rclpy
+    from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    from std_msgs.msg import Float32
+
+    from dcee.ros.node import LATCHED, RELIABLE, SearchNode
+    from dcee.ros.sim_node import stamp_of
+
+    context = rclpy.Context()
+    rclpy.init(context=context, args=[], domain_id=_domain())
+    try:
+        node = SearchNode(
+            context=context,
+            parameter_overrides=[
+                Parameter("pose_type", value="pose_with_covariance"),
+                Parameter("pose_topic", value="amcl_pose"),
+                Parameter("particles", value=300),
+                Parameter("strategy", value="mpc"),
+            ],
+        )
+        robot = rclpy.create_node("robot", context=context)
+        pose_pub = robot.create_publisher(PoseWithCovarianceStamped, "amcl_pose", RELIABLE)
+        conc_pub = robot.create_publisher(Float32, "concentration", RELIABLE)
+        goals = []
+        robot.create_subscription(PoseStamped, "goal_pose", goals.append, LATCHED)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+        executor.add_node(robot)
+        start = node.scenario.agent.start
+        deadline = time.monotonic() + 60
+        t = 1.0  # a zero stamp means "unstamped": the node would use its own clock
+        while not goals and time.monotonic() < deadline:
+            msg = PoseWithCovarianceStamped()
+            msg.header.stamp = stamp_of(t)
+            msg.header.frame_id = "map"
+            msg.pose.pose.position.x, msg.pose.pose.position.y = start[0], start[1]
+            msg.pose.pose.orientation.w = 1.0
+            conc_pub.publish(Float32(data=0.0))
+            pose_pub.publish(msg)
+            for _ in range(4):
+                executor.spin_once(timeout_sec=0.01)
+            t += 0.1
+        assert goals, "no goal published"
+        g = goals[0].pose.position
+        assert math.hypot(g.x - start[0], g.y - start[1]) == pytest.approx(0.3)
+        rec = node.cycle.records[0]
+        assert rec["reading"] == 0.0 and rec["time"] >= node.scenario.dwell - 1e-9
+    finally:
+        rclpy.try_shutdown(context=context)
