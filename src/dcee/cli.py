@@ -336,7 +336,9 @@ def _run_with_progress(job: Callable[[Any], Any], budget: float, quiet: bool) ->
         return job(progress)
 
 
-def _print_summary(summary: dict[str, Any], out_dir: Path) -> None:
+def _print_summary(
+    summary: dict[str, Any], out_dir: Path | None, where: str = "results in"
+) -> None:
     from rich.console import Console
     from rich.table import Table
 
@@ -358,7 +360,8 @@ def _print_summary(summary: dict[str, Any], out_dir: Path) -> None:
         table.add_row(k, v)
     console = Console()
     console.print(table)
-    console.print(f"results in {out_dir}")
+    if out_dir is not None:
+        console.print(f"{where} {out_dir}")
 
 
 def _fmt(v: float | None) -> str:

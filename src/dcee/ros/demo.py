@@ -236,7 +236,7 @@ def cli(
     summary.pop("records")
     if json_file is not None:
         write_json(json_file, summary)
-    _print_summary(summary, record or Path("."))
+    _print_summary(summary, record, where="topics recorded in")
 
 
 def main(argv: list[str] | None = None) -> None:
