@@ -98,6 +98,20 @@ def test_cycle_waits_for_settling() -> None:
     assert cycle.state == "driving"
 
 
+def test_cycle_reports_a_hold_without_readings() -> None:
+    sc = _lab()
+    searcher = make_searcher(sc, None, *streams(0)[1:3])
+    cycle = SearchCycle(searcher, CycleSettings.from_scenario(sc), plan=False)
+    t = 0.0
+    while t < 10.0:  # standing still, no concentration messages at all
+        assert cycle.on_pose(Pose(t, 0.3, 3.2)).record is None
+        t += 0.1
+    assert cycle.state == "holding" and cycle.starved
+    cycle.on_reading(t, 1e-3)
+    assert not cycle.starved
+    assert cycle.on_pose(Pose(t, 0.3, 3.2)).record is not None
+
+
 def test_cycle_settings_validation() -> None:
     sc = _lab()
     with pytest.raises(DceeInputError, match="calibration"):

@@ -131,6 +131,14 @@ class SearchCycle:
             return 0.0
         return self._pose.t - self.start_time
 
+    @property
+    def starved(self) -> bool:
+        """True while a hold has lasted 5 s beyond its length without one reading (no
+        concentration messages arrive: the node warns)."""
+        if self.state != "holding" or self._samples or self._pose is None:
+            return False
+        return self._pose.t - self._since > self.settings.hold + 5.0
+
     def on_goal(self, goal: np.ndarray) -> None:
         """A goal from outside (replay): drive to it."""
         if self.state == "done":

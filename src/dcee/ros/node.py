@@ -203,6 +203,13 @@ class SearchNode(Node):
             if self.done.is_set():
                 return
             out = self.cycle.on_pose(pose)
+            starved = self.cycle.starved
+        if starved:
+            topic = self.params["concentration_topic"]
+            self.get_logger().warning(
+                f"holding for a reading, but nothing arrives on {topic}",
+                throttle_duration_sec=5.0,
+            )
         if out.record is not None:
             self._publish_belief(out.record)
             if self.checkpoint is not None:
