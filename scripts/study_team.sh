@@ -8,11 +8,11 @@ D=.venv/bin/dcee
 # preliminary, small: 10,000 particles, 3 repeats (36 searches per planner and team size)
 for K in 1 2 3; do
     $D bench --suite paper --repeats 3 --particles 10000 --agents "$K" \
-        --strategies infotaxis,dcee-cl --out "results/team10k-a$K"
+        --strategies infotaxis,dcee-cl --out "results/team10k-a$K" --allow-code-change
 done
 .venv/bin/python scripts/team_table.py results/team10k-a1 results/team10k-a2 results/team10k-a3
 # paper scale: 20,000 particles, 10 repeats; one robot is results/paper-source-cl2 (same seeds)
-# (about 5 h on two cores: 2-robot searches take about 50 s, 3-robot about 90 s of one core)
+# (2026-11-22: 2 robots 37 min, 3 robots about 75 min on two cores shared with other work)
 for K in 2 3; do
     $D bench --suite paper --repeats 10 --agents "$K" --strategies infotaxis,dcee-cl \
         --out "results/team-a$K" --allow-code-change
