@@ -62,44 +62,22 @@ def test_replay_reproduces_the_search_it_recorded(tmp_path) -> None:
     assert {e.kind for e in events} == {"pose", "reading", "goal"}
 
 
+def _replay(*args: str) -> int:
+    """``dcee replay ARGS`` in this process; its exit code."""
+    with pytest.raises(SystemExit) as exit_:
+        main(["replay", *args])
+    return exit_.value.code
+
+
 def test_replay_cli(tmp_path, capsys) -> None:
     _record_search(tmp_path / "bag")
-    out = tmp_path / "out"
-    with pytest.raises(SystemExit) as exit_:
-        main(
-            [
-                "replay",
-                str(tmp_path / "bag"),
-                "--scenario",
-                "lab:upwind",
-                "--particles",
-                "800",
-                "--set",
-                "search.budget=60",
-                "--out",
-                str(out),
-            ]
-        )
-    assert exit_.value.code == 0
+    bag, out = str(tmp_path / "bag"), tmp_path / "out"
+    lab = ("--scenario", "lab:upwind", "--out", str(out))
+    assert _replay(bag, *lab, "--particles", "800", "--set", "search.budget=60") == 0
     for name in ("steps.parquet", "summary.json", "figure.png", "posterior.npz"):
         assert (out / name).exists()
-    with pytest.raises(SystemExit) as exit_:
-        main(["replay", str(tmp_path / "nobag"), "--scenario", "lab:upwind", "--out", str(out)])
-    assert exit_.value.code == 2
+    assert _replay(str(tmp_path / "nobag"), *lab) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err[-1].startswith("dcee: error: bag: no bag at")
-    with pytest.raises(SystemExit) as exit_:
-        main(
-            [
-                "replay",
-                str(tmp_path / "bag"),
-                "--scenario",
-                "lab:upwind",
-                "--out",
-                str(out),
-                "--calibration",
-                "-1",
-            ]
-        )
-    assert exit_.value.code == 2
+    assert _replay(bag, *lab, "--calibration", "-1") == 2
     assert "calibration" in capsys.readouterr().err

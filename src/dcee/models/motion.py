@@ -88,7 +88,6 @@ class MotionModel:
         raise NotImplementedError
 
 
-MotionFactory = Callable[..., MotionModel]
 MOTION_MODELS: dict[str, type[MotionModel]] = {}
 """Motion models by name (``agent.model``), filled by :func:`register_motion`."""
 

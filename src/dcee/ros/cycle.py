@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from numbers import Real
 from typing import Any
 
 import numpy as np
@@ -42,8 +43,8 @@ class CycleSettings:
     ppm: the gas's g/m³ per ppm); settled = within ``goal_tolerance`` m of the goal, slower than
     ``settle_speed`` m/s and ``settle_turn_rate`` rad/s for ``settle_time`` s; ``altitude`` m of
     the readings (a ground robot's sensor height, the scenario's start z); ``budget`` s of
-    search; ``step`` m and ``shortest_move`` s bound the next move (a move that cannot end in
-    the budget is not asked for)."""
+    search; ``shortest_move`` s, the fastest any move can be (a move that cannot end in the
+    budget is not asked for)."""
 
     hold: float
     average: float
@@ -152,7 +153,7 @@ class SearchCycle:
     def on_reading(self, t: float, value: float) -> None:
         """A concentration sample (sensor units) received at ``t`` s; kept while holding.
         Non-finite or negative samples are dropped and counted (:attr:`dropped_readings`)."""
-        if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
+        if not (isinstance(value, Real) and math.isfinite(value) and value >= 0):
             self.dropped_readings += 1
             return
         if self.state == "holding":
@@ -200,7 +201,7 @@ class SearchCycle:
         time = self.search_time
         position = np.array([pose.x, pose.y, s.altitude])
         info = self.searcher.tell(position, reading, time)
-        sensor = self.searcher.filter.sensor
+        sensor = self.searcher.filter.sensor  # the estimator's: the same threshold
         record = reading_record(
             self.searcher,
             info,
@@ -210,7 +211,7 @@ class SearchCycle:
             position=position,
             told=position,
             reading=reading,
-            detection=bool(reading >= sensor.threshold),
+            detection=bool(sensor.is_detection(reading)),
             true_location=self.true_location,
             heading=math.degrees(pose.heading),
             travel_time=self._since - self._drive_started - s.settle_time,

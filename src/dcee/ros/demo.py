@@ -58,11 +58,10 @@ def run_demo(
     from dcee.ros.node import SearchNode
     from dcee.ros.sim_node import SimRobotNode
     from dcee.scenarios import load_scenario
-    from dcee.simulation.metrics import summarise
+    from dcee.scenarios.config import truth_choice
+    from dcee.simulation.episode import search_summary
 
     get_planner(strategy)  # fail fast on a bad name
-    from dcee.scenarios.config import truth_choice
-
     scenario = load_scenario(scenario_name).with_overrides(
         **{
             "search.particles": particles,
@@ -131,7 +130,9 @@ def run_demo(
         if writer is not None:
             writer.close()
     cycle = search.cycle
-    summary = summarise(cycle.records, scenario, strategy, seed, sim.robot.path_length)
+    summary = search_summary(
+        cycle.records, scenario, strategy, seed, sim.robot.path_length, search.searcher
+    )
     summary.update(
         transport="ros2",
         wall_seconds=wall,

@@ -43,7 +43,6 @@ from nav_msgs.msg import Path as PathMsg
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSDurabilityPolicy, QoSProfile, QoSReliabilityPolicy
-from rclpy.task import Future
 from std_msgs.msg import Float32
 from visualization_msgs.msg import Marker, MarkerArray
 
@@ -139,7 +138,6 @@ class SearchNode(Node):
         )
         self.cycle = SearchCycle(searcher, settings, true_location=true_location)
         self.done = threading.Event()
-        self.finished = Future()  # done with the number of readings when the budget is spent
         self._lock = threading.Lock()
         self._last_pose: Pose | None = None
         self._marker_rng = np.random.default_rng(int(p["seed"]) + 1)
@@ -223,7 +221,6 @@ class SearchNode(Node):
                 f"({est.mean[0]:.2f}, {est.mean[1]:.2f}) m, spread {est.spread:.2f} m"
             )
             self.done.set()
-            self.finished.set_result(len(self.cycle.records))
 
     # --- outputs ------------------------------------------------------------------------------
 

@@ -14,8 +14,7 @@ from dcee.provenance import code_version
 from dcee.ros.bag import read_events
 from dcee.ros.cycle import CycleSettings, Pose, SearchCycle
 from dcee.scenarios.config import Scenario
-from dcee.simulation.episode import EpisodeResult, make_searcher, streams
-from dcee.simulation.metrics import summarise
+from dcee.simulation.episode import EpisodeResult, make_searcher, search_summary, streams
 
 
 def replay_bag(
@@ -47,17 +46,9 @@ def replay_bag(
             break
     if not cycle.records:
         raise DceeInputError("bag", f"{bag}: the robot never settled for a whole hold")
-    summary = summarise(cycle.records, scenario, "replay", seed, cycle.path_length)
+    summary = search_summary(cycle.records, scenario, "replay", seed, cycle.path_length, searcher)
+    summary.update(bag=str(bag), dropped_readings=cycle.dropped_readings)
     pf = searcher.filter
-    summary["recoveries"] = len(pf.recoveries)
-    summary["truth_in_95"] = pf.in_credible_region(scenario.truth_theta()[:3], 0.95)
-    summary["resamples"] = pf.n_resamples
-    summary["config"] = scenario.name
-    summary["parameter_names"] = list(scenario.unknown_names)
-    summary["planner_options"] = {}
-    summary["bag"] = str(bag)
-    summary["dropped_readings"] = cycle.dropped_readings
-    summary.update(scenario.resolved_settings())
     config: dict[str, Any] = {
         "scenario": scenario.model_dump(mode="json"),
         "strategy": "replay",

@@ -15,6 +15,7 @@ import threading
 from typing import Any
 
 import numpy as np
+from geometry_msgs.msg import PoseStamped
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
@@ -53,12 +54,7 @@ class SimRobotNode(Node):
         self.clock_pub = self.create_publisher(Clock, "/clock", 10)
         self.odom_pub = self.create_publisher(Odometry, "odom", RELIABLE)
         self.conc_pub = self.create_publisher(Float32, "concentration", RELIABLE)
-        self.create_subscription(
-            __import__("geometry_msgs.msg", fromlist=["PoseStamped"]).PoseStamped,
-            "goal_pose",
-            self._on_goal,
-            LATCHED,
-        )
+        self.create_subscription(PoseStamped, "goal_pose", self._on_goal, LATCHED)
         self.goals = 0
         self._lock = threading.Lock()
         self._stopped = False

@@ -392,21 +392,37 @@ class SearchSimulation:
         self.time += self.travel_time + self.agent.dwell
 
     def summary(self, strategy: str) -> dict[str, Any]:
-        """The search's summary (:func:`dcee.simulation.metrics.summarise` and the filter's
-        diagnostics) under the name ``strategy``."""
-        scenario, pf = self.scenario, self.filter
-        out = summarise(self.records, scenario, strategy, self.seed, self.path_length)
-        planner = self.searcher.planner
-        out["planner_options"] = planner.options() if planner is not None else {}
-        out["recoveries"] = len(pf.recoveries)
-        out["tempering_events"] = sum(r["kind"] == "tempering" for r in pf.recoveries)
-        out["rejected_readings"] = sum(r["kind"] == "rejected" for r in pf.recoveries)
-        out["truth_in_95"] = pf.in_credible_region(self.true_location, 0.95)
-        out.update(scenario.resolved_settings())
-        out["resamples"] = pf.n_resamples
-        out["config"] = scenario.name
-        out["parameter_names"] = list(scenario.unknown_names)
-        return out
+        """The search's summary (:func:`search_summary`) under the name ``strategy``."""
+        return search_summary(
+            self.records, self.scenario, strategy, self.seed, self.path_length, self.searcher
+        )
+
+
+def search_summary(
+    records: list[dict[str, Any]],
+    scenario: Scenario,
+    strategy: str,
+    seed: int,
+    path_length: float,
+    searcher: Searcher,
+) -> dict[str, Any]:
+    """A search's summary: :func:`dcee.simulation.metrics.summarise` of its ``records``, the
+    planner's options and the filter's diagnostics (recoveries, calibration against the
+    scenario's true source, resamplings) and the scenario's resolved settings. The simulation,
+    ``dcee replay`` and the ROS demo all summarise through it."""
+    pf = searcher.filter
+    out = summarise(records, scenario, strategy, seed, path_length)
+    planner = searcher.planner
+    out["planner_options"] = planner.options() if planner is not None else {}
+    out["recoveries"] = len(pf.recoveries)
+    out["tempering_events"] = sum(r["kind"] == "tempering" for r in pf.recoveries)
+    out["rejected_readings"] = sum(r["kind"] == "rejected" for r in pf.recoveries)
+    out["truth_in_95"] = pf.in_credible_region(scenario.truth_theta()[:3], 0.95)
+    out.update(scenario.resolved_settings())
+    out["resamples"] = pf.n_resamples
+    out["config"] = scenario.name
+    out["parameter_names"] = list(scenario.unknown_names)
+    return out
 
 
 def run_episode(
@@ -498,6 +514,7 @@ __all__ = [
     "planner_defaults",
     "reading_record",
     "run_episode",
+    "search_summary",
     "snapshot_times",
     "streams",
 ]
