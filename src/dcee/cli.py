@@ -64,7 +64,8 @@ LIKELIHOOD_OPTION = click.option(
     "--likelihood",
     type=RegistryChoice(_likelihood_names),
     help="Reading model of the filter and planners: paper (eq. 3) | fluctuation (intermittent "
-    "log-normal, for turbulent plumes) [default: the scenario's estimator.likelihood].",
+    "log-normal for turbulent plumes, with the paper's calm model beside it, the two selected "
+    "online by the readings' evidence) [default: the scenario's estimator.likelihood].",
 )
 SET_OPTION = click.option(
     "--set",

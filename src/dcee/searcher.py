@@ -13,6 +13,7 @@ import numpy as np
 
 from dcee.blas import one_blas_thread
 from dcee.errors import DceeInputError
+from dcee.estimation.model_bank import ModelBank
 from dcee.estimation.particle_filter import ParticleFilter, UpdateInfo
 from dcee.io import write_atomic
 from dcee.models.agent import GridAgent
@@ -52,7 +53,7 @@ class Searcher:
 
     def __init__(
         self,
-        particle_filter: ParticleFilter,
+        particle_filter: ParticleFilter | ModelBank,
         planner: Planner | None,
         agent: GridAgent,
         rng: np.random.Generator,

@@ -249,12 +249,15 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("agent", "heading"): 0.0,
     ("agent", "localisation_sd"): 0.0,
     ("agent", "unicycle"): _unicycle_defaults(),
+    # the fluctuation likelihood ran without the calm model before the setting existed (so a
+    # campaign stored before resumes only with calm_prior = 0, not with the new default)
+    ("estimator", "calm_prior"): 0.0,
 }
-"""Scenario settings added after campaigns were first stored, with their defaults: a stored
-scenario without one ran with the default, so the two must compare equal."""
+"""Scenario settings added after campaigns were first stored, with the value a stored scenario
+without one ran with, so the two compare equal."""
 
 
-FLUCTUATION_ONLY = ("intermittency", "log_sd", "near_source_length")
+FLUCTUATION_ONLY = ("intermittency", "log_sd", "near_source_length", "calm_prior")
 """Estimator settings that only the fluctuation likelihood reads: under the paper's likelihood
 they decide nothing, so changing their defaults must not orphan a campaign."""
 

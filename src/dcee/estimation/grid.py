@@ -21,10 +21,12 @@ from dcee.models.sensor import Sensor
 
 @dataclass(frozen=True)
 class GridPosterior:
-    """Normalised posterior weights (K,) at grid points (K, 2), with mean (2,) and sd (2,)."""
+    """Normalised posterior weights (K,) at grid points (K, 2), with mean (2,) and sd (2,), and
+    the log evidence log p(readings) = log ∫ prior · likelihood (midpoint rule)."""
 
     points: np.ndarray
     weights: np.ndarray
+    log_evidence: float = float("nan")
 
     @property
     def mean(self) -> np.ndarray:
@@ -62,14 +64,30 @@ def location_grid_posterior(
     gx, gy = np.meshgrid(xs, ys, indexing="ij")
     pts = np.column_stack([gx.ravel(), gy.ravel()])
     loglik = _loglik(theta, pts, positions, readings, sensor, plume)
+    # prior mass of a cell: uniform over the grid's cells
+    log_cell = np.full(len(pts), -np.log(len(pts)))
     if refine > 1:
-        keep = pts[loglik > loglik.max() + np.log(1e-12)]
+        kept = loglik > loglik.max() + np.log(1e-12)
         offsets = (np.arange(refine) + 0.5) / refine * spacing - spacing / 2
         ox, oy = np.meshgrid(offsets, offsets, indexing="ij")
-        pts = (keep[:, None, :] + np.column_stack([ox.ravel(), oy.ravel()])[None]).reshape(-1, 2)
-        loglik = _loglik(theta, pts, positions, readings, sensor, plume)
+        sub = pts[kept][:, None, :] + np.column_stack([ox.ravel(), oy.ravel()])[None]
+        sub_loglik = _loglik(theta, sub.reshape(-1, 2), positions, readings, sensor, plume)
+        # the evidence keeps the coarse cells that were not refined
+        log_ev = _logsumexp(
+            np.concatenate(
+                [loglik[~kept] + log_cell[~kept], sub_loglik + log_cell[0] - 2 * np.log(refine)]
+            )
+        )
+        pts, loglik = sub.reshape(-1, 2), sub_loglik
+    else:
+        log_ev = _logsumexp(loglik + log_cell)
     w = np.exp(loglik - loglik.max())
-    return GridPosterior(pts, w / w.sum())
+    return GridPosterior(pts, w / w.sum(), log_ev)
+
+
+def _logsumexp(a: np.ndarray) -> float:
+    top = a.max()
+    return float(top + np.log(np.exp(a - top).sum()))
 
 
 def _loglik(theta, pts, positions, readings, sensor, plume) -> np.ndarray:

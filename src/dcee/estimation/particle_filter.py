@@ -30,12 +30,18 @@ explain (log-likelihood −inf or NaN for all) is not assimilated and is recorde
 kind "rejected"; so no sequence of inputs leaves the filter with no live particle. The sensor's
 outlier component (``Sensor.outlier``) bounds the influence of any finite reading.
 
+Model evidence: every assimilated reading adds log Σᵢ wᵢ p(z | Θᵢ) (the normalised weights
+before the reading) to :attr:`ParticleFilter.log_evidence`, the standard SMC estimate of
+log p(z₁…z_k | model); :class:`dcee.estimation.model_bank.ModelBank` compares reading models
+with it. A refused reading adds nothing.
+
 Known parameters stay at their fixed values: the filter stores full (N, 8) source terms but only
 the unknown columns are sampled, moved and reported by :attr:`ParticleFilter.particles`.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -89,6 +95,8 @@ class UpdateInfo:
     move_sweeps: int = 0
     distinct: int = 0
     rejected: bool = False
+    log_evidence: float = 0.0
+    """log p(z | earlier readings) of this reading under the filter's model (0 if refused)"""
 
 
 class ParticleFilter:
@@ -167,6 +175,8 @@ class ParticleFilter:
         self.recoveries: list[dict[str, float | str]] = []
         self._origin = np.arange(self.n)
         self.n_resamples = 0
+        self.log_evidence = 0.0
+        """log p(every assimilated reading | model), the SMC estimate (see the module doc)"""
 
     # --- public state -----------------------------------------------------------------------
 
@@ -300,6 +310,12 @@ class ParticleFilter:
         self.n_readings += 1
 
         logw = self._logw + ll_new
+        # log Σ wᵢ p(z|Θᵢ), wᵢ the normalised weights before z (_logw's max is 0 or −ln N)
+        top = logw.max()
+        log_ev = float(
+            top + math.log(np.exp(logw - top).sum()) - math.log(np.exp(self._logw).sum())
+        )
+        self.log_evidence += log_ev
         w = _normalise(logw)
         ess = effective_sample_size(w)
         if ess >= self.collapse_threshold * self.n:
@@ -308,9 +324,10 @@ class ParticleFilter:
             if ess < self.resample_threshold * self.n:
                 self._resample()
                 acc, sweeps, distinct = self._rejuvenate()
-                return UpdateInfo(ess, True, acc, 1, sweeps, distinct)
-            return UpdateInfo(ess, False, math.nan, 1, 0, self.n)
-        return self._tempered_update(ll_new, entry, base_mult, ess)
+                return UpdateInfo(ess, True, acc, 1, sweeps, distinct, log_evidence=log_ev)
+            return UpdateInfo(ess, False, math.nan, 1, 0, self.n, log_evidence=log_ev)
+        info = self._tempered_update(ll_new, entry, base_mult, ess)
+        return dataclasses.replace(info, log_evidence=log_ev)
 
     # --- internals --------------------------------------------------------------------------
 

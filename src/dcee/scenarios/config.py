@@ -42,6 +42,7 @@ A scenario is a TOML file (or a built-in, see :mod:`dcee.scenarios.builtin`)::
     intermittency = 0.63           # fluctuation only
     log_sd = 1.3                   # fluctuation only
     near_source_length = 5.4       # fluctuation only, m
+    calm_prior = 0.5               # fluctuation only: prior probability of a calm plume (0: off)
     meander = 0.15                 # plume broadening [default: 0 paper, 0.15 fluctuation]
     outlier = 0.0                  # outlier weight [default: 0 paper, 0.01 fluctuation]
 
@@ -298,13 +299,16 @@ LIKELIHOODS: tuple[str, ...] = get_args(Likelihood)
 OUTLIER_DEFAULT: dict[str, float] = {"paper": 0.0, "fluctuation": 0.01}
 """Outlier weight per likelihood when ``estimator.outlier`` is not given: the paper's model has
 none (its numbers are reproduced exactly); the fluctuation likelihood, meant for real plumes,
-bounds the influence of every reading (docs/scenarios.md)."""
+bounds the influence of every reading (docs/scenarios.md). With ``calm_prior`` > 0 the
+fluctuation likelihood's calm member gets the same weight, so a spike moves neither model's evidence more
+than the other's."""
 
 
 MEANDER_DEFAULT: dict[str, float] = {"paper": 0.0, "fluctuation": 0.15}
 """Meander broadening per likelihood when ``estimator.meander`` is not given: none for the
 paper's model; 0.15 for the fluctuation model, the crosswind turbulence intensity that fits the
-filament truth's time mean best (docs/scenarios.md)."""
+filament truth's time mean best (docs/scenarios.md). The calm member of the fluctuation
+likelihood (``calm_prior``) never meanders."""
 
 
 class EstimatorSpec(BaseModel):
@@ -316,6 +320,12 @@ class EstimatorSpec(BaseModel):
     threshold, ``intermittency``, ``log_sd`` and ``near_source_length`` (defaults fitted by
     maximum likelihood to 5 s hold averages of the filament truth, readings as the instrument
     reports them: ``scripts/fluctuation_stats.py``, docs/scenarios.md).
+    With ``calm_prior`` > 0 the fluctuation likelihood estimates the turbulence level online: a
+    second filter runs the paper's calm model (the ``[sensor]`` parameters, no meander) on the
+    same readings, with prior probability ``calm_prior``, and the planners and the estimate use
+    whichever model is the more probable given the readings
+    (:mod:`dcee.estimation.model_bank`); a calm plume is then searched with the paper's model,
+    a turbulent one with the fluctuation model.
     """
 
     model_config = _FROZEN
@@ -333,6 +343,10 @@ class EstimatorSpec(BaseModel):
     outlier: Annotated[float | None, Field(ge=0, lt=1)] = None
     """weight of the outlier component (log-uniform up to sensor.max_reading); None: the
     likelihood's default, :data:`OUTLIER_DEFAULT`"""
+    calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.5
+    """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
+    filter and selected by the readings' evidence: the turbulence level estimated online); 0: the
+    turbulent model alone"""
 
 
 def team_starts(
@@ -554,6 +568,7 @@ class Scenario(BaseModel):
             "dwell": self.dwell,
             "average": self.average,
             "likelihood": self.estimator.likelihood,
+            "reading_models": "+".join(self.reading_models),
             "outlier": self.outlier,
             "meander": self.meander,
         }
@@ -568,10 +583,28 @@ class Scenario(BaseModel):
         spec = self.sensor.model_dump(exclude={"average", "response_time"})
         return Sensor(**spec)
 
-    def make_estimator_sensor(self) -> Sensor:
-        """The reading model of the filter and the planners (``[estimator]``)."""
+    @property
+    def reading_models(self) -> tuple[str, ...]:
+        """The reading models the filter runs, the preferred first: ``("paper",)``,
+        ``("fluctuation",)``, or with ``estimator.calm_prior`` > 0 ``("fluctuation", "paper")``."""
+        e = self.estimator
+        if e.likelihood == "fluctuation" and e.calm_prior > 0:
+            return ("fluctuation", "paper")
+        return (e.likelihood,)
+
+    @property
+    def reading_model_priors(self) -> tuple[float, ...]:
+        """Prior probability of each of :attr:`reading_models`."""
+        if len(self.reading_models) == 1:
+            return (1.0,)
+        return (1.0 - self.estimator.calm_prior, self.estimator.calm_prior)
+
+    def make_estimator_sensor(self, model: str | None = None) -> Sensor:
+        """The reading model ``model`` (one of :attr:`reading_models`; None: the first) of the
+        filter and the planners (``[estimator]``)."""
         s, e = self.sensor, self.estimator
-        if e.likelihood == "paper":
+        model = self._reading_model(model)
+        if model == "paper":
             return dataclasses.replace(self.make_sensor(), outlier=self.outlier)
         return Sensor(
             threshold=s.threshold,
@@ -583,9 +616,20 @@ class Scenario(BaseModel):
             max_reading=s.max_reading,
         )
 
-    def make_plume(self) -> IsotropicPlume:
-        """The dispersion model of the filter and the planners."""
+    def make_plume(self, model: str | None = None) -> IsotropicPlume:
+        """The dispersion model of the filter and the planners under reading model ``model``
+        (None: the first of :attr:`reading_models`)."""
+        model = self._reading_model(model)
+        if self.estimator.likelihood != model:  # the fluctuation likelihood's calm member
+            return IsotropicPlume(meander=0.0)
         return IsotropicPlume(meander=self.meander)
+
+    def _reading_model(self, model: str | None) -> str:
+        if model is None:
+            return self.reading_models[0]
+        if model not in self.reading_models:
+            raise DceeInputError("model", f"must be one of {', '.join(self.reading_models)}")
+        return model
 
     def starts(self) -> np.ndarray:
         """(count, 3) start positions of the robots, m (row 0 is ``agent.start``)."""

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from dcee.estimation.model_bank import ModelBank
 from dcee.estimation.particle_filter import ParticleFilter, UpdateInfo
 from dcee.io import write_atomic, write_json
 from dcee.models.sensor import Sensor
@@ -191,19 +192,32 @@ def make_searcher(
     ``planner`` in a :class:`~dcee.searcher.Searcher`; the simulation, the ROS node and
     ``dcee replay`` build theirs here (with the generators of :func:`streams`)."""
     search = scenario.search
-    pf = ParticleFilter(
-        scenario.make_prior(),
-        scenario.make_estimator_sensor(),  # the reading model of the filter and planners
-        scenario.make_plume(),
-        n_particles=search.particles,
-        seed=filter_rng,
-        resample_threshold=search.resample_threshold,
-        mcmc_steps=search.mcmc_steps,
-        global_share=search.global_share,
-        diversify=search.diversify,
-        max_sweeps=search.max_sweeps,
+    models = scenario.reading_models
+    # the first (preferred) model draws from filter_rng itself, as a lone filter does; the others
+    # from children of it (spawning does not move filter_rng). So a second model changes nothing
+    # while it is not selected, and comparisons with and without it are paired exactly.
+    rngs = [filter_rng, *filter_rng.spawn(len(models) - 1)]
+    filters = [
+        ParticleFilter(
+            scenario.make_prior(),
+            scenario.make_estimator_sensor(model),  # the reading model of filter and planners
+            scenario.make_plume(model),
+            n_particles=search.particles,
+            seed=rng,
+            resample_threshold=search.resample_threshold,
+            mcmc_steps=search.mcmc_steps,
+            global_share=search.global_share,
+            diversify=search.diversify,
+            max_sweeps=search.max_sweeps,
+        )
+        for model, rng in zip(models, rngs, strict=True)
+    ]
+    estimator = (
+        filters[0]
+        if len(filters) == 1
+        else ModelBank(filters, models, scenario.reading_model_priors)
     )
-    return Searcher(pf, planner, scenario.make_agent(), planner_rng)
+    return Searcher(estimator, planner, scenario.make_agent(), planner_rng)
 
 
 def reading_record(
@@ -269,6 +283,12 @@ def reading_record(
         "rejected": info.rejected,
         "update_seconds": searcher.last_update_seconds,
         "decision_seconds": 0.0,
+        "log_evidence": pf.log_evidence,
+        **(
+            {"model": pf.selected_name, "model_probability": float(pf.probabilities[pf.selected])}
+            if isinstance(pf, ModelBank)
+            else {}
+        ),
     }
 
 
@@ -420,6 +440,10 @@ def search_summary(
     out["truth_in_95"] = pf.in_credible_region(scenario.truth_theta()[:3], 0.95)
     out.update(scenario.resolved_settings())
     out["resamples"] = pf.n_resamples
+    if isinstance(pf, ModelBank):  # which reading model the readings chose, and how firmly
+        out["model"] = pf.selected_name
+        out["model_probability"] = float(pf.probabilities[pf.selected])
+        out["model_switches"] = pf.switches
     out["config"] = scenario.name
     out["parameter_names"] = list(scenario.unknown_names)
     return out

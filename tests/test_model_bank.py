@@ -1,0 +1,189 @@
+"""The filter's model evidence and the model bank that estimates the turbulence level online."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from dcee import DceeInputError, ParticleFilter
+from dcee.campaign.runner import scenario_identity
+from dcee.estimation.grid import location_grid_posterior
+from dcee.estimation.model_bank import ModelBank
+from dcee.planning import get as get_planner
+from dcee.scenarios import load_scenario
+from dcee.searcher import Searcher
+from dcee.simulation import run_episode
+from dcee.simulation.episode import make_searcher, streams
+from tests.test_robust_estimation import _xy_prior
+
+PAPER1 = load_scenario("paper:1")
+FLUCT = PAPER1.with_overrides(**{"estimator.likelihood": "fluctuation"})
+
+
+def _lawnmower(n: int = 40) -> np.ndarray:
+    xs = np.linspace(5, 45, 8)
+    rows = [(x, y, 4.0) for y in (5.0, 15.0, 25.0, 35.0, 45.0) for x in xs]
+    return np.array(rows[:n])
+
+
+def _readings(sensor, positions, seed: int, plume=None) -> np.ndarray:
+    from dcee.models.plume import IsotropicPlume
+
+    conc = (plume or IsotropicPlume()).concentration(PAPER1.truth_theta(), positions)[0]
+    return sensor.simulate(conc, np.random.default_rng(seed))
+
+
+def test_log_evidence_matches_the_exact_grid_integral():
+    """x, y unknown: the filter's running SMC estimate of log p(z₁…z_k) against the exact
+    integral of prior × likelihood on a grid, after 10, 25 and 40 readings."""
+    sensor = PAPER1.make_sensor()
+    ps = _lawnmower()
+    zs = _readings(sensor, ps, seed=3)
+    assert (zs > 0).sum() >= 5  # the test needs detections
+    pf = ParticleFilter(_xy_prior(), sensor, n_particles=20_000, seed=1)
+    for k, (p, z) in enumerate(zip(ps, zs, strict=True), start=1):
+        info = pf.update(p, z)
+        assert math.isfinite(info.log_evidence)
+        if k in (10, 25, 40):
+            exact = location_grid_posterior(
+                PAPER1.truth_theta(), (0, 0), (50, 50), 0.25, ps[:k], zs[:k], sensor, refine=5
+            )
+            assert pf.log_evidence == pytest.approx(exact.log_evidence, abs=0.3), k
+
+
+def test_log_evidence_of_the_first_reading_by_hand():
+    """Before any reading the weights are the prior's: the first increment is log of the
+    prior-mean likelihood of that reading."""
+    sensor = PAPER1.make_sensor()
+    pf = ParticleFilter(_xy_prior(), sensor, n_particles=4000, seed=0)
+    theta = pf.theta.copy()
+    p = np.array([30.0, 12.5, 4.0])
+    info = pf.update(p, 0.004)
+    by_hand = math.log(np.mean(np.exp(pf.log_likelihood(theta, p, 0.004))))
+    assert info.log_evidence == pytest.approx(by_hand, rel=1e-9)
+    assert pf.log_evidence == info.log_evidence
+
+
+@pytest.mark.parametrize("generating", ["paper", "fluctuation"])
+def test_bank_selects_the_model_that_made_the_readings(generating):
+    """Readings drawn from one of the two reading models (the same mean plume) on a fixed
+    path: the bank gives that model a posterior probability above 0.99."""
+    ps = _lawnmower(40)
+    ps = np.vstack([ps, ps])  # 80 readings
+    sensor = FLUCT.make_estimator_sensor(generating)
+    zs = _readings(sensor, ps, seed=11, plume=FLUCT.make_plume(generating))
+    filters = [
+        ParticleFilter(
+            _xy_prior(),
+            FLUCT.make_estimator_sensor(m),
+            FLUCT.make_plume(m),
+            n_particles=3000,
+            seed=i,
+        )
+        for i, m in enumerate(FLUCT.reading_models)
+    ]
+    bank = ModelBank(filters, FLUCT.reading_models)
+    for p, z in zip(ps, zs, strict=True):
+        bank.update(p, z)
+    assert bank.selected_name == generating
+    assert bank.probabilities[bank.selected] > 0.99
+    assert bank.probabilities.sum() == pytest.approx(1.0)
+    # everything the searcher reads comes from the selected member
+    assert bank.theta is bank.members[bank.selected].theta
+    assert bank.sensor == FLUCT.make_estimator_sensor(generating)
+    np.testing.assert_array_equal(bank.source_mean(), bank.current.source_mean())
+
+
+def test_bank_prior_probabilities_and_bad_input():
+    pf = [
+        ParticleFilter(_xy_prior(), PAPER1.make_sensor(), n_particles=100, seed=s) for s in (0, 1)
+    ]
+    bank = ModelBank(pf, ("a", "b"), prior_probabilities=(1.0, 3.0))
+    np.testing.assert_allclose(bank.probabilities, [0.25, 0.75])
+    assert bank.selected_name == "b" and bank.switches == 0
+    with pytest.raises(DceeInputError, match="unique"):
+        ModelBank(pf, ("a", "a"))
+    with pytest.raises(DceeInputError, match="prior_probabilities"):
+        ModelBank(pf, ("a", "b"), prior_probabilities=(1.0, 0.0))
+
+
+def test_fluctuation_likelihood_runs_the_calm_model_unless_told_not_to():
+    assert PAPER1.reading_models == ("paper",)
+    assert FLUCT.reading_models == ("fluctuation", "paper")
+    assert FLUCT.reading_model_priors == (0.5, 0.5)
+    assert FLUCT.with_overrides(**{"estimator.calm_prior": 0.2}).reading_model_priors == (
+        0.8,
+        0.2,
+    )
+    assert FLUCT.with_overrides(**{"estimator.calm_prior": 0}).reading_models == ("fluctuation",)
+    # the calm member is the paper's model with the fluctuation likelihood's outlier weight
+    calm = FLUCT.make_estimator_sensor("paper")
+    assert calm.family == "gaussian" and calm.pd == PAPER1.make_sensor().pd
+    assert calm.outlier == FLUCT.outlier == 0.01
+    assert FLUCT.make_plume("paper").meander == 0 and FLUCT.make_plume().meander == 0.15
+    with pytest.raises(DceeInputError, match="model"):
+        PAPER1.make_estimator_sensor("fluctuation")
+    _, filter_rng, planner_rng, _ = streams(0)
+    searcher = make_searcher(FLUCT, None, filter_rng, planner_rng)
+    assert isinstance(searcher.filter, ModelBank)
+    _, filter_rng, planner_rng, _ = streams(0)
+    assert isinstance(make_searcher(PAPER1, None, filter_rng, planner_rng).filter, ParticleFilter)
+
+
+def test_campaigns_stored_before_the_calm_model_resume_only_without_it():
+    """A fluctuation campaign stored before ``calm_prior`` existed ran without the calm model:
+    its identity equals calm_prior = 0, not the new default; under the paper's likelihood the
+    setting decides nothing."""
+    stored = FLUCT.model_dump(mode="json")
+    del stored["estimator"]["calm_prior"]
+    off = FLUCT.with_overrides(**{"estimator.calm_prior": 0}).model_dump(mode="json")
+    assert scenario_identity(stored) == scenario_identity(off)
+    assert scenario_identity(stored) != scenario_identity(FLUCT.model_dump(mode="json"))
+    paper_stored = PAPER1.model_dump(mode="json")
+    del paper_stored["estimator"]["calm_prior"]
+    assert scenario_identity(paper_stored) == scenario_identity(PAPER1.model_dump(mode="json"))
+
+
+def test_search_with_the_bank_records_the_model_and_is_reproducible():
+    sc = FLUCT.with_overrides(**{"search.particles": 1500, "search.budget": 40.0})
+    a = run_episode(sc, "infotaxis", seed=4)
+    b = run_episode(sc, "infotaxis", seed=4)
+    assert [r["x"] for r in a.records] == [r["x"] for r in b.records]
+    assert a.summary["model"] in ("fluctuation", "paper")
+    assert 0.5 <= a.summary["model_probability"] <= 1.0
+    assert a.summary["reading_models"] == "fluctuation+paper"
+    assert all("model" in r and "log_evidence" in r for r in a.records)
+
+
+def test_a_bank_searcher_checkpoint_resumes_identically(tmp_path):
+    _, filter_rng, planner_rng, _ = streams(2)
+    sc = FLUCT.with_overrides(**{"search.particles": 1000})
+    searcher = make_searcher(sc, get_planner("infotaxis", n_hypotheses=10), filter_rng, planner_rng)
+    pos = np.array(sc.agent.start, dtype=float)
+    rng = np.random.default_rng(0)
+    for k in range(6):
+        searcher.tell(pos, float(rng.choice([0.0, 0.002])), float(k))
+        pos = searcher.ask()
+    searcher.save(tmp_path / "c.pkl")
+    restored = Searcher.load(tmp_path / "c.pkl")
+    for k in range(6, 10):
+        z = float(rng.choice([0.0, 0.003]))
+        searcher.tell(pos, z, float(k))
+        restored.tell(pos, z, float(k))
+        a, b = searcher.ask(), restored.ask()
+        np.testing.assert_array_equal(a, b)
+        pos = a
+    assert restored.filter.selected_name == searcher.filter.selected_name
+
+
+def test_the_calm_model_changes_nothing_while_it_is_not_selected():
+    """The preferred member draws from the same generator as a lone filter: with a calm prior
+    too small ever to be selected, the search is the one without the calm model, step by step."""
+    sc = FLUCT.with_overrides(**{"search.particles": 1500, "search.budget": 40.0})
+    alone = run_episode(sc.with_overrides(**{"estimator.calm_prior": 0}), "infotaxis", seed=3)
+    bank = run_episode(sc.with_overrides(**{"estimator.calm_prior": 1e-300}), "infotaxis", seed=3)
+    assert all(r["model"] == "fluctuation" for r in bank.records)
+    assert [r["x"] for r in bank.records] == [r["x"] for r in alone.records]
+    assert [r["rmse"] for r in bank.records] == [r["rmse"] for r in alone.records]
