@@ -300,8 +300,8 @@ OUTLIER_DEFAULT: dict[str, float] = {"paper": 0.0, "fluctuation": 0.01}
 """Outlier weight per likelihood when ``estimator.outlier`` is not given: the paper's model has
 none (its numbers are reproduced exactly); the fluctuation likelihood, meant for real plumes,
 bounds the influence of every reading (docs/scenarios.md). With ``calm_prior`` > 0 the
-fluctuation likelihood's calm member gets the same weight, so a spike moves neither model's evidence more
-than the other's."""
+fluctuation likelihood's calm member gets the same weight, so a spike moves neither model's
+evidence more than the other's."""
 
 
 MEANDER_DEFAULT: dict[str, float] = {"paper": 0.0, "fluctuation": 0.15}
