@@ -112,7 +112,7 @@ def test_bank_prior_probabilities_and_bad_input():
 def test_fluctuation_likelihood_runs_the_calm_model_unless_told_not_to():
     assert PAPER1.reading_models == ("paper",)
     assert FLUCT.reading_models == ("fluctuation", "paper")
-    assert FLUCT.reading_model_priors == (0.5, 0.5)
+    assert FLUCT.reading_model_priors == (0.9, 0.1)
     assert FLUCT.with_overrides(**{"estimator.calm_prior": 0.2}).reading_model_priors == (
         0.8,
         0.2,

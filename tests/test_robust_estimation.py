@@ -104,7 +104,7 @@ def test_turbulent_truth_defaults_to_a_four_second_hold_and_average():
         "lognormal",
         0.63,
         1.3,
-        5.4,
+        10.0,
         0.01,
     )
     assert fluct.make_plume().meander == 0.15
