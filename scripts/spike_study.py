@@ -25,7 +25,8 @@ def main() -> None:
     ap.add_argument("--scenario", default="paper:1")
     args = ap.parse_args()
     models = {
-        "fluctuation": {"estimator.likelihood": "fluctuation"},
+        "fluctuation (with the calm model)": {"estimator.likelihood": "fluctuation"},
+        "fluctuation alone": {"estimator.likelihood": "fluctuation", "estimator.calm_prior": 0},
         "paper + outlier 0.01": {"estimator.outlier": 0.01},
         "paper (no outlier)": {},
     }

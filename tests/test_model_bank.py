@@ -187,3 +187,25 @@ def test_the_calm_model_changes_nothing_while_it_is_not_selected():
     assert all(r["model"] == "fluctuation" for r in bank.records)
     assert [r["x"] for r in bank.records] == [r["x"] for r in alone.records]
     assert [r["rmse"] for r in bank.records] == [r["rmse"] for r in alone.records]
+
+
+def test_the_bank_survives_absurd_readings():
+    """Readings over eight decades up to the physical maximum, and a spike: both members stay
+    alive, the model probabilities stay finite and sum to 1."""
+    rng = np.random.default_rng(7)
+    filters = [
+        ParticleFilter(
+            _xy_prior(), FLUCT.make_estimator_sensor(m), FLUCT.make_plume(m), 2000, seed=i
+        )
+        for i, m in enumerate(FLUCT.reading_models)
+    ]
+    bank = ModelBank(filters, FLUCT.reading_models, FLUCT.reading_model_priors)
+    for k in range(60):
+        pos = np.array([rng.uniform(0, 50), rng.uniform(0, 50), 4.0])
+        z = 0.0 if rng.random() < 0.5 else float(10 ** rng.uniform(-3.3, 4))
+        info = bank.update(pos, z)
+        assert math.isfinite(info.log_evidence) and not info.rejected
+        p = bank.probabilities
+        assert np.all(np.isfinite(p)) and p.sum() == pytest.approx(1.0)
+    for f in bank.members:
+        assert np.all(np.isfinite(f.weights)) and f.ess >= 1.0
