@@ -200,7 +200,7 @@ def test_the_bank_survives_absurd_readings():
         for i, m in enumerate(FLUCT.reading_models)
     ]
     bank = ModelBank(filters, FLUCT.reading_models, FLUCT.reading_model_priors)
-    for k in range(60):
+    for _ in range(60):
         pos = np.array([rng.uniform(0, 50), rng.uniform(0, 50), 4.0])
         z = 0.0 if rng.random() < 0.5 else float(10 ** rng.uniform(-3.3, 4))
         info = bank.update(pos, z)
