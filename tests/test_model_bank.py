@@ -209,3 +209,22 @@ def test_the_bank_survives_absurd_readings():
         assert np.all(np.isfinite(p)) and p.sum() == pytest.approx(1.0)
     for f in bank.members:
         assert np.all(np.isfinite(f.weights)) and f.ess >= 1.0
+
+
+def test_report_tables_which_model_the_searches_ended_with():
+    import pandas as pd
+
+    from dcee.analysis.report import model_selection_markdown
+
+    runs = pd.DataFrame(
+        {
+            "strategy": ["a", "a", "a", "b"],
+            "model": ["paper", "paper", "fluctuation", "paper"],
+            "model_probability": [1.0, 0.9, 0.8, 1.0],
+            "model_switches": [1, 3, 2, 0],
+        }
+    )
+    md = model_selection_markdown(runs)
+    assert "| a | paper | 2/3 (67 [21, 94]%) | 0.950 | 2.0 |" in md
+    assert "| a | fluctuation | 1/3" in md and "| b | paper | 1/1" in md
+    assert model_selection_markdown(runs.drop(columns="model")) is None

@@ -158,6 +158,29 @@ def metrics_table(runs: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
+def model_selection_markdown(runs: pd.DataFrame) -> str | None:
+    """Which reading model each strategy's searches ended with, when the filter selected between
+    several (the fluctuation likelihood with its calm model): per strategy and model the searches
+    that ended with it (share, Wilson 95 % interval), the median final probability of the
+    selected model and the mean number of switches. None when no search selected a model."""
+    if "model" not in runs or runs["model"].isna().all():
+        return None
+    lines = [
+        "| strategy | final reading model | searches | median P(model) at the end | "
+        "mean switches |",
+        "|---|---|---|---|---|",
+    ]
+    for strategy, g in runs.dropna(subset=["model"]).groupby("strategy", sort=True):
+        n = len(g)
+        for model, h in g.groupby("model", sort=True):
+            r, lo, hi = wilson(len(h), n)
+            lines.append(
+                f"| {strategy} | {model} | {len(h)}/{n} ({_fmt(r, lo, hi, pct=True)}) "
+                f"| {h['model_probability'].median():.3f} | {h['model_switches'].mean():.1f} |"
+            )
+    return "\n".join(lines) + "\n"
+
+
 def per_configuration_table(runs: pd.DataFrame) -> pd.DataFrame:
     """Searches that acquired the source, per configuration (rows, in suite order) and strategy
     (columns), as "k/n" strings: where a strategy fails, which the pooled rates hide."""
@@ -566,6 +589,9 @@ def write_report(results_dir: Path, out_dir: Path) -> list[Path]:
         "per_configuration.csv": lambda p: per_config.to_csv(p),
         "per_configuration.md": lambda p: p.write_text(per_config_md),
     }
+    models_md = model_selection_markdown(runs)
+    if models_md is not None:
+        tables["model_selection.md"] = lambda p: p.write_text(models_md)
     for name, writer in tables.items():
         write_atomic(out_dir / name, writer)
     failed = len(list(results_dir.rglob("error.json")))
@@ -591,6 +617,11 @@ def write_report(results_dir: Path, out_dir: Path) -> list[Path]:
         "<h2>source acquired per configuration</h2>",
         _md_to_html(per_config_md),
     ]
+    if models_md is not None:
+        html += [
+            "<h2>reading model selected by the readings (turbulence level)</h2>",
+            _md_to_html(models_md),
+        ]
     for name, data in figures.items():
         b64 = base64.b64encode(data).decode()
         title = name[:-4].replace("_", " ")
