@@ -356,6 +356,11 @@ def _print_summary(
         ("path length (m)", f"{summary['path_length']:.1f}"),
         ("mean decision time (ms)", f"{1e3 * summary['decision_seconds_mean']:.2f}"),
         ("total compute (s)", f"{summary['compute_seconds_total']:.2f}"),
+        *(
+            [("reading model, P", f"{summary['model']}, {summary['model_probability']:.3f}")]
+            if "model" in summary  # the fluctuation likelihood with its calm model
+            else []
+        ),
     ]
     for k, v in rows:
         table.add_row(k, v)
