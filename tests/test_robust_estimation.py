@@ -272,7 +272,7 @@ def test_run_with_fluctuation_likelihood_records_the_resolved_settings(tmp_path,
     out = tmp_path / "r"
     argv = ["run", "--scenario", "paper:1", "--particles", "500", "--budget", "30", "--truth"]
     argv += ["filament", "--likelihood", "fluctuation", "--set", "estimator.log_sd=1.1"]
-    code, _, err = run_cli([*argv, "--out", str(out), "-q", "--no-figure"], capsys)
+    code, printed, err = run_cli([*argv, "--out", str(out), "-q", "--no-figure"], capsys)
     assert code == 0, err
     import json
 
@@ -282,6 +282,11 @@ def test_run_with_fluctuation_likelihood_records_the_resolved_settings(tmp_path,
     assert isinstance(summary["truth_in_95"], bool)
     config = json.loads((out / "config.json").read_text())
     assert config["scenario"]["estimator"]["log_sd"] == 1.1
+    # the calm model runs beside it: the summary and the printed table name the chosen model
+    assert summary["reading_models"] == "fluctuation+paper"
+    assert summary["model"] in ("fluctuation", "paper")
+    row = next(line for line in printed.splitlines() if "reading model" in line)
+    assert summary["model"] in row and f"{summary['model_probability']:.3f}" in row
 
 
 @pytest.mark.parametrize(

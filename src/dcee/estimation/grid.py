@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.special import logsumexp
 
 from dcee.estimation.filter_kernels import history_log_likelihood
 from dcee.models.plume import IsotropicPlume
@@ -73,21 +74,16 @@ def location_grid_posterior(
         sub = pts[kept][:, None, :] + np.column_stack([ox.ravel(), oy.ravel()])[None]
         sub_loglik = _loglik(theta, sub.reshape(-1, 2), positions, readings, sensor, plume)
         # the evidence keeps the coarse cells that were not refined
-        log_ev = _logsumexp(
+        log_ev = logsumexp(
             np.concatenate(
                 [loglik[~kept] + log_cell[~kept], sub_loglik + log_cell[0] - 2 * np.log(refine)]
             )
         )
         pts, loglik = sub.reshape(-1, 2), sub_loglik
     else:
-        log_ev = _logsumexp(loglik + log_cell)
+        log_ev = logsumexp(loglik + log_cell)
     w = np.exp(loglik - loglik.max())
-    return GridPosterior(pts, w / w.sum(), log_ev)
-
-
-def _logsumexp(a: np.ndarray) -> float:
-    top = a.max()
-    return float(top + np.log(np.exp(a - top).sum()))
+    return GridPosterior(pts, w / w.sum(), float(log_ev))
 
 
 def _loglik(theta, pts, positions, readings, sensor, plume) -> np.ndarray:

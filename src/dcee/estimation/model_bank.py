@@ -23,10 +23,10 @@ Cost: one filter update per member per reading; the planners' cost is unchanged.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
+from scipy.special import logsumexp
 
 from dcee.errors import DceeInputError
 from dcee.estimation.particle_filter import ParticleFilter, UpdateInfo
@@ -60,25 +60,36 @@ class ModelBank:
         self.members = list(members)
         self.names = tuple(names)
         self.log_prior = np.log(probs / probs.sum())
-        self.selected = 0
+        self.selected = int(np.argmax(self.log_prior))
         self.switches = 0
         """how often the selected model changed"""
-        self._select()
-        self.switches = 0
 
     # --- model probabilities --------------------------------------------------------------
+
+    def _log_joint(self) -> np.ndarray:
+        """(M,) log P(m) + log p(readings | m)."""
+        return self.log_prior + np.array([f.log_evidence for f in self.members])
+
+    @property
+    def log_evidence(self) -> float:
+        """log p(readings) under the model mixture."""
+        return float(logsumexp(self._log_joint()))
 
     @property
     def log_posterior(self) -> np.ndarray:
         """(M,) log P(m | readings), normalised."""
-        lp = self.log_prior + np.array([f.log_evidence for f in self.members])
-        top = lp.max()
-        return lp - (top + math.log(np.exp(lp - top).sum()))
+        joint = self._log_joint()
+        return joint - logsumexp(joint)
 
     @property
     def probabilities(self) -> np.ndarray:
         """(M,) P(m | readings)."""
         return np.exp(self.log_posterior)
+
+    @property
+    def selected_probability(self) -> float:
+        """P(selected model | readings)."""
+        return float(self.probabilities[self.selected])
 
     @property
     def selected_name(self) -> str:
@@ -155,13 +166,6 @@ class ModelBank:
     @property
     def recoveries(self) -> list[dict[str, float | str]]:
         return self.current.recoveries
-
-    @property
-    def log_evidence(self) -> float:
-        """log p(readings) under the model mixture."""
-        lp = self.log_prior + np.array([f.log_evidence for f in self.members])
-        top = lp.max()
-        return float(top + math.log(np.exp(lp - top).sum()))
 
     def mean(self) -> np.ndarray:
         return self.current.mean()

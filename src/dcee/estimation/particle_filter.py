@@ -46,6 +46,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.special import logsumexp
 
 from dcee.errors import DceeInputError
 from dcee.estimation.filter_kernels import history_log_likelihood, reading_upper_bounds
@@ -310,14 +311,13 @@ class ParticleFilter:
         self.n_readings += 1
 
         logw = self._logw + ll_new
-        # log Σ wᵢ p(z|Θᵢ), wᵢ the normalised weights before z (_logw's max is 0 or −ln N)
         top = logw.max()
-        log_ev = float(
-            top + math.log(np.exp(logw - top).sum()) - math.log(np.exp(self._logw).sum())
-        )
+        scaled = np.exp(logw - top)
+        total = scaled.sum()
+        # log Σ wᵢ p(z|Θᵢ), wᵢ the normalised weights before z
+        log_ev = float(top + math.log(total) - logsumexp(self._logw))
         self.log_evidence += log_ev
-        w = _normalise(logw)
-        ess = effective_sample_size(w)
+        ess = effective_sample_size(scaled / total)
         if ess >= self.collapse_threshold * self.n:
             self._hist_loglik += ll_new
             self._set_logw(logw)

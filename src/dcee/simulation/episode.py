@@ -285,7 +285,7 @@ def reading_record(
         "decision_seconds": 0.0,
         "log_evidence": pf.log_evidence,
         **(
-            {"model": pf.selected_name, "model_probability": float(pf.probabilities[pf.selected])}
+            {"model": pf.selected_name, "model_probability": pf.selected_probability}
             if isinstance(pf, ModelBank)
             else {}
         ),
@@ -442,7 +442,7 @@ def search_summary(
     out["resamples"] = pf.n_resamples
     if isinstance(pf, ModelBank):  # which reading model the readings chose, and how firmly
         out["model"] = pf.selected_name
-        out["model_probability"] = float(pf.probabilities[pf.selected])
+        out["model_probability"] = pf.selected_probability
         out["model_switches"] = pf.switches
     out["config"] = scenario.name
     out["parameter_names"] = list(scenario.unknown_names)
