@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from dcee.models.plume_kernels import constants_at, plume_at, plume_from_constants, plume_terms
+from dcee.models.plume_kernels import constants_at, plume_at, plume_from_terms, plume_terms
 from dcee.models.sensor import Sensor
 from dcee.models.sensor_kernels import SensorParams, log_likelihood
 from dcee.numeric import HALF_LOG_2PI, vlog1m, vndtr_upper
@@ -50,9 +50,12 @@ def _plume_block(
     dist: np.ndarray,
 ) -> None:
     """conc[q], dist[q] for the block's particles q < nb from their plume constants pc (10, nb),
-    without meander; vectorised (:func:`~dcee.models.plume_kernels.plume_from_constants`)."""
-    for q in range(nb):
-        conc[q], dist[q] = plume_from_constants(pc, q, px, py, pz, rmin)
+    without meander; vectorised (:func:`~dcee.models.plume_kernels.plume_from_terms`)."""
+    for j in range(nb):
+        q = np.uint64(j)  # unsigned: no wraparound checks, which would block vectorising
+        conc[q], dist[q] = plume_from_terms(
+            pc[0, q], pc[1, q], pc[2, q], pc[3, q], pc[4, q], pc[5, q], pc[6, q], px, py, pz, rmin
+        )
 
 
 @njit(cache=True, fastmath={"contract"}, error_model="numpy")

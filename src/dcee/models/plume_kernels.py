@@ -90,18 +90,34 @@ def constants_at(pc: np.ndarray, i: int):
 
 
 @njit(cache=True, inline="always")
-def plume_from_constants(pc: np.ndarray, i, px: float, py: float, pz: float, rmin: float):
-    """(concentration, clamped distance r) at (px, py, pz) for particle i of the (10, N)
-    :func:`plume_terms` array pc, without meander. Branch-free (selects only) with the
-    vectorisable exp, so the loops over particles that call it vectorise; equals
-    :func:`plume_at` with meander 0 to rounding (0 below e^−700)."""
-    dx = px - pc[0, i]
-    dy = py - pc[1, i]
-    dz = pz - pc[2, i]
+def plume_from_terms(
+    x0: float,
+    y0: float,
+    z0: float,
+    pref: float,
+    inv_lam: float,
+    ax: float,
+    ay: float,
+    px: float,
+    py: float,
+    pz: float,
+    rmin: float,
+):
+    """(concentration, clamped distance r) at (px, py, pz) of a particle with the first seven
+    :func:`plume_terms` (x0, y0, z0, q/(4π ζ1), 1/λ, u cosφ/(2ζ1), u sinφ/(2ζ1)), without
+    meander. Branch-free (selects only) with the vectorisable exp; equals :func:`plume_at`
+    with meander 0 to rounding (0 below e^−700).
+
+    It takes scalars, not the (10, N) constants array and an index: called inside a loop over
+    particles, an array-and-index helper kept LLVM from vectorising the loop even inlined
+    (measured 18–23 against 1.8 ns per particle); the caller's loads vectorise."""
+    dx = px - x0
+    dy = py - y0
+    dz = pz - z0
     r = max(math.sqrt(dx * dx + dy * dy + dz * dz), rmin)
     # the exponent is ≤ 0 (1/λ ≥ u/(2ζ1)); min() guards against rounding
-    arg = min(-r * pc[4, i] - dx * pc[5, i] - dy * pc[6, i], 0.0)
-    value = pc[3, i] / r * _vexp(arg)
+    arg = min(-r * inv_lam - dx * ax - dy * ay, 0.0)
+    value = pref / r * _vexp(arg)
     return (value if arg > -700.0 else 0.0), r
 
 

@@ -19,7 +19,7 @@ from numba import njit, prange
 from dcee.models.plume_kernels import (
     constants_at,
     plume_at,
-    plume_from_constants,
+    plume_from_terms,
     plume_terms,
 )
 from dcee.models.sensor_kernels import (
@@ -100,7 +100,19 @@ def _rows_gaussian(
         # an unsigned index: numba then emits no negative-index wraparound, which would keep
         # LLVM from vectorising the loop
         i = np.uint64(i0 + j)
-        c, r = plume_from_constants(plume, i, px, py, pz, rmin)
+        c, r = plume_from_terms(
+            plume[0, i],
+            plume[1, i],
+            plume[2, i],
+            plume[3, i],
+            plume[4, i],
+            plume[5, i],
+            plume[6, i],
+            px,
+            py,
+            pz,
+            rmin,
+        )
         sigma = sp.sigma_frac * c + sp.sigma_min
         inv_s = 1.0 / sigma
         missed = vlog1m(sp.pd * vndtr_upper((sp.v_threshold - c) * inv_s))  # log(1 − Pd Φ(−x))
@@ -288,15 +300,102 @@ def _task_bounds(
         )
 
 
+@njit(cache=True)
+def _centred_offsets(source: np.ndarray, center: np.ndarray) -> np.ndarray:
+    """(4, N): dx, dy, dz of each source (N, 3) from ``center`` (3,) and dx² + dy² + dz²,
+    contiguous per component so that the statistics kernel loads them as vectors."""
+    n = source.shape[0]
+    out = np.empty((4, n))
+    for i in range(n):
+        dx = source[i, 0] - center[0]
+        dy = source[i, 1] - center[1]
+        dz = source[i, 2] - center[2]
+        out[0, i] = dx
+        out[1, i] = dy
+        out[2, i] = dz
+        out[3, i] = dx * dx + dy * dy + dz * dz
+    return out
+
+
+@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+def _block_sum(buf: np.ndarray, n: int) -> float:
+    """Σ buf[:n] for buf (_BLOCK,) by pairwise halving (buf is overwritten). Every pass is an
+    element-wise add that LLVM vectorises, and the order of additions is fixed (it does not
+    depend on the vector width, as a reassociated loop's would); pairwise, so also accurate."""
+    for q in range(n, _BLOCK):
+        buf[np.uint64(q)] = 0.0
+    m = _BLOCK
+    while m > 1:
+        m //= 2
+        for q in range(m):
+            buf[np.uint64(q)] += buf[np.uint64(q + m)]
+    return buf[0]
+
+
+@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+def _product_sum(a: np.ndarray, b: np.ndarray, i0: int, n: int, buf: np.ndarray) -> float:
+    """Σ_q a[q] · b[i0 + q] over q < n (see :func:`_block_sum`; buf (_BLOCK,) scratch)."""
+    for q in range(n):
+        buf[np.uint64(q)] = a[np.uint64(q)] * b[np.uint64(i0 + q)]
+    return _block_sum(buf, n)
+
+
+@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+def _single_stage_weights(
+    loc: np.ndarray,
+    log_nd: np.ndarray,
+    inv_sigma: np.ndarray,
+    det_offset: np.ndarray,
+    weights: np.ndarray,
+    i0: int,
+    n: int,
+    v: float,
+    out: float,
+    bnd: float,
+    sp: SensorParams,
+    e: np.ndarray,
+    ll: np.ndarray,
+) -> None:
+    """e[q] = w_i exp(ll_i − bnd) and ll[q] = log p(v | C_i) (less the Jacobian) for particles
+    i = i0 + q, q < n, of one position row (1-D rows of :func:`position_rows`) and one
+    single-stage reading (transformed reading v, outlier term out).
+
+    Branch-free loops (the detection test is the same for every particle), so LLVM vectorises
+    them, ``exp`` and the outlier's log-sum-exp included. A particle of weight 0 gives exactly
+    0: its exponent is clamped to ≤ 0 (for positive weights ll ≤ bnd already, ``bnd`` being
+    an upper bound over them)."""
+    if v < sp.v_threshold:
+        for q in range(n):
+            i = np.uint64(i0 + q)
+            lq = log_nd[i]
+            ll[np.uint64(q)] = lq
+            e[np.uint64(q)] = weights[i] * _vexp(min(lq - bnd, 0.0))
+        return
+    det_add = sp.log_keep - HALF_LOG_2PI
+    if sp.log_outlier > -np.inf:
+        for q in range(n):
+            i = np.uint64(i0 + q)
+            r = (v - loc[i]) * inv_sigma[i]
+            lq = vlogaddexp(det_offset[i] + det_add - 0.5 * r * r, out)
+            ll[np.uint64(q)] = lq
+            e[np.uint64(q)] = weights[i] * _vexp(min(lq - bnd, 0.0))
+        return
+    for q in range(n):
+        i = np.uint64(i0 + q)
+        r = (v - loc[i]) * inv_sigma[i]
+        lq = det_offset[i] + det_add - 0.5 * r * r
+        ll[np.uint64(q)] = lq
+        e[np.uint64(q)] = weights[i] * _vexp(min(lq - bnd, 0.0))
+
+
 @njit(cache=True, parallel=True, fastmath={"contract"}, error_model="numpy")
 def _grouped_stats(
     loc: np.ndarray,
     log_nd: np.ndarray,
     inv_sigma: np.ndarray,
     det_offset: np.ndarray,
-    source: np.ndarray,
+    offsets: np.ndarray,
     weights: np.ndarray,
-    center: np.ndarray,
     group_start: np.ndarray,
     task_positions: np.ndarray,
     task_v: np.ndarray,
@@ -318,7 +417,7 @@ def _grouped_stats(
     vectorised). Sums a planner does not need (the location moments, Σ e·ll for the KL
     divergence) are left at zero when not wanted.
     """
-    n = source.shape[0]
+    n = weights.shape[0]
     t_count = task_positions.shape[1]
     n_groups = group_start.shape[0] - 1
     n_blocks = (n + _BLOCK - 1) // _BLOCK
@@ -332,6 +431,41 @@ def _grouped_stats(
         b = item % n_blocks
         s0 = group_start[g]
         k = group_start[g + 1] - s0
+        i_start = b * _BLOCK
+        i_end = min(n, i_start + _BLOCK)
+        if single_stage:
+            # one task at a time: vectorised over the particles (see _single_stage_weights)
+            p = task_positions[s0, 0]
+            nb = i_end - i_start
+            e = np.empty(_BLOCK)
+            ll = np.empty(_BLOCK)
+            buf = np.empty(_BLOCK)
+            for j in range(k):
+                s = s0 + j
+                _single_stage_weights(
+                    loc[p],
+                    log_nd[p],
+                    inv_sigma[p],
+                    det_offset[p],
+                    weights,
+                    i_start,
+                    nb,
+                    task_v[s, 0],
+                    task_out[s, 0],
+                    bound[s],
+                    sp,
+                    e,
+                    ll,
+                )
+                for a in range(1, _N_ACC):
+                    partial[b, s, a] = 0.0
+                if want_moments:
+                    for a in range(4):
+                        partial[b, s, 1 + a] = _product_sum(e, offsets[a], i_start, nb, buf)
+                if want_kl:
+                    partial[b, s, 5] = _product_sum(e, ll, 0, nb, buf)
+                partial[b, s, 0] = _block_sum(e, nb)
+            continue
         z = np.empty((t_count, k))
         fa = np.empty((t_count, k))
         out = np.empty((t_count, k))
@@ -348,41 +482,15 @@ def _grouped_stats(
         a3 = np.zeros(k)
         a4 = np.zeros(k)
         a5 = np.zeros(k)
-        i_start = b * _BLOCK
-        for q in range(min(n, i_start + _BLOCK) - i_start):
+        for q in range(i_end - i_start):
             i = np.uint64(i_start + q)  # unsigned: no wraparound checks on the loads
             wi = weights[i]
             if wi <= 0.0:
                 continue
-            dx = source[i, 0] - center[0]
-            dy = source[i, 1] - center[1]
-            dz = source[i, 2] - center[2]
-            d2 = dx * dx + dy * dy + dz * dz
-            if single_stage and k < 8:
-                # few readings of one stage (too few to vectorise over them): the likelihood
-                # and the weight in one pass over j
-                p = task_positions[s0, 0]
-                m = loc[p, i]
-                lnd = log_nd[p, i]
-                inv_s = inv_sigma[p, i]
-                det_const = det_offset[p, i] - HALF_LOG_2PI + log_keep
-                for j in range(k):
-                    zj = z[0, j]
-                    r = (zj - m) * inv_s
-                    d = det_const - 0.5 * r * r
-                    if with_outliers:
-                        d = vlogaddexp(d, out[0, j])
-                    llj = d if zj >= v_thr else lnd
-                    e = wi * _vexp(llj - bnd[j])
-                    a0[j] += e
-                    if want_moments:
-                        a1[j] += e * dx
-                        a2[j] += e * dy
-                        a3[j] += e * dz
-                        a4[j] += e * d2
-                    if want_kl:
-                        a5[j] += e * llj
-                continue
+            dx = offsets[0, i]
+            dy = offsets[1, i]
+            dz = offsets[2, i]
+            d2 = offsets[3, i]
             ll[:] = 0.0
             for t in range(t_count):
                 p = task_positions[s0, t]
@@ -546,7 +654,12 @@ def predicted_posterior_stats(
     partial = np.empty((n_blocks, s_count, _N_ACC))
     common = (loc, log_nd, inv_sigma, det_offset, source, weights, center)
     _grouped_stats(
-        *common,
+        loc,
+        log_nd,
+        inv_sigma,
+        det_offset,
+        _centred_offsets(source, center),
+        weights,
         group_start,
         task_positions,
         task_v,
