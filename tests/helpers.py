@@ -90,7 +90,7 @@ def compiled_predicted_stats(conc, source, weights, task_pos, task_z, sensor, di
     dist = np.full_like(conc, np.inf) if dist is None else np.ascontiguousarray(dist)
     # the reading-free terms, from the NumPy sensor model (position_rows computes them from
     # source terms; these tests feed raw concentrations)
-    loc, sigma = sensor._loc_sigma(conc)
+    loc, sigma = sensor._loc_sigma(conc, dist)
     with np.errstate(divide="ignore"):
         det_offset = np.log(sensor.detect_prob(dist)) - np.log(sigma)
     terms = [

@@ -105,8 +105,9 @@ def test_predicted_stats_multi_step_sequences_match_reference():
         Sensor(family="lognormal", pd=0.6, outlier=0.01, false_alarm=0.02),
         Sensor(family="lognormal", pd=0.6, outlier=0.01, near_length=5.0),
         Sensor(near_length=3.0),
+        Sensor(family="lognormal", pd=0.6, log_sd_near=2.0, log_sd_length=3.0, outlier=0.01),
     ],
-    ids=["ln", "ln+out", "gauss+out", "ln+out+fa", "ln+near", "gauss+near"],
+    ids=["ln", "ln+out", "gauss+out", "ln+out+fa", "ln+near", "gauss+near", "ln+spread"],
 )
 def test_predicted_stats_match_reference_for_every_family(sensor):
     """The transformed-frame kernels (vectorised log-sum-exp of the outlier component, the
@@ -140,8 +141,9 @@ def test_vectorised_log1p_matches_math_log1p():
         Sensor(pd=1.0),
         Sensor(family="lognormal", pd=0.6),
         Sensor(family="lognormal", pd=0.6, near_length=3.0),
+        Sensor(family="lognormal", pd=0.6, log_sd_near=2.0, log_sd_length=3.0),
     ],
-    ids=["gauss", "gauss-pd1", "ln", "ln+near"],
+    ids=["gauss", "gauss-pd1", "ln", "ln+near", "ln+spread"],
 )
 def test_position_rows_match_the_numpy_plume_and_likelihood(sensor, meander):
     """The planners' per-position terms, written into chosen rows, against the NumPy plume and
@@ -201,7 +203,22 @@ def test_vectorised_erfc_and_log_match_scipy_and_numpy():
     normal = ref > 1e-300
     np.testing.assert_allclose(out[normal], ref[normal], rtol=1e-13, atol=0)
     assert np.all(out[~normal] <= 1e-300)
-    x = np.concatenate([np.geomspace(2.0**-63, 2.0**63, 20_001), np.linspace(0.5, 2.0, 2_001)])
+    # every normal float: the exponent is read from the bits (2^−1022 … 2^1023)
+    tiny, huge = np.finfo(float).tiny, np.finfo(float).max
+    x = np.concatenate(
+        [np.geomspace(tiny, huge, 40_001), np.linspace(0.5, 2.0, 2_001), [tiny, huge, 1.0]]
+    )
     lg = np.empty_like(x)
     vlog(x, lg)
     np.testing.assert_allclose(lg, np.log(x), rtol=1e-15, atol=3e-16)
+    assert lg[-1] == 0.0  # log 1 exactly
+
+
+def test_vectorised_exp_matches_math_exp_at_every_power_of_two():
+    from dcee.numeric import vexp
+
+    # 2^−m is assembled from its bits: every exponent of −700 ≤ x ≤ 0 (below, −700 is used)
+    x = np.concatenate([-np.arange(0, 1010) * math.log(2.0), np.linspace(-700.0, 0.0, 50_001)])
+    out = np.empty_like(x)
+    vexp(x, out)
+    np.testing.assert_allclose(out, np.exp(x), rtol=2e-15, atol=0)

@@ -174,8 +174,9 @@ def test_nan_reading_is_rejected(sensor, bad):
         Sensor(pd=1.0),
         Sensor(false_alarm=0.02, outlier=0.01),
         Sensor(family="lognormal", pd=0.6, log_sd=1.3, outlier=0.01),
+        Sensor(family="lognormal", pd=0.6, log_sd=1.0, log_sd_near=2.0, log_sd_length=3.0),
     ],
-    ids=["paper", "pd1", "fa+outlier", "lognormal"],
+    ids=["paper", "pd1", "fa+outlier", "lognormal", "lognormal+spread"],
 )
 def test_history_likelihood_and_reading_bounds_against_numpy(sensor):
     from dcee.estimation.filter_kernels import history_log_likelihood, reading_upper_bounds

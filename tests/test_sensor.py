@@ -83,12 +83,16 @@ ROBUST = Sensor(family="lognormal", pd=0.5, log_sd=1.0, outlier=0.01)
 ROBUST_PAPER = Sensor(outlier=0.02, false_alarm=0.03)
 NEAR = Sensor(family="lognormal", pd=0.6, log_sd=1.2, outlier=0.01, near_length=5.0)
 NEAR_PAPER = Sensor(near_length=3.0, false_alarm=0.01)
-FAMILIES = [FLUCTUATION, ROBUST, ROBUST_PAPER, NEAR, NEAR_PAPER]
-FAMILY_IDS = ["ln", "ln+out", "gauss+out", "ln+near", "gauss+near"]
+# the spread grows near the source: s(r) = 1.0 + 2.0 exp(−r / 3)
+SPREAD = Sensor(
+    family="lognormal", pd=0.6, log_sd=1.0, log_sd_near=2.0, log_sd_length=3.0, outlier=0.01
+)
+FAMILIES = [FLUCTUATION, ROBUST, ROBUST_PAPER, NEAR, NEAR_PAPER, SPREAD]
+FAMILY_IDS = ["ln", "ln+out", "gauss+out", "ln+near", "gauss+near", "ln+spread"]
 
 
 @pytest.mark.parametrize(
-    "s", [FLUCTUATION, ROBUST, ROBUST_PAPER], ids=["ln", "ln+out", "gauss+out"]
+    "s", [FLUCTUATION, ROBUST, ROBUST_PAPER, SPREAD], ids=["ln", "ln+out", "gauss+out", "spread"]
 )
 @pytest.mark.parametrize("conc", [0.0, 2e-4, 5e-4, 3e-3, 0.5])
 @pytest.mark.parametrize("r", [0.5, 40.0])
@@ -118,7 +122,7 @@ def test_lognormal_reading_keeps_the_mean_and_intermittency():
 
 
 @pytest.mark.parametrize(
-    "s", [FLUCTUATION, ROBUST, ROBUST_PAPER], ids=["ln", "ln+out", "gauss+out"]
+    "s", [FLUCTUATION, ROBUST, ROBUST_PAPER, SPREAD], ids=["ln", "ln+out", "gauss+out", "spread"]
 )
 def test_simulated_readings_follow_every_family(s):
     rng = np.random.default_rng(12)
@@ -132,14 +136,14 @@ def test_simulated_readings_follow_every_family(s):
     for k in range(len(edges) - 1):
         lo, hi = math.log(edges[k]), math.log(edges[k + 1])
         p, _ = integrate.quad(
-            lambda u: float(s.likelihood(math.exp(u), conc)) * math.exp(u), lo, hi
+            lambda u: float(s.likelihood(math.exp(u), conc, r)) * math.exp(u), lo, hi
         )
         sd = math.sqrt(p * (1 - p) / len(z))
         assert counts[k] / len(z) == pytest.approx(p, abs=5 * sd + 1e-6)
 
 
 @pytest.mark.parametrize(
-    "s", [FLUCTUATION, ROBUST, ROBUST_PAPER], ids=["ln", "ln+out", "gauss+out"]
+    "s", [FLUCTUATION, ROBUST, ROBUST_PAPER, SPREAD], ids=["ln", "ln+out", "gauss+out", "spread"]
 )
 def test_compiled_likelihood_matches_reference_for_every_family(s):
     rng = np.random.default_rng(6)
@@ -149,6 +153,28 @@ def test_compiled_likelihood_matches_reference_for_every_family(s):
         r = rng.uniform(0.1, 30.0, len(c))
         fast = np.array([log_likelihood(zi, ci, ri, s.params) for ci, ri in zip(c, r, strict=True)])
         np.testing.assert_allclose(fast, s.log_likelihood(zi, c, r), rtol=1e-9, atol=1e-12)
+
+
+def test_spread_near_the_source_by_hand():
+    """s(r) = s∞ + log_sd_near · exp(−r / log_sd_length): its limits, one value by hand, the
+    compiled kernel's, and the mean kept at every distance (E[z | true detection] = C with a
+    threshold far below C)."""
+    from dcee.models.sensor_kernels import log_sd_at
+
+    assert float(SPREAD.log_sd_at(0.0)) == pytest.approx(3.0)
+    assert float(SPREAD.log_sd_at(1e6)) == pytest.approx(1.0)
+    assert float(SPREAD.log_sd_at(3.0)) == pytest.approx(1.0 + 2.0 / math.e)
+    for r in (0.0, 0.7, 3.0, 30.0):
+        assert log_sd_at(r, SPREAD.params) == pytest.approx(float(SPREAD.log_sd_at(r)), rel=1e-15)
+    assert float(FLUCTUATION.log_sd_at(0.0)) == 1.0  # log_sd_length 0: constant
+    low = Sensor(
+        family="lognormal", pd=1.0, log_sd=0.5, log_sd_near=0.5, log_sd_length=2.0, threshold=1e-12
+    )
+    noise = low.draw_noise(np.random.default_rng(5), 400_000)
+    for r, s_r in ((0.0, 1.0), (50.0, 0.5)):
+        z = low.simulate_from(np.full(400_000, 2e-2), noise, r)
+        assert np.log(z).std() == pytest.approx(s_r, rel=0.01)
+        assert z.mean() == pytest.approx(2e-2, rel=0.02)
 
 
 def test_outlier_component_bounds_the_influence_of_one_reading():

@@ -252,12 +252,22 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     # the fluctuation likelihood ran without the calm model before the setting existed (so a
     # campaign stored before resumes only with calm_prior = 0, not with the new default)
     ("estimator", "calm_prior"): 0.0,
+    # a constant log-sd before the distance-dependent spread existed
+    ("estimator", "log_sd_near"): 0.0,
+    ("estimator", "log_sd_length"): 0.0,
 }
 """Scenario settings added after campaigns were first stored, with the value a stored scenario
 without one ran with, so the two compare equal."""
 
 
-FLUCTUATION_ONLY = ("intermittency", "log_sd", "near_source_length", "calm_prior")
+FLUCTUATION_ONLY = (
+    "intermittency",
+    "log_sd",
+    "log_sd_near",
+    "log_sd_length",
+    "near_source_length",
+    "calm_prior",
+)
 """Estimator settings that only the fluctuation likelihood reads: under the paper's likelihood
 they decide nothing, so changing their defaults must not orphan a campaign."""
 

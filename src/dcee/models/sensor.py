@@ -18,6 +18,11 @@ Generative model of one reading z given the expected (time-mean) concentration C
      uses the same two-part form with a clipped gamma). This is the ``"fluctuation"``
      likelihood of the scenarios.
 
+   With ``log_sd_length`` > 0 the spread grows near the source, s(r) = ``log_sd`` +
+   ``log_sd_near`` · exp(−r / ``log_sd_length``): hold-averaged readings of a turbulent plume
+   fluctuate most close to the release and are smoothed by mixing downwind (fitted to the
+   filament truth: 2Δℓ ≈ 1,150 for the two parameters, docs/scenarios.md).
+
    With ``near_length`` > 0 the detection probability falls near the source:
    Pd(r) = ``pd`` · (1 − exp(−r / near_length)) at distance r from the (hypothesised) source.
    Close to a release the plume is a thin, meandering thread that a held sensor rarely meets,
@@ -71,6 +76,8 @@ class Sensor:
     outlier: float = 0.0
     max_reading: float = 1e4
     near_length: float = 0.0
+    log_sd_near: float = 0.0
+    log_sd_length: float = 0.0
 
     def __post_init__(self) -> None:
         if self.family not in ("gaussian", "lognormal"):
@@ -88,6 +95,8 @@ class Sensor:
             "outlier": (0 <= self.outlier < 1, "in [0, 1)"),
             "max_reading": (self.max_reading > self.threshold, "> threshold"),
             "near_length": (0 <= self.near_length <= 1e3, "in [0, 1000] m"),
+            "log_sd_near": (0 <= self.log_sd_near <= 10, "in [0, 10]"),
+            "log_sd_length": (0 <= self.log_sd_length <= 1e3, "in [0, 1000] m"),
         }
         for name, (ok, allowed) in checks.items():
             value = getattr(self, name)
@@ -110,9 +119,10 @@ class Sensor:
         P(missed) = 1 − Pd Φ(−9) = 1 to 1e-18, so lin0 = lin1 = 0.
         """
         if self.lognormal:
-            s = self.log_sd
+            # the largest spread (at the source) puts the threshold fewest s above the location
+            s = self.log_sd + (self.log_sd_near if self.log_sd_length > 0 else 0.0)
             v_thr = math.log(self.threshold)
-            c_lin = self.threshold * math.exp(0.5 * s * s - 9.0 * s)
+            c_lin = self.threshold * math.exp(0.5 * s * s - 9.0 * s) if s < 9 else -1.0
             lin0 = lin1 = 0.0
         else:
             v_thr = self.threshold
@@ -139,6 +149,8 @@ class Sensor:
             sigma_frac=self.sigma_frac,
             log_sd=self.log_sd,
             half_s2=0.5 * self.log_sd**2,
+            log_sd_near=self.log_sd_near,
+            log_sd_length=self.log_sd_length,
             false_alarm=self.false_alarm,
             false_alarm_scale=self.false_alarm_scale,
             log_false_alarm=math.log(self.false_alarm) if self.false_alarm > 0 else -math.inf,
@@ -183,10 +195,22 @@ class Sensor:
 
     # --- likelihood -------------------------------------------------------------------------
 
-    def _loc_sigma(self, c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def log_sd_at(self, distance: np.ndarray | float = np.inf) -> np.ndarray:
+        """s(r): the log-normal family's standard deviation of ln z at ``distance`` m from the
+        source, ``log_sd`` + ``log_sd_near`` · exp(−r / ``log_sd_length``) (constant with
+        ``log_sd_length`` = 0)."""
+        r = np.asarray(distance, dtype=np.float64)
+        if self.log_sd_length == 0:
+            return np.full_like(r, self.log_sd)
+        return self.log_sd + self.log_sd_near * np.exp(-r / self.log_sd_length)
+
+    def _loc_sigma(
+        self, c: np.ndarray, distance: np.ndarray | float = np.inf
+    ) -> tuple[np.ndarray, np.ndarray]:
         if self.lognormal:
-            loc = np.log(np.maximum(c, 1e-300)) - 0.5 * self.log_sd**2
-            return loc, np.full_like(loc, self.log_sd)
+            s = self.log_sd_at(distance)
+            loc = np.log(np.maximum(c, 1e-300)) - 0.5 * s**2
+            return np.broadcast_arrays(loc, s)
         return c, self.sigma_frac * c + self.sigma_min
 
     def detect_prob(self, distance: np.ndarray | float = np.inf) -> np.ndarray:
@@ -203,11 +227,11 @@ class Sensor:
         distance: np.ndarray | float = np.inf,
     ) -> np.ndarray:
         """log p(z | C, r), NumPy reference; broadcasts ``reading``, ``conc`` and ``distance``
-        (m from the source; only used with ``near_length`` > 0)."""
+        (m from the source; only used with ``near_length`` or ``log_sd_length`` > 0)."""
         z = np.asarray(reading, dtype=np.float64)
         c = np.asarray(conc, dtype=np.float64)
         pd = self.detect_prob(distance)
-        loc, sigma = self._loc_sigma(c)
+        loc, sigma = self._loc_sigma(c, distance)
         v_thr = math.log(self.threshold) if self.lognormal else self.threshold
         # P(no true detection | C) = (1 − Pd) + Pd Φ((v_thr − loc)/σ)
         log_below = log_ndtr((v_thr - loc) / sigma)
@@ -307,14 +331,15 @@ class Sensor:
         distance: np.ndarray | float = np.inf,
     ) -> np.ndarray:
         """Readings for concentrations ``conc`` from pre-drawn ``noise`` (conc.shape + (n,)),
-        ``distance`` m from the source (only used with ``near_length`` > 0).
+        ``distance`` m from the source (only used with ``near_length`` or ``log_sd_length``
+        > 0).
 
         Non-detections are returned as 0.0.
         """
         c = np.asarray(conc, dtype=np.float64)
         noise = np.asarray(noise, dtype=np.float64)
         if self.lognormal:
-            s = self.log_sd
+            s = self.log_sd_at(distance)
             y = c * np.exp(s * noise[..., 1] - 0.5 * s * s)
         else:
             y = c + (self.sigma_frac * c + self.sigma_min) * noise[..., 1]
@@ -344,7 +369,7 @@ class Sensor:
         """
         c = np.asarray(conc, dtype=np.float64)
         u = np.asarray(uniforms, dtype=np.float64)
-        loc, sigma = self._loc_sigma(c)
+        loc, sigma = self._loc_sigma(c, distance)
         v_thr = math.log(self.threshold) if self.lognormal else self.threshold
         a = (v_thr - loc) / sigma  # the threshold in standard units
         log_tail = log_ndtr(-a)  # log P(y ≥ threshold | C)

@@ -45,8 +45,10 @@ class SensorParams(NamedTuple):
     near_length: float  # m; > 0: Pd(r) = pd (1 − exp(−r / near_length)); 0: Pd = pd
     sigma_min: float  # gaussian: σ(C) = sigma_frac · C + sigma_min
     sigma_frac: float
-    log_sd: float  # lognormal: s, the standard deviation of ln z
-    half_s2: float  # s² / 2
+    log_sd: float  # lognormal: s∞, the standard deviation of ln z far from the source
+    half_s2: float  # s∞² / 2
+    log_sd_near: float  # lognormal: s(r) = s∞ + log_sd_near · exp(−r / log_sd_length)
+    log_sd_length: float  # m; 0: s = s∞ everywhere
     false_alarm: float
     false_alarm_scale: float
     log_false_alarm: float  # −inf without false alarms
@@ -59,9 +61,22 @@ class SensorParams(NamedTuple):
 
 
 @njit(cache=True, inline="always")
-def transform(c: float, sp: SensorParams):
-    """(loc, σ) of an expected concentration C in the transformed frame."""
+def log_sd_at(r: float, sp: SensorParams) -> float:
+    """s(r), the log-normal family's standard deviation of ln z at distance r m from the
+    source: s∞ + log_sd_near · exp(−r / log_sd_length) (s∞ with log_sd_length 0)."""
+    if sp.log_sd_length > 0.0:
+        return sp.log_sd + sp.log_sd_near * math.exp(-r / sp.log_sd_length)
+    return sp.log_sd
+
+
+@njit(cache=True, inline="always")
+def transform(c: float, r: float, sp: SensorParams):
+    """(loc, σ) of an expected concentration C at distance r m from the source in the
+    transformed frame."""
     if sp.lognormal > 0.0:
+        if sp.log_sd_length > 0.0:
+            s = log_sd_at(r, sp)
+            return math.log(max(c, TINY_CONCENTRATION)) - 0.5 * s * s, s
         return math.log(max(c, TINY_CONCENTRATION)) - sp.half_s2, sp.log_sd
     return c, sp.sigma_frac * c + sp.sigma_min
 
@@ -91,7 +106,7 @@ def log_missed(c: float, r: float, sp: SensorParams) -> float:
     """
     if c < sp.c_lin:
         return sp.lin0 + sp.lin1 * c
-    loc, sigma = transform(c, sp)
+    loc, sigma = transform(c, r, sp)
     x = (sp.v_threshold - loc) / sigma
     pd = detection_probability(r, sp)
     if pd < 1.0:
@@ -106,7 +121,7 @@ def log_likelihood(z: float, c: float, r: float, sp: SensorParams) -> float:
     thr = sp.threshold
     if z < thr:
         return log_missed(c, r, sp) + sp.log_not_false_alarm + sp.log_keep
-    loc, sigma = transform(c, sp)
+    loc, sigma = transform(c, r, sp)
     log_pd = log_detection_probability(r, sp)
     if sp.lognormal > 0.0:
         log_z = math.log(z)

@@ -52,7 +52,7 @@ def _floor_position_terms(
         for m in range(m_count):
             c = conc[m, i]
             r = dist[m, i]
-            mu, sigma = transform(c, sp)
+            mu, sigma = transform(c, r, sp)
             loc[m, i] = mu
             inv_sigma[m, i] = 1.0 / sigma
             log_nd[m, i] = log_likelihood(0.0, c, r, sp)

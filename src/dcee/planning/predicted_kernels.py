@@ -192,7 +192,7 @@ def position_rows(
                 continue
             for i in range(i0, i1):
                 c, r = plume_at(constants_at(plume, i), px, py, pz, rmin, meander)
-                m, sigma = transform(c, sp)
+                m, sigma = transform(c, r, sp)
                 conc[row, i] = c
                 dist[row, i] = r
                 loc[row, i] = m

@@ -334,7 +334,14 @@ class EstimatorSpec(BaseModel):
     intermittency: Annotated[float, Field(gt=0, le=1)] = 0.63
     """fluctuation: probability that a reading well inside the plume is not zero"""
     log_sd: Annotated[float, Field(gt=0, le=5)] = 1.3
-    """fluctuation: standard deviation of ln(reading) about ln(mean) − log_sd²/2"""
+    """fluctuation: standard deviation s of ln(reading) about ln(mean) − s²/2 (far from the
+    source when ``log_sd_length`` > 0)"""
+    log_sd_near: Annotated[float, Field(ge=0, le=10)] = 0.0
+    """fluctuation: the extra spread at the source, s(r) = log_sd + log_sd_near ·
+    exp(−r / log_sd_length) (r: sensor to hypothesised source)"""
+    log_sd_length: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] = 0.0
+    """fluctuation: m; how fast the extra spread decays with distance; 0 = s the same
+    everywhere"""
     near_source_length: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] = 10.0
     """fluctuation: m; the intermittency falls near the source as 1 − exp(−r / this)
     (r: sensor to hypothesised source); 0 = the same everywhere. 10 m, not the 5.4 m of the
@@ -616,6 +623,8 @@ class Scenario(BaseModel):
             pd=e.intermittency,
             family="lognormal",
             log_sd=e.log_sd,
+            log_sd_near=e.log_sd_near,
+            log_sd_length=e.log_sd_length,
             near_length=e.near_source_length,
             outlier=self.outlier,
             max_reading=s.max_reading,
