@@ -6,7 +6,8 @@ truth at points downwind of the source and across the mean plume, averages over 
 ``--hold`` seconds (as ``dcee`` readings do by default), applies the instrument (threshold and
 random misses), and reports per point: the isotropic mean C, the time mean of the averages, the
 share of non-detections, and the log-sd of the detected readings about ln C. It then fits the
-fluctuation likelihood's intermittency γ(r) = γ∞ (1 − exp(−r / r_γ)) by maximum likelihood.
+fluctuation likelihood's intermittency γ(r) = γ∞ (1 − exp(−r / r_γ)) by maximum likelihood, then
+the same with a log-sd that grows near the source, s(r) = s∞ + s_near exp(−r / r_s).
 
     .venv/bin/python scripts/fluctuation_stats.py [--hold 5] [--seconds 1800] [--seeds 3]
     .venv/bin/python scripts/fluctuation_stats.py --scenario lab:upwind --hold 4
@@ -44,9 +45,7 @@ def main() -> None:
     height = scenario.agent.start[2]
     wind = -np.array([np.cos(theta[5]), np.sin(theta[5])])  # where the plume goes
     normal = np.array([-wind[1], wind[0]])
-    pts = np.array(
-        [[*(theta[:2] + d * wind + c * normal), height] for d in down for c in cross]
-    )
+    pts = np.array([[*(theta[:2] + d * wind + c * normal), height] for d in down for c in cross])
     lo, hi = np.array(scenario.volume.low), np.array(scenario.volume.high)
     pts = pts[np.all((pts >= lo) & (pts <= hi), axis=1)]  # inside the area
     mean_c = isotropic_concentration(theta, pts, meander=args.meander)[0]
@@ -94,12 +93,39 @@ def main() -> None:
         ll_det = np.log(g) + stats.norm.logpdf(lz, mu, s) - lz
         return -float(np.where(det, ll_det, ll_nd).sum())
 
+    def nll_spread(par: np.ndarray) -> float:
+        """The same with the spread growing near the source: s(r) = s∞ + s_near e^(−r/r_s)."""
+        g_inf, r_g = 1 / (1 + np.exp(-par[0])), np.exp(par[1])
+        s_inf, s_near, r_s = np.exp(par[2]), np.exp(par[3]), np.exp(par[4])
+        s = s_inf + s_near * np.exp(-r / r_s)
+        g = g_inf * (1 - np.exp(-r / r_g))
+        mu = np.log(mean_c) - 0.5 * s * s
+        p_nd = 1 - g + g * stats.norm.cdf((np.log(thr) - mu) / s)
+        with np.errstate(divide="ignore"):
+            lz = np.log(np.where(det, z, thr))
+        ll_det = np.log(g) + stats.norm.logpdf(lz, mu, s) - lz
+        return -float(np.where(det, ll_det, np.log(p_nd)).sum())
+
+    spread = optimize.minimize(
+        nll_spread,
+        np.array([0.5, 1.7, 0.0, 0.5, 1.0]),
+        method="Nelder-Mead",
+        options={"maxfev": 4000},
+    )
+    spread = optimize.minimize(nll_spread, spread.x, method="Nelder-Mead", options={"maxfev": 4000})
     best = optimize.minimize(nll, np.array([0.0, 0.0, 0.0]), method="Nelder-Mead")
     g_inf, r_g, s = 1 / (1 + np.exp(-best.x[0])), np.exp(best.x[1]), np.exp(best.x[2])
     flat = optimize.minimize(
         lambda q: nll(np.array([q[0], -10.0, q[1]])), np.array([0.0, 0.0]), method="Nelder-Mead"
     )
     print(f"fit: gamma_inf {g_inf:.3f}  r_gamma {r_g:.2f} m  log_sd {s:.3f}  (nll {best.fun:.1f})")
+    x = spread.x
+    print(
+        f"spread fit: gamma_inf {1 / (1 + np.exp(-x[0])):.3f}  r_gamma {np.exp(x[1]):.2f} m  "
+        f"log_sd {np.exp(x[2]):.3f}  log_sd_near {np.exp(x[3]):.2f}  log_sd_length "
+        f"{np.exp(x[4]):.2f} m  (nll {spread.fun:.1f}; 2 Δnll = {2 * (best.fun - spread.fun):.1f} "
+        "for two parameters)"
+    )
     print(
         f"constant gamma: gamma {1 / (1 + np.exp(-flat.x[0])):.3f}  log_sd {np.exp(flat.x[1]):.3f}"
         f"  (nll {flat.fun:.1f}; 2 Δnll = {2 * (flat.fun - best.fun):.1f} for one parameter)"
