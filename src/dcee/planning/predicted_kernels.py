@@ -409,13 +409,17 @@ def _grouped_stats(
 ) -> None:
     """partial[b, s, :] = the six sums of task s over particle block b.
 
-    Tasks group_start[g]..group_start[g+1]−1 share one position sequence (equal task_positions
-    rows), so a particle's per-position terms are loaded once and the loops over the group's
-    hypothesised readings are branch-free arithmetic that LLVM vectorises (the outlier
-    component's log-sum-exp included). Weights are e_i = w_i exp(ll_i − bound_s): one pass, no
-    per-task maximum. With false alarms the exact scalar likelihood is used instead (slower, not
-    vectorised). Sums a planner does not need (the location moments, Σ e·ll for the KL
-    divergence) are left at zero when not wanted.
+    Weights are e_i = w_i exp(ll_i − bound_s): one pass, no per-task maximum. One-stage tasks
+    (one hypothesised reading each, the one-step planners) run one task at a time over the
+    block's particles in branch-free loops that LLVM vectorises (:func:`_single_stage_weights`),
+    with the sums formed by pairwise halving in a fixed order (:func:`_block_sum`). Tasks of
+    several stages: group_start[g]..group_start[g+1]−1 share one position sequence (equal
+    task_positions rows), so a particle's per-position terms are loaded once and the loops over
+    the group's hypothesised readings are branch-free arithmetic that LLVM vectorises (the
+    outlier component's log-sum-exp included). With false alarms the exact scalar likelihood is
+    used instead (slower, not vectorised). Sums a planner does not need (the location moments,
+    Σ e·ll for the KL divergence) are left at zero when not wanted; ``offsets`` (4, N) from
+    :func:`_centred_offsets` is only read for the moments.
     """
     n = weights.shape[0]
     t_count = task_positions.shape[1]
@@ -487,10 +491,12 @@ def _grouped_stats(
             wi = weights[i]
             if wi <= 0.0:
                 continue
-            dx = offsets[0, i]
-            dy = offsets[1, i]
-            dz = offsets[2, i]
-            d2 = offsets[3, i]
+            dx = dy = dz = d2 = 0.0
+            if want_moments:
+                dx = offsets[0, i]
+                dy = offsets[1, i]
+                dz = offsets[2, i]
+                d2 = offsets[3, i]
             ll[:] = 0.0
             for t in range(t_count):
                 p = task_positions[s0, t]
@@ -658,7 +664,7 @@ def predicted_posterior_stats(
         log_nd,
         inv_sigma,
         det_offset,
-        _centred_offsets(source, center),
+        _centred_offsets(source, center) if want_moments else np.zeros((4, 0)),
         weights,
         group_start,
         task_positions,
