@@ -561,13 +561,12 @@ def perf(json_path: str | None, quick: bool, compare_stonesoup: bool, decisions:
     for t in timings:
         d = t.as_dict()
         mark = {True: "[green]pass", False: "[red]FAIL", None: "—"}[t.passed]
-        target = f"{t.target:.3g} {t.unit}" if t.target is not None else "—"
         table.add_row(
             t.name,
             f"{d['median']:.3g} {t.unit}",
             f"{d['min']:.3g}",
             f"{d['max']:.3g}",
-            target,
+            t.target_text,
             mark,
         )
     console.print(table)

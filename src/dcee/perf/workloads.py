@@ -44,7 +44,12 @@ class Timing:
     note: str = ""
     ratio_to: dict[str, float] = field(default_factory=dict)
     """Median of this workload over the median of each named reference timed in the same run
-    (``floor``: the plain compiled loop, ``numpy``: the NumPy reference, ``stonesoup``)."""
+    (``floor``: the plain compiled loop, ``numpy``: the NumPy reference, ``filter-update``,
+    ``full-import``)."""
+    ratio_target: tuple[str, float] | None = None
+    """(reference, bound): the target as a ratio, ratio_to[reference] ≤ bound. On this shared
+    machine absolute times swing 3-5× between days, so a workload with a reference timed in the
+    same run is judged by the ratio; ``target`` then stays None."""
 
     @property
     def median(self) -> float:
@@ -52,10 +57,24 @@ class Timing:
 
     @property
     def passed(self) -> bool | None:
-        """True/False against the target; None when the workload has no target."""
-        if self.target is None or not self.values:
+        """True/False against the target (the ratio target if there is one); None when the
+        workload has no target."""
+        if not self.values:
+            return None
+        if self.ratio_target is not None:
+            reference, bound = self.ratio_target
+            ratio = self.ratio_to.get(reference)
+            return None if ratio is None else ratio <= bound
+        if self.target is None:
             return None
         return self.median <= self.target
+
+    @property
+    def target_text(self) -> str:
+        """The target as the table prints it: "5 ms", "≤ 1.5× floor" or "—"."""
+        if self.ratio_target is not None:
+            return f"≤ {self.ratio_target[1]:g}× {self.ratio_target[0]}"
+        return f"{self.target:.3g} {self.unit}" if self.target is not None else "—"
 
     def as_dict(self) -> dict:
         out = {
@@ -66,6 +85,7 @@ class Timing:
             "min": float(np.min(self.values)) if self.values else None,
             "max": float(np.max(self.values)) if self.values else None,
             "target": self.target,
+            "ratio_target": list(self.ratio_target) if self.ratio_target else None,
             "passed": self.passed,
             "repeats": len(self.values),
             "note": self.note,
@@ -75,6 +95,15 @@ class Timing:
             out["median_ms"] = out["median"]
             out["target_ms"] = self.target
         return out
+
+
+RATIO_TO_FLOOR_TARGETS = {
+    "dcee-decision-20k": 1.5,
+    "entrotaxis-decision-20k": 1.5,
+    "infotaxis-decision-20k": 1.5,
+}
+"""Issue 17: a paper-scale decision costs at most 1.5× the plain compiled loop of the same
+arithmetic timed in the same run (it replaced issue 3's absolute 5 ms)."""
 
 
 def _times_ms(fn: Callable[[], object], repeats: int, setup: Callable[[], None] | None = None):
@@ -244,6 +273,8 @@ def _decisions_interleaved(
         )
         for t in out_timings:
             t.ratio_to = {"floor": t.median / floor.median, "numpy": t.median / numpy_ref.median}
+            if t.name in RATIO_TO_FLOOR_TARGETS:
+                t.ratio_target = ("floor", RATIO_TO_FLOOR_TARGETS[t.name])
             t.note = (
                 f"{t.ratio_to['floor']:.2f}× the plain compiled loop, "
                 f"{t.ratio_to['numpy']:.3f}× the NumPy reference (same run)"
@@ -289,7 +320,7 @@ def _resample_move(repeats: int) -> Timing:
     return Timing(
         "resample-mcmc-500-readings-20k",
         "systematic resampling + full-history MCMC move, 500 readings, 20,000 particles",
-        100.0,
+        None,  # judged as a ratio to the filter update (run_workloads)
         times,
     )
 
@@ -361,10 +392,12 @@ def _startup(repeats: int) -> list[Timing]:
     for _ in range(repeats):
         helps.append(once(help_code))
         imports.append(once(FULL_IMPORT))
-    help_t = Timing("cli-help-startup", "`dcee --help` in a fresh process", 1000.0, helps)
+    help_t = Timing("cli-help-startup", "`dcee --help` in a fresh process", None, helps)
     full_t = Timing("full-import", "importing every dcee subpackage, fresh process", None, imports)
     ratio = help_t.median / full_t.median
-    help_t.note = f"{ratio:.2f}× the full import in this run (target ≤ 0.35)"
+    help_t.ratio_to = {"full-import": ratio}
+    help_t.ratio_target = ("full-import", 0.35)
+    help_t.note = f"{ratio:.2f}× the full import in this run (target ≤ 0.35); absolute 1 s"
     return [help_t, full_t]
 
 
@@ -381,9 +414,9 @@ def run_workloads(quick: bool = False, progress: Callable[[str], None] | None = 
             "dcee, entrotaxis, infotaxis, dcee-cl decisions (20k, in alternation)",
             lambda: _decisions_interleaved(
                 [
-                    ("dcee-decision-20k", "dcee", 5.0),
-                    ("entrotaxis-decision-20k", "entrotaxis", 5.0),
-                    ("infotaxis-decision-20k", "infotaxis", 5.0),
+                    ("dcee-decision-20k", "dcee", None),
+                    ("entrotaxis-decision-20k", "entrotaxis", None),
+                    ("infotaxis-decision-20k", "infotaxis", None),
                     ("dcee-cl-decision-20k", "dcee-cl", None),
                 ],
                 20_000,
@@ -453,6 +486,7 @@ def run_workloads(quick: bool = False, progress: Callable[[str], None] | None = 
     # was 227 when the issue was filed; the target is a third of it)
     move, update = by_name["resample-mcmc-500-readings-20k"], by_name["filter-update-20k"]
     move.ratio_to = {"filter-update": move.median / update.median}
+    move.ratio_target = ("filter-update", 76.0)
     move.note = f"{move.median / update.median:.0f}× the filter update in this run (target ≤ 76)"
     if not quick:
         out.append(_campaign_estimate(out, say))
