@@ -146,6 +146,22 @@ def test_campaigns_stored_before_the_calm_model_resume_only_without_it():
     assert scenario_identity(paper_stored) == scenario_identity(PAPER1.model_dump(mode="json"))
 
 
+def test_campaigns_stored_before_the_spread_option_keep_their_identity():
+    """``log_sd_near`` / ``log_sd_length`` at 0 are what ran before they existed; a non-zero
+    spread is another campaign."""
+    stored = FLUCT.model_dump(mode="json")
+    del stored["estimator"]["log_sd_near"], stored["estimator"]["log_sd_length"]
+    assert scenario_identity(stored) == scenario_identity(FLUCT.model_dump(mode="json"))
+    spread = FLUCT.with_overrides(
+        **{"estimator.log_sd_near": 2.0, "estimator.log_sd_length": 3.0}
+    ).model_dump(mode="json")
+    assert scenario_identity(spread) != scenario_identity(stored)
+    sensor = FLUCT.with_overrides(
+        **{"estimator.log_sd_near": 2.0, "estimator.log_sd_length": 3.0}
+    ).make_estimator_sensor()
+    assert (sensor.log_sd_near, sensor.log_sd_length) == (2.0, 3.0)
+
+
 def test_search_with_the_bank_records_the_model_and_is_reproducible():
     sc = FLUCT.with_overrides(**{"search.particles": 1500, "search.budget": 40.0})
     a = run_episode(sc, "infotaxis", seed=4)
