@@ -82,29 +82,26 @@ def main() -> None:
     # (readings are the instrument's; the likelihood's γ absorbs its random misses).
     thr = sensor.threshold
 
-    def nll(par: np.ndarray) -> float:
-        g_inf, r_g, s = 1 / (1 + np.exp(-par[0])), np.exp(par[1]), np.exp(par[2])
-        g = g_inf * (1 - np.exp(-r / r_g))
+    with np.errstate(divide="ignore"):
+        lz = np.log(np.where(det, z, thr))
+
+    def neg_log_lik(g: np.ndarray, s: np.ndarray) -> float:
+        """−log p(readings) for intermittency g and log-sd s per point (arrays over points)."""
         mu = np.log(mean_c) - 0.5 * s * s
         p_nd = 1 - g + g * stats.norm.cdf((np.log(thr) - mu) / s)
-        ll_nd = np.log(p_nd)
-        with np.errstate(divide="ignore"):
-            lz = np.log(np.where(det, z, thr))
         ll_det = np.log(g) + stats.norm.logpdf(lz, mu, s) - lz
-        return -float(np.where(det, ll_det, ll_nd).sum())
+        return -float(np.where(det, ll_det, np.log(p_nd)).sum())
+
+    def intermittency(par: np.ndarray) -> np.ndarray:
+        return 1 / (1 + np.exp(-par[0])) * (1 - np.exp(-r / np.exp(par[1])))
+
+    def nll(par: np.ndarray) -> float:
+        return neg_log_lik(intermittency(par), np.full_like(r, np.exp(par[2])))
 
     def nll_spread(par: np.ndarray) -> float:
         """The same with the spread growing near the source: s(r) = s∞ + s_near e^(−r/r_s)."""
-        g_inf, r_g = 1 / (1 + np.exp(-par[0])), np.exp(par[1])
-        s_inf, s_near, r_s = np.exp(par[2]), np.exp(par[3]), np.exp(par[4])
-        s = s_inf + s_near * np.exp(-r / r_s)
-        g = g_inf * (1 - np.exp(-r / r_g))
-        mu = np.log(mean_c) - 0.5 * s * s
-        p_nd = 1 - g + g * stats.norm.cdf((np.log(thr) - mu) / s)
-        with np.errstate(divide="ignore"):
-            lz = np.log(np.where(det, z, thr))
-        ll_det = np.log(g) + stats.norm.logpdf(lz, mu, s) - lz
-        return -float(np.where(det, ll_det, np.log(p_nd)).sum())
+        s = np.exp(par[2]) + np.exp(par[3]) * np.exp(-r / np.exp(par[4]))
+        return neg_log_lik(intermittency(par), s)
 
     spread = optimize.minimize(
         nll_spread,

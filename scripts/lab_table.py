@@ -1,7 +1,8 @@
 """The lab-experiment table (issue 15): the paper's indoor search in simulation with the
 unicycle robot against the idealised grid agent, per start and planner, paired by seed.
 
-    .venv/bin/python scripts/lab_table.py results/lab-robot results/lab-grid [results/lab-robot-filament]
+    .venv/bin/python scripts/lab_table.py results/lab-robot results/lab-grid \
+        [results/lab-robot-filament]
 
 prints the per-start table (robot against grid, paired) and a compact one pooled over both
 starts with one column group per campaign given.
@@ -17,7 +18,6 @@ from __future__ import annotations
 import sys
 
 import numpy as np
-import pandas as pd
 from scipy import stats
 
 from dcee.analysis.report import censored_median_time, median_ci, wilson

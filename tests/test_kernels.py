@@ -81,6 +81,14 @@ def test_predicted_stats_optional_outputs_are_skipped_not_wrong():
     no_kl = _run(conc, source, weights, task_pos, task_z, sensor, want_kl=False)
     np.testing.assert_array_equal(no_kl[1], full[1])
     assert np.isnan(no_kl[3]).all()
+    # several stages per task take the other path; without moments it reads no offsets
+    task_pos2 = np.array([[0, 1], [0, 1], [2, 0]])
+    task_z2 = np.array([[0.0, 2e-3], [1e-3, 0.0], [0.0, 0.0]])
+    full2 = _run(conc, source, weights, task_pos2, task_z2, sensor)
+    only_kl2 = _run(conc, source, weights, task_pos2, task_z2, sensor, want_moments=False)
+    np.testing.assert_array_equal(only_kl2[0], full2[0])
+    np.testing.assert_array_equal(only_kl2[3], full2[3])
+    assert np.isnan(only_kl2[1]).all() and np.isnan(only_kl2[2]).all()
 
 
 def test_predicted_stats_multi_step_sequences_match_reference():
