@@ -1,8 +1,13 @@
 """Markdown table of an ablation: each campaign folder against a reference one, searches paired
 by (configuration, repeat) — the common random numbers make the pairing exact — with Wilson
-intervals, exact McNemar tests and median final RMSE.
+intervals, exact McNemar tests, median final RMSE and the paired time to RMSE < 1 m (Wilcoxon).
+
+A folder may hold several strategies: ``DIR=STRATEGY`` picks one (the strategy spec as stored,
+e.g. ``results/filament-calm=infotaxis``); a folder without ``=`` must hold just one.
 
     .venv/bin/python scripts/ablation_table.py results/ablation/all results/ablation/*
+    .venv/bin/python scripts/ablation_table.py results/paper-full-cl2=infotaxis \\
+        results/paper-full-info-loc results/paper-full-cl2=dcee-cl
 """
 
 from __future__ import annotations
@@ -10,23 +15,34 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from scipy.stats import binomtest
+import pandas as pd
+from scipy.stats import binomtest, wilcoxon
 
 from dcee.analysis.report import load_campaign, wilson
 
 
+def _runs(arg: str) -> tuple[str, pd.DataFrame]:
+    folder, _, strategy = arg.partition("=")
+    _, runs = load_campaign(Path(folder))
+    if strategy:
+        runs = runs[runs["strategy"] == strategy]
+    if runs.empty or runs["strategy"].nunique() != 1:
+        sys.exit(f"ablation_table: {arg}: name one strategy with DIR=STRATEGY")
+    label = f"{Path(folder).name} ({runs['strategy'].iloc[0]})"
+    return label, runs.set_index(["scenario", "seed"])
+
+
 def main() -> None:
-    ref_dir, *others = (Path(a) for a in sys.argv[1:])
-    _, ref = load_campaign(ref_dir)
-    ref = ref.set_index(["scenario", "seed"])
+    ref_arg, *others = sys.argv[1:]
+    _, ref = _runs(ref_arg)
     print(
         "| variant | n | source acquired | truth in 95% region | median final RMSE (m) | "
-        "only reference / only variant | McNemar p |"
+        "only reference / only variant | McNemar p | median time to RMSE < 1 m (s) | "
+        "paired difference to the reference (s), Wilcoxon p |"
     )
-    print("|---|---|---|---|---|---|---|")
-    for d in [ref_dir, *others]:
-        _, runs = load_campaign(d)
-        runs = runs.set_index(["scenario", "seed"])
+    print("|---|---|---|---|---|---|---|---|---|")
+    for arg in [ref_arg, *others]:
+        label, runs = _runs(arg)
         keys = runs.index.intersection(ref.index)
         a = ref.loc[keys, "source_acquired"].astype(bool)
         b = runs.loc[keys, "source_acquired"].astype(bool)
@@ -34,10 +50,20 @@ def main() -> None:
         p = binomtest(only_ref, only_ref + only_var).pvalue if only_ref + only_var else 1.0
         r, lo, hi = wilson(int(b.sum()), len(b))
         c, clo, chi = wilson(int(runs.loc[keys, "truth_in_95"].astype(bool).sum()), len(b))
+        t_ref = ref.loc[keys, "time_to_rmse_1m"].astype(float)
+        t_var = runs.loc[keys, "time_to_rmse_1m"].astype(float)
+        both = t_ref.notna() & t_var.notna()
+        diff = (t_var - t_ref)[both]
+        paired = "—"
+        if both.sum() > 0 and (diff != 0).any():
+            paired = f"{diff.median():+.0f} (p = {wilcoxon(t_var[both], t_ref[both]).pvalue:.2g})"
+        got = int(t_var.notna().sum())
+        reached = f"{t_var.median():.0f} ({got} got there)" if got else "— (none got there)"
         print(
-            f"| {d.name} | {len(b)} | {r:.0%} [{lo:.0%}, {hi:.0%}] "
+            f"| {label} | {len(b)} | {r:.0%} [{lo:.0%}, {hi:.0%}] "
             f"| {c:.0%} [{clo:.0%}, {chi:.0%}] "
-            f"| {runs.loc[keys, 'final_rmse'].median():.2f} | {only_ref} / {only_var} | {p:.3f} |"
+            f"| {runs.loc[keys, 'final_rmse'].median():.2f} | {only_ref} / {only_var} | {p:.3f} "
+            f"| {reached} | {paired} |"
         )
 
 

@@ -113,6 +113,34 @@ def compiled_predicted_stats(conc, source, weights, task_pos, task_z, sensor, di
     return out
 
 
+def compiled_location_kl(conc, source, weights, task_pos, task_z, sensor, cell, dist=None):
+    """The compiled location-cell KL divergence with the reference's arguments (see
+    :func:`compiled_predicted_stats`)."""
+    from dcee.planning.predicted_kernels import location_cells, location_kl
+
+    conc = np.ascontiguousarray(conc)
+    dist = np.full_like(conc, np.inf) if dist is None else np.ascontiguousarray(dist)
+    loc, sigma = sensor._loc_sigma(conc, dist)
+    with np.errstate(divide="ignore"):
+        det_offset = np.log(sensor.detect_prob(dist)) - np.log(sigma)
+    terms = [
+        np.ascontiguousarray(a)
+        for a in (loc, sensor.log_likelihood(0.0, conc, dist), 1.0 / sigma, det_offset)
+    ]
+    tv, tfa, tout, _ = sensor.transformed_readings(np.asarray(task_z, dtype=float))
+    out = np.empty(len(task_pos))
+    location_kl(
+        *terms,
+        weights,
+        *location_cells(np.ascontiguousarray(source), weights, cell),
+        np.ascontiguousarray(task_pos, dtype=np.int64),
+        *(np.ascontiguousarray(a, dtype=np.float64) for a in (tv, tfa, tout)),
+        sensor.params,
+        out,
+    )
+    return out
+
+
 def random_theta(n: int, rng: np.random.Generator) -> np.ndarray:
     """(n, 8) source terms spread over a 50 × 50 × 5 m area and plausible environments."""
     return np.column_stack(

@@ -9,8 +9,8 @@ import pytest
 from dcee.models import Sensor
 from dcee.models.sensor_kernels import log_likelihood
 from dcee.numeric import vexp, vlog1p
-from dcee.planning.predicted import predicted_posterior_stats_reference
-from tests.helpers import compiled_predicted_stats
+from dcee.planning.predicted import location_kl_reference, predicted_posterior_stats_reference
+from tests.helpers import compiled_location_kl, compiled_predicted_stats
 
 
 def test_vectorised_exp_matches_math_exp():
@@ -230,3 +230,29 @@ def test_vectorised_exp_matches_math_exp_at_every_power_of_two():
     out = np.empty_like(x)
     vexp(x, out)
     np.testing.assert_allclose(out, np.exp(x), rtol=2e-15, atol=0)
+
+
+@pytest.mark.parametrize(
+    "sensor",
+    [Sensor(), Sensor(family="lognormal", pd=0.6, outlier=0.01, near_length=5.0)],
+    ids=["paper", "fluctuation"],
+)
+def test_location_kl_matches_reference_and_its_limits(sensor):
+    """The KL divergence of the source location over cells (infotaxis:about=location) against
+    the NumPy reference, and its limiting cases: one cell holds no location information (0);
+    cells so small that every particle has its own equal the joint KL over the particles; and
+    any cells lie between (marginalising cannot add information)."""
+    source, weights, conc = _stats_case(n=1500, seed=8)
+    rng = np.random.default_rng(5)
+    dist = rng.uniform(0.1, 20.0, conc.shape)
+    for task_pos in (np.repeat(np.array([[0], [2]]), 5, axis=0), np.repeat([[0, 1, 2]], 8, axis=0)):
+        shape = task_pos.shape
+        task_z = np.where(rng.random(shape) < 0.4, 0.0, rng.lognormal(-6, 2, shape))
+        args = (conc, source, weights, task_pos, task_z, sensor)
+        joint = _run(*args, dist)[3]
+        for cell in (2.0, 5.0):
+            fast = compiled_location_kl(*args, cell, dist)
+            np.testing.assert_allclose(fast, location_kl_reference(*args, cell, dist), rtol=1e-9)
+            assert np.all(fast <= joint * (1 + 1e-9) + 1e-12) and np.all(fast >= 0)
+        np.testing.assert_allclose(compiled_location_kl(*args, 1e-6, dist), joint, rtol=1e-9)
+        np.testing.assert_allclose(compiled_location_kl(*args, 1e3, dist), 0.0, atol=1e-12)

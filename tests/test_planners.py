@@ -141,6 +141,35 @@ def test_entrotaxis_and_infotaxis_sample_where_the_reading_discriminates():
     assert np.all(gain[2:7] < 0.05 * gain[0])
 
 
+def test_location_infotaxis_values_only_what_a_reading_tells_about_the_location():
+    # Two release rates at one location: a reading discriminates them (joint KL > 0) but the
+    # location is certain, so the location information is 0 for every move.
+    pts = [(13.0, 10.0, 0.0)] * 400
+    theta = np.vstack([theta_at(pts[:200], q=0.02, u=0.0), theta_at(pts[200:], q=2.0, u=0.0)])
+    rates = Belief(theta, np.full(400, 1 / 400), Sensor(), IsotropicPlume())
+    rng = np.random.default_rng
+    joint = planners.get("infotaxis").decide(rates, START, AGENT, rng(0))
+    location = planners.get("infotaxis:about=location").decide(rates, START, AGENT, rng(0))
+    assert -joint.costs.min() > 0.05
+    np.testing.assert_allclose(location.costs, 0.0, atol=1e-12)
+    # Where the parameters differ only by location, the two are the same information.
+    belief = _two_point_belief()
+    joint = planners.get("infotaxis").decide(belief, START, AGENT, rng(0))
+    location = planners.get("infotaxis:about=location:cell=0.5").decide(
+        belief, START, AGENT, rng(0)
+    )
+    np.testing.assert_allclose(location.costs, joint.costs, rtol=1e-9, atol=1e-12)
+    assert location.heading == 0
+
+
+def test_a_belief_of_the_wrong_shape_is_refused():
+    theta = theta_at([(1.0, 2.0, 0.0)] * 3)
+    with pytest.raises(DceeInputError, match="theta"):
+        Belief(theta[:, :7], np.full(3, 1 / 3), Sensor(), IsotropicPlume())
+    with pytest.raises(DceeInputError, match="weights"):
+        Belief(theta, np.full(4, 1 / 4), Sensor(), IsotropicPlume())
+
+
 def test_multistage_plans_through_an_intermediate_point():
     # Source 4 m north: horizon 2 ends exactly on it by going north twice.
     belief = _belief([(10.0, 14.0)] * 20, q=5.0, u=4.0, phi=math.radians(270))
@@ -290,6 +319,9 @@ def test_planner_specs_set_options_and_reject_bad_ones():
         ("dcee:hypotheses=2.5", "hypotheses"),
         ("dcee-cl-tree:branch_hypotheses=0", "branch_hypotheses"),
         ("dcee-ms:beam_width=true", "beam_width"),
+        ("infotaxis:about=wind", "about"),
+        ("infotaxis:about=location:cell=0", "cell"),
+        ("infotaxis:cell=nan", "cell"),
     ]:
         with pytest.raises(DceeInputError, match=field):
             planners.get(bad)

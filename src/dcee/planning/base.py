@@ -34,6 +34,15 @@ class Belief:
     plume: IsotropicPlume
     cache: ParticleTerms | None = field(default=None, compare=False, repr=False)
 
+    def __post_init__(self) -> None:
+        # a wrong shape would otherwise be read as other columns and give silent nonsense
+        if np.ndim(self.theta) != 2 or np.shape(self.theta)[1] != 8:
+            raise DceeInputError("theta", f"must have shape (N, 8), got {np.shape(self.theta)}")
+        if np.shape(self.weights) != (np.shape(self.theta)[0],):
+            raise DceeInputError(
+                "weights", f"must have shape ({len(self.theta)},), got {np.shape(self.weights)}"
+            )
+
     @property
     def source(self) -> np.ndarray:
         """(N, 3) source locations."""

@@ -45,6 +45,8 @@ class HypothesisPlanner(Planner):
     needs_kl: ClassVar[bool] = True
     default_horizon: ClassVar[int] = 1
     default_expectation: ClassVar[str] = "sampled"
+    #: side (m) of the location cubes of ``SequenceStats.location_kl``; None: not computed
+    location_cell: float | None = None
 
     def __init__(
         self,
@@ -94,7 +96,12 @@ class HypothesisPlanner(Planner):
         self, sequences: np.ndarray, ctx: PredictionContext, belief: Belief
     ) -> np.ndarray:
         """(S,) expected loss of (S, T, 3) position sequences."""
-        stats = ctx.stats(sequences, moments=self.needs_moments, kl=self.needs_kl)
+        stats = ctx.stats(
+            sequences,
+            moments=self.needs_moments,
+            kl=self.needs_kl,
+            location_cell=self.location_cell,
+        )
         return stats.expect(self.loss(sequences[:, -1], stats, belief))
 
     def context(

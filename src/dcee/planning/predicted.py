@@ -29,7 +29,11 @@ from dcee.estimation.particle_filter import systematic_resample
 from dcee.models.sensor import Sensor
 from dcee.planning.base import Belief
 from dcee.planning.particle_terms import ParticleTerms
-from dcee.planning.predicted_kernels import predicted_posterior_stats
+from dcee.planning.predicted_kernels import (
+    location_cells,
+    location_kl,
+    predicted_posterior_stats,
+)
 
 
 @dataclass(frozen=True)
@@ -46,6 +50,7 @@ class SequenceStats:
     mean: np.ndarray
     trace_cov: np.ndarray
     kl: np.ndarray
+    location_kl: np.ndarray
 
     def expect(self, values: np.ndarray) -> np.ndarray:
         """(S,) expectation over the next readings of per-hypothesis ``values`` (S, J)."""
@@ -86,6 +91,36 @@ def predicted_posterior_stats_reference(
         pos = w_post > 0
         kl[s] = np.sum(w_post[pos] * (np.log(w_post[pos]) - np.log(weights[pos])))
     return log_ev, mean, trace, kl
+
+
+def location_kl_reference(
+    conc: np.ndarray,
+    source: np.ndarray,
+    weights: np.ndarray,
+    task_positions: np.ndarray,
+    task_readings: np.ndarray,
+    sensor: Sensor,
+    cell: float,
+    dist: np.ndarray | None = None,
+) -> np.ndarray:
+    """NumPy reference of :func:`dcee.planning.predicted_kernels.location_kl`: (S,) KL
+    divergences of the source location's distribution over cubes of side ``cell`` (m), from
+    concentrations (P, N), sources (N, 3), weights (N,), positions (S, T) and readings (S, T)."""
+    dist = np.full_like(conc, np.inf) if dist is None else dist
+    _, cell_of = np.unique(np.floor(source / cell), axis=0, return_inverse=True)
+    cell_of = cell_of.reshape(-1)
+    prior = np.bincount(cell_of, weights=weights)
+    out = np.empty(task_positions.shape[0])
+    for s in range(task_positions.shape[0]):
+        ll = sum(
+            sensor.log_likelihood(task_readings[s, t], conc[p], dist[p])
+            for t, p in enumerate(task_positions[s])
+        )
+        e = weights * np.exp(np.minimum(ll - ll[weights > 0].max(), 0.0))
+        post = np.bincount(cell_of, weights=e / e.sum(), minlength=len(prior))
+        pos = post > 0
+        out[s] = np.sum(post[pos] * np.log(post[pos] / prior[pos]))
+    return out
 
 
 def unique_per_sequence(readings: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -187,6 +222,7 @@ class PredictionContext:
         self._draw()
         self._source = np.ascontiguousarray(belief.source)
         self._center = belief.source_mean()
+        self._cell_cache: dict[float, tuple[np.ndarray, ...]] = {}
 
     def _draw(self) -> None:
         """Every random number one set of hypotheses needs (see the class docstring)."""
@@ -226,6 +262,7 @@ class PredictionContext:
         other.belief = Belief(theta, weights, self.sensor, self.belief.plume)
         other._n, other._horizon, other._rng = int(n_hypotheses), 1, rng
         other._center = other.belief.source_mean()
+        other._cell_cache = {}
         other._draw()
         return other
 
@@ -309,11 +346,18 @@ class PredictionContext:
         )
         return z, prob
 
-    def stats(self, sequences: np.ndarray, moments: bool = True, kl: bool = True) -> SequenceStats:
+    def stats(
+        self,
+        sequences: np.ndarray,
+        moments: bool = True,
+        kl: bool = True,
+        location_cell: float | None = None,
+    ) -> SequenceStats:
         """Statistics for (S, T, 3) candidate position sequences (T ≤ horizon).
 
         ``moments=False`` leaves mean and trace_cov NaN, ``kl=False`` leaves kl NaN: each
-        saves work in the kernel when a planner's cost does not use it.
+        saves work in the kernel when a planner's cost does not use it. ``location_cell`` (m)
+        asks for location_kl over cubes of that side (NaN otherwise).
         """
         s_count, t_count, _ = sequences.shape
         j_count = self.n_hypotheses
@@ -348,6 +392,20 @@ class PredictionContext:
             moments,
             kl,
         )
+        loc_kl = np.full(n_tasks, np.nan)
+        if location_cell is not None:
+            tv, tfa, tout, _ = self.sensor.transformed_readings(tz)
+            location_kl(
+                *self.terms[2:],
+                self.belief.weights,
+                *self._cells(location_cell),
+                tp,
+                np.ascontiguousarray(tv, dtype=np.float64),
+                np.ascontiguousarray(tfa, dtype=np.float64),
+                np.ascontiguousarray(tout, dtype=np.float64),
+                self._sp,
+                loc_kl,
+            )
         return SequenceStats(
             readings,
             probability,
@@ -355,4 +413,13 @@ class PredictionContext:
             mean[inverse],
             trace[inverse],
             kl_div[inverse],
+            loc_kl[inverse],
         )
+
+    def _cells(self, cell: float) -> tuple[np.ndarray, ...]:
+        """:func:`~dcee.planning.predicted_kernels.location_cells` of this context's belief,
+        computed once per cell size."""
+        key = float(cell)
+        if key not in self._cell_cache:
+            self._cell_cache[key] = location_cells(self._source, self.belief.weights, key)
+        return self._cell_cache[key]
