@@ -11,6 +11,7 @@ the same with a log-sd that grows near the source, s(r) = s∞ + s_near exp(−r
 
     .venv/bin/python scripts/fluctuation_stats.py [--hold 5] [--seconds 1800] [--seeds 3]
     .venv/bin/python scripts/fluctuation_stats.py --scenario lab:upwind --hold 4
+    .venv/bin/python scripts/fluctuation_stats.py --hold 4 --pd 1   # no random misses
 
 Another scenario (``--scenario``) gets the same pattern of points scaled to its area (the
 distances above × area width / 50 m) at its sensor height.
@@ -35,8 +36,12 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--meander", type=float, default=0.15, help="the model's meander intensity")
     ap.add_argument("--scenario", default="paper:1")
+    ap.add_argument("--pd", type=float, help="the instrument's Pd (default: the scenario's)")
     args = ap.parse_args()
-    scenario = load_scenario(args.scenario).with_overrides(**{"truth.model": "filament"})
+    overrides = {"truth.model": "filament"}
+    if args.pd is not None:
+        overrides["sensor.pd"] = args.pd
+    scenario = load_scenario(args.scenario).with_overrides(**overrides)
     theta = scenario.truth_theta()
     sensor = scenario.make_sensor()
     scale = (scenario.volume.high[0] - scenario.volume.low[0]) / 50.0
