@@ -474,6 +474,26 @@ def test_campaigns_stored_before_a_setting_existed_still_resume():
     assert scenario_identity(slower) != scenario_identity(older)
 
 
+def test_a_filament_campaign_stored_before_sensor_dropout_ran_with_the_misses():
+    # before sensor.dropout, the instrument missed 1 − pd of the readings on every truth: an
+    # isotropic campaign is what the default still does, a filament one is not
+    from dcee.campaign.runner import scenario_identity
+    from dcee.scenarios import load_scenario
+
+    def stored_before(scenario):
+        d = scenario.model_dump(mode="json")
+        d["sensor"] = {k: v for k, v in d["sensor"].items() if k != "dropout"}
+        return d
+
+    iso = load_scenario("paper:1")
+    assert scenario_identity(stored_before(iso)) == scenario_identity(iso.model_dump(mode="json"))
+    fil = iso.with_overrides(**{"truth.model": "filament"})
+    old = scenario_identity(stored_before(fil))
+    assert old != scenario_identity(fil.model_dump(mode="json"))
+    lossy = fil.with_overrides(**{"sensor.dropout": 0.3})
+    assert old == scenario_identity(lossy.model_dump(mode="json"))
+
+
 def test_fluctuation_only_settings_do_not_matter_under_the_paper_likelihood():
     from dcee.campaign.runner import scenario_identity
     from dcee.scenarios import load_scenario

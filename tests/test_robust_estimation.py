@@ -102,13 +102,35 @@ def test_turbulent_truth_defaults_to_a_four_second_hold_and_average():
     s = fluct.make_estimator_sensor()
     assert (s.family, s.pd, s.log_sd, s.near_length, s.outlier) == (
         "lognormal",
-        0.63,
+        0.93,
         1.3,
         10.0,
         0.01,
     )
     assert fluct.make_plume().meander == 0.15
     assert PAPER1.make_estimator_sensor() == PAPER1.make_sensor()  # the paper's exact model
+
+
+def test_the_simulated_instrument_misses_readings_only_where_the_truth_is_calm():
+    # The paper's Pd stands for turbulent intermittency and missed detections together: the
+    # isotropic truth simulates no turbulence, so its instrument misses 1 − Pd; a turbulent
+    # truth makes its own gaps, so by default its instrument misses none. The paper's
+    # likelihood keeps its Pd either way; sensor.dropout sets the instrument's explicitly.
+    filament = PAPER1.with_overrides(**{"truth.model": "filament"})
+    assert PAPER1.make_sensor().pd == 0.7 and filament.make_sensor().pd == 1.0
+    assert filament.make_estimator_sensor().pd == 0.7
+    assert filament.resolved_settings()["dropout"] == 0.0
+    assert PAPER1.resolved_settings()["dropout"] == pytest.approx(0.3)
+    lossy = filament.with_overrides(**{"sensor.dropout": 0.25})
+    assert lossy.make_sensor().pd == 0.75 and lossy.make_estimator_sensor().pd == 0.7
+    rng = np.random.default_rng(0)
+    c = np.full(40_000, 0.01)  # 20× the threshold: only noise (sd 0.5 C) falls below it
+    noise_only = np.mean(filament.make_sensor().simulate(c, rng) < 5e-4)
+    assert noise_only < 0.05
+    missed = np.mean(lossy.make_sensor().simulate(c, rng) < 5e-4)
+    assert missed == pytest.approx(0.25 + 0.75 * noise_only, abs=0.01)
+    with pytest.raises(ValueError, match="dropout"):
+        filament.with_overrides(**{"sensor.dropout": 1.0})
 
 
 # --- outlier safety ---

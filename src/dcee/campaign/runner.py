@@ -294,6 +294,14 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
     if isinstance(estimator, dict) and estimator.get("likelihood", "paper") == "paper":
         for key in FLUCTUATION_ONLY:  # read by the fluctuation likelihood only
             estimator.pop(key, None)
+    sensor, truth = out.get("sensor"), out.get("truth")
+    if isinstance(sensor, dict) and "dropout" not in sensor and isinstance(truth, dict):
+        # stored before sensor.dropout existed, when the instrument missed 1 − pd of the
+        # readings on every truth: the default now does so on the isotropic truth only
+        if truth.get("model", "isotropic") != "isotropic":
+            sensor["dropout"] = round(1.0 - float(sensor.get("pd", 0.7)), 12)
+        else:
+            sensor["dropout"] = None
     for path, default in LATER_DEFAULTS.items():
         node = out
         for key in path[:-1]:

@@ -35,11 +35,12 @@ A scenario is a TOML file (or a built-in, see :mod:`dcee.scenarios.builtin`)::
     sigma_frac = 0.5
     false_alarm = 0.0
     max_reading = 1e4              # physical maximum; larger readings are refused
+    dropout = 0.0                  # simulated misses [default: 1 - pd isotropic, 0 turbulent]
     average = 5.0                  # s averaged at the end of each hold [default: see SensorSpec]
 
     [estimator]                    # the reading model of the filter and the planners
     likelihood = "paper"           # or "fluctuation" (intermittent log-normal, for real plumes)
-    intermittency = 0.63           # fluctuation only
+    intermittency = 0.93           # fluctuation only
     log_sd = 1.3                   # fluctuation only
     near_source_length = 10.0      # fluctuation only, m
     calm_prior = 0.1               # fluctuation only: prior probability of a calm plume (0: off)
@@ -284,6 +285,12 @@ class SensorSpec(BaseModel):
     """g/m³: scale of the exponential distribution of false-alarm readings"""
     max_reading: Positive = 1e4
     """g/m³: physical maximum; a told reading above it is refused (a fault, not a measurement)"""
+    dropout: Annotated[float | None, Field(ge=0, lt=1, allow_inf_nan=False)] = None
+    """probability that the *simulated* instrument misses a reading above the threshold.
+    None: 1 − ``pd`` on the isotropic truth (the paper's Pd stands for turbulent intermittency
+    and missed detections together, and that truth simulates no turbulence), 0 on a time-varying
+    truth (it makes the turbulence's gaps itself; an instrument's own dropout rate is not known).
+    ``pd`` itself is the paper likelihood's (estimator side)."""
     average: Annotated[float | None, Field(ge=0, le=600, allow_inf_nan=False)] = None
     """s: each reading averages the truth over the last ``average`` seconds of the hold,
     sub-sampled at the truth's time step (no effect on the time-invariant isotropic truth).
@@ -318,8 +325,9 @@ class EstimatorSpec(BaseModel):
     ``likelihood = "fluctuation"``: an intermittent log-normal reading about the isotropic
     plume's time mean (Yee & Chan 1997; see :mod:`dcee.models.sensor`), with the sensor's
     threshold, ``intermittency``, ``log_sd`` and ``near_source_length`` (intermittency and
-    log_sd fitted by maximum likelihood to 5 s hold averages of the filament truth, readings as
-    the instrument reports them: ``scripts/fluctuation_stats.py``; the near-source length
+    log_sd fitted by maximum likelihood to 4 s hold averages of the filament truth, readings as
+    the instrument reports them there — without random misses, ``sensor.dropout``'s default on
+    a turbulent truth: ``scripts/fluctuation_stats.py --hold 4 --pd 1``; the near-source length
     chosen by the searches' calibration, docs/scenarios.md).
     With ``calm_prior`` > 0 the fluctuation likelihood estimates the turbulence level online: a
     second filter runs the paper's calm model (the ``[sensor]`` parameters, no meander) on the
@@ -331,7 +339,7 @@ class EstimatorSpec(BaseModel):
 
     model_config = _FROZEN
     likelihood: Likelihood = "paper"
-    intermittency: Annotated[float, Field(gt=0, le=1)] = 0.63
+    intermittency: Annotated[float, Field(gt=0, le=1)] = 0.93
     """fluctuation: probability that a reading well inside the plume is not zero"""
     log_sd: Annotated[float, Field(gt=0, le=5)] = 1.3
     """fluctuation: standard deviation s of ln(reading) about ln(mean) − s²/2 (far from the
@@ -565,6 +573,14 @@ class Scenario(BaseModel):
         return self.dwell if self.time_varying_truth else 0.0
 
     @property
+    def instrument_pd(self) -> float:
+        """P(the simulated instrument reports a concentration above the threshold): 1 −
+        ``sensor.dropout``, or its default for the truth (see :class:`SensorSpec`)."""
+        if self.sensor.dropout is not None:
+            return 1.0 - self.sensor.dropout
+        return 1.0 if self.time_varying_truth else self.sensor.pd
+
+    @property
     def meander(self) -> float:
         e = self.estimator
         return e.meander if e.meander is not None else MEANDER_DEFAULT[e.likelihood]
@@ -579,6 +595,7 @@ class Scenario(BaseModel):
         return {
             "dwell": self.dwell,
             "average": self.average,
+            "dropout": round(1.0 - self.instrument_pd, 12),
             "likelihood": self.estimator.likelihood,
             "reading_models": "+".join(self.reading_models),
             "outlier": self.outlier,
@@ -591,9 +608,13 @@ class Scenario(BaseModel):
         return SearchVolume(tuple(self.volume.low), tuple(self.volume.high))
 
     def make_sensor(self) -> Sensor:
-        """The instrument that produces the (simulated) real readings."""
-        spec = self.sensor.model_dump(exclude={"average", "response_time"})
-        return Sensor(**spec)
+        """The instrument that produces the (simulated) real readings: the ``[sensor]``
+        parameters with its detection probability :attr:`instrument_pd`."""
+        return dataclasses.replace(self._paper_sensor(), pd=self.instrument_pd)
+
+    def _paper_sensor(self) -> Sensor:
+        """The paper's eq. 3 with the ``[sensor]`` parameters (its Pd included)."""
+        return Sensor(**self.sensor.model_dump(exclude={"average", "response_time", "dropout"}))
 
     @property
     def reading_models(self) -> tuple[str, ...]:
@@ -617,7 +638,7 @@ class Scenario(BaseModel):
         s, e = self.sensor, self.estimator
         model = self._reading_model(model)
         if model == "paper":
-            return dataclasses.replace(self.make_sensor(), outlier=self.outlier)
+            return dataclasses.replace(self._paper_sensor(), outlier=self.outlier)
         return Sensor(
             threshold=s.threshold,
             pd=e.intermittency,
