@@ -80,23 +80,28 @@ def search_that_kills_its_worker_on_seed_1(task):
     return run_search(task)
 
 
+def _terms_from_concentrations(conc, dist, sensor):
+    """The position terms (loc, log_nd, inv_sigma, det_offset), each (P, N), from raw
+    concentrations (P, N) and distances (P, N; None: far), by the NumPy sensor model
+    (position_rows computes them from source terms; these tests feed raw concentrations)."""
+    conc = np.ascontiguousarray(conc)
+    dist = np.full_like(conc, np.inf) if dist is None else np.ascontiguousarray(dist)
+    loc, sigma = sensor._loc_sigma(conc, dist)
+    with np.errstate(divide="ignore"):
+        det_offset = np.log(sensor.detect_prob(dist)) - np.log(sigma)
+    return [
+        np.ascontiguousarray(a)
+        for a in (loc, sensor.log_likelihood(0.0, conc, dist), 1.0 / sigma, det_offset)
+    ]
+
+
 def compiled_predicted_stats(conc, source, weights, task_pos, task_z, sensor, dist=None, **flags):
     """The compiled predicted-posterior statistics with the reference's arguments:
     (log_evidence, mean, trace_cov, kl) for raw concentrations (P, N), distances (P, N; None:
     far) and readings (S, T)."""
     from dcee.planning.predicted_kernels import predicted_posterior_stats
 
-    conc = np.ascontiguousarray(conc)
-    dist = np.full_like(conc, np.inf) if dist is None else np.ascontiguousarray(dist)
-    # the reading-free terms, from the NumPy sensor model (position_rows computes them from
-    # source terms; these tests feed raw concentrations)
-    loc, sigma = sensor._loc_sigma(conc, dist)
-    with np.errstate(divide="ignore"):
-        det_offset = np.log(sensor.detect_prob(dist)) - np.log(sigma)
-    terms = [
-        np.ascontiguousarray(a)
-        for a in (loc, sensor.log_likelihood(0.0, conc, dist), 1.0 / sigma, det_offset)
-    ]
+    terms = _terms_from_concentrations(conc, dist, sensor)
     s = len(task_pos)
     out = [np.empty(s), np.empty((s, 3)), np.empty(s), np.empty(s)]
     predicted_posterior_stats(
@@ -118,15 +123,7 @@ def compiled_location_kl(conc, source, weights, task_pos, task_z, sensor, cell, 
     :func:`compiled_predicted_stats`)."""
     from dcee.planning.predicted_kernels import location_cells, location_kl
 
-    conc = np.ascontiguousarray(conc)
-    dist = np.full_like(conc, np.inf) if dist is None else np.ascontiguousarray(dist)
-    loc, sigma = sensor._loc_sigma(conc, dist)
-    with np.errstate(divide="ignore"):
-        det_offset = np.log(sensor.detect_prob(dist)) - np.log(sigma)
-    terms = [
-        np.ascontiguousarray(a)
-        for a in (loc, sensor.log_likelihood(0.0, conc, dist), 1.0 / sigma, det_offset)
-    ]
+    terms = _terms_from_concentrations(conc, dist, sensor)
     tv, tfa, tout, _ = sensor.transformed_readings(np.asarray(task_z, dtype=float))
     out = np.empty(len(task_pos))
     location_kl(

@@ -57,6 +57,24 @@ class SequenceStats:
         return np.einsum("sj,sj->s", self.probability, values)
 
 
+def _predicted_weights_reference(
+    conc: np.ndarray,
+    dist: np.ndarray,
+    weights: np.ndarray,
+    positions: np.ndarray,
+    readings: np.ndarray,
+    sensor: Sensor,
+) -> tuple[np.ndarray, float]:
+    """Unnormalised predicted weights (N,) w_i Π_t p(z_t | C_i(p_t)) / e^mx after the readings
+    (T,) at position rows (T,), and mx, the largest log-likelihood of a particle with weight."""
+    ll = np.zeros(conc.shape[1])
+    for p, z in zip(positions, readings, strict=True):
+        ll += sensor.log_likelihood(z, conc[p], dist[p])
+    mx = ll[weights > 0].max()
+    # zero-weight particles may exceed mx; clip them so that 0 · exp(·) stays 0
+    return weights * np.exp(np.minimum(ll - mx, 0.0)), float(mx)
+
+
 def predicted_posterior_stats_reference(
     conc: np.ndarray,
     source: np.ndarray,
@@ -70,19 +88,15 @@ def predicted_posterior_stats_reference(
     from concentrations (P, N), source distances (P, N; None: far) and raw readings (S, T).
     Returns (log_evidence, mean, trace_cov, kl)."""
     dist = np.full_like(conc, np.inf) if dist is None else dist
-    s_count, t_count = task_positions.shape
+    s_count = task_positions.shape[0]
     log_ev = np.empty(s_count)
     mean = np.empty((s_count, 3))
     trace = np.empty(s_count)
     kl = np.empty(s_count)
     for s in range(s_count):
-        ll = np.zeros(source.shape[0])
-        for t in range(t_count):
-            p = task_positions[s, t]
-            ll += sensor.log_likelihood(task_readings[s, t], conc[p], dist[p])
-        mx = ll[weights > 0].max()
-        # zero-weight particles may exceed mx; clip them so that 0 · exp(·) stays 0
-        e = weights * np.exp(np.minimum(ll - mx, 0.0))
+        e, mx = _predicted_weights_reference(
+            conc, dist, weights, task_positions[s], task_readings[s], sensor
+        )
         w_post = e / e.sum()
         log_ev[s] = mx + np.log(e.sum())
         mean[s] = w_post @ source
@@ -112,11 +126,9 @@ def location_kl_reference(
     prior = np.bincount(cell_of, weights=weights)
     out = np.empty(task_positions.shape[0])
     for s in range(task_positions.shape[0]):
-        ll = sum(
-            sensor.log_likelihood(task_readings[s, t], conc[p], dist[p])
-            for t, p in enumerate(task_positions[s])
+        e, _ = _predicted_weights_reference(
+            conc, dist, weights, task_positions[s], task_readings[s], sensor
         )
-        e = weights * np.exp(np.minimum(ll - ll[weights > 0].max(), 0.0))
         post = np.bincount(cell_of, weights=e / e.sum(), minlength=len(prior))
         pos = post > 0
         out[s] = np.sum(post[pos] * np.log(post[pos] / prior[pos]))

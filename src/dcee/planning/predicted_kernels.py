@@ -540,6 +540,44 @@ def _grouped_stats(
             partial[b, s0 + j, 5] = a5[j]
 
 
+@njit(cache=True, inline="always")
+def _task_log_likelihoods(
+    s: int,
+    task_positions: np.ndarray,
+    task_v: np.ndarray,
+    task_fa: np.ndarray,
+    task_out: np.ndarray,
+    loc: np.ndarray,
+    log_nd: np.ndarray,
+    inv_sigma: np.ndarray,
+    det_offset: np.ndarray,
+    weights: np.ndarray,
+    sp: SensorParams,
+    ll: np.ndarray,
+) -> float:
+    """ll[i] = Σ_t log p(z_st | C_i(p_st)) (less the Jacobian) for every particle i, sequentially;
+    returns the largest over the particles with weight (−inf if none)."""
+    mx = -np.inf
+    for i in range(weights.shape[0]):
+        v = 0.0
+        for t in range(task_positions.shape[1]):
+            p = task_positions[s, t]
+            v += _loglik_cached(
+                task_v[s, t],
+                task_fa[s, t],
+                task_out[s, t],
+                loc[p, i],
+                log_nd[p, i],
+                inv_sigma[p, i],
+                det_offset[p, i],
+                sp,
+            )
+        ll[i] = v
+        if weights[i] > 0.0 and v > mx:
+            mx = v
+    return mx
+
+
 @njit(cache=True, parallel=True)
 def _exact_task_stats(
     loc: np.ndarray,
@@ -564,24 +602,20 @@ def _exact_task_stats(
     for q in prange(tasks.shape[0]):
         s = tasks[q]
         ll = np.empty(n)
-        mx = -np.inf
-        for i in range(n):
-            v = 0.0
-            for t in range(task_positions.shape[1]):
-                p = task_positions[s, t]
-                v += _loglik_cached(
-                    task_v[s, t],
-                    task_fa[s, t],
-                    task_out[s, t],
-                    loc[p, i],
-                    log_nd[p, i],
-                    inv_sigma[p, i],
-                    det_offset[p, i],
-                    sp,
-                )
-            ll[i] = v
-            if weights[i] > 0.0 and v > mx:
-                mx = v
+        mx = _task_log_likelihoods(
+            s,
+            task_positions,
+            task_v,
+            task_fa,
+            task_out,
+            loc,
+            log_nd,
+            inv_sigma,
+            det_offset,
+            weights,
+            sp,
+            ll,
+        )
         log_max[q] = mx
         for a in range(_N_ACC):
             sums[q, a] = 0.0
@@ -754,28 +788,23 @@ def location_kl(
     task (its largest log-likelihood, then the cell sums), sequential within a task, so results do
     not depend on the thread count."""
     n = weights.shape[0]
-    t_count = task_positions.shape[1]
     n_cells = cell_start.shape[0] - 1
     for s in prange(task_positions.shape[0]):
         ll = np.empty(n)
-        mx = -np.inf
-        for i in range(n):
-            v = 0.0
-            for t in range(t_count):
-                p = task_positions[s, t]
-                v += _loglik_cached(
-                    task_v[s, t],
-                    task_fa[s, t],
-                    task_out[s, t],
-                    loc[p, i],
-                    log_nd[p, i],
-                    inv_sigma[p, i],
-                    det_offset[p, i],
-                    sp,
-                )
-            ll[i] = v
-            if weights[i] > 0.0 and v > mx:
-                mx = v
+        mx = _task_log_likelihoods(
+            s,
+            task_positions,
+            task_v,
+            task_fa,
+            task_out,
+            loc,
+            log_nd,
+            inv_sigma,
+            det_offset,
+            weights,
+            sp,
+            ll,
+        )
         total = 0.0
         acc = 0.0  # Σ_c A_c log(A_c / W_c), A_c the cell's unnormalised predicted weight
         for c in range(n_cells):
