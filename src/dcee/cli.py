@@ -352,6 +352,11 @@ def _print_summary(
         ("plume acquired", str(summary["plume_acquired"])),
         ("time to RMSE < 1 m (s)", _fmt(summary["time_to_rmse_1m"])),
         ("time to RMSE < 0.5 m (s)", _fmt(summary["time_to_rmse_0_5m"])),
+        *(
+            [("longest stall before acquired (s)", f"{summary['longest_stall']:.0f}")]
+            if "longest_stall" in summary  # searches saved before the metric lack it
+            else []
+        ),
         ("steps", str(summary["steps"])),
         ("path length (m)", f"{summary['path_length']:.1f}"),
         ("mean decision time (ms)", f"{1e3 * summary['decision_seconds_mean']:.2f}"),
@@ -459,6 +464,12 @@ def scenarios() -> None:
 
     for name, data in builtin_scenarios().items():
         click.echo(f"{name:14s} {data['description']}")
+    click.echo(
+        f"{'random:K':14s} Random configuration K (any integer >= 1): source anywhere in the "
+        "50 m x 50 m area, wind from any direction, speed, release rate, height and dispersion "
+        "drawn from K alone; K < 1000 tuning range, K >= 1000 reporting range (docs/scenarios.md)."
+    )
+    click.echo(f"{'random-start:K':14s} The same as random:K with a start drawn over the area.")
 
 
 @cli.command()

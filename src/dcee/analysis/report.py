@@ -150,6 +150,11 @@ def metrics_table(runs: pd.DataFrame) -> pd.DataFrame:
                     f"reached_{level}": float(np.isfinite(t).mean()),
                 }
             )
+        # the longest stall of any search (s), and how many stalled > STALL_SECONDS; NaN for
+        # searches saved before the metric existed
+        stall = pd.to_numeric(g.get("longest_stall", pd.Series(np.nan, g.index)), errors="coerce")
+        row["longest_stall"] = float(stall.max()) if stall.notna().all() else math.nan
+        row["stalled"] = int((stall > STALL_SECONDS).sum()) if stall.notna().all() else -1
         for key, col in (("path_length", "path_length"), ("decision_ms", "decision_seconds_mean")):
             scale = 1e3 if key == "decision_ms" else 1.0
             v, lo, hi = mean_ci(g[col].to_numpy() * scale)
@@ -226,13 +231,25 @@ def _fmt(v: float, lo: float, hi: float, digits: int = 2, pct: bool = False) -> 
     return body + ("%" if pct else "")
 
 
+STALL_SECONDS = 60.0
+"""s: a search that stays within one step of one position longer than this before it has the
+source is counted as stalled (the issue-28 bar)."""
+
+
+def _fmt_stall(longest: float, stalled: int) -> str:
+    """The longest stall of any search, s, and how many searches stalled > STALL_SECONDS."""
+    if not math.isfinite(longest):
+        return "n/a"
+    return f"{longest:.0f} ({stalled} > {STALL_SECONDS:.0f} s)"
+
+
 def markdown_table(table: pd.DataFrame) -> str:
     head = (
         "| strategy | n | source acquired | plume acquired | mean final RMSE (m) | "
         "median final RMSE (m) | median time to RMSE < 1 m (s) | to < 0.5 m (s) | "
-        "path (m) | decision (ms) | truth in 95% region |"
+        "path (m) | decision (ms) | truth in 95% region | longest stall (s) |"
     )
-    lines = [head, "|" + "---|" * 11]
+    lines = [head, "|" + "---|" * 12]
     for _, r in table.iterrows():
         src = _fmt(r.source_acquired_rate, r.source_acquired_lo, r.source_acquired_hi, pct=True)
         plume = _fmt(r.plume_acquired_rate, r.plume_acquired_lo, r.plume_acquired_hi, pct=True)
@@ -246,7 +263,8 @@ def markdown_table(table: pd.DataFrame) -> str:
             f"| {t05} ({r.reached_0_5m:.0%}) "
             f"| {_fmt(r.path_length, r.path_length_lo, r.path_length_hi, 0)} "
             f"| {_fmt(r.decision_ms, r.decision_ms_lo, r.decision_ms_hi, 1)} "
-            f"| {_fmt(r.truth_in_95_rate, r.truth_in_95_lo, r.truth_in_95_hi, pct=True)} |"
+            f"| {_fmt(r.truth_in_95_rate, r.truth_in_95_lo, r.truth_in_95_hi, pct=True)} "
+            f"| {_fmt_stall(r.longest_stall, r.stalled)} |"
         )
     return "\n".join(lines) + "\n"
 

@@ -8,6 +8,10 @@
   code (sources scaled by 1.5; ``paper75:K``).
 * ``lab`` and ``lab-robot``: the paper's indoor experiment (section 6) in simulation, its two
   starts, with the grid agent and with the unicycle robot (``agent.model = "unicycle"``).
+* ``random-tune``: ``random:1`` … ``random:40``, random configurations of the tuning range
+  (choose defaults here).
+* ``held-out``: ``random:1000`` … ``random:1199``, 200 random configurations of the reporting
+  range (report here; no default is chosen on them). See docs/scenarios.md.
 * ``smoke``: two of them at toy scale (1,000 particles, 10 hypothesised readings, 60 s) so a
   campaign with every strategy finishes in well under a minute; for CI and for trying options.
 """
@@ -18,6 +22,7 @@ from typing import Any
 
 from dcee.errors import DceeInputError
 from dcee.scenarios import Scenario, load_scenario
+from dcee.scenarios.builtin import RANDOM_REPORTING_FROM
 
 SUITES: dict[str, dict] = {
     "paper": {"configs": [f"paper:{k}" for k in range(1, 13)], "overrides": {}},
@@ -38,6 +43,13 @@ SUITES: dict[str, dict] = {
     "lab-robot": {
         "configs": ["lab:downwind", "lab:upwind"],
         "overrides": {"agent.model": "unicycle"},
+    },
+    "random-tune": {"configs": [f"random:{k}" for k in range(1, 41)], "overrides": {}},
+    "held-out": {
+        "configs": [
+            f"random:{k}" for k in range(RANDOM_REPORTING_FROM, RANDOM_REPORTING_FROM + 200)
+        ],
+        "overrides": {},
     },
     "smoke": {
         "configs": ["paper:1", "paper:6"],

@@ -6,19 +6,29 @@ import tomllib
 from pathlib import Path
 
 from dcee.errors import DceeInputError
-from dcee.scenarios.builtin import builtin_scenarios
+from dcee.scenarios.builtin import builtin_scenarios, random_configuration, random_family_name
 from dcee.scenarios.config import Scenario, validate_scenario
 
 
 def load_scenario(name_or_path: str) -> Scenario:
-    """A built-in (``paper:3``, ``lab:upwind``) or a TOML file by path."""
+    """A built-in (``paper:3``, ``lab:upwind``, ``random:17``) or a TOML file by path."""
     builtins = builtin_scenarios()
     if name_or_path in builtins:
         return validate_scenario(builtins[name_or_path])
+    try:
+        family = random_family_name(name_or_path)
+    except ValueError as exc:
+        raise DceeInputError("scenario", str(exc)) from None
+    if family is not None:
+        return validate_scenario(
+            random_configuration(family[1], random_start=family[0] == "random-start")
+        )
     path = Path(name_or_path)
     if not path.suffix == ".toml" and ":" in name_or_path:
         raise DceeInputError(
-            "scenario", f"unknown built-in {name_or_path!r}; choose one of {', '.join(builtins)}"
+            "scenario",
+            f"unknown built-in {name_or_path!r}; choose one of {', '.join(builtins)}, "
+            "random:K or random-start:K (K an integer >= 1)",
         )
     if not path.is_file():
         raise DceeInputError("scenario", f"no such file {str(path)!r} and no such built-in")

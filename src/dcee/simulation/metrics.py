@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -16,6 +17,57 @@ def first_time_below(times: np.ndarray, values: np.ndarray, level: float) -> flo
     return float(times[hit[0]]) if len(hit) else None
 
 
+def longest_stall(
+    times: np.ndarray,
+    positions: np.ndarray,
+    acquired: np.ndarray,
+    step: float,
+) -> float:
+    """Longest time, s, the agent stayed within one step of one position while the source was
+    not yet acquired: the longest window [t_i, t_j] of consecutive readings whose positions all
+    lie within ``step`` m (horizontally) of the window's first position p_i and none of which
+    had the source acquired (``acquired`` False: RMSE ≥ ``search.acquired_rmse``).
+
+    times: (n,) s, non-decreasing; positions: (n, 2 or 3) m; acquired: (n,) bool. A robot that
+    paces between two cells one step apart, or hovers on one spot, makes a long window; one that
+    moves on makes windows of a step or two (0 s when every reading is at a new place). Holding
+    where the source is already acquired is not a stall.
+    """
+    n = len(times)
+    xy = np.asarray(positions, float)[:, :2]
+    reach = step * (1.0 + 1e-9) + 1e-9
+    best = 0.0
+    i = 0
+    while i < n:
+        if acquired[i]:
+            i += 1
+            continue
+        j = i
+        while j + 1 < n and not acquired[j + 1] and math.hypot(*(xy[j + 1] - xy[i])) <= reach:
+            j += 1
+        best = max(best, float(times[j] - times[i]))
+        i += 1
+    return best
+
+
+def search_stall(records: list[dict[str, Any]], step: float, acquired_rmse: float) -> float:
+    """:func:`longest_stall` of a search's records, s: the longest over its robots."""
+    robots = np.array([r.get("robot", 0) for r in records])
+    best = 0.0
+    for robot in np.unique(robots):
+        rows = [r for r, k in zip(records, robots, strict=True) if k == robot]
+        best = max(
+            best,
+            longest_stall(
+                np.array([r["time"] for r in rows]),
+                np.array([[r["x"], r["y"]] for r in rows]),
+                np.array([r["rmse"] < acquired_rmse for r in rows]),
+                step,
+            ),
+        )
+    return best
+
+
 def summarise(
     records: list[dict[str, Any]],
     scenario: Scenario,
@@ -27,7 +79,8 @@ def summarise(
 
     plume_acquired: any reading at or above the sensor threshold; source_acquired: final RMSE
     below ``search.acquired_rmse`` (3 m in the paper); time_to_rmse_*: first time the RMSE of
-    the particles about the true source falls below 1 m / 0.5 m (null if never).
+    the particles about the true source falls below 1 m / 0.5 m (null if never);
+    longest_stall: :func:`search_stall`, s (a robot pacing on one spot before it has the source).
     """
     times = np.array([r["time"] for r in records])
     rmse = np.array([r["rmse"] for r in records])
@@ -54,6 +107,7 @@ def summarise(
         "detections": int(sum(r["detection"] for r in records)),
         "time_to_rmse_1m": first_time_below(times, rmse, 1.0),
         "time_to_rmse_0_5m": first_time_below(times, rmse, 0.5),
+        "longest_stall": search_stall(records, scenario.agent.step, scenario.search.acquired_rmse),
         "steps": steps,
         "readings": len(records),
         "agents": int(scenario.agent.count),
