@@ -17,6 +17,7 @@ SUMMARY_KEYS = {
     "strategy",
     "scenario",
     "seed",
+    "longest_stall",
 }
 """Keys the issue requires in every run summary."""
 

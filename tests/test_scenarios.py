@@ -133,3 +133,44 @@ def test_the_base_of_those_cases_is_valid(tmp_path):
     path = tmp_path / "s.toml"
     path.write_text(BASE_TOML.format(agent="", q=GOOD_Q, u=GOOD_U))
     assert load_scenario(str(path)).unknown == "full"
+
+
+def test_random_family_is_reproducible_covers_the_area_and_keeps_ranges_apart():
+    from dcee.scenarios.builtin import RANDOM_RANGES, RANDOM_REPORTING_FROM
+
+    a, b = load_scenario("random:17"), load_scenario("random:17")
+    assert a.model_dump() == b.model_dump() and a.name == "random:17"
+    # pinned values: the draw must not change across machines or releases (PCG64 is stable)
+    assert (a.truth.x, a.truth.y, a.truth.phi) == (42.01, 2.99, 231.57)
+    assert "tuning range" in a.description
+    assert "reporting range" in load_scenario(f"random:{RANDOM_REPORTING_FROM}").description
+    truths = [load_scenario(f"random:{k}").truth for k in range(1, 201)]
+    for name, (low, high) in RANDOM_RANGES.items():
+        values = np.array([getattr(t, name) for t in truths])
+        assert values.min() >= low and values.max() <= high, name
+        assert values.max() - values.min() > 0.8 * (high - low), name  # the whole range
+    xy = np.array([(t.x, t.y) for t in truths])
+    assert (xy < 4).any(axis=0).all() and (xy > 46).any(axis=0).all()  # near every edge
+    s = load_scenario("random:5")
+    assert s.prior["phi"].mean == s.truth.phi and s.agent.start == (2, 2, 4)
+
+
+def test_random_start_keeps_the_source_and_draws_a_start():
+    a, b = load_scenario("random:9"), load_scenario("random-start:9")
+    assert a.truth == b.truth and b.agent.start != a.agent.start
+    assert all(1 <= c <= 49 for c in b.agent.start[:2]) and b.agent.start[2] == 4
+
+
+@pytest.mark.parametrize("name", ["random:0", "random:x", "random:-3", "random:1.5"])
+def test_bad_random_names_are_user_errors(name):
+    with pytest.raises(DceeInputError, match="scenario"):
+        load_scenario(name)
+
+
+def test_random_suites_keep_tuning_and_reporting_apart():
+    from dcee.campaign.suites import SUITES
+
+    tune = {int(n.split(":")[1]) for n in SUITES["random-tune"]["configs"]}
+    report = {int(n.split(":")[1]) for n in SUITES["held-out"]["configs"]}
+    assert len(report) == 200 and not tune & report
+    assert max(tune) < 1000 <= min(report)

@@ -6,7 +6,14 @@ planner in another package appears everywhere through the ``dcee.planners`` entr
 (see :data:`dcee.planning.base.ENTRY_POINT_GROUP`).
 """
 
-from dcee.planning import dcee, dcee_closed_loop, entrotaxis, infotaxis, mpc  # noqa: F401
+from dcee.planning import (  # noqa: F401
+    dcee,
+    dcee_closed_loop,
+    entrotaxis,
+    infotaxis,
+    mpc,
+    tree_search,
+)
 from dcee.planning.base import (
     Belief,
     Decision,

@@ -30,7 +30,7 @@ def longest_stall(
 
     times: (n,) s, non-decreasing; positions: (n, 2 or 3) m; acquired: (n,) bool. A robot that
     paces between two cells one step apart, or hovers on one spot, makes a long window; one that
-    moves on makes windows of a step or two (0 s when every reading is at a new place). Holding
+    moves on makes windows of one move (the reading before it and the one after). Holding
     where the source is already acquired is not a stall.
     """
     n = len(times)

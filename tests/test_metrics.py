@@ -1,0 +1,38 @@
+"""Summary metrics against hand calculations: the longest stall."""
+
+import numpy as np
+
+from dcee.simulation.metrics import longest_stall, search_stall
+
+
+def _stall(xy, acquired=None, step=2.0, dt=2.0):
+    xy = np.asarray(xy, float)
+    times = dt * np.arange(len(xy))
+    acq = np.zeros(len(xy), bool) if acquired is None else np.asarray(acquired, bool)
+    return longest_stall(times, xy, acq, step)
+
+
+def test_pacing_between_two_cells_is_a_stall_and_moving_on_is_not():
+    pacing = [(0, 0), (2, 0)] * 10  # 20 readings 2 s apart, never more than a step away
+    assert _stall(pacing) == 38.0
+    straight = [(2 * k, 0) for k in range(20)]  # each reading one step further
+    assert _stall(straight) == 2.0  # one move: the reading before and the one after
+    diagonal = [(0, 0), (2, 0), (2, 2), (0, 2)] * 3  # a 2 m square: (2, 2) is 2.83 m away
+    assert _stall(diagonal) == 2.0
+    assert _stall([(0, 0)]) == 0.0
+
+
+def test_pacing_after_the_source_is_acquired_is_not_a_stall():
+    pacing = [(0, 0), (2, 0)] * 10
+    acquired = [False] * 6 + [True] * 14
+    assert _stall(pacing, acquired) == 10.0  # readings 0-5
+    assert _stall(pacing, [True] * 20) == 0.0
+
+
+def test_a_team_stalls_as_long_as_its_longest_stalling_robot():
+    rows = []
+    for k in range(10):  # robot 0 paces, robot 1 moves on, both read every 2 s
+        rows.append({"robot": 0, "time": 2.0 * k, "x": 2.0 * (k % 2), "y": 0.0, "rmse": 9.0})
+        rows.append({"robot": 1, "time": 2.0 * k, "x": 2.0 * k, "y": 9.0, "rmse": 9.0})
+    assert search_stall(rows, 2.0, 3.0) == 18.0
+    assert search_stall(rows[1::2], 2.0, 3.0) == 2.0
