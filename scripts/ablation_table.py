@@ -1,6 +1,8 @@
 """Markdown table of an ablation: each campaign folder against a reference one, searches paired
 by (configuration, repeat) — the common random numbers make the pairing exact — with Wilson
-intervals, exact McNemar tests, median final RMSE and the paired time to RMSE < 1 m (Wilcoxon).
+intervals, exact McNemar tests, median final RMSE, the paired time to RMSE < 1 m (Wilcoxon) and
+the longest stall (summary ``longest_stall``: the longest time within one step of one position
+before the source was acquired; how many searches stalled > 60 s).
 
 A folder may hold several strategies: ``DIR=STRATEGY`` picks one (the strategy spec as stored,
 e.g. ``results/filament-calm=infotaxis``); a folder without ``=`` must hold just one.
@@ -38,9 +40,9 @@ def main() -> None:
     print(
         "| variant | n | source acquired | truth in 95% region | median final RMSE (m) | "
         "only reference / only variant | McNemar p | median time to RMSE < 1 m (s) | "
-        "paired difference to the reference (s), Wilcoxon p |"
+        "paired difference to the reference (s), Wilcoxon p | longest stall (s) |"
     )
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for arg in [ref_arg, *others]:
         label, runs = _runs(arg)
         keys = runs.index.intersection(ref.index)
@@ -58,12 +60,18 @@ def main() -> None:
         if both.sum() > 0 and (diff != 0).any():
             paired = f"{diff.median():+.0f} (p = {wilcoxon(t_var[both], t_ref[both]).pvalue:.2g})"
         got = int(t_var.notna().sum())
-        reached = f"{t_var.median():.0f} ({got} got there)" if got else "— (none got there)"
+        # the median over every search, one that never got there counting as later than all
+        median = t_var.fillna(float("inf")).median()
+        reached = f"{median:.0f} ({got}/{len(t_var)} got there)" if got else "— (none got there)"
+        stall = pd.to_numeric(runs.loc[keys].get("longest_stall"), errors="coerce")
+        stalls = "n/a"
+        if stall.notna().all():
+            stalls = f"{stall.max():.0f} ({int((stall > 60).sum())} > 60 s)"
         print(
             f"| {label} | {len(b)} | {r:.0%} [{lo:.0%}, {hi:.0%}] "
             f"| {c:.0%} [{clo:.0%}, {chi:.0%}] "
             f"| {runs.loc[keys, 'final_rmse'].median():.2f} | {only_ref} / {only_var} | {p:.3f} "
-            f"| {reached} | {paired} |"
+            f"| {reached} | {paired} | {stalls} |"
         )
 
 

@@ -97,7 +97,7 @@ def test_bad_scenarios_exit_2(tmp_path, capsys):
 
 def test_scenarios_and_show(capsys):
     code, out, _ = run_cli(["scenarios"], capsys)
-    assert code == 0 and out.count("\n") == 26 and "lab:upwind" in out
+    assert code == 0 and out.count("\n") == 28 and "lab:upwind" in out and "random:K" in out
     code, out, _ = run_cli(["show", "paper:3", "--format", "json"], capsys)
     assert code == 0 and json.loads(out)["truth"]["y"] == 40.0
 
@@ -107,7 +107,7 @@ def test_show_writes_a_scenario_file_that_loads_back_equal(capsys, tmp_path):
     the same scenario (the issue: show printed JSON that --scenario could not load)."""
     from dcee.scenarios import load_scenario
 
-    for name in ("paper:3", "lab:upwind", "paper75:12"):
+    for name in ("paper:3", "lab:upwind", "paper75:12", "random:17", "random-start:1200"):
         code, out, _ = run_cli(["show", name], capsys)
         path = tmp_path / f"{name.replace(':', '-')}.toml"
         path.write_text(out)
@@ -287,3 +287,34 @@ def test_smoke_bench_with_four_strategies_then_report(tmp_path, capsys):
 def test_perf_refuses_an_unwritable_json_before_timing(capsys):
     code, _, err = run_cli(["perf", "--quick", "--json", "/proc/dcee-perf/x.json"], capsys)
     assert code == 2 and err.startswith("dcee: error: json:") and err.count("\n") == 1
+
+
+def test_every_registered_planner_runs_on_a_random_configuration(capsys, tmp_path):
+    """`dcee run --scenario random:K --strategy S` for every registered S (toy scale)."""
+    from dcee.planning import names
+
+    for k, strategy in enumerate(names()):
+        out = tmp_path / strategy
+        code, _, err = run_cli(
+            [
+                "run",
+                "--scenario",
+                f"random:{1000 + k}",
+                "--strategy",
+                strategy,
+                "--particles",
+                "300",
+                "--hypotheses",
+                "4",
+                "--budget",
+                "6",
+                "--out",
+                str(out),
+                "--no-figure",
+                "-q",
+            ],
+            capsys,
+        )
+        assert code == 0, (strategy, err)
+        summary = json.loads((out / "summary.json").read_text())
+        assert summary["scenario"] == f"random:{1000 + k}" and summary["longest_stall"] >= 0

@@ -281,7 +281,7 @@ def test_closed_loop_dcee_limits():
     rng = np.random.default_rng
     # reach 0 and the location variance as the uncertainty: the open-loop DCEE loss,
     # hypothesis by hypothesis
-    cl = planners.get("dcee-cl:info_share=0", reach=0.0, n_hypotheses=200).decide(
+    cl = planners.get("dcee-cl:info_share=0:spread_reach=0", reach=0.0, n_hypotheses=200).decide(
         belief, START, AGENT, rng(3)
     )
     op = planners.get("dcee", expectation="stratified", n_hypotheses=200).decide(
@@ -403,7 +403,8 @@ def test_spread_reach_scales_the_free_disk_with_the_belief():
     # Four equally weighted points at (±3, ±4) around (10, 10): var x + var y = 9 + 16 = 25.
     pts = [(7.0, 6.0), (13.0, 14.0), (7.0, 14.0), (13.0, 6.0)]
     belief = _belief(pts)
-    assert planners.get("dcee-cl:reach=2").effective_reach(belief) == 2.0
+    assert planners.get("dcee-cl:reach=2:spread_reach=0").effective_reach(belief) == 2.0
+    assert planners.get("dcee-cl:reach=2").effective_reach(belief) == 10.0  # the default 2 σ
     assert planners.get("dcee-cl:reach=2:spread_reach=1").effective_reach(belief) == 5.0
     assert planners.get("dcee-cl:reach=8:spread_reach=1").effective_reach(belief) == 8.0
     with pytest.raises(DceeInputError, match="spread_reach"):
