@@ -96,3 +96,13 @@ def test_tree_search_options_are_checked():
     ):
         with pytest.raises(DceeInputError, match=field):
             planners.get(spec)
+
+
+def test_tree_search_plans_for_each_robot_of_a_team():
+    from dcee.planning import decide_team
+
+    belief = _spread_belief()
+    planner = planners.get("dcee-mcts", simulations=16, depth=2, subsample=1.0)
+    positions = np.array([START, START + np.array([2.0, 0.0, 0.0])])
+    out = decide_team(planner, belief, positions, AGENT, np.random.default_rng(0))
+    assert len(out) == 2 and not np.allclose(out[0].position, out[1].position)

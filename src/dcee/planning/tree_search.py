@@ -72,6 +72,8 @@ class TreeNode:
     position: np.ndarray
     heading: int
     value: float = math.inf
+    rollout_value: float = math.inf
+    """the cost of this node's own rollout (inf until scored)"""
     visits: int = 0
     """sequences scored at this node (its own rollout) and below it"""
     scored: bool = False
@@ -109,7 +111,8 @@ def search_tree(
             continue
         costs = score(np.stack([complete(k) for k in kids]))
         for k, c in zip(kids, costs, strict=True):
-            k.value, k.visits, k.scored = float(c), 1, True
+            k.value = k.rollout_value = float(c)
+            k.visits, k.scored = 1, True
             k.exhausted = len(k.path) >= depth
         node.children = kids
         scored += len(kids)
@@ -129,10 +132,11 @@ def _ucb_choice(live: Sequence[TreeNode], parent_visits: int, exploration: float
 
 
 def _backup(ancestors: list[TreeNode]) -> None:
-    """Values (least cost below) and visits (sequences scored below) from the leaf upwards."""
+    """Values (least cost of a scored sequence through the node: its own rollout or one
+    below it) and visits (sequences scored there and below) from the leaf upwards."""
     for node in reversed(ancestors):
         if node.children:
-            node.value = min(c.value for c in node.children)
+            node.value = min(node.rollout_value, *(c.value for c in node.children))
             node.visits = int(node.scored) + sum(c.visits for c in node.children)
             node.exhausted = all(c.exhausted for c in node.children)
 
@@ -203,7 +207,10 @@ class TreeSearchPlanner(Planner):
     ) -> tuple[np.ndarray, dict[str, Any]]:
         belief, ctx = self.cost.context(belief, rng, self.depth)
         turn = np.random.default_rng(rng.integers(2**63))  # rollouts' turns at the edges
-        first_headings = agent.candidates(position)[1]
+        # the heading of each candidate given (a team's robot gets a subset of its moves)
+        every, every_heading = agent.candidates(position)
+        match = np.all(np.abs(candidates[:, None, :] - every[None, :, :]) < 1e-9, axis=2)
+        first_headings = np.where(match.any(axis=1), every_heading[match.argmax(axis=1)], -1)
 
         def children_of(node: TreeNode) -> list[TreeNode]:
             if node.path:
