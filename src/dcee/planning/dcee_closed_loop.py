@@ -14,7 +14,10 @@ with dist² = max(0, ‖s̄'_xy − p_xy‖ − R)² + (s̄'_z − p_z)². Far f
 of it the distance term vanishes and what is left is the expected variance reduction, which
 points at the informative move: the dual-control term the open loop cancels. R must exceed one
 step (otherwise the reading can never change what the agent does next) and not be so large that
-the MPC pull is lost; the default was chosen by measurement (docs/dual-control.md).
+the MPC pull is lost; the default was chosen by measurement (docs/dual-control.md). A fixed R
+cannot suit a belief 20 m wide and one 1 m wide: R = max(``reach``, ``spread_reach`` · σ_xy)
+(default 2 σ_xy) keeps a wide belief's every move free of the distance charge, where a fixed
+8 m made the agent pace on the disk's edge (docs/held-out.md).
 
 The uncertainty term: tr P'(ẑ) counts only what a reading tells about the source *location*.
 With the wind and dispersion unknown, readings that resolve them narrow the location later, and
