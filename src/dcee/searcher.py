@@ -35,6 +35,37 @@ class SourceEstimate:
         return float(math.sqrt(max(np.trace(self.cov), 0.0)))
 
 
+DEFAULT_STALL_GUARD = 30.0
+"""s: after the agent has stayed this long within one step of one position while the belief is
+still wide, its next move must take it further from that position (:class:`Searcher`). Half the
+60 s a stall may last by issue 28's bar; chosen by that bar, not tuned on any configuration."""
+
+STALL_HISTORY = 64
+"""Told positions the stall guard looks back over (more than 30 s of readings at 1 s)."""
+
+
+class LeavingAgent:
+    """An agent's move set without the moves that fail to take the agent further from
+    ``anchor`` (3,) m than it is: what the stall guard hands a planner. Every other attribute
+    is the wrapped agent's. Where no move leaves (a corner), every move stays admissible."""
+
+    def __init__(self, agent: GridAgent, anchor: np.ndarray, start: np.ndarray) -> None:
+        self.agent = agent
+        self.anchor = np.asarray(anchor, dtype=np.float64)
+        self.start = np.asarray(start, dtype=np.float64)
+
+    def candidates(self, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        cands, headings = self.agent.candidates(position)
+        if not np.allclose(position, self.start):  # later moves of a look-ahead: unrestricted
+            return cands, headings
+        now = math.hypot(*(self.start[:2] - self.anchor[:2]))
+        away = np.hypot(*(cands[:, :2] - self.anchor[:2]).T) > now + 0.5 * self.agent.step
+        return (cands[away], headings[away]) if away.any() else (cands, headings)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.agent, name)
+
+
 CHECKPOINT_FORMAT = "dcee-searcher-checkpoint-1"
 """Identifies a :meth:`Searcher.save` file (and its layout version)."""
 
@@ -46,6 +77,14 @@ class Searcher:
     >>> waypoint = searcher.ask()                # where to sample next (3,)
 
     The planner's random draws come from ``rng`` (seeded by the caller); the filter owns its own.
+
+    The stall guard (``stall_guard`` s, 0 = off): when the told positions of the last
+    ``stall_guard`` seconds or more all lie within one step of the first of them (the robot has
+    paced or hovered there) while the belief's spread √tr P exceeds ``guard_spread`` m (the
+    source is not yet located), :meth:`ask` offers the planner only the moves that take the robot
+    further from that position (:class:`LeavingAgent`). A planner whose candidates' costs tie
+    where no reading can tell the hypotheses apart then still moves on to gain information. It
+    never fires in a search that does not pace, so such searches are unchanged.
     A Searcher changes no process-wide state: a program of its own may apply
     :func:`dcee.allocator.tune_allocator` (the command line, campaign workers and the ROS node
     do), and ``tell``/``ask`` limit BLAS to one thread only while they run.
@@ -57,7 +96,20 @@ class Searcher:
         planner: Planner | None,
         agent: GridAgent,
         rng: np.random.Generator,
+        stall_guard: float = DEFAULT_STALL_GUARD,
+        guard_spread: float = 3.0,
     ) -> None:
+        for name, value in (("stall_guard", stall_guard), ("guard_spread", guard_spread)):
+            if isinstance(value, bool) or not (
+                isinstance(value, int | float) and math.isfinite(value) and value >= 0
+            ):
+                raise DceeInputError(name, f"must be a number >= 0, got {value!r}")
+        self.stall_guard = float(stall_guard)
+        self.guard_spread = float(guard_spread)
+        self.recent: list[tuple[float, np.ndarray]] = []
+        """(time s, position (3,) m) of the last told readings, for the stall guard"""
+        self.guard_fired = 0
+        """how many decisions the stall guard restricted"""
         self.filter = particle_filter
         self.planner = planner
         self.agent = agent
@@ -92,6 +144,7 @@ class Searcher:
         self.position = np.asarray(position, dtype=np.float64)
         if time is not None:
             self.time = float(time)
+        self.recent = [*self.recent[-(STALL_HISTORY - 1) :], (self.time, self.position.copy())]
         return self.last_update
 
     def ask(self) -> np.ndarray:
@@ -101,12 +154,35 @@ class Searcher:
         if self.planner is None:
             raise DceeInputError("planner", "this searcher has no planner to ask")
         t0 = _time.perf_counter()
+        agent = self.agent
+        anchor = self.stall_anchor()
+        if anchor is not None:
+            agent = LeavingAgent(self.agent, anchor, self.position)  # type: ignore[assignment]
+            self.guard_fired += 1
         with one_blas_thread():
-            self.last_decision = self.planner.decide(
-                self.belief(), self.position, self.agent, self.rng
-            )
+            self.last_decision = self.planner.decide(self.belief(), self.position, agent, self.rng)
         self.last_decision_seconds = _time.perf_counter() - t0
         return self.last_decision.position.copy()
+
+    def stall_anchor(self) -> np.ndarray | None:
+        """The position (3,) m the robot has stayed within one step of for at least
+        ``stall_guard`` s (the first of the latest run of told positions all within one step of
+        it, as :func:`dcee.simulation.metrics.longest_stall` measures) while the belief's spread
+        exceeds ``guard_spread``; None when the guard does not fire."""
+        if self.stall_guard <= 0 or len(self.recent) < 2:
+            return None
+        times = np.array([t for t, _ in self.recent])
+        xy = np.array([p[:2] for _, p in self.recent])
+        reach = self.agent.step * (1.0 + 1e-9) + 1e-9
+        first = None
+        for i in range(len(xy) - 1, -1, -1):
+            if np.all(np.hypot(*(xy[i:] - xy[i]).T) <= reach):
+                first = i
+        if first is None or times[-1] - times[first] < self.stall_guard:
+            return None
+        if self.estimate().spread <= self.guard_spread:
+            return None  # the source is located: staying near it is what the robot should do
+        return self.recent[first][1]
 
     def ask_team(self, positions: np.ndarray) -> np.ndarray:
         """Next waypoints (K, 3) m of K robots at ``positions`` (K, 3) that share this
@@ -141,6 +217,8 @@ class Searcher:
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
+        # checkpoints written before the stall guard: it was off
+        state = {"stall_guard": 0.0, "guard_spread": 3.0, "recent": [], "guard_fired": 0, **state}
         self.__dict__.update(state)
         self.planning_cache = ParticleTerms()
 

@@ -252,6 +252,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     # the fluctuation likelihood ran without the calm model before the setting existed (so a
     # campaign stored before resumes only with calm_prior = 0, not with the new default)
     ("estimator", "calm_prior"): 0.0,
+    # no stall guard before issue 28
+    ("search", "stall_guard"): 0.0,
     # a constant log-sd before the distance-dependent spread existed
     ("estimator", "log_sd_near"): 0.0,
     ("estimator", "log_sd_length"): 0.0,

@@ -452,6 +452,9 @@ class SearchSpec(BaseModel):
     """m: "source acquired" when the final RMSE is below it"""
     stop_spread: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
     """m: > 0 stops the search once the posterior spread is below it"""
+    stall_guard: Annotated[float, Field(ge=0, le=1e6, allow_inf_nan=False)] = 30.0
+    """s: after this long within one step of one position while the posterior spread exceeds
+    ``acquired_rmse``, the next move must leave that position (0: off; docs/held-out.md)"""
     resample_threshold: Annotated[float, Field(gt=0, le=1)] = 0.5
     """resample when the effective sample size falls below this share of the particles"""
     mcmc_steps: Annotated[int, Field(ge=0, le=100)] = 1

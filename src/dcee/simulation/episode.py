@@ -217,7 +217,14 @@ def make_searcher(
         if len(filters) == 1
         else ModelBank(filters, models, scenario.reading_model_priors)
     )
-    return Searcher(estimator, planner, scenario.make_agent(), planner_rng)
+    return Searcher(
+        estimator,
+        planner,
+        scenario.make_agent(),
+        planner_rng,
+        stall_guard=search.stall_guard,
+        guard_spread=search.acquired_rmse,
+    )
 
 
 def reading_record(

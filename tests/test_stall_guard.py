@@ -1,0 +1,79 @@
+"""The stall guard (Searcher, ``search.stall_guard``): a planner that would pace on one spot
+for ever is made to move on, hovering at a located source is left alone, and a search that
+never paces is unchanged."""
+
+import numpy as np
+import pytest
+
+from dcee import (
+    DceeInputError,
+    GridAgent,
+    IsotropicPlume,
+    ParticleFilter,
+    Searcher,
+    SearchVolume,
+    Sensor,
+)
+from dcee.planning import Planner
+from dcee.scenarios import load_scenario
+from dcee.simulation import run_episode
+from dcee.simulation.metrics import longest_stall
+from tests.helpers import planar_prior
+
+AGENT = GridAgent(SearchVolume((0.0, 0.0, 0.0), (40.0, 40.0, 0.0)), step=2.0, speed=2.0)
+
+
+class _Homing(Planner):
+    """Goes to (10, 10) and then paces around it: the cost is the distance to that point alone,
+    so no reading ever changes its mind (the tie of a stalled planner, made exact)."""
+
+    def costs(self, belief, position, candidates, agent, rng):
+        return np.hypot(candidates[:, 0] - 10.0, candidates[:, 1] - 10.0), {}
+
+
+def _fly(guard: float, prior_box=(0.0, 40.0), moves: int = 120) -> tuple[float, Searcher]:
+    pf = ParticleFilter(
+        planar_prior(x=prior_box, y=prior_box), Sensor(), IsotropicPlume(), 500, seed=0
+    )
+    searcher = Searcher(pf, _Homing(), AGENT, np.random.default_rng(0), stall_guard=guard)
+    position, times, path = np.array([2.0, 2.0, 0.0]), [], []
+    for k in range(moves):
+        searcher.tell(position, 0.0, 2.0 * k)  # nothing is ever detected
+        times.append(2.0 * k)
+        path.append(position)
+        position = searcher.ask()
+    stall = longest_stall(np.array(times), np.array(path), np.zeros(len(path), bool), 2.0)
+    return stall, searcher
+
+
+def test_the_guard_ends_a_stall_that_the_planner_would_never_end():
+    unguarded, s0 = _fly(0.0)
+    assert unguarded > 150 and s0.guard_fired == 0  # it paces around (10, 10) to the end
+    guarded, s1 = _fly(30.0)
+    assert guarded <= 30.0 + 2 * 2.0 and s1.guard_fired > 0  # every stall broken at 30 s
+
+
+def test_the_guard_leaves_a_robot_alone_at_a_located_source():
+    # a belief concentrated near (10, 10): hovering there is the point of the search
+    stall, searcher = _fly(30.0, prior_box=(9.0, 11.0))
+    assert searcher.guard_fired == 0 and stall > 150
+
+
+def test_the_guard_is_off_in_old_checkpoints_and_checked():
+    with pytest.raises(DceeInputError, match="stall_guard"):
+        Searcher(None, None, AGENT, np.random.default_rng(0), stall_guard=-1)
+    state = {"filter": None, "planner": None, "agent": AGENT}
+    old = Searcher.__new__(Searcher)
+    old.__setstate__(state)  # a checkpoint written before the guard existed
+    assert old.stall_guard == 0.0 and old.recent == []
+
+
+def test_a_search_that_never_paces_is_unchanged_by_the_guard():
+    sc = load_scenario("paper:1").with_overrides(
+        **{"search.particles": 1000, "search.hypotheses": 10, "search.budget": 120.0}
+    )
+    a = run_episode(sc, "infotaxis", 0)
+    b = run_episode(sc.with_overrides(**{"search.stall_guard": 0.0}), "infotaxis", 0)
+    assert a.summary["longest_stall"] < 30
+    assert [r["x"] for r in a.records] == [r["x"] for r in b.records]
+    assert a.summary["final_rmse"] == b.summary["final_rmse"]
