@@ -36,3 +36,12 @@ def test_a_team_stalls_as_long_as_its_longest_stalling_robot():
         rows.append({"robot": 1, "time": 2.0 * k, "x": 2.0 * k, "y": 9.0, "rmse": 9.0})
     assert search_stall(rows, 2.0, 3.0) == 18.0
     assert search_stall(rows[1::2], 2.0, 3.0) == 2.0
+
+
+def test_stall_start_is_the_first_of_the_latest_run_within_one_step():
+    from dcee.models.agent import stall_start
+
+    assert stall_start(np.array([[0, 0], [2, 0], [0, 0], [2, 0]]), 2.0) == 0
+    assert stall_start(np.array([[9, 9], [0, 0], [2, 0], [0, 0]]), 2.0) == 1
+    assert stall_start(np.array([[0, 0], [2, 0], [4, 0]]), 2.0) == 1  # moved on: its last move
+    assert stall_start(np.array([[5, 5]]), 2.0) == 0

@@ -16,7 +16,7 @@ from dcee.errors import DceeInputError
 from dcee.estimation.model_bank import ModelBank
 from dcee.estimation.particle_filter import ParticleFilter, UpdateInfo
 from dcee.io import write_atomic
-from dcee.models.agent import GridAgent
+from dcee.models.agent import GridAgent, stall_start
 from dcee.planning.base import Belief, Decision, Planner
 from dcee.planning.particle_terms import ParticleTerms
 from dcee.planning.team import decide_team
@@ -171,14 +171,8 @@ class Searcher:
         exceeds ``guard_spread``; None when the guard does not fire."""
         if self.stall_guard <= 0 or len(self.recent) < 2:
             return None
-        times = np.array([t for t, _ in self.recent])
-        xy = np.array([p[:2] for _, p in self.recent])
-        reach = self.agent.step * (1.0 + 1e-9) + 1e-9
-        first = None
-        for i in range(len(xy) - 1, -1, -1):
-            if np.all(np.hypot(*(xy[i:] - xy[i]).T) <= reach):
-                first = i
-        if first is None or times[-1] - times[first] < self.stall_guard:
+        first = stall_start(np.array([p for _, p in self.recent]), self.agent.step)
+        if self.recent[-1][0] - self.recent[first][0] < self.stall_guard:
             return None
         if self.estimate().spread <= self.guard_spread:
             return None  # the source is located: staying near it is what the robot should do

@@ -68,3 +68,17 @@ class GridAgent:
         nxt = np.asarray(position, dtype=np.float64)[None, :] + self.moves
         ok = self.volume.contains(nxt)
         return nxt[ok], np.flatnonzero(ok)
+
+
+def stall_start(xy: np.ndarray, step: float) -> int:
+    """Index of the first of the latest run of positions that all lie within ``step`` m
+    (horizontally) of it: the latest k with every row of ``xy[k:]`` within ``step`` of
+    ``xy[k]`` and none earlier (the stall guard's window; ``xy`` (n, 2 or 3) m, n ≥ 1, in time
+    order). A robot that moved on has its last position alone (n − 1) or its last move."""
+    xy = np.asarray(xy, dtype=np.float64)[:, :2]
+    reach = step * (1.0 + 1e-9) + 1e-9
+    first = len(xy) - 1
+    for i in range(len(xy) - 2, -1, -1):
+        if np.all(np.hypot(*(xy[i:] - xy[i]).T) <= reach):
+            first = i
+    return first
