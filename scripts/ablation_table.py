@@ -68,7 +68,7 @@ def main() -> None:
         if stall.notna().all():
             stalls = f"{stall.max():.0f} ({int((stall > 60).sum())} > 60 s)"
         print(
-            f"| {label} | {len(b)} | {r:.0%} [{lo:.0%}, {hi:.0%}] "
+            f"| {label} | {len(b)} | {int(b.sum())}/{len(b)}, {r:.1%} [{lo:.1%}, {hi:.1%}] "
             f"| {c:.0%} [{clo:.0%}, {chi:.0%}] "
             f"| {runs.loc[keys, 'final_rmse'].median():.2f} | {only_ref} / {only_var} | {p:.3f} "
             f"| {reached} | {paired} | {stalls} |"

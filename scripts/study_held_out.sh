@@ -19,10 +19,10 @@ FIL="--unknown full --truth filament --likelihood fluctuation"
 [ -f results/held-out-wind-known/campaign.json ] ||
     $D bench $HO --unknown source --strategies dcee-cl,infotaxis --out results/held-out-wind-known \
         --set search.stall_guard=0
-$D bench $HO $FIL --strategies dcee-cl,infotaxis --out results/held-out-filament
 $D bench $HO --unknown full --strategies dcee-cl,infotaxis --out results/held-out-full
 # the tree search (about 3x a dcee-cl search)
 $D bench $HO --unknown source --strategies dcee-mcts --out results/held-out-wind-known-mcts
+$D bench $HO $FIL --strategies dcee-cl,infotaxis --out results/held-out-filament
 # the public study again with the defaults kept (dcee-cl's spread_reach 2): 12 x 10, paper scale
 $D bench --suite paper --repeats 10 --strategies dcee-cl --out results/paper-source-cl3
 $D bench --suite paper --repeats 10 --unknown full --strategies dcee-cl --out results/paper-full-cl3
