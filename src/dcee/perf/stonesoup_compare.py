@@ -35,6 +35,7 @@ TRUTH = np.array([30.0, 40.0, 1.0, 5.0, 4.0, np.radians(90.0), 1.0, 8.0])
 START = np.array([5.0, 5.0, 0.0])
 N_PARTICLES = 10_000
 N_HYPOTHESES = 4
+STONESOUP_START = datetime(2026, 1, 1)
 
 
 def _candidates(position: np.ndarray) -> np.ndarray:
@@ -90,9 +91,11 @@ def dcee_decisions(n_decisions: int, seed: int = 1990) -> Iterator[float]:
             yield elapsed
 
 
-def stonesoup_decisions(n_decisions: int, seed: int = 1990) -> Iterator[float]:
-    """Milliseconds of each ``choose_actions`` call in Stone Soup's own example set-up, one per
-    ``next``."""
+def stonesoup_example(start: np.ndarray, resolution: int, n_steps: int, step_size: int) -> tuple:
+    """The parts of Stone Soup's STE examples both comparisons share: (truth, sensor, platform
+    at ``start`` with an ``NStepDirectionalGridMovable`` of the given settings, predictor,
+    updater with the examples' ESS resampler, MCMC regulariser and constraint), built at a
+    fixed timestamp. :class:`DceeInputError` if Stone Soup (the ``bench`` extra) is missing."""
     try:
         from stonesoup.models.measurement.gas import IsotropicPlume as SSPlume
         from stonesoup.models.transition.linear import (
@@ -105,12 +108,8 @@ def stonesoup_decisions(n_decisions: int, seed: int = 1990) -> Iterator[float]:
         from stonesoup.regulariser.particle import MCMCRegulariser
         from stonesoup.resampler.particle import ESSResampler
         from stonesoup.sensor.gas import GasIntensitySensor
-        from stonesoup.sensormanager import BruteForceSensorManager
-        from stonesoup.sensormanager.reward import MultiUpdateExpectedKLDivergence
         from stonesoup.types.groundtruth import GroundTruthState
-        from stonesoup.types.hypothesis import SingleHypothesis
-        from stonesoup.types.state import ParticleState, State, StateVectors
-        from stonesoup.types.track import Track
+        from stonesoup.types.state import State
         from stonesoup.updater.particle import ParticleUpdater
     except ImportError:
         raise DceeInputError(
@@ -118,20 +117,18 @@ def stonesoup_decisions(n_decisions: int, seed: int = 1990) -> Iterator[float]:
             "Stone Soup is not installed; install the optional extra: pip install 'dcee[bench]'",
         ) from None
 
-    np.random.seed(seed)  # noqa: NPY002 - Stone Soup draws from the global generator
-    start = datetime(2026, 1, 1)
-    truth = GroundTruthState(list(TRUTH), timestamp=start)
-    model = SSPlume()
+    when = STONESOUP_START
+    truth = GroundTruthState(list(TRUTH), timestamp=when)
     sensor = GasIntensitySensor(
         min_noise=1e-4, missed_detection_probability=0.3, sensing_threshold=5e-4
     )
     platform = FixedPlatform(
         movement_controller=NStepDirectionalGridMovable(
-            states=[State([[START[0]], [START[1]], [START[2]]], timestamp=start)],
+            states=[State([[start[0]], [start[1]], [start[2]]], timestamp=when)],
             position_mapping=(0, 1, 2),
-            resolution=1,
-            n_steps=2,
-            step_size=2,
+            resolution=resolution,
+            n_steps=n_steps,
+            step_size=step_size,
             action_mapping=(0, 1),
             action_space=np.array([[0, 50], [0, 50]]),
         ),
@@ -144,11 +141,27 @@ def stonesoup_decisions(n_decisions: int, seed: int = 1990) -> Iterator[float]:
 
     predictor = ParticlePredictor(CombinedGaussianTransitionModel([RandomWalk(0.0)] * 8))
     updater = ParticleUpdater(
-        model,
+        SSPlume(),
         resampler=ESSResampler(),
         regulariser=MCMCRegulariser(constraint_func=constraint),
         constraint_func=constraint,
     )
+    return truth, sensor, platform, predictor, updater
+
+
+def stonesoup_decisions(n_decisions: int, seed: int = 1990) -> Iterator[float]:
+    """Milliseconds of each ``choose_actions`` call in Stone Soup's own example set-up, one per
+    ``next``."""
+    truth, sensor, platform, predictor, updater = stonesoup_example(START, 1, 2, 2)
+    from stonesoup.sensormanager import BruteForceSensorManager
+    from stonesoup.sensormanager.reward import MultiUpdateExpectedKLDivergence
+    from stonesoup.types.hypothesis import SingleHypothesis
+    from stonesoup.types.state import ParticleState, StateVectors
+    from stonesoup.types.track import Track
+    from stonesoup.updater.particle import ParticleUpdater
+
+    np.random.seed(seed)  # noqa: NPY002 - Stone Soup draws from the global generator
+    start = STONESOUP_START
     reward = MultiUpdateExpectedKLDivergence(
         updater=ParticleUpdater(measurement_model=None), updates_per_track=N_HYPOTHESES
     )

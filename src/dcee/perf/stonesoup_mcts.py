@@ -19,17 +19,17 @@ from __future__ import annotations
 
 import math
 import time
-from datetime import datetime, timedelta
+from datetime import timedelta
 from typing import Any
 
 import numpy as np
 
 from dcee.allocator import tune_allocator
-from dcee.errors import DceeInputError
 from dcee.estimation import ParticleFilter
 from dcee.estimation.priors import Gamma, Normal, SourcePrior, Uniform
 from dcee.models import IsotropicPlume, Sensor
 from dcee.models.agent import GridAgent, SearchVolume
+from dcee.perf.stonesoup_compare import STONESOUP_START, stonesoup_example
 from dcee.planning import get as get_planner
 from dcee.searcher import Searcher
 
@@ -49,61 +49,16 @@ def _xy_rmse(xy: np.ndarray, weights: np.ndarray) -> float:
 def stonesoup_mcts_search(seed: int, max_moves: int = MAX_MOVES) -> dict[str, Any]:
     """Stone Soup's MCTS search with its example's settings: x-y RMSE after each move (m) and
     ms per decision, until its stopping rule or ``max_moves``."""
-    try:
-        from stonesoup.models.measurement.gas import IsotropicPlume as SSPlume
-        from stonesoup.models.transition.linear import (
-            CombinedGaussianTransitionModel,
-            RandomWalk,
-        )
-        from stonesoup.movable.grid import NStepDirectionalGridMovable
-        from stonesoup.platform import FixedPlatform
-        from stonesoup.predictor.particle import ParticlePredictor
-        from stonesoup.regulariser.particle import MCMCRegulariser
-        from stonesoup.resampler.particle import ESSResampler
-        from stonesoup.sensor.gas import GasIntensitySensor
-        from stonesoup.sensormanager.reward import ExpectedKLDivergence
-        from stonesoup.sensormanager.tree_search import MCTSRolloutSensorManager
-        from stonesoup.types.groundtruth import GroundTruthState
-        from stonesoup.types.hypothesis import SingleHypothesis
-        from stonesoup.types.state import ParticleState, State, StateVectors
-        from stonesoup.types.track import Track
-        from stonesoup.updater.particle import ParticleUpdater
-    except ImportError:
-        raise DceeInputError(
-            "compare-stonesoup",
-            "Stone Soup is not installed; install the optional extra: pip install 'dcee[bench]'",
-        ) from None
+    truth, sensor, platform, predictor, updater = stonesoup_example(START, 2, 1, 1)
+    from stonesoup.sensormanager.reward import ExpectedKLDivergence
+    from stonesoup.sensormanager.tree_search import MCTSRolloutSensorManager
+    from stonesoup.types.hypothesis import SingleHypothesis
+    from stonesoup.types.state import ParticleState, StateVectors
+    from stonesoup.types.track import Track
+    from stonesoup.updater.particle import ParticleUpdater
 
     np.random.seed(seed)  # noqa: NPY002 - Stone Soup draws from the global generator
-    start = datetime(2026, 1, 1)
-    truth = GroundTruthState(list(TRUTH), timestamp=start)
-    sensor = GasIntensitySensor(
-        min_noise=1e-4, missed_detection_probability=0.3, sensing_threshold=5e-4
-    )
-    platform = FixedPlatform(
-        movement_controller=NStepDirectionalGridMovable(
-            states=[State([[START[0]], [START[1]], [START[2]]], timestamp=start)],
-            position_mapping=(0, 1, 2),
-            resolution=2,
-            n_steps=1,
-            step_size=1,
-            action_mapping=(0, 1),
-            action_space=np.array([[0, 50], [0, 50]]),
-        ),
-        sensors=[sensor],
-    )
-
-    def constraint(state):
-        v = state.state_vector
-        return (v[3, :] < 0) | (v[4, :] < 0) | (v[6, :] < 0) | (v[7, :] < 0)
-
-    predictor = ParticlePredictor(CombinedGaussianTransitionModel([RandomWalk(0.0)] * 8))
-    updater = ParticleUpdater(
-        SSPlume(),
-        resampler=ESSResampler(),
-        regulariser=MCMCRegulariser(constraint_func=constraint),
-        constraint_func=constraint,
-    )
+    start = STONESOUP_START
     reward = ExpectedKLDivergence(
         updater=ParticleUpdater(measurement_model=None), measurement_noise=True, return_tracks=True
     )
