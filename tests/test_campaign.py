@@ -250,6 +250,13 @@ def test_report_tables_and_figures(finished, tmp_path):
         assert (table[f"{key}_lo"] <= table[f"{key}_rate"]).all()
         assert (table[f"{key}_rate"] <= table[f"{key}_hi"]).all()
     assert "mean final RMSE" in (tmp_path / "report/metrics.md").read_text()
+    # the longest stall of any search per strategy, recounted from the summaries
+    stalls = {}
+    for run in (out / "runs").rglob("summary.json"):
+        s = json.loads(run.read_text())
+        stalls[s["strategy"]] = max(stalls.get(s["strategy"], 0.0), s["longest_stall"])
+    assert dict(zip(table["strategy"], table["longest_stall"], strict=True)) == stalls
+    assert "longest stall (s)" in (tmp_path / "report/metrics.md").read_text()
     # Per configuration: k/n recounted by hand from the summaries.
     per_config = pd.read_csv(tmp_path / "report/per_configuration.csv", index_col=0)
     assert list(per_config.index) == ["paper:1", "paper:6"]

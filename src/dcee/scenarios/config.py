@@ -59,6 +59,7 @@ A scenario is a TOML file (or a built-in, see :mod:`dcee.scenarios.builtin`)::
     budget = 900.0                 # s of flight
     acquired_rmse = 3.0            # m; "source acquired" when the final RMSE is below this
     stop_spread = 0.0              # m; > 0 stops early once the posterior spread is below it
+    stall_guard = 30.0             # s within one step of one spot before a move must leave it
 
 Normal priors are truncated to physical values (u ≥ 0, ζ1 > 0, ζ2 > 0) automatically.
 """
