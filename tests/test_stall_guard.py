@@ -77,3 +77,14 @@ def test_a_search_that_never_paces_is_unchanged_by_the_guard():
     assert a.summary["longest_stall"] < 30
     assert [r["x"] for r in a.records] == [r["x"] for r in b.records]
     assert a.summary["final_rmse"] == b.summary["final_rmse"]
+
+
+def test_campaigns_stored_before_the_guard_resume_only_without_it():
+    from dcee.campaign.runner import scenario_identity
+
+    now = load_scenario("paper:2")
+    stored = now.model_dump(mode="json")
+    del stored["search"]["stall_guard"]  # a campaign stored before the guard ran without it
+    off = now.with_overrides(**{"search.stall_guard": 0.0}).model_dump(mode="json")
+    assert scenario_identity(stored) == scenario_identity(off)
+    assert scenario_identity(stored) != scenario_identity(now.model_dump(mode="json"))
