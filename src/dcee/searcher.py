@@ -84,7 +84,9 @@ class Searcher:
     source is not yet located), :meth:`ask` offers the planner only the moves that take the robot
     further from that position (:class:`LeavingAgent`). A planner whose candidates' costs tie
     where no reading can tell the hypotheses apart then still moves on to gain information. It
-    never fires in a search that does not pace, so such searches are unchanged.
+    never fires in a search that does not pace, so such searches are unchanged. It guards
+    :meth:`ask` (one robot); a team's :meth:`ask_team` is not guarded.
+
     A Searcher changes no process-wide state: a program of its own may apply
     :func:`dcee.allocator.tune_allocator` (the command line, campaign workers and the ROS node
     do), and ``tell``/``ask`` limit BLAS to one thread only while they run.

@@ -447,6 +447,7 @@ def search_summary(
     out["truth_in_95"] = pf.in_credible_region(scenario.truth_theta()[:3], 0.95)
     out.update(scenario.resolved_settings())
     out["resamples"] = pf.n_resamples
+    out["stall_guard_fired"] = searcher.guard_fired  # decisions the stall guard restricted
     if isinstance(pf, ModelBank):  # which reading model the readings chose, and how firmly
         out["model"] = pf.selected_name
         out["model_probability"] = pf.selected_probability
