@@ -8,7 +8,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 D=.venv/bin/dcee
-HO="--suite held-out --repeats 1 --particles 10000"
+# --allow-code-change: these campaigns span commits that did not change a search (each version
+# used is recorded in campaign.json)
+HO="--suite held-out --repeats 1 --particles 10000 --allow-code-change"
 FIL="--unknown full --truth filament --likelihood fluctuation"
 # the two one-step planners the done-when compares, on the three studies. The wind-known study
 # ran before the stall guard existed (search.stall_guard = 0); scripts/guard_replay.py finds
