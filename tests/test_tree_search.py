@@ -106,3 +106,8 @@ def test_tree_search_plans_for_each_robot_of_a_team():
     positions = np.array([START, START + np.array([2.0, 0.0, 0.0])])
     out = decide_team(planner, belief, positions, AGENT, np.random.default_rng(0))
     assert len(out) == 2 and not np.allclose(out[0].position, out[1].position)
+
+
+def test_a_misspelt_tree_option_names_the_tree():
+    with pytest.raises(DceeInputError, match="dcee-mcts: unknown option among"):
+        planners.get("dcee-mcts:simulatons=3")

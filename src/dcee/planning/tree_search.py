@@ -181,9 +181,20 @@ class TreeSearchPlanner(Planner):
         self.cost_name = cost
         # the tree asks the cost planner for one context of `depth` stages; its own horizon
         # (beam search) is not used
-        self.cost: HypothesisPlanner = get(
-            cost, subsample=subsample, n_hypotheses=n_hypotheses, **cost_options
-        )  # type: ignore[assignment]
+        try:
+            self.cost: HypothesisPlanner = get(  # type: ignore[assignment]
+                cost, subsample=subsample, n_hypotheses=n_hypotheses, **cost_options
+            )
+        except DceeInputError as exc:
+            if exc.field != "planner_options":
+                raise
+            # name the tree, whose spec the user wrote, not the cost planner it builds
+            raise DceeInputError(
+                "planner_options",
+                f"{self.name}: unknown option among {sorted(cost_options)} (options: "
+                "cost, simulations, depth, exploration, subsample, n_hypotheses, and the "
+                f"cost planner's; `dcee strategies` lists them)",
+            ) from None  # type: ignore[assignment]
 
     def options(self) -> dict[str, Any]:
         cost_options = self.cost.options()
