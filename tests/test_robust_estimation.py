@@ -4,6 +4,7 @@ calibration of the credible region."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -108,7 +109,10 @@ def test_turbulent_truth_defaults_to_a_four_second_hold_and_average():
         0.01,
     )
     assert fluct.make_plume().meander == 0.15
-    assert PAPER1.make_estimator_sensor() == PAPER1.make_sensor()  # the paper's exact model
+    # the paper's model with the default outlier component (0: exactly the paper's)
+    assert PAPER1.make_estimator_sensor() == dataclasses.replace(PAPER1.make_sensor(), outlier=0.01)
+    exact = PAPER1.with_overrides(**{"estimator.outlier": 0.0})
+    assert exact.make_estimator_sensor() == exact.make_sensor()
 
 
 def test_the_simulated_instrument_misses_readings_only_where_the_truth_is_calm():

@@ -296,6 +296,11 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
     if isinstance(estimator, dict) and estimator.get("likelihood", "paper") == "paper":
         for key in FLUCTUATION_ONLY:  # read by the fluctuation likelihood only
             estimator.pop(key, None)
+    if isinstance(estimator, dict) and estimator.get("outlier", 0) is None:
+        # stored before issue 29, when an unset weight meant 0 for the paper's likelihood
+        from dcee.scenarios.config import OLD_OUTLIER_DEFAULT
+
+        estimator["outlier"] = OLD_OUTLIER_DEFAULT[estimator.get("likelihood", "paper")]
     sensor, truth = out.get("sensor"), out.get("truth")
     if isinstance(sensor, dict) and "dropout" not in sensor and isinstance(truth, dict):
         # stored before sensor.dropout existed, when the instrument missed 1 − pd of the

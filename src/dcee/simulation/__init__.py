@@ -1,8 +1,9 @@
-"""Simulated searches: ground truth (isotropic, filament, playback) and the episode loop."""
+"""Simulated searches: ground truth (isotropic, filament, puffs, playback) and the episode loop."""
 
 from dcee.simulation.episode import EpisodeResult, run_episode, streams
 from dcee.simulation.filament import FilamentTruth
 from dcee.simulation.playback import PlaybackTruth, load_recording, save_recording
+from dcee.simulation.puffs import PuffTruth
 from dcee.simulation.truth import (
     InjectedTruth,
     IsotropicTruth,
@@ -17,6 +18,7 @@ __all__ = [
     "InjectedTruth",
     "IsotropicTruth",
     "PlaybackTruth",
+    "PuffTruth",
     "TruthModel",
     "load_recording",
     "make_truth",

@@ -356,7 +356,7 @@ class SearchSimulation:
         # the same count of noise draws per step, whatever the positions
         noise = self.sensor.draw_noise(self._truth_rng, ())
         conc = self.truth.sensed(position, t, scenario.average, scenario.sensor.response_time)
-        reading = float(self.sensor.simulate_from(conc, noise))
+        reading = self.truth.reported(float(self.sensor.simulate_from(conc, noise)), conc, t)
         told = position.copy()  # where the robot believes it is
         sd = self.scenario.agent.localisation_sd
         if sd > 0:

@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from dcee.simulation.truth import TruthModel, plume_stream, register_truth
+from dcee.simulation.truth import SteppedTruth, plume_stream, register_truth
 
 if TYPE_CHECKING:
     from dcee.scenarios.config import FilamentSpec, Scenario
@@ -51,25 +51,36 @@ DECAY_CUTOFF = 1e-6
 """A puff is dropped once its mass has decayed below this fraction (age > ζ2 · ln 1e6)."""
 PRUNE_EVERY = 10
 """steps between removals of dead or far-away puffs (pruning every step costs more than it saves)"""
-CHECKPOINT_SECONDS = 10.0
-"""simulated seconds between stored states (for looking back in time)"""
 
 
 @dataclass
 class _State:
-    step: int  # the field is the state after this many steps from -spin_up
     centres: np.ndarray  # (P, 3) m
     ages: np.ndarray  # (P,) s
     meander: np.ndarray  # (2, 2): [along, cross] x [displacement-like state, its rate]
     released: int  # puffs released so far
 
     def copy(self) -> _State:
-        return _State(
-            self.step, self.centres.copy(), self.ages.copy(), self.meander.copy(), self.released
-        )
+        return _State(self.centres.copy(), self.ages.copy(), self.meander.copy(), self.released)
 
 
-class FilamentTruth(TruthModel):
+def gaussian_puffs_field(
+    positions: np.ndarray, centres: np.ndarray, var: np.ndarray, masses: np.ndarray
+) -> np.ndarray:
+    """(K,) concentration (g/m³) at (K, 3) positions of isotropic 3-D Gaussian puffs with
+    (P, 3) centres (m), (P,) variances σ² (m²) and (P,) masses (g): each integrates to its mass."""
+    out = np.zeros(len(positions))
+    if not len(masses):
+        return out
+    amp = masses / (2.0 * math.pi * var) ** 1.5
+    chunk = max(1, 2_000_000 // len(masses))  # bound the (K, P) temporaries to ~16 MB
+    for a in range(0, len(positions), chunk):
+        d = positions[a : a + chunk, None, :] - centres[None, :, :]
+        out[a : a + chunk] = np.exp(-np.einsum("kpi,kpi->kp", d, d) / (2.0 * var)) @ amp
+    return out
+
+
+class FilamentTruth(SteppedTruth):
     """Farrell-style filament plume.
 
     Parameters
@@ -95,38 +106,40 @@ class FilamentTruth(TruthModel):
         self.source = theta[:3].copy()
         self.q, self.u, phi, zeta1, self.tau = (float(v) for v in theta[3:])
         self.spec = spec
-        self.dt = spec.dt
         self.direction = -np.array([math.cos(phi), math.sin(phi), 0.0])
         self.crosswind = np.array([-self.direction[1], self.direction[0], 0.0])
         self.puff_diffusivity = spec.puff_share * zeta1
-        self.walk_scale = math.sqrt(2.0 * (1.0 - spec.puff_share) * zeta1 * self.dt)
+        self.walk_scale = math.sqrt(2.0 * (1.0 - spec.puff_share) * zeta1 * spec.dt)
         self.puff_mass = self.q / spec.puff_rate
         self.max_age = self.tau * math.log(1.0 / DECAY_CUTOFF)
         self.low = np.asarray(low, dtype=np.float64)
         self.high = np.asarray(high, dtype=np.float64)
-        # spin-up: the oldest puff alive in steady state; then the field no longer depends on
-        # the empty start
-        self.spin_steps = math.ceil(self.max_age / self.dt)
-        self.checkpoint_steps = max(1, round(CHECKPOINT_SECONDS / self.dt))
         # coloured noise with stationary sd s: G = s · sqrt(4ζ/ω)  (var x = G² ω / 4ζ)
         w, z = spec.meander_bandwidth, spec.meander_damping
         sd = spec.meander_intensity * self.u
         self._omega, self._damping = w, z
         self._noise_gain = w * w * sd * math.sqrt(4.0 * z / w)
-        self._rng = rng
         meander = np.zeros((2, 2))
         meander[:, 0] = sd * rng.standard_normal(2)  # start in the stationary distribution
         meander[:, 1] = w * sd * rng.standard_normal(2)
-        self._state = _State(0, np.empty((0, 3)), np.empty(0), meander, 0)
-        self._checkpoints: dict[int, tuple[_State, dict]] = {}  # step -> (state, rng state)
-        self._advance_to(self.spin_steps)
+        self._state = _State(np.empty((0, 3)), np.empty(0), meander, 0)
+        # spin-up: the oldest puff alive in steady state; then the field no longer depends on
+        # the empty start
+        self._start_stepping(spec.dt, math.ceil(self.max_age / spec.dt), rng)
 
     # --- dynamics -----------------------------------------------------------------------------
 
     def _velocity(self, meander: np.ndarray) -> np.ndarray:
         return (self.u + meander[0, 0]) * self.direction + meander[1, 0] * self.crosswind
 
-    def _step(self) -> None:
+    def _save(self) -> _State:
+        return self._state.copy()
+
+    def _restore(self, saved: object) -> None:
+        assert isinstance(saved, _State)
+        self._state = saved.copy()
+
+    def _advance_one(self) -> None:
         s, dt = self._state, self.dt
         # meander: semi-implicit Euler-Maruyama (ω dt ≤ 0.02 by default: accurate and stable)
         m = s.meander
@@ -139,40 +152,25 @@ class FilamentTruth(TruthModel):
             walk = self.walk_scale * self._rng.standard_normal(s.centres.shape)
             s.centres += velocity * dt + walk
             s.ages += dt
-        s.step += 1
+        step = self.step_count
         # puffs whose release time falls in this step, with their exact sub-step ages
-        due = math.floor(s.step * dt * self.spec.puff_rate + 1e-9)
+        due = math.floor(step * dt * self.spec.puff_rate + 1e-9)
         if due > s.released:
             k = np.arange(s.released, due, dtype=np.float64)
-            ages = s.step * dt - k / self.spec.puff_rate
+            ages = step * dt - k / self.spec.puff_rate
             new = self.source + np.outer(ages, velocity)
             s.centres = np.concatenate([s.centres, new])
             s.ages = np.concatenate([s.ages, ages])
             s.released = due
-        if s.step % PRUNE_EVERY == 0 and s.ages.size:
+        if step % PRUNE_EVERY == 0 and s.ages.size:
             sigma = np.sqrt(self._sigma_sq(s.ages))
             margin = (5.0 * sigma + 1.0)[:, None]
             near = np.all((s.centres > self.low - margin) & (s.centres < self.high + margin), 1)
             keep = near & (s.ages < self.max_age)
             s.centres, s.ages = s.centres[keep], s.ages[keep]
-        if s.step >= self.spin_steps and (s.step - self.spin_steps) % self.checkpoint_steps == 0:
-            self._checkpoints[s.step] = (s.copy(), self._rng.bit_generator.state)
-
-    def _advance_to(self, step: int) -> None:
-        if step < self._state.step:  # looking back: restart from the last checkpoint before it
-            state, rng_state = self._checkpoints[max(k for k in self._checkpoints if k <= step)]
-            self._state = state.copy()
-            self._rng.bit_generator.state = rng_state
-        while self._state.step < step:
-            self._step()
 
     def _sigma_sq(self, ages: np.ndarray) -> np.ndarray:
         return self.spec.puff_radius**2 + 2.0 * self.puff_diffusivity * ages
-
-    def _step_for(self, time: float) -> int:
-        if not math.isfinite(time) or time < 0:
-            raise ValueError(f"time must be a finite number of seconds >= 0 (got {time})")
-        return self.spin_steps + round(time / self.dt)
 
     # --- queries ------------------------------------------------------------------------------
 
@@ -190,23 +188,10 @@ class FilamentTruth(TruthModel):
     def field(self, positions: np.ndarray, time: float) -> np.ndarray:
         """(K,) instantaneous concentrations (g/m³) at (K, 3) positions at ``time`` s."""
         positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
-        centres, var, masses = self._live_puffs(time)
-        out = np.zeros(len(positions))
-        if not len(masses):
-            return out
-        amp = masses / (2.0 * math.pi * var) ** 1.5
-        chunk = max(1, 2_000_000 // len(masses))  # bound the (K, P) temporaries to ~16 MB
-        for a in range(0, len(positions), chunk):
-            d = positions[a : a + chunk, None, :] - centres[None, :, :]
-            out[a : a + chunk] = np.exp(-np.einsum("kpi,kpi->kp", d, d) / (2.0 * var)) @ amp
-        return out
+        return gaussian_puffs_field(positions, *self._live_puffs(time))
 
     def concentration(self, position: np.ndarray, time: float) -> float:
         return float(self.field(np.reshape(position, (1, 3)), time)[0])
-
-    @property
-    def time_step(self) -> float:
-        return self.dt
 
 
 @register_truth("filament")

@@ -36,6 +36,12 @@ class TruthModel(ABC):
         """Seconds between changes of the field; None if it does not change in time."""
         return None
 
+    def reported(self, reading: float, true: float, time: float) -> float:
+        """What the instrument reports given its simulated ``reading`` (g/m³) of the ``true``
+        sensed concentration at ``time`` s: the reading itself, except where a fault is
+        injected (:class:`InjectedTruth`)."""
+        return reading
+
     def sensed(
         self, position: np.ndarray, time: float, average: float = 0.0, response_time: float = 0.0
     ) -> float:
@@ -79,26 +85,95 @@ class IsotropicTruth(TruthModel):
         return self.plume.concentration(self.theta, positions)[0]
 
 
+CHECKPOINT_SECONDS = 10.0
+"""simulated seconds between stored states of a :class:`SteppedTruth` (for looking back)"""
+
+
+class SteppedTruth(TruthModel):
+    """A stochastic field advanced in fixed steps of ``dt`` s from ``-spin_steps · dt`` (so the
+    field at time 0 no longer depends on the empty start), piecewise constant over a step.
+
+    A subclass implements :meth:`_advance_one` (one step of its dynamics, drawing from
+    ``self._rng``) and :meth:`_save` / :meth:`_restore` (a copy of its state). The field can be
+    asked for at any time, in any order: a state and the generator's state are stored every
+    :data:`CHECKPOINT_SECONDS`, so looking back (figures) restarts from the last one before it
+    and replays the same draws.
+    """
+
+    dt: float
+    spin_steps: int
+    step_count: int
+    """the current state is the one after this many steps from ``-spin_steps · dt``"""
+
+    def _start_stepping(self, dt: float, spin_steps: int, rng: np.random.Generator) -> None:
+        """Call at the end of ``__init__``, once the state at step 0 exists: spins up."""
+        self.dt, self.spin_steps, self._rng = dt, spin_steps, rng
+        self.step_count = 0
+        self._checkpoint_steps = max(1, round(CHECKPOINT_SECONDS / dt))
+        self._checkpoints: dict[int, tuple[object, dict]] = {}
+        self._advance_to(spin_steps)
+
+    @abstractmethod
+    def _advance_one(self) -> None:
+        """One step of the dynamics (``self.step_count`` is already the new step)."""
+
+    @abstractmethod
+    def _save(self) -> object:
+        """A copy of the state (restored by :meth:`_restore`)."""
+
+    @abstractmethod
+    def _restore(self, saved: object) -> None:
+        """Make a saved copy the current state (the saved object must stay unchanged)."""
+
+    def _advance_to(self, step: int) -> None:
+        if step < self.step_count:  # looking back: restart from the last checkpoint before it
+            at = max(k for k in self._checkpoints if k <= step)
+            saved, rng_state = self._checkpoints[at]
+            self._restore(saved)
+            self.step_count = at
+            self._rng.bit_generator.state = rng_state
+        while self.step_count < step:
+            self.step_count += 1
+            self._advance_one()
+            k = self.step_count - self.spin_steps
+            if k >= 0 and k % self._checkpoint_steps == 0:
+                self._checkpoints[self.step_count] = (self._save(), self._rng.bit_generator.state)
+
+    def _step_for(self, time: float) -> int:
+        """The step whose state is the field at episode ``time`` s (rounded to a step)."""
+        if not math.isfinite(time) or time < 0:
+            raise ValueError(f"time must be a finite number of seconds >= 0 (got {time})")
+        return self.spin_steps + round(time / self.dt)
+
+    @property
+    def time_step(self) -> float:
+        return self.dt
+
+
+Injection = float | Callable[[float], float]
+"""What an :class:`InjectedTruth` reports instead of the instrument: a reading (g/m³), or a
+function of the true sensed concentration (g/m³) returning one (``lambda c: 1e6 * c``)."""
+
+
 class InjectedTruth(TruthModel):
-    """Another truth with chosen concentrations injected at chosen times: fault injection (a
-    spike, a stuck sensor) to test what one reading does to a search.
+    """Another truth whose instrument reports chosen readings at chosen times: fault injection
+    (a spike, a stuck sensor) to test what one reading does to a search.
 
-    ``injections`` maps a reading time (s) to the concentration (g/m³) sensed then."""
+    ``injections`` maps a time (s) to an :data:`Injection`. Each fires once, at the first reading
+    taken at or after its time (reading times depend on the motion model, so an exact time would
+    miss), and replaces what the instrument reports, after its noise and dropout, so the injected
+    value is exactly what the estimator is told. Every other reading, and the field itself, is
+    the inner truth's."""
 
-    def __init__(self, inner: TruthModel, injections: dict[float, float]) -> None:
+    def __init__(self, inner: TruthModel, injections: dict[float, Injection]) -> None:
         self.inner = inner
-        self.injections = dict(injections)
+        self.pending = sorted(injections.items())
+        self.fired: list[tuple[float, float, float]] = []
+        """(reading time s, true concentration g/m³, reported g/m³) of each injection so far"""
         self.name, self.label = inner.name, inner.label
 
-    def _injected(self, time: float) -> float | None:
-        for t, value in self.injections.items():
-            if abs(time - t) < 1e-9:
-                return value
-        return None
-
     def concentration(self, position: np.ndarray, time: float) -> float:
-        value = self._injected(time)
-        return self.inner.concentration(position, time) if value is None else value
+        return self.inner.concentration(position, time)
 
     def field(self, positions: np.ndarray, time: float) -> np.ndarray:
         return self.inner.field(positions, time)
@@ -110,9 +185,14 @@ class InjectedTruth(TruthModel):
     def sensed(
         self, position: np.ndarray, time: float, average: float = 0.0, response_time: float = 0.0
     ) -> float:
-        value = self._injected(time)
-        if value is None:
-            return self.inner.sensed(position, time, average, response_time)
+        return self.inner.sensed(position, time, average, response_time)
+
+    def reported(self, reading: float, true: float, time: float) -> float:
+        if not self.pending or time < self.pending[0][0] - 1e-9:
+            return reading
+        _, injection = self.pending.pop(0)
+        value = float(injection(true) if callable(injection) else injection)
+        self.fired.append((time, true, value))
         return value
 
 
