@@ -57,7 +57,7 @@ def _likelihood_names() -> list[str]:
 # Shared by ``run`` and ``bench``: what the sensor sees.
 TRUTH_OPTION = click.option(
     "--truth",
-    help="What the sensor sees: isotropic | filament | PATH of a .npy/.h5 recording "
+    help="What the sensor sees: isotropic | filament | puffs | PATH of a recording "
     "[default: the scenario's truth.model].",
 )
 LIKELIHOOD_OPTION = click.option(

@@ -190,7 +190,22 @@ class PlaybackSpec(BaseModel):
     model_config = _FROZEN
     kind: Literal["playback"] = "playback"
     file: str = Field(min_length=1)
-    """.npy (metadata in a .json beside it) or .h5 recording; relative to the scenario file"""
+    """.npy (metadata in a .json beside it), .h5, or a CF-convention NetCDF file (.nc; or .h5
+    with ``variable`` or ``axes`` set); relative to the scenario file"""
+    variable: str | None = None
+    """NetCDF: the concentration variable; None: found by its units (docs/scenarios.md)"""
+    axes: dict[Literal["t", "x", "y", "z"], str] = Field(default_factory=dict)
+    """NetCDF: dimension name of each axis where the file's CF attributes do not tell, e.g.
+    ``{t = "time", x = "easting"}``"""
+    units: str | None = None
+    """NetCDF: concentration units overriding the file's (g/m3, kg m-3, mg/m3, ug/m3, ppm,
+    ppb, mol/mol)"""
+    molar_mass: Annotated[float | None, Field(gt=0, le=1000, allow_inf_nan=False)] = None
+    """g/mol of the released gas: needed to convert a mixing ratio (ppm, ppb) to g/m³"""
+    temperature: Annotated[float, Field(gt=0, le=1000, allow_inf_nan=False)] = 293.15
+    """K, for a mixing ratio's conversion (ideal gas)"""
+    pressure: Annotated[float, Field(gt=0, le=1e7, allow_inf_nan=False)] = 101325.0
+    """Pa, for a mixing ratio's conversion (ideal gas)"""
     time_interpolation: Literal["nearest", "linear"] = "linear"
     loop: bool = False
     """replay from the first frame when the recording ends (else the budget must fit in it)"""
@@ -807,9 +822,10 @@ def truth_choice(value: str) -> str | dict[str, str]:
     if value in ("isotropic", "filament", "puffs"):
         return value
     path = Path(value).expanduser()
-    if path.suffix.lower() not in (".npy", ".h5", ".hdf5"):
+    if path.suffix.lower() not in (".npy", ".h5", ".hdf5", ".nc", ".nc4", ".netcdf", ".cdf"):
         raise DceeInputError(
-            "truth", f"must be isotropic, filament, puffs or a .npy/.h5 recording (got {value!r})"
+            "truth",
+            f"must be isotropic, filament, puffs or a .npy/.h5/.nc recording (got {value!r})",
         )
     if not path.is_file():
         raise DceeInputError("truth", f"no such recording {value!r}")

@@ -222,7 +222,9 @@ def load_recording(
         except OSError as exc:
             raise _fail(f"cannot read {path.name} as HDF5: {exc}") from None
     else:
-        raise _fail(f"unsupported recording {path.name!r}: use .npy (with .json) or .h5")
+        raise _fail(
+            f"unsupported recording {path.name!r}: use .npy (with .json), .h5 or CF NetCDF (.nc)"
+        )
     missing = [k for k in ("t", "x", "y") if k not in meta]
     if arr.ndim == 4 and "z" not in meta:
         missing.append("z")
@@ -285,7 +287,23 @@ def playback_truth(scenario: Scenario, seed: int) -> PlaybackTruth:
     spec = scenario.truth.model
     theta = scenario.truth_theta()
     low, high = np.array(scenario.volume.low), np.array(scenario.volume.high)
-    truth, source = load_recording(spec.file, spec.time_interpolation, spec.loop)
+    from dcee.simulation.cf_recording import SUFFIXES, load_cf_recording
+
+    cf = Path(spec.file).suffix.lower() in SUFFIXES or spec.variable is not None or spec.axes
+    if cf:
+        truth, source = load_cf_recording(
+            spec.file,
+            spec.variable,
+            dict(spec.axes),
+            spec.units,
+            spec.molar_mass,
+            spec.temperature,
+            spec.pressure,
+            spec.time_interpolation,
+            spec.loop,
+        )
+    else:
+        truth, source = load_recording(spec.file, spec.time_interpolation, spec.loop)
     problem = truth.covers(low, high)
     if problem:
         raise _fail(problem)
