@@ -51,6 +51,16 @@ SUITES: dict[str, dict] = {
         ],
         "overrides": {},
     },
+    # the first 24 held-out configurations: a small reporting sample for slow studies (turbulent
+    # truths); say "small sample" beside any number it gives
+    "held-out-24": {
+        "configs": [
+            f"random:{k}" for k in range(RANDOM_REPORTING_FROM, RANDOM_REPORTING_FROM + 24)
+        ],
+        "overrides": {},
+    },
+    # tuning configurations for slow studies (never report them)
+    "random-tune-12": {"configs": [f"random:{k}" for k in range(1, 13)], "overrides": {}},
     "smoke": {
         "configs": ["paper:1", "paper:6"],
         "overrides": {"search.particles": 1000, "search.hypotheses": 10, "search.budget": 60.0},
