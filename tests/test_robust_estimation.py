@@ -199,20 +199,34 @@ def test_no_fuzzed_stream_kills_the_filter(name):
     assert dead == []
 
 
-def test_one_huge_spike_does_not_decide_a_search():
-    """Limiting case of the issue's measurement: a 500 g/m³ reading (1e6 × threshold) at reading
-    20 of an infotaxis search on the isotropic truth, with the outlier component: the search
-    ends as it ends without the spike (both acquire the source)."""
-    scenario = PAPER1.with_overrides(
-        **{"search.particles": 3000, "search.budget": 300.0, "estimator.outlier": 0.01}
+@pytest.mark.parametrize("config", ["paper:1", "random:3"])
+def test_one_huge_spike_does_not_decide_a_search_with_default_settings(config):
+    """Issue 29: one reading of 10⁶ × the true concentration (at least 10⁶ × the threshold) at
+    60 s of a dcee-cl search with the *default* settings (paper likelihood): the search still
+    acquires the source. With the outlier component off (the paper's exact likelihood) the same
+    spike captures the filter, so the check can fail."""
+    scenario = load_scenario(config).with_overrides(
+        **{"search.particles": 3000, "search.budget": 300.0}
     )
-    ends = []
-    for spike in (False, True):
-        truth = make_truth(scenario, 0)
-        truth = InjectedTruth(truth, {40.0: 500.0}) if spike else truth
-        res = run_episode(scenario, "infotaxis", 0, truth=truth)
-        ends.append(res.summary["final_rmse"])
-    assert ends[0] < 3.0 and ends[1] < 3.0
+    threshold = scenario.sensor.threshold
+
+    def spike(true: float) -> float:
+        return min(1e6 * max(true, threshold), 5e3)
+
+    ends = {}
+    for outlier in (None, 0.0):
+        sc = (
+            scenario
+            if outlier is None
+            else scenario.with_overrides(**{"estimator.outlier": outlier})
+        )
+        clean = run_episode(sc, "dcee-cl", 0).summary["source_acquired"]
+        truth = InjectedTruth(make_truth(sc, 0), {60.0: spike})
+        spiked = run_episode(sc, "dcee-cl", 0, truth=truth).summary["source_acquired"]
+        assert truth.fired and truth.fired[0][2] >= 500.0
+        ends[outlier] = (clean, spiked)
+    assert ends[None] == (True, True)
+    assert ends[0.0] == (True, False)
 
 
 # --- a filter that keeps every mode ---

@@ -1,0 +1,119 @@
+"""Where does a turbulent search's final error come from? Setting variants on tuning
+configurations (issue 29, item 3; lab notes for docs/results.md, never a reported result).
+
+Each variant is a set of scenario overrides; every variant flies the same configurations and
+seeds on each truth (all eight parameters unknown, fluctuation likelihood, 10,000 particles
+unless overridden). Prints per variant and truth: acquired (final RMSE < 3 m), median final RMSE,
+the share with the truth in the 95 % region, and the median signed along-wind and absolute
+cross-wind error of the final mean (m; along > 0 means the estimate lies downwind).
+
+    .venv/bin/python scripts/precision_variants.py --configs random:1-12 --truths puffs filament \\
+        --variant base: --variant hold8:agent.dwell=8 --variant n20k:search.particles=20000 \\
+        [--strategy dcee-cl] [--seeds 1] [--workers 2] [--csv out.csv]
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import tomllib
+from multiprocessing import Pool
+
+import numpy as np
+
+
+def expand(names: list[str]) -> list[str]:
+    out = []
+    for name in names:
+        family, _, rest = name.partition(":")
+        if "-" in rest and rest.replace("-", "").isdigit():
+            a, b = (int(v) for v in rest.split("-"))
+            out += [f"{family}:{k}" for k in range(a, b + 1)]
+        else:
+            out.append(name)
+    return out
+
+
+def parse_variant(text: str) -> tuple[str, dict]:
+    label, _, body = text.partition(":")
+    over = {}
+    for item in filter(None, body.split(",")):
+        key, _, value = item.partition("=")
+        over[key] = tomllib.loads(f"v = {value}")["v"]
+    return label, over
+
+
+def one(task: tuple) -> dict:
+    label, over, name, truth, seed, strategy = task
+    from dcee.scenarios import load_scenario
+    from dcee.simulation import run_episode
+
+    base = {
+        "search.particles": 10000,
+        "unknown": "full",
+        "truth.model": truth,
+        "estimator.likelihood": "fluctuation",
+    }
+    scenario = load_scenario(name).with_overrides(**base).with_overrides(**over)
+    res = run_episode(scenario, strategy, seed)
+    s, last = res.summary, res.records[-1]
+    theta = scenario.truth_theta()
+    down = -np.array([math.cos(theta[5]), math.sin(theta[5])])
+    err = np.array([last["mean_x"] - theta[0], last["mean_y"] - theta[1]])
+    return {
+        "variant": label,
+        "truth": truth,
+        "scenario": name,
+        "seed": seed,
+        "acquired": s["source_acquired"],
+        "final_rmse": s["final_rmse"],
+        "truth_in_95": s["truth_in_95"],
+        "along": float(err @ down),
+        "cross": float(abs(err @ np.array([-down[1], down[0]]))),
+        "steps": s["steps"],
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--configs", nargs="+", default=["random:1-12"])
+    ap.add_argument("--truths", nargs="+", default=["puffs", "filament"])
+    ap.add_argument("--variant", action="append", default=[])
+    ap.add_argument("--strategy", default="dcee-cl")
+    ap.add_argument("--seeds", type=int, default=1)
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--csv", default=None)
+    args = ap.parse_args()
+    variants = [parse_variant(v) for v in (args.variant or ["base:"])]
+    tasks = [
+        (label, over, name, truth, seed, args.strategy)
+        for label, over in variants
+        for truth in args.truths
+        for name in expand(args.configs)
+        for seed in range(args.seeds)
+    ]
+    with Pool(args.workers) as pool:
+        rows = pool.map(one, tasks, chunksize=1)
+    if args.csv:
+        with open(args.csv, "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)
+    print("| variant | truth | n | acquired | median final RMSE (m) | truth in 95 % | "
+          "median along-wind error (m) | median cross-wind error (m) |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|")
+    for label, _ in variants:
+        for truth in args.truths:
+            rs = [r for r in rows if r["variant"] == label and r["truth"] == truth]
+            print(
+                f"| {label} | {truth} | {len(rs)} | {sum(r['acquired'] for r in rs)} | "
+                f"{np.median([r['final_rmse'] for r in rs]):.2f} | "
+                f"{np.mean([r['truth_in_95'] for r in rs]):.0%} | "
+                f"{np.median([r['along'] for r in rs]):+.2f} | "
+                f"{np.median([r['cross'] for r in rs]):.2f} |"
+            )
+
+
+if __name__ == "__main__":
+    main()
