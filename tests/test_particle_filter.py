@@ -26,8 +26,9 @@ def _readings(sensor: Sensor, seed: int = 2) -> list[tuple[np.ndarray, float]]:
     return out
 
 
-def _grid_posterior(sensor, data):
-    """Exact posterior on an (x, y, q) grid with NumPy reference models (prior: U × U × Γ(2,1))."""
+def _grid_posterior(sensor, data, power=1.0):
+    """Exact posterior on an (x, y, q) grid with NumPy reference models (prior: U × U × Γ(2,1)),
+    each reading's likelihood raised to ``power``."""
     xs = np.linspace(0, 10, 161)
     ys = np.linspace(0, 10, 161)
     qs = np.linspace(0.01, 9.0, 90)
@@ -49,7 +50,7 @@ def _grid_posterior(sensor, data):
     pos = np.array([p for p, _ in data])
     z = np.array([r for _, r in data])
     logp += history_log_likelihood_reference(
-        theta, pos, z, np.ones(len(z)), sensor, IsotropicPlume()
+        theta, pos, z, np.full(len(z), power), sensor, IsotropicPlume()
     )
     w = np.exp(logp - logp.max())
     w /= w.sum()
@@ -79,6 +80,23 @@ def test_filter_matches_exact_grid_posterior(sensor, resample_threshold, mcmc_st
     assert pf.parameter_names == ("x", "y", "q")
     np.testing.assert_array_less(np.abs(mean - grid_mean), 0.2 * grid_sd)
     np.testing.assert_allclose(sd, grid_sd, rtol=0.2)
+
+
+def test_reading_weight_gives_the_exact_power_likelihood_posterior(sensor):
+    """estimator.reading_weight = 0.5: each reading counts as half an independent one. The filter
+    (resampling, moves and all) matches the exact grid posterior of prior × Π p(z|Θ)^0.5, which
+    is wider than the plain posterior."""
+    data = _readings(sensor)
+    grid_mean, grid_sd = _grid_posterior(sensor, data, power=0.5)
+    _, plain_sd = _grid_posterior(sensor, data)
+    assert np.all(grid_sd > 1.1 * plain_sd)
+    pf = ParticleFilter(planar_prior(u=2.0), sensor, n_particles=20_000, seed=7, reading_weight=0.5)
+    for pos, z in data:
+        pf.update(pos, z)
+    np.testing.assert_array_less(np.abs(pf.mean() - grid_mean), 0.2 * grid_sd)
+    np.testing.assert_allclose(np.sqrt(np.diag(pf.cov())), grid_sd, rtol=0.2)
+    with pytest.raises(DceeInputError, match="reading_weight"):
+        ParticleFilter(planar_prior(u=2.0), sensor, n_particles=100, reading_weight=0.0)
 
 
 def test_collapse_is_recovered_by_tempering_and_still_matches_the_posterior(sensor):

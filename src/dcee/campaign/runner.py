@@ -254,6 +254,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("estimator", "calm_prior"): 0.0,
     # no stall guard before issue 28
     ("search", "stall_guard"): 0.0,
+    # every reading counted fully before issue 29
+    ("estimator", "reading_weight"): 1.0,
     # a constant log-sd before the distance-dependent spread existed
     ("estimator", "log_sd_near"): 0.0,
     ("estimator", "log_sd_length"): 0.0,

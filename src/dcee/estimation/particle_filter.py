@@ -131,7 +131,12 @@ class ParticleFilter:
         global_share: float = 0.2,
         diversify: float = 0.5,
         max_sweeps: int = 8,
+        reading_weight: float = 1.0,
     ) -> None:
+        if not (isinstance(reading_weight, int | float) and 0 < reading_weight <= 1):
+            raise DceeInputError(
+                "estimator.reading_weight", f"must be in (0, 1], got {reading_weight!r}"
+            )
         if int(n_particles) != n_particles or n_particles < 2:
             raise DceeInputError("particles", f"must be an integer >= 2, got {n_particles}")
         if not 0 < resample_threshold <= 1:
@@ -160,6 +165,7 @@ class ParticleFilter:
         self.global_share = global_share
         self.diversify = diversify
         self.max_sweeps = int(max_sweeps)
+        self.reading_weight = float(reading_weight)
         self._unknown = np.array(prior.unknown)
         # the unknown location columns: the block the global proposal redraws from the prior
         self._loc_block = [int(i) for i in self._unknown if i < 3]
@@ -268,7 +274,8 @@ class ParticleFilter:
     # --- update -----------------------------------------------------------------------------
 
     def log_likelihood(self, theta: np.ndarray, position: np.ndarray, reading: float) -> np.ndarray:
-        """(N,) log p(reading | Θ) at ``position`` for source terms ``theta`` (N, 8)."""
+        """(N,) w · log p(reading | Θ) at ``position`` for source terms ``theta`` (N, 8), w the
+        filter's ``reading_weight`` (1: the plain likelihood)."""
         out = np.empty(theta.shape[0])
         history_log_likelihood(
             theta,
@@ -281,6 +288,8 @@ class ParticleFilter:
             self._sp,
             out,
         )
+        if self.reading_weight != 1.0:
+            out *= self.reading_weight
         return out
 
     def update(self, position: np.ndarray, reading: float) -> UpdateInfo:
@@ -336,11 +345,11 @@ class ParticleFilter:
         if reading == 0.0 and key in self._nd_index:
             idx = self._nd_index[key]
             base = self._hist_mult[idx]
-            self._hist_mult[idx] = base + 1.0
+            self._hist_mult[idx] = base + self.reading_weight
             return idx, base
         self._hist_pos.append(key)
         self._hist_z.append(reading)
-        self._hist_mult.append(1.0)
+        self._hist_mult.append(self.reading_weight)
         idx = len(self._hist_z) - 1
         if reading == 0.0:
             self._nd_index[key] = idx
@@ -467,7 +476,7 @@ class ParticleFilter:
             # ll_new: the new reading's log-likelihood for the current particles.
             self._set_logw(self._logw + (new_beta - beta) * ll_new)
             self._hist_loglik = hist_base + new_beta * ll_new
-            self._hist_mult[entry] = base_mult + new_beta
+            self._hist_mult[entry] = base_mult + new_beta * self.reading_weight
             beta = new_beta
             ll_new, hist_base = self._resample(ll_new, hist_base)
             stage_acc, stage_sweeps, distinct = self._rejuvenate()
@@ -479,7 +488,7 @@ class ParticleFilter:
                     self.theta, np.array(self._hist_pos[entry]), self._hist_z[entry]
                 )
                 hist_base = self._hist_loglik - beta * ll_new
-        self._hist_mult[entry] = base_mult + 1.0
+        self._hist_mult[entry] = base_mult + self.reading_weight
         self.recoveries.append(
             {
                 "kind": "tempering",

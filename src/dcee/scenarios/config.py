@@ -423,6 +423,12 @@ class EstimatorSpec(BaseModel):
     """weight of the outlier component (log-uniform up to sensor.max_reading), every likelihood:
     a reading no hypothesis explains then weighs at most ~13 / outlier against any other
     (:data:`OUTLIER_DEFAULT`); 0 = the paper's exact likelihood"""
+    reading_weight: Annotated[float, Field(gt=0, le=1)] = 1.0
+    """how many independent readings one reading counts as in the filter: its log-likelihood
+    is multiplied by this (a power likelihood). Below 1 for readings that are not independent
+    (a turbulent plume's successive holds see the same puffs and gusts), so the posterior is not
+    narrower than the evidence; the planners still predict with the plain likelihood. 1: the
+    plain Bayes update"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the
