@@ -14,7 +14,8 @@ pytest.importorskip("h5netcdf")
 from dcee.errors import DceeInputError  # noqa: E402
 from dcee.scenarios import load_scenario  # noqa: E402
 from dcee.simulation import make_truth  # noqa: E402
-from dcee.simulation.cf_recording import concentration_factor, load_cf_recording  # noqa: E402
+from dcee.simulation.cf_recording import concentration_factor  # noqa: E402
+from dcee.simulation.playback import load_cf_recording  # noqa: E402
 from tests.helpers import run_cli  # noqa: E402
 
 R = 8.314462618

@@ -1,8 +1,10 @@
 """Recordings made by others: CF-convention NetCDF (or NetCDF-4/HDF5) read through xarray.
 
 Wind-tunnel, CFD and field recordings come with their own variable names, axis order and units.
-This reader finds what :class:`~dcee.simulation.playback.PlaybackTruth` needs by the CF
-conventions and converts it to dcee's units (g/m³, s, m), so a recording replays with one
+This reader (:func:`read_cf_recording`; :func:`dcee.simulation.playback.load_cf_recording`
+turns its arrays into a truth) finds what
+:class:`~dcee.simulation.playback.PlaybackTruth` needs by the CF conventions and converts it
+to dcee's units (g/m³, s, m), so a recording replays with one
 ``--set 'truth.model = {file = "plume.nc"}'``:
 
 * **Concentration variable**: ``variable`` if given; else the one data variable with three or
@@ -37,7 +39,6 @@ from typing import Any
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.simulation.playback import PlaybackTruth
 
 FIELD = "truth.model.file"
 SUFFIXES = (".nc", ".nc4", ".netcdf", ".cdf")
@@ -173,7 +174,7 @@ def _axis_of(ds: Any, dim: str, mapping: dict[str, str]) -> str | None:
     return None
 
 
-def load_cf_recording(
+def read_cf_recording(
     path: str | Path,
     variable: str | None = None,
     axes: dict[str, str] | None = None,
@@ -181,10 +182,10 @@ def load_cf_recording(
     molar_mass: float | None = None,
     temperature: float = 293.15,
     pressure: float = 101325.0,
-    time_interpolation: str = "linear",
-    loop: bool = False,
-) -> tuple[PlaybackTruth, np.ndarray | None]:
-    """(truth, recorded source (3,) m or None) from a CF-style NetCDF/HDF5 file (module doc)."""
+) -> dict[str, np.ndarray | None]:
+    """The arrays of a CF-style NetCDF/HDF5 recording in dcee's units (module doc):
+    ``concentration`` (T, ny, nx[, nz]) g/m³, ``t`` (s from the first frame), ``x``, ``y``, ``z``
+    (m, increasing; ``z`` None for a 2-D recording) and ``source`` ((3,) m or None)."""
     path = Path(path)
     if not path.is_file():
         raise _fail(f"no such file {str(path)!r}")
@@ -253,17 +254,14 @@ def load_cf_recording(
                 raise _fail(f"{path.name}: attribute source_location must be 3 finite numbers")
             xs = _scale(ds[found["x"]].attrs.get("units"), LENGTH_METRES, "length", found["x"])
             source = source * xs
-    t = coords["t"] - coords["t"][0]
-    truth = PlaybackTruth(
-        arr * factor,
-        t,
-        coords["x"],
-        coords["y"],
-        coords.get("z"),
-        time_interpolation,
-        loop,
-    )
-    return truth, source
+    return {
+        "concentration": arr * factor,
+        "t": coords["t"] - coords["t"][0],
+        "x": coords["x"],
+        "y": coords["y"],
+        "z": coords.get("z"),
+        "source": source,
+    }
 
 
-__all__ = ["concentration_factor", "load_cf_recording"]
+__all__ = ["concentration_factor", "read_cf_recording"]

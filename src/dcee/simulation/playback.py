@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from dcee.errors import DceeInputError
+from dcee.simulation.cf_recording import SUFFIXES, read_cf_recording
 from dcee.simulation.truth import TruthModel, register_truth
 
 if TYPE_CHECKING:
@@ -241,6 +242,26 @@ def load_recording(
     return truth, source
 
 
+def load_cf_recording(
+    path: str | Path,
+    variable: str | None = None,
+    axes: dict[str, str] | None = None,
+    units: str | None = None,
+    molar_mass: float | None = None,
+    temperature: float = 293.15,
+    pressure: float = 101325.0,
+    time_interpolation: str = "linear",
+    loop: bool = False,
+) -> tuple[PlaybackTruth, np.ndarray | None]:
+    """(truth, recorded source (3,) m or None) from a CF-convention NetCDF/HDF5 recording made
+    by others (:mod:`dcee.simulation.cf_recording`: axes by attributes, units converted)."""
+    rec = read_cf_recording(path, variable, axes, units, molar_mass, temperature, pressure)
+    truth = PlaybackTruth(
+        rec["concentration"], rec["t"], rec["x"], rec["y"], rec["z"], time_interpolation, loop
+    )
+    return truth, rec["source"]
+
+
 def save_recording(
     path: str | Path,
     concentration: np.ndarray,
@@ -287,8 +308,6 @@ def playback_truth(scenario: Scenario, seed: int) -> PlaybackTruth:
     spec = scenario.truth.model
     theta = scenario.truth_theta()
     low, high = np.array(scenario.volume.low), np.array(scenario.volume.high)
-    from dcee.simulation.cf_recording import SUFFIXES, load_cf_recording
-
     cf = Path(spec.file).suffix.lower() in SUFFIXES or spec.variable is not None or spec.axes
     if cf:
         truth, source = load_cf_recording(
@@ -321,4 +340,4 @@ def playback_truth(scenario: Scenario, seed: int) -> PlaybackTruth:
     return truth
 
 
-__all__ = ["PlaybackTruth", "load_recording", "save_recording"]
+__all__ = ["PlaybackTruth", "load_cf_recording", "load_recording", "save_recording"]
