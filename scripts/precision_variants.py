@@ -22,17 +22,7 @@ from multiprocessing import Pool
 
 import numpy as np
 
-
-def expand(names: list[str]) -> list[str]:
-    out = []
-    for name in names:
-        family, _, rest = name.partition(":")
-        if "-" in rest and rest.replace("-", "").isdigit():
-            a, b = (int(v) for v in rest.split("-"))
-            out += [f"{family}:{k}" for k in range(a, b + 1)]
-        else:
-            out.append(name)
-    return out
+from dcee.scenarios import expand_names
 
 
 def parse_variant(text: str) -> tuple[str, dict]:
@@ -90,7 +80,7 @@ def main() -> None:
         (label, over, name, truth, seed, args.strategy)
         for label, over in variants
         for truth in args.truths
-        for name in expand(args.configs)
+        for name in expand_names(args.configs)
         for seed in range(args.seeds)
     ]
     with Pool(args.workers) as pool:

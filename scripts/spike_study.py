@@ -20,21 +20,8 @@ import argparse
 import csv
 import sys
 
-from dcee.scenarios import load_scenario
+from dcee.scenarios import expand_names, load_scenario
 from dcee.simulation import InjectedTruth, make_truth, run_episode
-
-
-def expand(names: list[str]) -> list[str]:
-    """``random:1-10`` -> random:1 … random:10; other names as given."""
-    out = []
-    for name in names:
-        family, _, rest = name.partition(":")
-        if "-" in rest and rest.replace("-", "").isdigit():
-            a, b = (int(v) for v in rest.split("-"))
-            out += [f"{family}:{k}" for k in range(a, b + 1)]
-        else:
-            out.append(name)
-    return out
 
 
 def spike(factor: float, floor: float, cap: float):
@@ -60,7 +47,7 @@ def main() -> None:
     rows = []
     for weight in args.outlier:
         over = {} if weight == "default" else {"estimator.outlier": float(weight)}
-        for name in expand(args.scenarios):
+        for name in expand_names(args.scenarios):
             scenario = load_scenario(name).with_overrides(
                 **{"search.particles": args.particles, **over, **extra}
             )

@@ -174,3 +174,19 @@ def test_random_suites_keep_tuning_and_reporting_apart():
     report = {int(n.split(":")[1]) for n in SUITES["held-out"]["configs"]}
     assert len(report) == 200 and not tune & report
     assert max(tune) < 1000 <= min(report)
+
+
+def test_expand_names_expands_integer_ranges_only():
+    from dcee.scenarios import expand_names
+
+    assert expand_names(["random:1000-1002", "paper:3"]) == [
+        "random:1000",
+        "random:1001",
+        "random:1002",
+        "paper:3",
+    ]
+    assert expand_names(["random:5-2", "my-file.toml", "lab:down-wind"]) == [
+        "random:5-2",
+        "my-file.toml",
+        "lab:down-wind",
+    ]

@@ -2,6 +2,6 @@
 
 from dcee.scenarios.builtin import builtin_scenarios
 from dcee.scenarios.config import Scenario, validate_scenario
-from dcee.scenarios.loader import load_scenario
+from dcee.scenarios.loader import expand_names, load_scenario
 
-__all__ = ["Scenario", "builtin_scenarios", "load_scenario", "validate_scenario"]
+__all__ = ["Scenario", "builtin_scenarios", "expand_names", "load_scenario", "validate_scenario"]

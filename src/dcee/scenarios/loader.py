@@ -10,6 +10,20 @@ from dcee.scenarios.builtin import builtin_scenarios, random_configuration, rand
 from dcee.scenarios.config import Scenario, validate_scenario
 
 
+def expand_names(names: list[str]) -> list[str]:
+    """Scenario names with ranges expanded: ``random:1-3`` -> random:1, random:2, random:3 (any
+    ``family:A-B`` with integers A <= B); every other name as given."""
+    out: list[str] = []
+    for name in names:
+        family, _, rest = name.partition(":")
+        a, dash, b = rest.partition("-")
+        if dash and a.isdigit() and b.isdigit() and int(a) <= int(b):
+            out += [f"{family}:{k}" for k in range(int(a), int(b) + 1)]
+        else:
+            out.append(name)
+    return out
+
+
 def load_scenario(name_or_path: str) -> Scenario:
     """A built-in (``paper:3``, ``lab:upwind``, ``random:17``) or a TOML file by path."""
     builtins = builtin_scenarios()

@@ -132,13 +132,6 @@ class FilamentTruth(SteppedTruth):
     def _velocity(self, meander: np.ndarray) -> np.ndarray:
         return (self.u + meander[0, 0]) * self.direction + meander[1, 0] * self.crosswind
 
-    def _save(self) -> _State:
-        return self._state.copy()
-
-    def _restore(self, saved: object) -> None:
-        assert isinstance(saved, _State)
-        self._state = saved.copy()
-
     def _advance_one(self) -> None:
         s, dt = self._state, self.dt
         # meander: semi-implicit Euler-Maruyama (ω dt ≤ 0.02 by default: accurate and stable)

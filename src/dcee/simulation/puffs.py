@@ -194,13 +194,6 @@ class PuffTruth(SteppedTruth):
 
     # --- dynamics -----------------------------------------------------------------------------
 
-    def _save(self) -> _State:
-        return self._state.copy()
-
-    def _restore(self, saved: object) -> None:
-        assert isinstance(saved, _State)
-        self._state = saved.copy()
-
     def _advance_one(self) -> None:
         s, dt, rng = self._state, self.dt, self._rng
         s.anchors = self._ou_keep * s.anchors + self._ou_kick * rng.standard_normal(s.anchors.shape)

@@ -93,8 +93,8 @@ class SteppedTruth(TruthModel):
     """A stochastic field advanced in fixed steps of ``dt`` s from ``-spin_steps · dt`` (so the
     field at time 0 no longer depends on the empty start), piecewise constant over a step.
 
-    A subclass implements :meth:`_advance_one` (one step of its dynamics, drawing from
-    ``self._rng``) and :meth:`_save` / :meth:`_restore` (a copy of its state). The field can be
+    A subclass keeps its whole state in ``self._state`` (an object with ``copy()``) and implements
+    :meth:`_advance_one` (one step of its dynamics, drawing from ``self._rng``). The field can be
     asked for at any time, in any order: a state and the generator's state are stored every
     :data:`CHECKPOINT_SECONDS`, so looking back (figures) restarts from the last one before it
     and replays the same draws.
@@ -117,13 +117,13 @@ class SteppedTruth(TruthModel):
     def _advance_one(self) -> None:
         """One step of the dynamics (``self.step_count`` is already the new step)."""
 
-    @abstractmethod
     def _save(self) -> object:
-        """A copy of the state (restored by :meth:`_restore`)."""
+        """A copy of the state: ``self._state.copy()`` (a subclass keeps its state there)."""
+        return self._state.copy()  # type: ignore[attr-defined]
 
-    @abstractmethod
     def _restore(self, saved: object) -> None:
-        """Make a saved copy the current state (the saved object must stay unchanged)."""
+        """Make a saved copy the current state (copied again: the checkpoint stays unchanged)."""
+        self._state = saved.copy()  # type: ignore[attr-defined]
 
     def _advance_to(self, step: int) -> None:
         if step < self.step_count:  # looking back: restart from the last checkpoint before it
