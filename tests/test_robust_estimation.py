@@ -105,10 +105,13 @@ def test_turbulent_truth_defaults_to_a_four_second_hold_and_average():
         "lognormal",
         0.93,
         1.3,
-        10.0,
+        5.0,
         0.01,
     )
     assert fluct.make_plume().meander == 0.15
+    # readings of a turbulent plume count half (issue 29); the paper's model counts them fully
+    assert fluct.reading_weight == 0.5 and filament.reading_weight == 1.0
+    assert fluct.with_overrides(**{"estimator.reading_weight": 0.8}).reading_weight == 0.8
     # the paper's model with the default outlier component (0: exactly the paper's)
     assert PAPER1.make_estimator_sensor() == dataclasses.replace(PAPER1.make_sensor(), outlier=0.01)
     exact = PAPER1.with_overrides(**{"estimator.outlier": 0.0})

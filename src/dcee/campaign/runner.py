@@ -303,6 +303,12 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
         from dcee.scenarios.config import OLD_OUTLIER_DEFAULT
 
         estimator["outlier"] = OLD_OUTLIER_DEFAULT[estimator.get("likelihood", "paper")]
+    if isinstance(estimator, dict) and "reading_weight" in estimator:
+        if estimator["reading_weight"] is None:  # the likelihood's default, as a number
+            from dcee.scenarios.config import READING_WEIGHT_DEFAULT
+
+            likelihood = estimator.get("likelihood", "paper")
+            estimator["reading_weight"] = READING_WEIGHT_DEFAULT[likelihood]
     sensor, truth = out.get("sensor"), out.get("truth")
     if isinstance(sensor, dict) and "dropout" not in sensor and isinstance(truth, dict):
         # stored before sensor.dropout existed, when the instrument missed 1 − pd of the

@@ -209,7 +209,7 @@ def make_searcher(
             global_share=search.global_share,
             diversify=search.diversify,
             max_sweeps=search.max_sweeps,
-            reading_weight=scenario.estimator.reading_weight,
+            reading_weight=scenario.reading_weight,
         )
         for model, rng in zip(models, rngs, strict=True)
     ]
