@@ -318,3 +318,19 @@ def test_every_registered_planner_runs_on_a_random_configuration(capsys, tmp_pat
         assert code == 0, (strategy, err)
         summary = json.loads((out / "summary.json").read_text())
         assert summary["scenario"] == f"random:{1000 + k}" and summary["longest_stall"] >= 0
+
+
+def test_show_prints_every_setting_that_changes_results(capsys):
+    """Issue 29: the outlier weight is printed; settings whose default follows the truth or the
+    likelihood appear as comments with the value they resolve to."""
+    code, out, _ = run_cli(["show", "paper:1"], capsys)
+    assert code == 0
+    assert "\noutlier = 0.01\n" in out
+    for line in (
+        "# reading_weight = 1.0",
+        "# meander = 0.0",
+        "# dwell = 1.0",
+        "# average = 0.0",
+        "# dropout = 0.3",
+    ):
+        assert line in out

@@ -907,8 +907,18 @@ def validate_scenario(data: dict[str, Any]) -> Scenario:
 def to_toml(scenario: Scenario) -> str:
     """The scenario as a TOML file that :func:`dcee.scenarios.load_scenario` reads back to an
     equal scenario (``dcee show NAME --format toml > my.toml``): every resolved setting, so the
-    file is a complete record; unset optional values (None) are left out."""
+    file is a complete record; optional values left unset (None), whose default depends on the
+    truth or the likelihood, appear as comments with the value they resolve to."""
     data = scenario.model_dump(mode="json", exclude_none=True)
+    # settings left unset follow the truth or the likelihood: shown as comments with the value
+    # this scenario resolves them to, so the file reads back with them still unset
+    resolved = {
+        ("sensor", "dropout"): round(1.0 - scenario.instrument_pd, 12),
+        ("sensor", "average"): scenario.average,
+        ("estimator", "meander"): scenario.meander,
+        ("estimator", "reading_weight"): scenario.reading_weight,
+        ("agent", "dwell"): scenario.dwell,
+    }
     lines = [f"# dcee scenario {scenario.name}"]
     tables = []
     for key, value in data.items():
@@ -921,6 +931,9 @@ def to_toml(scenario: Scenario) -> str:
         lines.append(f"[{key}]")
         for k, v in table.items():
             lines.append(f"{_toml_key(k)} = {_toml_value(v)}")
+        for (section, k), v in resolved.items():
+            if section == key and k not in table:
+                lines.append(f"# {k} = {_toml_value(v)}  (unset: the default for this scenario)")
     return "\n".join(lines) + "\n"
 
 
