@@ -517,3 +517,30 @@ def test_fluctuation_only_settings_do_not_matter_under_the_paper_likelihood():
         for extra in ({}, {"estimator.log_sd": 1.3})
     )
     assert scenario_identity(fa) != scenario_identity(fb)
+
+
+def test_campaigns_stored_before_issue_29_keep_the_estimator_they_ran_with():
+    """An unset outlier weight meant 0 for the paper's likelihood and 0.01 for the fluctuation
+    one; reading_weight did not exist (every reading weighed 1). A stored paper campaign then
+    differs from today's default (outlier 0.01) but not from an explicit 0; an unset
+    reading_weight is the likelihood's default as a number."""
+    from dcee.campaign.runner import scenario_identity
+    from dcee.scenarios import load_scenario
+
+    def stored_before(scenario):
+        d = scenario.model_dump(mode="json")
+        d["estimator"]["outlier"] = None
+        d["estimator"].pop("reading_weight")
+        return d
+
+    paper = load_scenario("paper:1")
+    old = scenario_identity(stored_before(paper))
+    assert old != scenario_identity(paper.model_dump(mode="json"))
+    exact = paper.with_overrides(**{"estimator.outlier": 0.0})
+    assert old == scenario_identity(exact.model_dump(mode="json"))
+    fluct = paper.with_overrides(**{"estimator.likelihood": "fluctuation"})
+    old_fluct = stored_before(fluct)
+    old_fluct["estimator"]["near_source_length"] = 5.0  # only the weights differ here
+    assert scenario_identity(old_fluct) != scenario_identity(fluct.model_dump(mode="json"))
+    full = fluct.with_overrides(**{"estimator.reading_weight": 1.0})
+    assert scenario_identity(old_fluct) == scenario_identity(full.model_dump(mode="json"))

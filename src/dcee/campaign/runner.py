@@ -295,19 +295,18 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
     free-text description and without later-added settings at their defaults."""
     out = copy.deepcopy({k: v for k, v in scenario.items() if k != "description"})
     estimator = out.get("estimator")
-    if isinstance(estimator, dict) and estimator.get("likelihood", "paper") == "paper":
-        for key in FLUCTUATION_ONLY:  # read by the fluctuation likelihood only
-            estimator.pop(key, None)
-    if isinstance(estimator, dict) and estimator.get("outlier", 0) is None:
-        # stored before issue 29, when an unset weight meant 0 for the paper's likelihood
-        from dcee.scenarios.config import OLD_OUTLIER_DEFAULT
+    if isinstance(estimator, dict):
+        from dcee.scenarios.config import OLD_OUTLIER_DEFAULT, READING_WEIGHT_DEFAULT
 
-        estimator["outlier"] = OLD_OUTLIER_DEFAULT[estimator.get("likelihood", "paper")]
-    if isinstance(estimator, dict) and "reading_weight" in estimator:
-        if estimator["reading_weight"] is None:  # the likelihood's default, as a number
-            from dcee.scenarios.config import READING_WEIGHT_DEFAULT
-
-            likelihood = estimator.get("likelihood", "paper")
+        likelihood = estimator.get("likelihood", "paper")
+        if likelihood == "paper":
+            for key in FLUCTUATION_ONLY:  # read by the fluctuation likelihood only
+                estimator.pop(key, None)
+        if estimator.get("outlier", 0) is None:
+            # stored before issue 29, when an unset weight meant 0 for the paper's likelihood
+            estimator["outlier"] = OLD_OUTLIER_DEFAULT[likelihood]
+        if "reading_weight" in estimator and estimator["reading_weight"] is None:
+            # unset: the likelihood's default, compared as the number it stands for
             estimator["reading_weight"] = READING_WEIGHT_DEFAULT[likelihood]
     sensor, truth = out.get("sensor"), out.get("truth")
     if isinstance(sensor, dict) and "dropout" not in sensor and isinstance(truth, dict):

@@ -217,13 +217,9 @@ def read_cf_recording(
         coords = {}
         for a in order:
             dim = found[a]
-            values = (
-                np.asarray(ds[dim].values, dtype=np.float64)
-                if dim in ds.variables
-                else np.arange(var.sizes[dim], dtype=np.float64)
-            )
             if dim not in ds.variables:
                 raise _fail(f"{path.name}: axis {a} ({dim!r}) has no coordinate values")
+            values = np.asarray(ds[dim].values, dtype=np.float64)
             what = "time" if a == "t" else "length"
             table = TIME_SECONDS if a == "t" else LENGTH_METRES
             values = values * _scale(ds[dim].attrs.get("units"), table, what, dim)

@@ -243,19 +243,12 @@ def load_recording(
 
 
 def load_cf_recording(
-    path: str | Path,
-    variable: str | None = None,
-    axes: dict[str, str] | None = None,
-    units: str | None = None,
-    molar_mass: float | None = None,
-    temperature: float = 293.15,
-    pressure: float = 101325.0,
-    time_interpolation: str = "linear",
-    loop: bool = False,
+    path: str | Path, time_interpolation: str = "linear", loop: bool = False, **mapping: Any
 ) -> tuple[PlaybackTruth, np.ndarray | None]:
     """(truth, recorded source (3,) m or None) from a CF-convention NetCDF/HDF5 recording made
-    by others (:mod:`dcee.simulation.cf_recording`: axes by attributes, units converted)."""
-    rec = read_cf_recording(path, variable, axes, units, molar_mass, temperature, pressure)
+    by others; ``mapping`` (variable, axes, units, molar_mass, temperature, pressure) goes to
+    :func:`dcee.simulation.cf_recording.read_cf_recording`."""
+    rec = read_cf_recording(path, **mapping)
     truth = PlaybackTruth(
         rec["concentration"], rec["t"], rec["x"], rec["y"], rec["z"], time_interpolation, loop
     )
@@ -312,14 +305,14 @@ def playback_truth(scenario: Scenario, seed: int) -> PlaybackTruth:
     if cf:
         truth, source = load_cf_recording(
             spec.file,
-            spec.variable,
-            dict(spec.axes),
-            spec.units,
-            spec.molar_mass,
-            spec.temperature,
-            spec.pressure,
             spec.time_interpolation,
             spec.loop,
+            variable=spec.variable,
+            axes=dict(spec.axes),
+            units=spec.units,
+            molar_mass=spec.molar_mass,
+            temperature=spec.temperature,
+            pressure=spec.pressure,
         )
     else:
         truth, source = load_recording(spec.file, spec.time_interpolation, spec.loop)

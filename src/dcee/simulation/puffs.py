@@ -108,11 +108,11 @@ class PuffTruth(SteppedTruth):
         self.x0, self.y0 = self.low[0] - margin, self.low[1] - margin
         self.h, self.nx, self.ny = h, nx, ny
         self._boundary = _perimeter(nx, ny)  # (B, 2) (iy, ix) in order round the boundary
-        arc = _arc_lengths(self._boundary, h)  # (B,) m along the boundary, from 0
-        self._perimeter_length = arc[-1] + h
+        # neighbouring boundary nodes are one cell apart: (B,) m along the boundary, from 0
+        self._boundary_arc = h * np.arange(len(self._boundary), dtype=np.float64)
+        self._perimeter_length = h * len(self._boundary)
         count = max(4, round(self._perimeter_length / spec.boundary_spacing))
         self._anchor_arc = np.linspace(0.0, self._perimeter_length, count, endpoint=False)
-        self._boundary_arc = arc
         sd = spec.meander_intensity * self.u
         self._walk = math.sqrt(2.0 * spec.centre_diffusivity * spec.dt)
         # the wind advances every wind_steps puff steps: about one cell's travel time at the
@@ -259,11 +259,6 @@ def _perimeter(nx: int, ny: int) -> np.ndarray:
     top = [(ny - 1, i) for i in range(nx - 2, -1, -1)]
     left = [(j, 0) for j in range(ny - 2, 0, -1)]
     return np.array(bottom + right + top + left, dtype=np.int64)
-
-
-def _arc_lengths(nodes: np.ndarray, spacing: float) -> np.ndarray:
-    """(B,) distance (m) along the boundary from the first node (neighbours are one cell apart)."""
-    return spacing * np.arange(len(nodes), dtype=np.float64)
 
 
 @register_truth("puffs")
