@@ -13,8 +13,8 @@ see the same truth noise, and compare their RMSE over time.
 import matplotlib.pyplot as plt
 
 from dcee.planning import HypothesisPlanner, register, unregister
+from dcee.runs import run_episode
 from dcee.scenarios import load_scenario
-from dcee.simulation import run_episode
 
 
 @register("greedy-spread")

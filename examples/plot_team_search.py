@@ -12,8 +12,9 @@ trajectories.
 import matplotlib.pyplot as plt
 
 from dcee.analysis.figures import draw_search_figure
+from dcee.runs import run_episode
 from dcee.scenarios import load_scenario
-from dcee.simulation import make_truth, run_episode
+from dcee.simulation import make_truth
 
 base = load_scenario("paper:1").with_overrides(**{"search.particles": 3000, "search.budget": 300.0})
 results = {}

@@ -20,7 +20,8 @@ from pathlib import Path
 import pandas as pd
 from scipy.stats import binomtest, wilcoxon
 
-from dcee.analysis.report import load_campaign, wilson
+from dcee.analysis.report import load_campaign
+from dcee.analysis.statistics import wilson
 
 
 def _runs(arg: str) -> tuple[str, pd.DataFrame]:

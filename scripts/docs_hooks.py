@@ -61,7 +61,7 @@ def scenario_reference() -> str:
     out = [
         "# Scenario reference",
         "",
-        "Generated from the validating models (`dcee.scenarios.config`) when the documentation "
+        "Generated from the validating models (`dcee.scenarios`) when the documentation "
         "is built. A scenario is a TOML file; `dcee show paper:1` prints a complete one, and "
         "`dcee schema` the JSON Schema of the same models (for editors). Why each default is "
         "what it is: [scenarios](../scenarios.md).",

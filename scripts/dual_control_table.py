@@ -23,7 +23,8 @@ import numpy as np
 import pandas as pd
 from scipy.stats import binomtest, wilcoxon
 
-from dcee.analysis.report import load_campaign, median_order_statistic_ranks, wilson
+from dcee.analysis.report import load_campaign
+from dcee.analysis.statistics import median_order_statistic_ranks, wilson
 
 HARD = (5, 7, 12)
 

@@ -24,9 +24,9 @@ import pandas as pd
 
 from dcee.analysis.results import find_runs
 from dcee.models.agent import stall_start
+from dcee.runs import run_episode
 from dcee.scenarios import validate_scenario
 from dcee.searcher import STALL_HISTORY
-from dcee.simulation.episode import run_episode
 
 
 def guard_fires(steps: pd.DataFrame, step: float, guard: float, spread_limit: float) -> bool:

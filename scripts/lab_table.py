@@ -20,8 +20,8 @@ import sys
 import numpy as np
 from scipy import stats
 
-from dcee.analysis.report import censored_median_time, median_ci, wilson
 from dcee.analysis.results import load_summaries
+from dcee.analysis.statistics import censored_median_time, median_ci, wilson
 
 
 def table(robot_dir: str, grid_dir: str) -> str:

@@ -42,7 +42,7 @@ out["stonesoup-infotaxis"] = float(np.median(t))
 import numba
 numba.set_num_threads(1)
 from dcee.scenarios import load_scenario
-from dcee.simulation import run_episode
+from dcee.runs import run_episode
 t0 = time.perf_counter()
 run_episode(load_scenario("paper:1"), "dcee", 0)
 out["search-dcee"] = 1e3 * (time.perf_counter() - t0)

@@ -36,8 +36,8 @@ def parse_variant(text: str) -> tuple[str, dict]:
 
 def one(task: tuple) -> dict:
     label, over, name, truth, seed, strategy = task
+    from dcee.runs import run_episode
     from dcee.scenarios import load_scenario
-    from dcee.simulation import run_episode
 
     base = {
         "search.particles": 10000,

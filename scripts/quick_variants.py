@@ -15,8 +15,8 @@ from multiprocessing import Pool
 
 def one(args: tuple[str, str, str, str, str]) -> tuple:
     spec, name, unknown, truth, likelihood = args
+    from dcee.runs import run_episode
     from dcee.scenarios import load_scenario
-    from dcee.simulation.episode import run_episode
 
     overrides: dict[str, object] = {"search.particles": 10000, "unknown": unknown}
     if truth != "isotropic":

@@ -20,8 +20,9 @@ import argparse
 import csv
 import sys
 
+from dcee.runs import run_episode
 from dcee.scenarios import expand_names, load_scenario
-from dcee.simulation import InjectedTruth, make_truth, run_episode
+from dcee.simulation import InjectedTruth, make_truth
 
 
 def spike(factor: float, floor: float, cap: float):

@@ -12,8 +12,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from dcee.analysis.figures import _draw_map
+from dcee.runs import run_episode
 from dcee.scenarios import load_scenario
-from dcee.simulation import make_truth, run_episode
+from dcee.simulation import make_truth
 
 STRATEGIES = ("mpc", "dcee", "dcee-cl", "infotaxis")
 

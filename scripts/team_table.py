@@ -16,8 +16,8 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from dcee.analysis.report import censored_median_time, median_ci
 from dcee.analysis.results import load_summaries
+from dcee.analysis.statistics import censored_median_time, median_ci
 
 PLANNERS = ("infotaxis", "dcee-cl")
 

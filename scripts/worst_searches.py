@@ -18,9 +18,9 @@ import numpy as np
 
 from dcee.analysis.figures import _draw_map
 from dcee.analysis.report import load_campaign
+from dcee.runs import EpisodeResult
 from dcee.scenarios import validate_scenario
 from dcee.simulation import make_truth
-from dcee.simulation.episode import EpisodeResult
 
 
 def main() -> None:

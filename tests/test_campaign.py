@@ -12,14 +12,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from dcee.analysis.report import (
+from dcee.analysis.report import load_campaign, write_report
+from dcee.analysis.statistics import (
     censored_median_time,
-    load_campaign,
     median_ci,
     median_order_statistic_ranks,
     rmse_over_time,
     wilson,
-    write_report,
 )
 from dcee.campaign import Campaign, SearchTask, run_campaign
 from dcee.campaign.runner import _local_results, is_done, run_search
@@ -317,7 +316,7 @@ def test_whole_study_loads_in_one_call(finished):
 def test_snapshots_follow_the_budget(finished):
     """Repeat 0 keeps snapshots at 10/30/50/100% of its budget (60 s in the smoke suite), so a
     short search still fills the comparison grid; later repeats keep none."""
-    from dcee.simulation import EpisodeResult
+    from dcee.runs import EpisodeResult
 
     out, _ = finished
     first = EpisodeResult.load(_run(out, "paper:1", "dcee", 0))
@@ -391,7 +390,7 @@ def test_posterior_histogram_range_ignores_a_lost_minority():
     """85% of errors ~ N(0, 1) and 15% from lost searches at +20 m: the histogram range keeps
     the bulk and leaves the lost ones outside; with no outliers it is the central
     98%."""
-    from dcee.analysis.report import _robust_range
+    from dcee.analysis.report_figures import _robust_range
 
     rng = np.random.default_rng(3)
     bulk = rng.normal(size=8500)
@@ -462,7 +461,7 @@ def test_plain_progress_lines_for_logs(capsys):
 
 def test_campaigns_stored_before_a_setting_existed_still_resume():
     # agent.count came later: a stored scenario without it ran with the default (1 robot)
-    from dcee.campaign.runner import scenario_identity
+    from dcee.runs import scenario_identity
     from dcee.scenarios import load_scenario
 
     now = load_scenario("paper:1").model_dump(mode="json")
@@ -484,7 +483,7 @@ def test_campaigns_stored_before_a_setting_existed_still_resume():
 def test_a_filament_campaign_stored_before_sensor_dropout_ran_with_the_misses():
     # before sensor.dropout, the instrument missed 1 − pd of the readings on every truth: an
     # isotropic campaign is what the default still does, a filament one is not
-    from dcee.campaign.runner import scenario_identity
+    from dcee.runs import scenario_identity
     from dcee.scenarios import load_scenario
 
     def stored_before(scenario):
@@ -502,7 +501,7 @@ def test_a_filament_campaign_stored_before_sensor_dropout_ran_with_the_misses():
 
 
 def test_fluctuation_only_settings_do_not_matter_under_the_paper_likelihood():
-    from dcee.campaign.runner import scenario_identity
+    from dcee.runs import scenario_identity
     from dcee.scenarios import load_scenario
 
     lab = load_scenario("lab:upwind")
@@ -524,7 +523,7 @@ def test_campaigns_stored_before_issue_29_keep_the_estimator_they_ran_with():
     one; reading_weight did not exist (every reading weighed 1). A stored paper campaign then
     differs from today's default (outlier 0.01) but not from an explicit 0; an unset
     reading_weight is the likelihood's default as a number."""
-    from dcee.campaign.runner import scenario_identity
+    from dcee.runs import scenario_identity
     from dcee.scenarios import load_scenario
 
     def stored_before(scenario):

@@ -7,9 +7,9 @@ import pytest
 
 from dcee.errors import DceeInputError
 from dcee.planning import get as get_planner
+from dcee.runs import SearchSimulation, planner_defaults
 from dcee.scenarios import load_scenario
 from dcee.searcher import Searcher
-from dcee.simulation.episode import SearchSimulation, planner_defaults
 
 
 def _sim(strategy: str, particles: int = 1500) -> SearchSimulation:

@@ -10,8 +10,8 @@ from gymnasium.utils.env_checker import check_env
 
 import dcee.gym
 from dcee import DceeInputError
+from dcee.runs import run_episode
 from dcee.scenarios import load_scenario
-from dcee.simulation import run_episode
 
 SMALL = {"scenario": "paper:1", "particles": 300, "budget": 60.0}
 

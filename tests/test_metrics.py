@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from dcee.simulation.metrics import longest_stall, search_stall
+from dcee.runs.metrics import longest_stall, search_stall
 
 
 def _stall(xy, acquired=None, step=2.0, dt=2.0):

@@ -8,14 +8,12 @@ import numpy as np
 import pytest
 
 from dcee import DceeInputError, ParticleFilter
-from dcee.campaign.runner import scenario_identity
 from dcee.estimation.grid import location_grid_posterior
 from dcee.estimation.model_bank import ModelBank
 from dcee.planning import get as get_planner
+from dcee.runs import make_searcher, run_episode, scenario_identity, streams
 from dcee.scenarios import load_scenario
 from dcee.searcher import Searcher
-from dcee.simulation import run_episode
-from dcee.simulation.episode import make_searcher, streams
 from tests.test_robust_estimation import _xy_prior
 
 PAPER1 = load_scenario("paper:1")

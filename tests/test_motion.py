@@ -9,8 +9,8 @@ import pytest
 
 from dcee.errors import DceeInputError
 from dcee.models.motion import MOTION_MODELS, GridMotion, UnicycleMotion, make_motion, wrap_angle
+from dcee.runs import run_episode
 from dcee.scenarios import load_scenario
-from dcee.simulation.episode import run_episode
 
 
 def test_registry_and_errors() -> None:

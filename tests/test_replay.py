@@ -10,12 +10,12 @@ pytest.importorskip("rosbags")
 
 from dcee.cli import main
 from dcee.planning import get as get_planner
-from dcee.ros.bag import BagWriter, read_events, stamp_seconds
-from dcee.ros.cycle import CycleSettings, Pose, SearchCycle
-from dcee.ros.replay import replay_bag
+from dcee.robot.bag import BagWriter, read_events, stamp_seconds
+from dcee.robot.cycle import CycleSettings, Pose, SearchCycle
+from dcee.robot.replay import replay_bag
+from dcee.robot.simulated import SimulatedRobot
+from dcee.runs import make_searcher, planner_defaults, streams
 from dcee.scenarios import load_scenario
-from dcee.simulation.episode import make_searcher, planner_defaults, streams
-from dcee.simulation.robot import SimulatedRobot
 
 SCENARIO = {"search.particles": 800, "search.hypotheses": 8, "search.budget": 60.0}
 

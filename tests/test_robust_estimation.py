@@ -18,9 +18,10 @@ from dcee.estimation.particle_filter import history_log_likelihood_reference
 from dcee.estimation.priors import Fixed, Uniform
 from dcee.models.plume import isotropic_concentration, isotropic_concentration_reference
 from dcee.planning import get as get_planner
+from dcee.runs import run_episode
 from dcee.scenarios import load_scenario
 from dcee.searcher import Searcher
-from dcee.simulation import InjectedTruth, make_truth, run_episode
+from dcee.simulation import InjectedTruth, make_truth
 from tests.helpers import random_theta, run_cli
 
 PAPER1 = load_scenario("paper:1")  # source (37.5, 12.5, 1), wind from +x at 4 m/s: plume to -x

@@ -10,10 +10,10 @@ import pytest
 
 from dcee.errors import DceeInputError
 from dcee.planning import get as get_planner
-from dcee.ros.cycle import CycleSettings, Pose, SearchCycle
+from dcee.robot.cycle import CycleSettings, Pose, SearchCycle
+from dcee.robot.simulated import SimulatedRobot
+from dcee.runs import make_searcher, planner_defaults, streams
 from dcee.scenarios import load_scenario
-from dcee.simulation.episode import make_searcher, planner_defaults, streams
-from dcee.simulation.robot import SimulatedRobot
 
 
 def _lab(**changes):

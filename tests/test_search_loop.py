@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from dcee import DceeInputError, ParticleFilter, Searcher, planners
+from dcee.runs import run_episode
 from dcee.scenarios import load_scenario
-from dcee.simulation import run_episode
 from tests.helpers import SUMMARY_KEYS
 
 

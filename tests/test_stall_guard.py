@@ -15,9 +15,9 @@ from dcee import (
     Sensor,
 )
 from dcee.planning import Planner
+from dcee.runs import run_episode
+from dcee.runs.metrics import longest_stall
 from dcee.scenarios import load_scenario
-from dcee.simulation import run_episode
-from dcee.simulation.metrics import longest_stall
 from tests.helpers import planar_prior
 
 AGENT = GridAgent(SearchVolume((0.0, 0.0, 0.0), (40.0, 40.0, 0.0)), step=2.0, speed=2.0)
@@ -80,7 +80,7 @@ def test_a_search_that_never_paces_is_unchanged_by_the_guard():
 
 
 def test_campaigns_stored_before_the_guard_resume_only_without_it():
-    from dcee.campaign.runner import scenario_identity
+    from dcee.runs import scenario_identity
 
     now = load_scenario("paper:2")
     stored = now.model_dump(mode="json")

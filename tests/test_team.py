@@ -8,8 +8,8 @@ import pytest
 
 from dcee import DceeInputError, GridAgent, SearchVolume, planners
 from dcee.planning import decide_team
+from dcee.runs import run_episode
 from dcee.scenarios import load_scenario
-from dcee.simulation import run_episode
 from tests.helpers import run_cli
 from tests.test_planners import AGENT, START, _spread_belief, _two_point_belief
 

@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 from dcee.errors import DceeInputError
-from dcee.scenarios import load_scenario
-from dcee.scenarios.config import FilamentSpec, truth_choice
+from dcee.scenarios import FilamentSpec, load_scenario, truth_choice
 from dcee.simulation import (
     FilamentTruth,
     IsotropicTruth,

@@ -169,7 +169,7 @@ class Searcher:
     def stall_anchor(self) -> np.ndarray | None:
         """The position (3,) m the robot has stayed within one step of for at least
         ``stall_guard`` s (the first of the latest run of told positions all within one step of
-        it, as :func:`dcee.simulation.metrics.longest_stall` measures) while the belief's spread
+        it, as :func:`dcee.runs.metrics.longest_stall` measures) while the belief's spread
         exceeds ``guard_spread``; None when the guard does not fire."""
         if self.stall_guard <= 0 or len(self.recent) < 2:
             return None

@@ -19,8 +19,8 @@ else:
     pytest.importorskip("rclpy")
 
 from dcee.errors import DceeInputError
+from dcee.robot.replay import replay_bag
 from dcee.ros.demo import run_demo
-from dcee.ros.replay import replay_bag
 from dcee.scenarios import load_scenario
 
 
@@ -91,7 +91,7 @@ def test_node_refuses_a_bad_pose_type() -> None:
 def test_yaw_and_quaternion_round_trip() -> None:
     from geometry_msgs.msg import Quaternion
 
-    from dcee.ros.bag import quaternion_of, yaw_of
+    from dcee.robot.bag import quaternion_of, yaw_of
 
     for yaw in np.linspace(-3.1, 3.1, 13):
         x, y, z, w = quaternion_of(yaw)

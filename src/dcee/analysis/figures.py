@@ -15,8 +15,8 @@ from matplotlib.colors import LogNorm
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
-    from dcee.scenarios.config import Scenario
-    from dcee.simulation.episode import EpisodeResult
+    from dcee.runs import EpisodeResult
+    from dcee.scenarios import Scenario
     from dcee.simulation.truth import TruthModel
 
 

@@ -23,7 +23,7 @@ from dcee.errors import DceeInputError
 def find_runs(folder: str | Path) -> list[Path]:
     """Every complete saved search at or below ``folder`` (sorted). Incomplete ones (a search
     killed mid-write, a failed one) are skipped."""
-    from dcee.simulation.episode import EpisodeResult
+    from dcee.runs import EpisodeResult
 
     folder = Path(folder)
     if not folder.is_dir():

@@ -31,7 +31,6 @@ every session that ran searches in it; resuming with different code is refused u
 
 from __future__ import annotations
 
-import copy
 import json
 import os
 import time
@@ -45,6 +44,7 @@ from urllib.parse import quote
 from dcee.errors import DceeInputError
 from dcee.io import write_json
 from dcee.provenance import code_version, describe, same_code
+from dcee.runs.identity import first_difference, settings_identity
 
 
 def partition(key: str, value: object) -> str:
@@ -76,7 +76,7 @@ class SearchTask:
 
 def is_done(task: SearchTask) -> bool:
     """True when the search's summary, record and posterior sample are complete and consistent."""
-    from dcee.simulation.episode import EpisodeResult
+    from dcee.runs import EpisodeResult
 
     return EpisodeResult.is_complete(task.folder)
 
@@ -86,9 +86,9 @@ def run_search(task: SearchTask) -> dict[str, Any]:
 
     Never raises for a failing search: the error is recorded where the result would be.
     """
+    from dcee.runs import run_episode, snapshot_times
     from dcee.scenarios import Scenario
-    from dcee.simulation import make_truth, run_episode
-    from dcee.simulation.episode import snapshot_times
+    from dcee.simulation import make_truth
 
     folder = task.folder
     t0 = time.perf_counter()
@@ -192,9 +192,9 @@ class Campaign:
                 raise DceeInputError(
                     "out", f"{path} is unreadable; move the folder aside or choose another --out"
                 ) from None
-            before, now = _identity(stored.get("settings", {})), _identity(settings)
+            before, now = settings_identity(stored.get("settings", {})), settings_identity(settings)
             if before != now:
-                changed = _first_difference(before, now)
+                changed = first_difference(before, now)
                 raise DceeInputError(
                     "out",
                     f"{self.out_dir} holds results of a different configuration ({changed}); "
@@ -234,103 +234,6 @@ class Campaign:
                 for strategy in self.strategies:
                     out.append(SearchTask(str(self.out_dir), name, strategy, seed, dump))
         return out
-
-
-def _unicycle_defaults() -> dict[str, Any]:
-    from dcee.scenarios.config import UnicycleSpec
-
-    return UnicycleSpec().model_dump(mode="json")
-
-
-LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
-    ("agent", "count"): 1,
-    # the robot's motion (issue 15); the grid agent at these defaults is the one that ran before
-    ("agent", "model"): "grid",
-    ("agent", "heading"): 0.0,
-    ("agent", "localisation_sd"): 0.0,
-    ("agent", "unicycle"): _unicycle_defaults(),
-    # the fluctuation likelihood ran without the calm model before the setting existed (so a
-    # campaign stored before resumes only with calm_prior = 0, not with the new default)
-    ("estimator", "calm_prior"): 0.0,
-    # no stall guard before issue 28
-    ("search", "stall_guard"): 0.0,
-    # every reading counted fully before issue 29
-    ("estimator", "reading_weight"): 1.0,
-    # a constant log-sd before the distance-dependent spread existed
-    ("estimator", "log_sd_near"): 0.0,
-    ("estimator", "log_sd_length"): 0.0,
-}
-"""Scenario settings added after campaigns were first stored, with the value a stored scenario
-without one ran with, so the two compare equal."""
-
-
-FLUCTUATION_ONLY = (
-    "intermittency",
-    "log_sd",
-    "log_sd_near",
-    "log_sd_length",
-    "near_source_length",
-    "calm_prior",
-)
-"""Estimator settings that only the fluctuation likelihood reads: under the paper's likelihood
-they decide nothing, so changing their defaults must not orphan a campaign."""
-
-
-def _identity(settings: dict[str, Any]) -> dict[str, Any]:
-    """What must match for results to belong together: the settings without the scenarios'
-    free-text descriptions (rewording one must not orphan a campaign; it changes no result) and
-    without later-added settings at their defaults (:data:`LATER_DEFAULTS`)."""
-    out = dict(settings)
-    scenarios = out.get("scenarios")
-    if isinstance(scenarios, dict):
-        out["scenarios"] = {
-            name: scenario_identity(sc) if isinstance(sc, dict) else sc
-            for name, sc in scenarios.items()
-        }
-    return out
-
-
-def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
-    """A stored scenario (its JSON dump) reduced to what decides the results: without its
-    free-text description and without later-added settings at their defaults."""
-    out = copy.deepcopy({k: v for k, v in scenario.items() if k != "description"})
-    estimator = out.get("estimator")
-    if isinstance(estimator, dict):
-        from dcee.scenarios.config import OLD_OUTLIER_DEFAULT, READING_WEIGHT_DEFAULT
-
-        likelihood = estimator.get("likelihood", "paper")
-        if likelihood == "paper":
-            for key in FLUCTUATION_ONLY:  # read by the fluctuation likelihood only
-                estimator.pop(key, None)
-        if estimator.get("outlier", 0) is None:
-            # stored before issue 29, when an unset weight meant 0 for the paper's likelihood
-            estimator["outlier"] = OLD_OUTLIER_DEFAULT[likelihood]
-        if "reading_weight" in estimator and estimator["reading_weight"] is None:
-            # unset: the likelihood's default, compared as the number it stands for
-            estimator["reading_weight"] = READING_WEIGHT_DEFAULT[likelihood]
-    sensor, truth = out.get("sensor"), out.get("truth")
-    if isinstance(sensor, dict) and "dropout" not in sensor and isinstance(truth, dict):
-        # stored before sensor.dropout existed, when the instrument missed 1 − pd of the
-        # readings on every truth: the default now does so on the isotropic truth only
-        if truth.get("model", "isotropic") != "isotropic":
-            sensor["dropout"] = round(1.0 - float(sensor.get("pd", 0.7)), 12)
-        else:
-            sensor["dropout"] = None
-    for path, default in LATER_DEFAULTS.items():
-        node = out
-        for key in path[:-1]:
-            node = node.get(key) if isinstance(node, dict) else None
-        if isinstance(node, dict) and node.get(path[-1], default) == default:
-            node.pop(path[-1], None)
-    return out
-
-
-def _first_difference(a: Any, b: Any, path: str = "") -> str:
-    if isinstance(a, dict) and isinstance(b, dict):
-        for k in sorted(set(a) | set(b)):
-            if a.get(k) != b.get(k):
-                return _first_difference(a.get(k), b.get(k), f"{path}.{k}" if path else k)
-    return f"{path or 'settings'}: stored {a!r}, now {b!r}"
 
 
 _STARTED: Any = None  # in a local worker: shared flags, set when a search starts

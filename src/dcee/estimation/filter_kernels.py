@@ -4,7 +4,7 @@
 The history likelihood Σ_k m_k log p(z_k | Θ_i) is the cost of the filter's MCMC move (every
 proposal against every reading so far) and of each update (one reading). Particles are taken
 in blocks; for each reading the plume is evaluated for the whole block in a branch-free loop
-that LLVM vectorises (:func:`dcee.numeric._vexp`), then the likelihood: far from a
+that LLVM vectorises (:func:`dcee.numeric.vexp`), then the likelihood: far from a
 hypothesised source the concentration is below the sensor's linearisation point and a
 non-detection costs a multiply-add; the other non-detections are gathered and evaluated in one
 vectorised pass (the paper's sensor; libm otherwise), detections in a scalar loop. Each

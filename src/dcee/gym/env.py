@@ -12,8 +12,8 @@ from gymnasium import spaces
 
 from dcee.errors import DceeInputError
 from dcee.planning.base import Belief
-from dcee.scenarios.config import Scenario, truth_choice
-from dcee.simulation.episode import EpisodeResult, SearchSimulation
+from dcee.runs import EpisodeResult, SearchSimulation
+from dcee.scenarios import Scenario, truth_choice
 
 REWARDS = ("spread", "rmse")
 """``spread``: the drop of the posterior spread √tr P over the step (m; what the robot itself
@@ -45,7 +45,7 @@ OBSERVATION_FIELDS = (
 class SourceSearchEnv(gymnasium.Env):
     """Source search as a Gymnasium environment.
 
-    One episode is one simulated search (:class:`~dcee.simulation.episode.SearchSimulation`):
+    One episode is one simulated search (:class:`~dcee.runs.SearchSimulation`):
     the robot starts where the scenario says, takes a reading, and each action moves it one
     step along a heading, after which it takes the next reading and the particle filter
     assimilates it. With the same seed and the same moves it makes exactly the readings that

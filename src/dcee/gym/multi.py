@@ -19,8 +19,8 @@ from dcee.gym.env import (
     observation_space,
     observe,
 )
-from dcee.scenarios.config import Scenario
-from dcee.simulation.episode import SearchSimulation
+from dcee.runs import SearchSimulation
+from dcee.scenarios import Scenario
 
 
 class MultiSearchEnv(ParallelEnv):
@@ -139,7 +139,7 @@ class MultiSearchEnv(ParallelEnv):
         if self.render_mode != "rgb_array":
             return None
         from dcee.analysis.figures import render_search
-        from dcee.simulation.episode import EpisodeResult
+        from dcee.runs import EpisodeResult
 
         sim = self._sim()
         result = EpisodeResult(

@@ -13,7 +13,7 @@ import pandas as pd
 from dcee.errors import DceeInputError
 from dcee.gym.env import SourceSearchEnv
 from dcee.planning import get as get_planner
-from dcee.simulation.episode import planner_defaults, streams
+from dcee.runs import planner_defaults, streams
 
 
 class Policy(Protocol):
@@ -33,7 +33,7 @@ class PlannerPolicy:
 
     It reads the belief from the environment (:attr:`SourceSearchEnv.belief`), which a learned
     policy sees only through the observation. Its random draws come from the planner stream of
-    the episode's seed (:func:`dcee.simulation.episode.streams`), so with the same seed it makes
+    the episode's seed (:func:`dcee.runs.streams`), so with the same seed it makes
     exactly the decisions ``dcee run --strategy SPEC --seed S`` makes.
     """
 

@@ -18,8 +18,8 @@ import numpy as np
 from dcee.planning import get as get_planner
 from dcee.planning.base import Belief
 from dcee.planning.particle_terms import ParticleTerms
+from dcee.runs import SearchSimulation, planner_defaults
 from dcee.scenarios import load_scenario
-from dcee.simulation.episode import SearchSimulation, planner_defaults
 
 
 @dataclass

@@ -27,9 +27,9 @@ from dcee.perf.floor import floor_decision
 from dcee.planning import get as get_planner
 from dcee.planning.particle_terms import ParticleTerms
 from dcee.planning.predicted import PredictionContext, predicted_posterior_stats_reference
+from dcee.runs import run_episode, streams
 from dcee.scenarios import load_scenario
 from dcee.searcher import Searcher
-from dcee.simulation import run_episode, streams
 
 
 @dataclass

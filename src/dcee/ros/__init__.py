@@ -1,5 +1,5 @@
-"""dcee on a robot: the ROS-free search cycle (:mod:`dcee.ros.cycle`), the ROS 2 node
-(:mod:`dcee.ros.node`, ``dcee-ros-node``), the simulated robot node and the demo
-(:mod:`dcee.ros.demo`, ``dcee-ros-demo``), bag recording and replay (:mod:`dcee.ros.bag`,
-:mod:`dcee.ros.replay`, ``dcee replay``). Importing this package imports no ROS; rclpy is
-imported only by the node modules (extra ``ros``: ``bash scripts/setup-ros.sh``)."""
+"""dcee as ROS 2 nodes: the search node (:mod:`dcee.ros.node`, ``dcee-ros-node``), the simulated
+robot node (:mod:`dcee.ros.sim_node`) and the demo that runs both (:mod:`dcee.ros.demo`,
+``dcee-ros-demo``). What they run is ROS-free and lives in :mod:`dcee.robot` (the search
+cycle, bags, replay). Importing this package imports no ROS; rclpy is imported only by the node
+modules (extra ``ros``: ``bash scripts/setup-ros.sh``)."""

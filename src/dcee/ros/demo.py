@@ -12,7 +12,6 @@ with ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` (the demo sets it unless alread
 from __future__ import annotations
 
 import os
-import sys
 import threading
 import time
 from pathlib import Path
@@ -20,6 +19,7 @@ from typing import Any
 
 import click
 
+from dcee.console import print_summary, run_command
 from dcee.errors import DceeInputError
 
 RECORDED = {
@@ -46,7 +46,7 @@ def run_demo(
     likelihood: str | None = None,
 ) -> dict[str, Any]:
     """Run the search node against the simulated robot until the budget is spent; returns the
-    summary (:func:`dcee.simulation.metrics.summarise` plus the message counts, the driven
+    summary (:func:`dcee.runs.metrics.summarise` plus the message counts, the driven
     path and ``records``, the node's per-reading records)."""
     os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
     import rclpy
@@ -54,12 +54,11 @@ def run_demo(
     from rclpy.parameter import Parameter
 
     from dcee.planning import get as get_planner
-    from dcee.ros.bag import BagWriter
+    from dcee.robot.bag import BagWriter
     from dcee.ros.node import SearchNode
     from dcee.ros.sim_node import SimRobotNode
-    from dcee.scenarios import load_scenario
-    from dcee.scenarios.config import truth_choice
-    from dcee.simulation.episode import search_summary
+    from dcee.runs import search_summary
+    from dcee.scenarios import load_scenario, truth_choice
 
     get_planner(strategy)  # fail fast on a bad name
     scenario = load_scenario(scenario_name).with_overrides(
@@ -210,7 +209,6 @@ def cli(
     timeout: float,
 ) -> None:
     """Search over ROS 2 topics: the dcee node against a simulated unicycle robot."""
-    from dcee.cli import _print_summary
     from dcee.io import check_writable_file, write_json
 
     if seed < 0:
@@ -237,23 +235,12 @@ def cli(
     summary.pop("records")
     if json_file is not None:
         write_json(json_file, summary)
-    _print_summary(summary, record, where="topics recorded in")
+    print_summary(summary, record, where="topics recorded in")
 
 
 def main(argv: list[str] | None = None) -> None:
     """Entry point: user errors → one line on stderr and exit 2."""
-    try:
-        cli.main(args=argv, prog_name="dcee-ros-demo", standalone_mode=False)
-    except DceeInputError as exc:
-        click.echo(f"dcee-ros-demo: error: {exc}", err=True)
-        sys.exit(2)
-    except click.ClickException as exc:
-        click.echo(f"dcee-ros-demo: error: {exc.format_message()}", err=True)
-        sys.exit(2)
-    except (KeyboardInterrupt, click.exceptions.Abort):
-        click.echo("dcee-ros-demo: interrupted", err=True)
-        sys.exit(130)
-    sys.exit(0)
+    run_command(cli, "dcee-ros-demo", argv)
 
 
 __all__ = ["RECORDED", "main", "run_demo"]

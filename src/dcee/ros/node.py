@@ -1,4 +1,4 @@
-"""The dcee ROS 2 node (``dcee-ros-node``): the search cycle of :mod:`dcee.ros.cycle` on topics.
+"""The dcee ROS 2 node (``dcee-ros-node``): the search cycle of :mod:`dcee.robot.cycle` on topics.
 
 Subscribes
     ``concentration`` (std_msgs/Float32, sensor units × ``calibration`` = g/m³), stamped on
@@ -46,13 +46,13 @@ from rclpy.qos import QoSDurabilityPolicy, QoSProfile, QoSReliabilityPolicy
 from std_msgs.msg import Float32
 from visualization_msgs.msg import Marker, MarkerArray
 
+from dcee.console import error_exit
 from dcee.errors import DceeInputError
-from dcee.ros.bag import quaternion_of, yaw_of
-from dcee.ros.cycle import CycleSettings, Pose, SearchCycle
-from dcee.scenarios import load_scenario
-from dcee.scenarios.config import Scenario
+from dcee.robot.bag import quaternion_of, yaw_of
+from dcee.robot.cycle import CycleSettings, Pose, SearchCycle
+from dcee.runs import make_searcher, planner_defaults, streams
+from dcee.scenarios import Scenario, load_scenario
 from dcee.searcher import Searcher
-from dcee.simulation.episode import make_searcher, planner_defaults, streams
 
 RELIABLE = QoSProfile(depth=50, reliability=QoSReliabilityPolicy.RELIABLE)
 LATCHED = QoSProfile(
@@ -74,7 +74,7 @@ PARAMETERS: dict[str, Any] = {
     "pose_type": "odometry",
     "checkpoint": "",
     "marker_particles": 500,
-    # when a reading is taken (dcee.ros.cycle.CycleSettings); hold and averaging: the scenario's
+    # when a reading is taken (dcee.robot.cycle.CycleSettings); hold and averaging: the scenario's
     "goal_tolerance": 0.05,
     "settle_speed": 0.02,
     "settle_turn_rate": 5.0,
@@ -88,7 +88,7 @@ def seconds(stamp: Any) -> float:
 
 class SearchNode(Node):
     """The search cycle as a ROS 2 node. ``true_location`` (3,) m, when known (a simulation),
-    gives the records an RMSE; ``scenario`` (a :class:`~dcee.scenarios.config.Scenario`)
+    gives the records an RMSE; ``scenario`` (a :class:`~dcee.scenarios.Scenario`)
     replaces the ``scenario`` and ``particles`` parameters when the node is built from Python.
     :attr:`done` is set when the budget is spent."""
 
@@ -297,10 +297,8 @@ def main(argv: list[str] | None = None) -> None:
     try:
         node = SearchNode()
     except (DceeInputError, ParameterException, InvalidParameterTypeException) as exc:
-        message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        print(f"dcee-ros-node: error: {message}", file=sys.stderr)
         rclpy.try_shutdown()
-        raise SystemExit(2) from None
+        error_exit("dcee-ros-node", str(exc) or type(exc).__name__)
     # one thread: the node's callbacks share one mutually exclusive group anyway, and the
     # single-threaded executor has 3-4x the throughput (measured with the demo)
     executor = rclpy.executors.SingleThreadedExecutor()

@@ -1,4 +1,4 @@
-"""A simulated robot as a ROS 2 node: a unicycle (:class:`dcee.simulation.robot.SimulatedRobot`)
+"""A simulated robot as a ROS 2 node: a unicycle (:class:`dcee.robot.simulated.SimulatedRobot`)
 in any dcee truth (isotropic, filament, recording) that drives to ``goal_pose`` and publishes
 ``/clock`` (simulated time), ``odom`` (nav_msgs/Odometry in the ``frame_id`` frame, child
 ``base_link``, with the scenario's localisation error) and ``concentration``
@@ -21,10 +21,10 @@ from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float32
 
-from dcee.ros.bag import quaternion_of
+from dcee.robot.bag import quaternion_of
+from dcee.robot.simulated import SimulatedRobot
 from dcee.ros.node import LATCHED, RELIABLE
-from dcee.scenarios.config import Scenario
-from dcee.simulation.robot import SimulatedRobot
+from dcee.scenarios import Scenario
 
 
 def stamp_of(t: float) -> Any:

@@ -1,6 +1,7 @@
-"""Simulated searches: ground truth (isotropic, filament, puffs, playback) and the episode loop."""
+"""What the sensor sees in a simulated search: the ground-truth plumes (isotropic, filament,
+puffs, recorded playback), registered by name. The search that runs against them is
+:mod:`dcee.runs`."""
 
-from dcee.simulation.episode import EpisodeResult, run_episode, streams
 from dcee.simulation.filament import FilamentTruth
 from dcee.simulation.playback import PlaybackTruth, load_recording, save_recording
 from dcee.simulation.puffs import PuffTruth
@@ -13,7 +14,6 @@ from dcee.simulation.truth import (
 )
 
 __all__ = [
-    "EpisodeResult",
     "FilamentTruth",
     "InjectedTruth",
     "IsotropicTruth",
@@ -23,7 +23,5 @@ __all__ = [
     "load_recording",
     "make_truth",
     "plume_stream",
-    "run_episode",
     "save_recording",
-    "streams",
 ]

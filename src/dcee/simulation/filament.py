@@ -45,7 +45,7 @@ import numpy as np
 from dcee.simulation.truth import SteppedTruth, plume_stream, register_truth
 
 if TYPE_CHECKING:
-    from dcee.scenarios.config import FilamentSpec, Scenario
+    from dcee.scenarios import FilamentSpec, Scenario
 
 DECAY_CUTOFF = 1e-6
 """A puff is dropped once its mass has decayed below this fraction (age > ζ2 · ln 1e6)."""
@@ -86,7 +86,7 @@ class FilamentTruth(SteppedTruth):
     Parameters
     ----------
     theta : (8,) true source term (x, y, z, q, u, φ rad, ζ1, ζ2).
-    spec : the scenario's :class:`~dcee.scenarios.config.FilamentSpec`.
+    spec : the scenario's :class:`~dcee.scenarios.FilamentSpec`.
     rng : generator for the meander and the puff random walks (the episode's truth stream).
     low, high : (3,) corners of the search volume, m; puffs far outside it are dropped.
     """

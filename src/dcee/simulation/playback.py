@@ -30,7 +30,7 @@ from dcee.simulation.cf_recording import SUFFIXES, read_cf_recording
 from dcee.simulation.truth import TruthModel, register_truth
 
 if TYPE_CHECKING:
-    from dcee.scenarios.config import Scenario
+    from dcee.scenarios import Scenario
 
 FIELD = "truth.model.file"
 

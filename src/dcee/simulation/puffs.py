@@ -47,7 +47,7 @@ from dcee.simulation.filament import gaussian_puffs_field
 from dcee.simulation.truth import SteppedTruth, plume_stream, register_truth
 
 if TYPE_CHECKING:
-    from dcee.scenarios.config import PuffsSpec, Scenario
+    from dcee.scenarios import PuffsSpec, Scenario
 
 PRUNE_EVERY = 10
 """steps between removals of puffs that left the area (every step costs more than it saves)"""
@@ -77,7 +77,7 @@ class PuffTruth(SteppedTruth):
     Parameters
     ----------
     theta : (8,) true source term (x, y, z, q, u, φ rad, ζ1, ζ2); ζ1 and ζ2 are not used.
-    spec : the scenario's :class:`~dcee.scenarios.config.PuffsSpec`.
+    spec : the scenario's :class:`~dcee.scenarios.PuffsSpec`.
     rng : generator for the wind noise, the releases and the puff random walks.
     low, high : (3,) corners of the search volume, m.
     """

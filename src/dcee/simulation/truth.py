@@ -11,9 +11,10 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.models.plume import IsotropicPlume
+from dcee.scenarios.schema.truth import TRUTH_KINDS
 
 if TYPE_CHECKING:
-    from dcee.scenarios.config import Scenario
+    from dcee.scenarios import Scenario
 
 
 class TruthModel(ABC):
@@ -199,7 +200,7 @@ class InjectedTruth(TruthModel):
 PLUME_STREAM = 3
 """Child of ``SeedSequence(seed)`` that drives a stochastic truth (the filament's puffs and
 meander). Children 0-2 are the episode's sensor-noise, agent and figure streams
-(:func:`dcee.simulation.episode.streams`), so the plume is independent of them and identical for
+(:func:`dcee.runs.streams`), so the plume is independent of them and identical for
 every strategy run with the same seed (common random numbers)."""
 
 
@@ -209,20 +210,20 @@ def plume_stream(seed: int) -> np.random.Generator:
 
 
 TruthFactory = Callable[["Scenario", int], TruthModel]
-TRUTH_KINDS: dict[str, TruthFactory] = {}
-"""Truth models by the ``kind`` of the scenario's ``truth.model`` (``"isotropic"`` for the plain
-string): each module registers its own factory ``(scenario, seed) -> TruthModel`` with
-:func:`register_truth`, so adding a truth edits no dispatcher."""
 
 
 def register_truth(kind: str) -> Callable[[TruthFactory], TruthFactory]:
     """Decorator: make ``factory(scenario, seed)`` build the truth of ``truth.model`` kind
-    ``kind``."""
+    ``kind``, an entry of the one registry of truth kinds
+    (:data:`dcee.scenarios.schema.truth.TRUTH_KINDS`, which holds its parameter table)."""
 
     def add(factory: TruthFactory) -> TruthFactory:
-        if kind in TRUTH_KINDS and TRUTH_KINDS[kind] is not factory:
+        entry = TRUTH_KINDS.get(kind)
+        if entry is None:
+            raise ValueError(f"truth kind {kind!r} has no parameter spec in TRUTH_KINDS")
+        if entry.build is not None and entry.build is not factory:
             raise ValueError(f"truth kind {kind!r} is already registered")
-        TRUTH_KINDS[kind] = factory
+        entry.build = factory
         return factory
 
     return add
@@ -237,7 +238,8 @@ def make_truth(scenario: Scenario, seed: int) -> TruthModel:
     """The scenario's ``truth.model`` for episode ``seed``, built by the factory registered for
     its kind (isotropic here; filament and playback in their modules)."""
     kind = truth_kind(scenario.truth.model)
-    factory = TRUTH_KINDS.get(kind)
+    entry = TRUTH_KINDS.get(kind)
+    factory = entry.build if entry is not None else None
     if factory is None:
         raise DceeInputError(
             "truth.model", f"unknown truth kind {kind!r}; choose one of {', '.join(TRUTH_KINDS)}"

@@ -2,7 +2,7 @@
 in real time steps, with a sensor sampled at every control step. The ROS 2 simulated robot node
 (:mod:`dcee.ros.sim_node`) publishes what it produces; tests drive it directly.
 
-Unlike :class:`~dcee.simulation.episode.SearchSimulation`, which jumps from reading to reading,
+Unlike :class:`~dcee.runs.simulation.SearchSimulation`, which jumps from reading to reading,
 this robot lives in continuous time: it reports its pose and an instantaneous noisy reading
 every ``control_dt`` s, and whoever drives it (the search cycle) decides when it has settled
 and which samples make a reading.
@@ -15,8 +15,8 @@ import math
 import numpy as np
 
 from dcee.models.motion import Drive, UnicycleMotion, UnicycleState
-from dcee.scenarios.config import Scenario
-from dcee.simulation.episode import motion_stream, streams
+from dcee.runs.streams import motion_stream, streams
+from dcee.scenarios import Scenario
 from dcee.simulation.truth import TruthModel, make_truth
 
 

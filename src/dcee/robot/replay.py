@@ -11,10 +11,10 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.provenance import code_version
-from dcee.ros.bag import read_events
-from dcee.ros.cycle import CycleSettings, Pose, SearchCycle
-from dcee.scenarios.config import Scenario
-from dcee.simulation.episode import EpisodeResult, make_searcher, search_summary, streams
+from dcee.robot.bag import read_events
+from dcee.robot.cycle import CycleSettings, Pose, SearchCycle
+from dcee.runs import EpisodeResult, make_searcher, search_summary, streams
+from dcee.scenarios import Scenario
 
 
 def replay_bag(

@@ -1,4 +1,5 @@
-"""Per-run summary metrics (the paper's definitions)."""
+"""Score a search: its summary metrics (the paper's definitions), the longest stall, and the
+whole summary a saved search carries (:func:`search_summary`)."""
 
 from __future__ import annotations
 
@@ -7,8 +8,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from dcee.estimation.model_bank import ModelBank
+
 if TYPE_CHECKING:
-    from dcee.scenarios.config import Scenario
+    from dcee.scenarios import Scenario
+    from dcee.searcher import Searcher
 
 
 def first_time_below(times: np.ndarray, values: np.ndarray, level: float) -> float | None:
@@ -117,3 +121,35 @@ def summarise(
         "update_seconds_total": float(update.sum()),
         "compute_seconds_total": float(decision.sum() + update.sum()),
     }
+
+
+def search_summary(
+    records: list[dict[str, Any]],
+    scenario: Scenario,
+    strategy: str,
+    seed: int,
+    path_length: float,
+    searcher: Searcher,
+) -> dict[str, Any]:
+    """A search's summary: :func:`dcee.runs.metrics.summarise` of its ``records``, the
+    planner's options and the filter's diagnostics (recoveries, calibration against the
+    scenario's true source, resamplings) and the scenario's resolved settings. The simulation,
+    ``dcee replay`` and the ROS demo all summarise through it."""
+    pf = searcher.filter
+    out = summarise(records, scenario, strategy, seed, path_length)
+    planner = searcher.planner
+    out["planner_options"] = planner.options() if planner is not None else {}
+    out["recoveries"] = len(pf.recoveries)
+    out["tempering_events"] = sum(r["kind"] == "tempering" for r in pf.recoveries)
+    out["rejected_readings"] = sum(r["kind"] == "rejected" for r in pf.recoveries)
+    out["truth_in_95"] = pf.in_credible_region(scenario.truth_theta()[:3], 0.95)
+    out.update(scenario.resolved_settings())
+    out["resamples"] = pf.n_resamples
+    out["stall_guard_fired"] = searcher.guard_fired  # decisions the stall guard restricted
+    if isinstance(pf, ModelBank):  # which reading model the readings chose, and how firmly
+        out["model"] = pf.selected_name
+        out["model_probability"] = pf.selected_probability
+        out["model_switches"] = pf.switches
+    out["config"] = scenario.name
+    out["parameter_names"] = list(scenario.unknown_names)
+    return out

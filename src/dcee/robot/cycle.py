@@ -1,6 +1,6 @@
 """The robot's search cycle without ROS: arrive → settle → hold (average the readings) → tell →
 ask → publish. The ROS 2 node (:mod:`dcee.ros.node`) feeds it the messages it receives and
-publishes what it returns; ``dcee replay`` (:mod:`dcee.ros.replay`) feeds it a recorded bag
+publishes what it returns; ``dcee replay`` (:mod:`dcee.robot.replay`) feeds it a recorded bag
 with the goals as recorded. Everything here is plain Python and tested without ROS.
 
 Time is the robot's clock in seconds (message stamps, simulated time in the demo); the search's
@@ -17,9 +17,9 @@ from typing import Any
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.scenarios.config import Scenario
+from dcee.runs import reading_record
+from dcee.scenarios import Scenario
 from dcee.searcher import Searcher
-from dcee.simulation.episode import reading_record
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,170 @@
+"""``dcee bench`` (a resumable campaign of simulated searches) and ``dcee report`` (its tables,
+tests, figures and HTML)."""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import click
+
+from dcee.cli.options import (
+    LIKELIHOOD_OPTION,
+    SET_OPTION,
+    TRUTH_OPTION,
+    RegistryChoice,
+    overrides,
+    suite_names,
+)
+from dcee.console import clock, compile_notice
+from dcee.io import check_writable_dir
+
+
+@click.command()
+@click.option(
+    "--suite",
+    default="paper",
+    show_default=True,
+    type=RegistryChoice(suite_names),
+    help="Named set of configurations (docs/scenarios.md).",
+)
+@click.option(
+    "--strategies",
+    default="dcee,mpc,entrotaxis,infotaxis,dcee-ms",
+    show_default=True,
+    help="Comma-separated planner specs NAME[:KEY=VALUE]... (`dcee strategies` lists them).",
+)
+@click.option("--repeats", default=10, show_default=True, help="Repeats per configuration.")
+@click.option(
+    "--out",
+    "out_dir",
+    required=True,
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Campaign folder (created, or resumed if it holds this campaign).",
+)
+@click.option("--workers", type=int, help="Local worker processes [default: all cores].")
+@click.option("--scheduler", help="Address of a running Dask scheduler, e.g. tcp://host:8786.")
+@click.option("--unknown", type=click.Choice(["source", "full"]), help="Override unknown set.")
+@click.option("--particles", type=int, help="Override the particle count.")
+@click.option(
+    "--agents",
+    type=int,
+    help="Robots searching together with one shared belief (override agent.count) [default: 1].",
+)
+@TRUTH_OPTION
+@LIKELIHOOD_OPTION
+@SET_OPTION
+@click.option(
+    "--allow-code-change",
+    is_flag=True,
+    help="Resume a campaign that other code started (every version used is recorded).",
+)
+def bench(
+    suite: str,
+    strategies: str,
+    repeats: int,
+    out_dir: Path,
+    workers: int | None,
+    scheduler: str | None,
+    unknown: str | None,
+    particles: int | None,
+    agents: int | None,
+    truth: str | None,
+    likelihood: str | None,
+    settings: tuple[str, ...],
+    allow_code_change: bool,
+) -> None:
+    """Run a campaign of simulated searches; resumes where a previous run stopped."""
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
+
+    from dcee.campaign import Campaign, run_campaign
+    from dcee.scenarios import truth_choice
+
+    names = tuple(s.strip() for s in strategies.split(",") if s.strip())
+    changes = overrides(likelihood, settings)
+    if agents is not None:
+        changes["agent.count"] = agents
+    campaign = Campaign(
+        out_dir,
+        suite,
+        names,
+        repeats,
+        unknown,
+        particles,
+        truth_choice(truth) if truth is not None else None,
+        changes,
+        allow_code_change,
+    )
+    check_writable_dir(out_dir, "out")
+    compile_notice(False)
+    failures: list[str] = []
+    columns = (
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("failed {task.fields[failed]}"),
+        TimeElapsedColumn(),
+        TextColumn("ETA"),
+        TimeRemainingColumn(),
+    )
+    interactive = sys.stderr.isatty()
+    started = time.monotonic()
+    with Progress(*columns, disable=not interactive) as progress:
+        bar = progress.add_task(suite, total=None, failed=0)
+
+        def on_result(res: dict[str, Any], finished: int, todo: int) -> None:
+            if res["status"] == "failed":
+                t = res["task"]
+                failures.append(f"{t.config} {t.strategy} seed {t.seed}: {res['error']}")
+            progress.update(bar, total=todo, completed=finished, failed=len(failures))
+            if not interactive:
+                _log_progress(suite, finished, todo, len(failures), time.monotonic() - started)
+
+        counts = run_campaign(campaign, workers=workers, scheduler=scheduler, on_result=on_result)
+    click.echo(
+        f"{counts['total']} searches: {counts['skipped']} already done, {counts['done']} run, "
+        f"{counts['failed']} failed · results in {out_dir}"
+    )
+    for line in failures[:20]:
+        click.echo(f"  failed: {line}", err=True)
+
+
+def _log_progress(suite: str, finished: int, todo: int, failed: int, elapsed: float) -> None:
+    """Plain progress lines for logs (stderr not a terminal, e.g. under nohup or a batch
+    system): about twenty per campaign plus the last, each with completed/total, failures and
+    an ETA from the mean rate so far."""
+    if finished != todo and finished % max(1, todo // 20):
+        return
+    eta = elapsed / finished * (todo - finished)
+    click.echo(
+        f"{suite}: {finished}/{todo} searches, failed {failed}, "
+        f"elapsed {clock(elapsed)}, ETA {clock(eta)}",
+        err=True,
+    )
+
+
+@click.command()
+@click.argument("results_dir", type=click.Path(file_okay=False, path_type=Path))
+@click.option(
+    "--out",
+    "out_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Report folder [default: RESULTS_DIR/report].",
+)
+def report(results_dir: Path, out_dir: Path | None) -> None:
+    """Tables (CSV, Markdown), paired tests, figures and a self-contained HTML report of a
+    campaign or of any folder of `dcee run` results."""
+    from dcee.analysis.report import write_report
+
+    paths = write_report(results_dir, out_dir or results_dir / "report")
+    for p in paths:
+        click.echo(str(p))

@@ -1,0 +1,91 @@
+"""``dcee perf``: the standard workloads timed against their targets."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import click
+
+from dcee.errors import DceeInputError
+from dcee.io import check_writable_file, write_json
+
+
+@click.command()
+@click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Also write JSON here.")
+@click.option("--quick", is_flag=True, help="Fewer repeats; skip the whole-search workloads.")
+@click.option(
+    "--compare-stonesoup",
+    is_flag=True,
+    help="Time Stone Soup's STE example side by side (needs the 'bench' extra).",
+)
+@click.option("--decisions", default=10, show_default=True, help="Decisions per side to time.")
+def perf(json_path: str | None, quick: bool, compare_stonesoup: bool, decisions: int) -> None:
+    """Time the standard workloads against their targets (see docs/performance.md)."""
+    import platform
+
+    from rich.console import Console
+    from rich.table import Table
+
+    if json_path:
+        check_writable_file(Path(json_path), "json")  # before minutes of timing, not after
+    console = Console(width=None if sys.stdout.isatty() else 120)
+    machine = {
+        "cpus": os.cpu_count(),
+        "machine": platform.machine(),
+        "processor": platform.processor(),
+        "python": platform.python_version(),
+        "numba_threads": _numba_threads(),
+    }
+    if compare_stonesoup:
+        from dcee.perf.stonesoup_compare import compare
+
+        if decisions < 1:
+            raise DceeInputError("decisions", f"must be >= 1, got {decisions}")
+        result = compare(decisions)
+        console.print(
+            f"{result['workload']}, {decisions} decisions each (medians, same process):\n"
+            f"  Stone Soup {result['stonesoup_median_ms']:.2f} ms · "
+            f"dcee infotaxis {result['dcee_infotaxis_median_ms']:.2f} ms · "
+            f"ratio {result['speedup']:.1f}x (target >= {result['target_speedup']:.0f}x)"
+        )
+        if json_path:
+            write_json(Path(json_path), {"machine": machine, "stonesoup": result})
+        return
+    from dcee.perf import run_workloads
+
+    with console.status("timing") as status:
+        timings = run_workloads(quick, progress=lambda name: status.update(f"timing {name}"))
+    table = Table(title=f"dcee perf · {machine['cpus']} CPUs · {machine['machine']}")
+    for col in ("workload", "median", "min", "max", "target", "pass"):
+        if col == "workload":
+            table.add_column(col, no_wrap=True, min_width=30)
+        else:
+            table.add_column(col, justify="right", no_wrap=True)
+    for t in timings:
+        d = t.as_dict()
+        mark = {True: "[green]pass", False: "[red]FAIL", None: "—"}[t.passed]
+        table.add_row(
+            t.name,
+            f"{d['median']:.3g} {t.unit}",
+            f"{d['min']:.3g}",
+            f"{d['max']:.3g}",
+            t.target_text,
+            mark,
+        )
+    console.print(table)
+    for t in timings:
+        if t.note:
+            console.print(f"  {t.name}: {t.note}")
+    if json_path:
+        write_json(
+            Path(json_path),
+            {"machine": machine, "workloads": [t.as_dict() for t in timings]},
+        )
+
+
+def _numba_threads() -> int:
+    import numba
+
+    return int(numba.get_num_threads())

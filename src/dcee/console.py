@@ -1,0 +1,142 @@
+"""What every interface prints: a search's summary table, progress, the one-line error of a user
+mistake and the exit codes. The command line, the ROS 2 entry points and replay all print through
+here, so none imports another to reuse its printing.
+
+Exit codes: 0 done, 2 a user mistake (one line on stderr, ``<program>: error: <field>: <what is
+allowed>``, printed before any work starts), 130 interrupted.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import click
+
+from dcee.errors import DceeInputError
+
+USER_ERROR = 2
+"""Exit code of a user mistake (bad option, bad scenario value, unknown name, missing file)."""
+INTERRUPTED = 130
+"""Exit code of an interrupted command (Ctrl-C)."""
+
+
+def error_exit(program: str, message: str) -> None:
+    """Print ``<program>: error: <message>`` (its first line) on stderr and exit 2."""
+    first = message.splitlines()[0] if message else "error"
+    click.echo(f"{program}: error: {first}", err=True)
+    sys.exit(USER_ERROR)
+
+
+def run_command(command: click.Command, program: str, argv: list[str] | None = None) -> None:
+    """Run a click ``command`` as program ``program``: a user mistake ends in one line on stderr
+    and exit 2, an interruption in exit 130, success in exit 0 (never a traceback for either)."""
+    try:
+        command.main(args=argv, prog_name=program, standalone_mode=False)
+    except DceeInputError as exc:
+        error_exit(program, str(exc))
+    except click.ClickException as exc:
+        error_exit(program, exc.format_message())
+    except (KeyboardInterrupt, click.exceptions.Abort):
+        click.echo(f"{program}: interrupted", err=True)
+        sys.exit(INTERRUPTED)
+    sys.exit(0)
+
+
+def compile_notice(quiet: bool) -> None:
+    """Say so when this process will compile the numerical kernels (first use after installing
+    or changing the code: up to a minute of no visible progress otherwise)."""
+    if quiet:
+        return
+    import dcee.models
+
+    cache = Path(dcee.models.__file__).parent / "__pycache__"
+    if not any(cache.glob("*.nbi")):
+        click.echo(
+            "dcee: compiling the numerical kernels (first run only; up to a minute)", err=True
+        )
+
+
+def run_with_progress(job: Callable[[Any], Any], budget: float, quiet: bool) -> Any:
+    """Call ``job(progress)`` with a progress bar over the search's ``budget`` (s) on a terminal;
+    ``progress(t, record)`` is None when ``quiet`` or stderr is not a terminal."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    if quiet or not sys.stderr.isatty():
+        return job(None)
+    with Progress(
+        TextColumn("[bold]searching"),
+        BarColumn(),
+        TextColumn("{task.fields[status]}"),
+        TimeElapsedColumn(),
+        transient=True,
+    ) as bar:
+        task = bar.add_task("search", total=budget, status="preparing (kernels, first step)")
+
+        def progress(t: float, rec: dict[str, Any]) -> None:
+            bar.update(task, completed=t, status=f"t={t:.0f}s RMSE {rec['rmse']:.2f} m")
+
+        return job(progress)
+
+
+def print_summary(summary: dict[str, Any], out_dir: Path | None, where: str = "results in") -> None:
+    """A search's summary (:func:`dcee.runs.search_summary`) as a table on stdout, then
+    ``<where> <out_dir>`` when there is a folder."""
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title=f"{summary['scenario']} · {summary['strategy']} · seed {summary['seed']}")
+    table.add_column("metric")
+    table.add_column("value", justify="right")
+    rows = [
+        ("final RMSE (m)", f"{summary['final_rmse']:.3f}"),
+        ("source acquired", str(summary["source_acquired"])),
+        ("plume acquired", str(summary["plume_acquired"])),
+        ("time to RMSE < 1 m (s)", _seconds(summary["time_to_rmse_1m"])),
+        ("time to RMSE < 0.5 m (s)", _seconds(summary["time_to_rmse_0_5m"])),
+        *(
+            [("longest stall before acquired (s)", f"{summary['longest_stall']:.0f}")]
+            if "longest_stall" in summary  # searches saved before the metric lack it
+            else []
+        ),
+        ("steps", str(summary["steps"])),
+        ("path length (m)", f"{summary['path_length']:.1f}"),
+        ("mean decision time (ms)", f"{1e3 * summary['decision_seconds_mean']:.2f}"),
+        ("total compute (s)", f"{summary['compute_seconds_total']:.2f}"),
+        *(
+            [("reading model, P", f"{summary['model']}, {summary['model_probability']:.3f}")]
+            if "model" in summary  # the fluctuation likelihood with its calm model
+            else []
+        ),
+    ]
+    for k, v in rows:
+        table.add_row(k, v)
+    console = Console()
+    console.print(table)
+    if out_dir is not None:
+        console.print(f"{where} {out_dir}")
+
+
+def clock(seconds: float) -> str:
+    """``h:mm:ss`` of a duration in s."""
+    m, s = divmod(round(seconds), 60)
+    h, m = divmod(m, 60)
+    return f"{h}:{m:02d}:{s:02d}"
+
+
+def _seconds(v: float | None) -> str:
+    return "never" if v is None else f"{v:.0f}"
+
+
+__all__ = [
+    "INTERRUPTED",
+    "USER_ERROR",
+    "clock",
+    "compile_notice",
+    "error_exit",
+    "print_summary",
+    "run_command",
+    "run_with_progress",
+]

@@ -1,0 +1,73 @@
+"""Assemble a search from a configuration: the scenario's estimator (one filter, or a bank of
+them when several reading models compete) and a planner's constructor defaults, in a
+:class:`~dcee.searcher.Searcher`. The simulation, the ROS node and ``dcee replay`` all build
+their searches here, so one scenario gives the same search wherever it runs."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from dcee.estimation.model_bank import ModelBank
+from dcee.estimation.particle_filter import ParticleFilter
+from dcee.planning.base import Planner, planner_class
+from dcee.scenarios import Scenario
+from dcee.searcher import Searcher
+
+
+def make_searcher(
+    scenario: Scenario,
+    planner: Planner | None,
+    filter_rng: np.random.Generator,
+    planner_rng: np.random.Generator,
+) -> Searcher:
+    """The scenario's filter (prior, estimator reading model, plume model, scale) and
+    ``planner`` in a :class:`~dcee.searcher.Searcher`; the simulation, the ROS node and
+    ``dcee replay`` build theirs here (with the generators of :func:`streams`)."""
+    search = scenario.search
+    models = scenario.reading_models
+    # the first (preferred) model draws from filter_rng itself, as a lone filter does; the others
+    # from children of it (spawning does not move filter_rng). So a second model changes nothing
+    # while it is not selected, and comparisons with and without it are paired exactly.
+    rngs = [filter_rng, *filter_rng.spawn(len(models) - 1)]
+    filters = [
+        ParticleFilter(
+            scenario.make_prior(),
+            scenario.make_estimator_sensor(model),  # the reading model of filter and planners
+            scenario.make_plume(model),
+            n_particles=search.particles,
+            seed=rng,
+            resample_threshold=search.resample_threshold,
+            mcmc_steps=search.mcmc_steps,
+            global_share=search.global_share,
+            diversify=search.diversify,
+            max_sweeps=search.max_sweeps,
+            reading_weight=scenario.reading_weight,
+        )
+        for model, rng in zip(models, rngs, strict=True)
+    ]
+    estimator = (
+        filters[0]
+        if len(filters) == 1
+        else ModelBank(filters, models, scenario.reading_model_priors)
+    )
+    return Searcher(
+        estimator,
+        planner,
+        scenario.make_agent(),
+        planner_rng,
+        stall_guard=search.stall_guard,
+        guard_spread=search.acquired_rmse,
+    )
+
+
+def planner_defaults(
+    strategy: str, scenario: Scenario, options: dict[str, Any] | None
+) -> dict[str, Any]:
+    """Constructor defaults: the scenario's hypothesis count (a spec's own, ``dcee:hypotheses=25``,
+    overrides it in :func:`dcee.planning.get`)."""
+    opts = dict(options or {})
+    if planner_class(strategy).uses_hypotheses:
+        opts.setdefault("n_hypotheses", scenario.search.hypotheses)
+    return opts

@@ -1,0 +1,134 @@
+"""How a scenario becomes the objects a search runs: the instrument, the estimator's reading
+models and plume model, the prior, the move set and the motion model. :class:`ScenarioBuilders`
+gives :class:`~dcee.scenarios.Scenario` these ``make_*`` methods; the schema itself only
+validates."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from dcee.errors import DceeInputError
+from dcee.estimation.priors import Distribution, Fixed, Gamma, Normal, SourcePrior, Uniform
+from dcee.models.agent import GridAgent, SearchVolume
+from dcee.models.motion import MotionModel, make_motion
+from dcee.models.plume import PARAMETER_NAMES, IsotropicPlume
+from dcee.models.sensor import Sensor
+from dcee.scenarios.schema.agent import team_starts
+from dcee.scenarios.schema.estimator import PHYSICAL_TRUNCATION, PriorSpec
+
+if TYPE_CHECKING:
+    from dcee.scenarios.schema.scenario import Scenario
+
+
+class ScenarioBuilders:
+    """The ``make_*`` methods of a :class:`~dcee.scenarios.Scenario` (a mixin: every attribute
+    it reads is a validated scenario field or property)."""
+
+    def search_volume(self: Scenario) -> SearchVolume:
+        return SearchVolume(tuple(self.volume.low), tuple(self.volume.high))
+
+    def make_sensor(self: Scenario) -> Sensor:
+        """The instrument that produces the (simulated) real readings: the ``[sensor]``
+        parameters with its detection probability :attr:`instrument_pd`."""
+        return dataclasses.replace(self._paper_sensor(), pd=self.instrument_pd)
+
+    def _paper_sensor(self: Scenario) -> Sensor:
+        """The paper's eq. 3 with the ``[sensor]`` parameters (its Pd included)."""
+        return Sensor(**self.sensor.model_dump(exclude={"average", "response_time", "dropout"}))
+
+    def make_estimator_sensor(self: Scenario, model: str | None = None) -> Sensor:
+        """The reading model ``model`` (one of :attr:`reading_models`; None: the first) of the
+        filter and the planners (``[estimator]``)."""
+        s, e = self.sensor, self.estimator
+        model = self._reading_model(model)
+        if model == "paper":
+            return dataclasses.replace(self._paper_sensor(), outlier=self.outlier)
+        return Sensor(
+            threshold=s.threshold,
+            pd=e.intermittency,
+            family="lognormal",
+            log_sd=e.log_sd,
+            log_sd_near=e.log_sd_near,
+            log_sd_length=e.log_sd_length,
+            near_length=e.near_source_length,
+            outlier=self.outlier,
+            max_reading=s.max_reading,
+        )
+
+    def make_plume(self: Scenario, model: str | None = None) -> IsotropicPlume:
+        """The dispersion model of the filter and the planners under reading model ``model``
+        (None: the first of :attr:`reading_models`)."""
+        model = self._reading_model(model)
+        if self.estimator.likelihood != model:  # the fluctuation likelihood's calm member
+            return IsotropicPlume(meander=0.0)
+        return IsotropicPlume(meander=self.meander)
+
+    def _reading_model(self: Scenario, model: str | None) -> str:
+        if model is None:
+            return self.reading_models[0]
+        if model not in self.reading_models:
+            raise DceeInputError("model", f"must be one of {', '.join(self.reading_models)}")
+        return model
+
+    def starts(self: Scenario) -> np.ndarray:
+        """(count, 3) start positions of the robots, m (row 0 is ``agent.start``)."""
+        lo, hi = np.array(self.volume.low), np.array(self.volume.high)
+        a = self.agent
+        out = team_starts(np.array(a.start, dtype=np.float64), a.step, a.count, lo, hi)
+        assert out is not None  # checked at validation
+        return out
+
+    def make_agent(self: Scenario) -> GridAgent:
+        """The planner's move set."""
+        a = self.agent
+        return GridAgent(self.search_volume(), a.step, a.speed, self.dwell, a.headings)
+
+    def make_motion(self: Scenario) -> MotionModel:
+        """How the robots drive to the planner's waypoints (``agent.model``)."""
+        a = self.agent
+        if a.model == "grid":
+            return make_motion("grid", step=a.step, speed=a.speed)
+        u = a.unicycle
+        return make_motion(
+            "unicycle",
+            max_speed=a.speed,
+            max_accel=u.max_accel,
+            max_turn_rate=math.radians(u.max_turn_rate),
+            max_turn_accel=math.radians(u.max_turn_accel),
+            lookahead=u.lookahead,
+            turn_in_place=math.radians(u.turn_in_place),
+            goal_tolerance=u.goal_tolerance,
+            control_dt=u.control_dt,
+        )
+
+    def truth_theta(self: Scenario) -> np.ndarray:
+        """(8,) true source term (φ in radians)."""
+        t = self.truth
+        return np.array([t.x, t.y, t.z, t.q, t.u, math.radians(t.phi), t.zeta1, t.zeta2])
+
+    def make_prior(self: Scenario) -> SourcePrior:
+        truth = self.truth_theta()
+        dists: dict[str, Distribution] = {}
+        for k, name in enumerate(PARAMETER_NAMES):
+            if name not in self.unknown_names:
+                dists[name] = Fixed(float(truth[k]))
+            elif k < 3 and name not in self.prior:
+                dists[name] = Uniform(self.volume.low[k], self.volume.high[k])
+            else:
+                dists[name] = _distribution(name, self.prior[name])
+        return SourcePrior.from_dict(dists)
+
+
+def _distribution(name: str, spec: PriorSpec) -> Distribution:
+    to_rad = math.radians if name == "phi" else (lambda v: v)
+    if spec.kind == "uniform":
+        return Uniform(to_rad(spec.low), to_rad(spec.high))
+    if spec.kind == "gamma":
+        return Gamma(spec.shape, spec.scale)
+    low = spec.low if spec.low is not None else PHYSICAL_TRUNCATION.get(name, -math.inf)
+    high = spec.high if spec.high is not None else math.inf
+    return Normal(to_rad(spec.mean), to_rad(spec.sd), to_rad(low), to_rad(high))

@@ -1,0 +1,161 @@
+"""Scenario files: find a scenario by built-in name or TOML path and validate it, write one back
+as TOML (``dcee show``), and read the command line's ``--set`` and ``--truth`` values."""
+
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from dcee.errors import DceeInputError
+from dcee.scenarios.builtin import builtin_scenarios, random_configuration, random_family_name
+from dcee.scenarios.schema import Scenario, validate_scenario
+
+
+def expand_names(names: list[str]) -> list[str]:
+    """Scenario names with ranges expanded: ``random:1-3`` -> random:1, random:2, random:3 (any
+    ``family:A-B`` with integers A <= B); every other name as given."""
+    out: list[str] = []
+    for name in names:
+        family, _, rest = name.partition(":")
+        a, dash, b = rest.partition("-")
+        if dash and a.isdigit() and b.isdigit() and int(a) <= int(b):
+            out += [f"{family}:{k}" for k in range(int(a), int(b) + 1)]
+        else:
+            out.append(name)
+    return out
+
+
+def load_scenario(name_or_path: str) -> Scenario:
+    """A built-in (``paper:3``, ``lab:upwind``, ``random:17``) or a TOML file by path."""
+    builtins = builtin_scenarios()
+    if name_or_path in builtins:
+        return validate_scenario(builtins[name_or_path])
+    try:
+        family = random_family_name(name_or_path)
+    except ValueError as exc:
+        raise DceeInputError("scenario", str(exc)) from None
+    if family is not None:
+        return validate_scenario(
+            random_configuration(family[1], random_start=family[0] == "random-start")
+        )
+    path = Path(name_or_path)
+    if not path.suffix == ".toml" and ":" in name_or_path:
+        raise DceeInputError(
+            "scenario",
+            f"unknown built-in {name_or_path!r}; choose one of {', '.join(builtins)}, "
+            "random:K or random-start:K (K an integer >= 1)",
+        )
+    if not path.is_file():
+        raise DceeInputError("scenario", f"no such file {str(path)!r} and no such built-in")
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise DceeInputError("scenario", f"malformed TOML in {path}: {exc}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise DceeInputError("scenario", f"cannot read {path}: {exc}") from None
+    data.setdefault("name", path.stem)
+    _resolve_recording(data, path.parent)
+    return validate_scenario(data)
+
+
+def _resolve_recording(data: dict, base: Path) -> None:
+    """A playback file named in a scenario file is relative to that file, not to the cwd."""
+    model = data.get("truth", {}).get("model") if isinstance(data.get("truth"), dict) else None
+    if isinstance(model, dict) and isinstance(model.get("file"), str):
+        file = Path(model["file"]).expanduser()
+        if not file.is_absolute():
+            model["file"] = str((base / file).resolve())
+
+
+def truth_choice(value: str) -> str | dict[str, str]:
+    """The ``truth.model`` a ``--truth`` option names: "isotropic", "filament", or the path of a
+    recording (``.npy``/``.h5``), made absolute so that it means the same file wherever the
+    configuration is used later."""
+    if value in ("isotropic", "filament", "puffs"):
+        return value
+    path = Path(value).expanduser()
+    if path.suffix.lower() not in (".npy", ".h5", ".hdf5", ".nc", ".nc4", ".netcdf", ".cdf"):
+        raise DceeInputError(
+            "truth",
+            f"must be isotropic, filament, puffs or a .npy/.h5/.nc recording (got {value!r})",
+        )
+    if not path.is_file():
+        raise DceeInputError("truth", f"no such recording {value!r}")
+    return {"file": str(path.resolve())}
+
+
+def parse_setting(text: str) -> tuple[str, Any]:
+    """``"estimator.log_sd=0.8"`` → ("estimator.log_sd", 0.8): a dotted scenario path and a
+    TOML value (a bare word that is not TOML is taken as a string)."""
+    path, sep, raw = text.partition("=")
+    path = path.strip()
+    if not sep or not path or any(not part for part in path.split(".")):
+        raise DceeInputError("set", f"must look like section.field=value, got {text!r}")
+    try:
+        value = tomllib.loads(f"v = {raw.strip()}")["v"]
+    except tomllib.TOMLDecodeError:
+        value = raw.strip()
+    return path, value
+
+
+def to_toml(scenario: Scenario) -> str:
+    """The scenario as a TOML file that :func:`dcee.scenarios.load_scenario` reads back to an
+    equal scenario (``dcee show NAME --format toml > my.toml``): every resolved setting, so the
+    file is a complete record; optional values left unset (None), whose default depends on the
+    truth or the likelihood, appear as comments with the value they resolve to."""
+    data = scenario.model_dump(mode="json", exclude_none=True)
+    # settings left unset follow the truth or the likelihood: shown as comments with the value
+    # this scenario resolves them to, so the file reads back with them still unset
+    resolved = {
+        ("sensor", "dropout"): round(1.0 - scenario.instrument_pd, 12),
+        ("sensor", "average"): scenario.average,
+        ("estimator", "meander"): scenario.meander,
+        ("estimator", "reading_weight"): scenario.reading_weight,
+        ("agent", "dwell"): scenario.dwell,
+    }
+    lines = [f"# dcee scenario {scenario.name}"]
+    tables = []
+    for key, value in data.items():
+        if isinstance(value, dict):
+            tables.append((key, value))
+        else:
+            lines.append(f"{key} = {_toml_value(value)}")
+    for key, table in tables:
+        lines.append("")
+        lines.append(f"[{key}]")
+        for k, v in table.items():
+            lines.append(f"{_toml_key(k)} = {_toml_value(v)}")
+        for (section, k), v in resolved.items():
+            if section == key and k not in table:
+                lines.append(f"# {k} = {_toml_value(v)}  (unset: the default for this scenario)")
+    return "\n".join(lines) + "\n"
+
+
+def _toml_key(key: str) -> str:
+    return key if key.replace("_", "").replace("-", "").isalnum() else json.dumps(key)
+
+
+def _toml_value(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "nan"
+        if math.isinf(value):
+            return "inf" if value > 0 else "-inf"
+        return repr(value)
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)  # a JSON string is a TOML basic string
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    if isinstance(value, dict):
+        inner = ", ".join(
+            f"{_toml_key(k)} = {_toml_value(v)}" for k, v in value.items() if v is not None
+        )
+        return "{ " + inner + " }" if inner else "{}"
+    raise TypeError(f"cannot write {type(value).__name__} as TOML")

@@ -1,0 +1,60 @@
+"""The scenario schema: pydantic models, one module per group of sections."""
+
+from dcee.scenarios.schema.agent import AgentSpec, SearchSpec, UnicycleSpec, team_starts
+from dcee.scenarios.schema.common import FROZEN, Finite, Positive
+from dcee.scenarios.schema.estimator import (
+    LIKELIHOODS,
+    MEANDER_DEFAULT,
+    OLD_OUTLIER_DEFAULT,
+    OUTLIER_DEFAULT,
+    PHYSICAL_TRUNCATION,
+    READING_WEIGHT_DEFAULT,
+    EstimatorSpec,
+    Likelihood,
+    PriorSpec,
+    SensorSpec,
+    default_priors,
+)
+from dcee.scenarios.schema.scenario import FIELD_MARK, Scenario, validate_scenario
+from dcee.scenarios.schema.truth import (
+    TRUTH_KINDS,
+    TURBULENT_HOLD,
+    FilamentSpec,
+    PlaybackSpec,
+    PuffsSpec,
+    Truth,
+    TruthKind,
+    Volume,
+)
+
+__all__ = [
+    "FIELD_MARK",
+    "FROZEN",
+    "LIKELIHOODS",
+    "MEANDER_DEFAULT",
+    "OLD_OUTLIER_DEFAULT",
+    "OUTLIER_DEFAULT",
+    "PHYSICAL_TRUNCATION",
+    "READING_WEIGHT_DEFAULT",
+    "TRUTH_KINDS",
+    "TURBULENT_HOLD",
+    "AgentSpec",
+    "EstimatorSpec",
+    "FilamentSpec",
+    "Finite",
+    "Likelihood",
+    "PlaybackSpec",
+    "Positive",
+    "PriorSpec",
+    "PuffsSpec",
+    "Scenario",
+    "SearchSpec",
+    "SensorSpec",
+    "Truth",
+    "TruthKind",
+    "UnicycleSpec",
+    "Volume",
+    "default_priors",
+    "team_starts",
+    "validate_scenario",
+]

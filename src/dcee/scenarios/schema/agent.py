@@ -1,0 +1,110 @@
+"""The ``[agent]`` and ``[search]`` sections: the mobile sensor(s) and how they move, and the
+search's scale, budget and success criterion."""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+import numpy as np
+from pydantic import BaseModel, Field
+
+from dcee.scenarios.schema.common import FROZEN, Finite, Positive
+
+
+def team_starts(
+    start: np.ndarray, step: float, count: int, low: np.ndarray, high: np.ndarray
+) -> np.ndarray | None:
+    """(count, 3) start positions: robot k at ``start`` + k · step along +y, or along −y where
+    the row would leave [low, high]; None when neither fits."""
+    for sign in (1.0, -1.0):
+        rows = np.repeat(np.asarray(start, dtype=np.float64)[None, :], count, axis=0)
+        rows[:, 1] += sign * step * np.arange(count)
+        if np.all(rows >= low - 1e-9) and np.all(rows <= high + 1e-9):
+            return rows
+    return None
+
+
+class UnicycleSpec(BaseModel):
+    """The differential-drive robot of ``agent.model = "unicycle"`` (:mod:`dcee.models.motion`).
+    Its top speed is ``agent.speed``. Defaults: a Turtlebot-2-class robot as Nav2 drives it
+    (0.5 m/s² and 60°/s, 180°/s²); a 0.3 m move then takes 1.9-4.4 s depending on the heading
+    change, against 1.5 s for the grid agent at 0.2 m/s."""
+
+    model_config = FROZEN
+    max_accel: Positive = 0.5
+    """m/s², forward acceleration and braking"""
+    max_turn_rate: Annotated[float, Field(gt=0, le=720, allow_inf_nan=False)] = 60.0
+    """°/s"""
+    max_turn_accel: Annotated[float, Field(gt=0, le=7200, allow_inf_nan=False)] = 180.0
+    """°/s²"""
+    lookahead: Positive = 0.15
+    """m, pure-pursuit look-ahead along the segment to the waypoint"""
+    turn_in_place: Annotated[float, Field(gt=0, le=180, allow_inf_nan=False)] = 45.0
+    """°: a waypoint further off the heading is first faced by turning on the spot"""
+    goal_tolerance: Positive = 0.02
+    """m: settled within this distance of the waypoint (and nearly still)"""
+    control_dt: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.05
+    """s, control and integration period"""
+
+
+class AgentSpec(BaseModel):
+    """The mobile sensor: where it starts and how it moves (one step along one of
+    ``headings`` directions per decision, at the start altitude)."""
+
+    model_config = FROZEN
+    start: tuple[Finite, Finite, Finite]
+    """start position (x, y, z), m; inside the volume"""
+    step: Positive = 2.0
+    """m per move; at least one heading from the start must stay inside the volume"""
+    speed: Positive = 2.0
+    """m/s; a move takes step / speed + dwell seconds"""
+    dwell: Annotated[float | None, Field(ge=0, le=600, allow_inf_nan=False)] = None
+    """s held at each waypoint to take a reading; None: 1 s for the isotropic truth,
+    :data:`TURBULENT_HOLD` for a time-varying one"""
+    headings: Annotated[int, Field(ge=1, le=64)] = 8
+    """number of equally spaced move directions (0°, 45°, … for 8)"""
+    count: Annotated[int, Field(ge=1, le=16)] = 1
+    """robots searching together with one shared belief; robot k starts k · step metres from
+    ``start`` along +y (along −y where +y would leave the area)"""
+    model: Literal["grid", "unicycle"] = "grid"
+    """how the robot drives to a waypoint (:mod:`dcee.models.motion`): "grid", every move takes
+    step / speed s and ends on the waypoint (the paper's); "unicycle", a differential-drive
+    robot with the limits of [agent.unicycle], so the time per move comes from its dynamics"""
+    unicycle: UnicycleSpec = UnicycleSpec()
+    """the unicycle robot's limits and path follower, see [agent.unicycle]"""
+    heading: Finite = 0.0
+    """start heading, ° counter-clockwise from +x"""
+    localisation_sd: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 0.0
+    """m: standard deviation of the localisation error (per axis, horizontal) on the position
+    told to the estimator with every reading; the reading itself is taken at the true position"""
+
+
+class SearchSpec(BaseModel):
+    """The estimator's and planners' scale, the flight budget and the success criterion."""
+
+    model_config = FROZEN
+    particles: Annotated[int, Field(ge=2, le=10_000_000)] = 20_000
+    """particles of the filter (the paper's 20,000)"""
+    hypotheses: Annotated[int, Field(ge=1, le=10_000)] = 40
+    """hypothesised readings per candidate move (the paper's 40); a planner spec's own
+    ``hypotheses=`` overrides it"""
+    budget: Positive = 900.0
+    """s of flight (the paper's 900)"""
+    acquired_rmse: Positive = 3.0
+    """m: "source acquired" when the final RMSE is below it"""
+    stop_spread: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
+    """m: > 0 stops the search once the posterior spread is below it"""
+    stall_guard: Annotated[float, Field(ge=0, le=1e6, allow_inf_nan=False)] = 30.0
+    """s: after this long within one step of one position while the posterior spread exceeds
+    ``acquired_rmse``, the next move must leave that position (0: off; docs/held-out.md)"""
+    resample_threshold: Annotated[float, Field(gt=0, le=1)] = 0.5
+    """resample when the effective sample size falls below this share of the particles"""
+    mcmc_steps: Annotated[int, Field(ge=0, le=100)] = 1
+    """least Metropolis-Hastings sweeps after a resampling"""
+    global_share: Annotated[float, Field(ge=0, le=1)] = 0.2
+    """share of particles proposing a source location from the prior in each sweep (keeps
+    separated modes alive; 0 = random walk only)"""
+    diversify: Annotated[float, Field(ge=0, le=1)] = 0.5
+    """sweep until this share of the particles has moved since the resampling"""
+    max_sweeps: Annotated[int, Field(ge=1, le=100)] = 8
+    """most sweeps after one resampling"""

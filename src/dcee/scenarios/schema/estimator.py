@@ -1,0 +1,194 @@
+"""The ``[prior]``, ``[sensor]`` and ``[estimator]`` sections: what is believed before the search,
+the instrument, and the reading model of the filter and the planners."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal, get_args
+
+from pydantic import BaseModel, Field, field_validator, model_validator
+
+from dcee.scenarios.schema.common import FROZEN, Finite, Positive
+
+PHYSICAL_TRUNCATION = {"u": 0.0, "zeta1": 0.0, "zeta2": 0.0}
+
+
+class PriorSpec(BaseModel):
+    """The prior of one unknown parameter (``[prior] q = { kind = "gamma", shape = 2.0,
+    scale = 5.0 }``); degrees for phi. x, y, z default to uniform over the volume."""
+
+    model_config = FROZEN
+    kind: Literal["uniform", "gamma", "normal"]
+    """distribution family"""
+    low: float | None = None
+    """uniform: lower bound (finite); normal: truncation below (default: the physical bound,
+    0 for u, ζ1, ζ2)"""
+    high: float | None = None
+    """uniform: upper bound (finite); normal: truncation above (default none)"""
+    shape: Positive | None = None
+    """gamma: shape k"""
+    scale: Positive | None = None
+    """gamma: scale θ"""
+    mean: Finite | None = None
+    """normal: mean"""
+    sd: Positive | None = None
+    """normal: standard deviation (the paper's N(m, δ) has variance δ, so sd = √δ)"""
+
+    @field_validator("low", "high")
+    @classmethod
+    def _not_nan(cls, value: float | None) -> float | None:
+        if value is not None and math.isnan(value):
+            raise ValueError("must be a number or ±inf, got nan")
+        return value
+
+    @model_validator(mode="after")
+    def _complete(self) -> PriorSpec:
+        need = {"uniform": ("low", "high"), "gamma": ("shape", "scale"), "normal": ("mean", "sd")}
+        missing = [f for f in need[self.kind] if getattr(self, f) is None]
+        if missing:
+            raise ValueError(f"a {self.kind} prior needs {', '.join(missing)}")
+        if self.kind == "uniform" and not (math.isfinite(self.low) and math.isfinite(self.high)):
+            raise ValueError(
+                f"a uniform prior needs finite low and high (got [{self.low}, {self.high}]): "
+                "no uniform density spans an infinite range; use a normal or gamma prior"
+            )
+        if self.low is not None and self.high is not None and not self.high > self.low:
+            raise ValueError(f"needs high > low, got [{self.low}, {self.high}]")
+        return self
+
+
+def default_priors() -> dict[str, PriorSpec]:
+    # The paper's table 1; N(m, δ) there has *variance* δ, so sd = √δ. The wind-direction prior
+    # is centred on the truth in the paper, so it has no default: give ``prior.phi`` for "full".
+    return {
+        "q": PriorSpec(kind="gamma", shape=2.0, scale=5.0),
+        "u": PriorSpec(kind="normal", mean=4.0, sd=math.sqrt(2.0)),
+        "zeta1": PriorSpec(kind="normal", mean=1.0, sd=math.sqrt(2.0)),
+        "zeta2": PriorSpec(kind="normal", mean=8.0, sd=math.sqrt(2.0)),
+    }
+
+
+class SensorSpec(BaseModel):
+    """The instrument: what the (simulated) robot's sensor reports. The estimator's model of it
+    is :class:`EstimatorSpec` (the two differ on a turbulent truth)."""
+
+    model_config = FROZEN
+    threshold: Positive = 5e-4
+    """g/m³: readings below it are non-detections"""
+    pd: Annotated[float, Field(gt=0, le=1)] = 0.7
+    """probability that a concentration above the threshold is detected (the paper's 0.7)"""
+    sigma_min: Positive = 1e-4
+    """g/m³: least standard deviation of a reading's noise"""
+    sigma_frac: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.5
+    """reading noise standard deviation as a share of the concentration (the paper's 0.5)"""
+    false_alarm: Annotated[float, Field(ge=0, lt=1)] = 0.0
+    """probability of a spurious detection where the concentration is below the threshold"""
+    false_alarm_scale: Positive = 5e-4
+    """g/m³: scale of the exponential distribution of false-alarm readings"""
+    max_reading: Positive = 1e4
+    """g/m³: physical maximum; a told reading above it is refused (a fault, not a measurement)"""
+    dropout: Annotated[float | None, Field(ge=0, lt=1, allow_inf_nan=False)] = None
+    """probability that the *simulated* instrument misses a reading above the threshold.
+    None: 1 − ``pd`` on the isotropic truth (the paper's Pd stands for turbulent intermittency
+    and missed detections together, and that truth simulates no turbulence), 0 on a time-varying
+    truth (it makes the turbulence's gaps itself; an instrument's own dropout rate is not known).
+    ``pd`` itself is the paper likelihood's (estimator side)."""
+    average: Annotated[float | None, Field(ge=0, le=600, allow_inf_nan=False)] = None
+    """s: each reading averages the truth over the last ``average`` seconds of the hold,
+    sub-sampled at the truth's time step (no effect on the time-invariant isotropic truth).
+    None: the whole hold (``agent.dwell``) for a time-varying truth, 0 for the isotropic one."""
+    response_time: Annotated[float, Field(ge=0, le=600, allow_inf_nan=False)] = 0.0
+    """s: first-order sensor response (time constant) applied before averaging; 0 = ideal"""
+
+
+Likelihood = Literal["paper", "fluctuation"]
+LIKELIHOODS: tuple[str, ...] = get_args(Likelihood)
+"""The reading models of the filter and the planners, by name (`--likelihood`)."""
+
+OUTLIER_DEFAULT = 0.01
+"""Outlier weight ``estimator.outlier`` for every likelihood, the paper's included, so that one
+reading no hypothesis can explain (a spike, a stuck or saturated sensor) never captures the
+posterior. Chosen on the tuning configurations (random:1-6, dcee-cl, one 10⁶ × reading at 40,
+60 or 100 s, ``scripts/spike_study.py``): weight 0 lost 14 of 18 acquired searches to the spike,
+0.001 and 0.01 none; 0.01, the larger, bounds a reading's likelihood ratio 10× tighter. Set 0
+for the paper's exact likelihood (docs/scenarios.md: the held-out check and the public study
+with this default). Before issue 29 the default was 0 for the paper's likelihood and 0.01 for
+the fluctuation likelihood (:data:`OLD_OUTLIER_DEFAULT`, for stored campaigns)."""
+
+OLD_OUTLIER_DEFAULT: dict[str, float] = {"paper": 0.0, "fluctuation": 0.01}
+"""What an unset (null) ``estimator.outlier`` meant in a scenario stored before issue 29."""
+
+
+READING_WEIGHT_DEFAULT: dict[str, float] = {"paper": 1.0, "fluctuation": 0.5}
+"""``estimator.reading_weight`` per likelihood when not given: 1 for the paper's model (its
+readings are independent given the source term: the paper's update); 0.5 for the fluctuation
+model, meant for turbulent plumes, whose successive holds are not. Chosen with
+``near_source_length`` 5 m on the tuning configurations random:1-12 (both turbulent truths) and
+checked on held-out random:1000-1023 with dcee-cl and infotaxis: the truth inside the 95 % region
+in 29 more searches and 10 fewer of 96 paired ones (exact McNemar p = 0.003), acquisition and
+final error no worse (docs/turbulent.md)."""
+
+MEANDER_DEFAULT: dict[str, float] = {"paper": 0.0, "fluctuation": 0.15}
+"""Meander broadening per likelihood when ``estimator.meander`` is not given: none for the
+paper's model; 0.15 for the fluctuation model, the crosswind turbulence intensity that fits the
+filament truth's time mean best (docs/scenarios.md). The calm member of the fluctuation
+likelihood (``calm_prior``) never meanders."""
+
+
+class EstimatorSpec(BaseModel):
+    """The reading model the filter and every planner use (one :class:`Sensor` for both).
+
+    ``likelihood = "paper"``: the paper's eq. 3 with the ``[sensor]`` parameters.
+    ``likelihood = "fluctuation"``: an intermittent log-normal reading about the isotropic
+    plume's time mean (Yee & Chan 1997; see :mod:`dcee.models.sensor`), with the sensor's
+    threshold, ``intermittency``, ``log_sd`` and ``near_source_length`` (intermittency and
+    log_sd fitted by maximum likelihood to 4 s hold averages of the filament truth, readings as
+    the instrument reports them there — without random misses, ``sensor.dropout``'s default on
+    a turbulent truth: ``scripts/fluctuation_stats.py --hold 4 --pd 1``; the near-source length
+    chosen by the searches' calibration, docs/scenarios.md).
+    With ``calm_prior`` > 0 the fluctuation likelihood estimates the turbulence level online: a
+    second filter runs the paper's calm model (the ``[sensor]`` parameters, no meander) on the
+    same readings, with prior probability ``calm_prior``, and the planners and the estimate use
+    whichever model is the more probable given the readings
+    (:mod:`dcee.estimation.model_bank`); a calm plume is then searched with the paper's model,
+    a turbulent one with the fluctuation model.
+    """
+
+    model_config = FROZEN
+    likelihood: Likelihood = "paper"
+    intermittency: Annotated[float, Field(gt=0, le=1)] = 0.93
+    """fluctuation: probability that a reading well inside the plume is not zero"""
+    log_sd: Annotated[float, Field(gt=0, le=5)] = 1.3
+    """fluctuation: standard deviation s of ln(reading) about ln(mean) − s²/2 (far from the
+    source when ``log_sd_length`` > 0)"""
+    log_sd_near: Annotated[float, Field(ge=0, le=10)] = 0.0
+    """fluctuation: the extra spread at the source, s(r) = log_sd + log_sd_near ·
+    exp(−r / log_sd_length) (r: sensor to hypothesised source)"""
+    log_sd_length: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] = 0.0
+    """fluctuation: m; how fast the extra spread decays with distance; 0 = s the same
+    everywhere"""
+    near_source_length: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] = 5.0
+    """fluctuation: m; the intermittency falls near the source as 1 − exp(−r / this)
+    (r: sensor to hypothesised source); 0 = the same everywhere. 5 m (the maximum-likelihood fit
+    at fixed points gave 5.4 m), chosen with ``reading_weight`` 0.5 on the tuning configurations
+    random:1-12 and checked on held-out ones (docs/turbulent.md); 10 m, the value before, set the
+    final estimate about 1 m upwind of the source there"""
+    meander: Annotated[float | None, Field(ge=0, le=2)] = None
+    """crosswind turbulence intensity of the plume model's time-mean meander broadening
+    (:mod:`dcee.models.plume`); None: the likelihood's default, :data:`MEANDER_DEFAULT`"""
+    outlier: Annotated[float, Field(ge=0, lt=1)] = OUTLIER_DEFAULT
+    """weight of the outlier component (log-uniform up to sensor.max_reading), every likelihood:
+    a reading no hypothesis explains then weighs at most ~13 / outlier against any other
+    (:data:`OUTLIER_DEFAULT`); 0 = the paper's exact likelihood"""
+    reading_weight: Annotated[float | None, Field(gt=0, le=1)] = None
+    """how many independent readings one reading counts as in the filter: its log-likelihood
+    is multiplied by this (a power likelihood). Below 1 for readings that are not independent
+    (a turbulent plume's successive holds see the same puffs and gusts), so the posterior is not
+    narrower than the evidence; the planners still predict with the plain likelihood. 1: the
+    plain Bayes update. None: the likelihood's default, :data:`READING_WEIGHT_DEFAULT`"""
+    calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
+    """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
+    filter and selected by the readings' evidence: the turbulence level estimated online); 0: the
+    turbulent model alone. 0.1: choosing the fluctuation likelihood says turbulence is expected;
+    measured, the calm model then still wins every isotropic search and is (almost) never
+    selected on the filament truth, where 0.5 let it lead 3 % of the steps (docs/scenarios.md)"""

@@ -1,0 +1,244 @@
+"""The scenario: every section validated together into one immutable object, and the one-line
+errors of a bad file (:func:`validate_scenario`). How a scenario becomes model objects is
+:mod:`dcee.scenarios.builders`; reading and writing files is :mod:`dcee.scenarios.files`."""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, Field, ValidationError, model_validator
+
+from dcee.errors import DceeInputError
+from dcee.models.agent import GridAgent, SearchVolume
+from dcee.models.plume import PARAMETER_NAMES
+from dcee.scenarios.builders import ScenarioBuilders
+from dcee.scenarios.schema.agent import AgentSpec, SearchSpec, team_starts
+from dcee.scenarios.schema.common import FROZEN
+from dcee.scenarios.schema.estimator import (
+    MEANDER_DEFAULT,
+    READING_WEIGHT_DEFAULT,
+    EstimatorSpec,
+    PriorSpec,
+    SensorSpec,
+    default_priors,
+)
+from dcee.scenarios.schema.truth import TRUTH_KINDS, TURBULENT_HOLD, Truth, Volume
+
+
+class Scenario(ScenarioBuilders, BaseModel):
+    """A validated, immutable scenario."""
+
+    model_config = FROZEN
+    name: str = "custom"
+    """shown in results; a file's name defaults to its stem"""
+    description: str = ""
+    """free text"""
+    dimensions: Literal[2, 3] = 3
+    """3: the source height is unknown in "source"; 2: it is known (planar search)"""
+    unknown: Literal["source", "full"] = "source"
+    """"source": x, y, (z), q unknown; "full": wind and dispersion (u, phi, zeta1, zeta2) too"""
+    volume: Volume
+    """the search volume, see [volume]"""
+    truth: Truth
+    """the true source term and the truth model, see [truth]"""
+    prior: dict[str, PriorSpec] = Field(default_factory=default_priors)
+    """priors of the unknown parameters by name (q, u, phi, zeta1, zeta2; x, y, z uniform over
+    the volume unless given); defaults: the paper's table 1 (phi has none)"""
+    sensor: SensorSpec = SensorSpec()
+    """the instrument, see [sensor]"""
+    estimator: EstimatorSpec = EstimatorSpec()
+    """the reading model of the filter and the planners, see [estimator]"""
+    agent: AgentSpec
+    """the mobile sensor, see [agent]"""
+    search: SearchSpec = SearchSpec()
+    """scale, budget and success criterion, see [search]"""
+
+    @model_validator(mode="after")
+    def _consistent(self) -> Scenario:
+        lo, hi = np.array(self.volume.low), np.array(self.volume.high)
+        src = np.array([self.truth.x, self.truth.y, self.truth.z])
+        if np.any(src < lo) or np.any(src > hi):
+            raise ValueError(
+                f"truth: source ({src[0]}, {src[1]}, {src[2]}) is outside the search volume "
+                f"{tuple(self.volume.low)}..{tuple(self.volume.high)}"
+            )
+        start = np.array(self.agent.start)
+        if np.any(start < lo) or np.any(start > hi):
+            raise ValueError(
+                f"{FIELD_MARK}agent.start: {tuple(self.agent.start)} is outside the search volume"
+            )
+        if self.dimensions == 3 and not hi[2] > lo[2]:
+            raise ValueError("volume: a 3-D scenario needs high z > low z")
+        for k in (0, 1):
+            if not hi[k] > lo[k]:
+                raise ValueError(f"volume: high[{k}] must be > low[{k}]")
+        unknown_env = ("q",) if self.unknown == "source" else ("q", "u", "phi", "zeta1", "zeta2")
+        missing = [p for p in unknown_env if p not in self.prior]
+        if missing:
+            raise ValueError(f"prior: missing a prior for unknown parameter(s) {missing}")
+        extra = [p for p in self.prior if p not in PARAMETER_NAMES]
+        if extra:
+            raise ValueError(f"prior: unknown parameter name(s) {extra}; allowed {PARAMETER_NAMES}")
+        agent = GridAgent(
+            SearchVolume(tuple(lo), tuple(hi)),
+            self.agent.step,
+            self.agent.speed,
+            self.dwell,
+            self.agent.headings,
+        )
+        starts = team_starts(start, self.agent.step, self.agent.count, lo, hi)
+        if starts is None:
+            raise ValueError(
+                f"{FIELD_MARK}agent.count: {self.agent.count} robots {self.agent.step:g} m apart "
+                f"along y from agent.start {tuple(self.agent.start)} do not fit in the area"
+            )
+        if len(agent.candidates(start)[0]) == 0:
+            raise ValueError(
+                f"{FIELD_MARK}agent.step: {self.agent.step:g} m leaves the search area from "
+                f"agent.start {tuple(self.agent.start)} in every heading (the area is "
+                f"{hi[0] - lo[0]:g} m × {hi[1] - lo[1]:g} m); use a shorter step"
+            )
+        if self.search.budget < self.agent.step / self.agent.speed + self.dwell:
+            raise ValueError(
+                f"{FIELD_MARK}search.budget: {self.search.budget:g} s is shorter than one move "
+                f"({self.agent.step / self.agent.speed + self.dwell:g} s: step / speed + dwell)"
+            )
+        if self.sensor.average is not None and self.sensor.average > self.dwell + 1e-9:
+            raise ValueError(
+                f"sensor.average = {self.sensor.average:g} s is longer than the hold "
+                f"agent.dwell = {self.dwell:g} s (a reading averages while the robot holds)"
+            )
+        if self.sensor.max_reading <= self.sensor.threshold:
+            raise ValueError("sensor.max_reading must be above sensor.threshold")
+        return self
+
+    # --- settings that depend on the truth ----------------------------------------------------
+
+    @property
+    def time_varying_truth(self) -> bool:
+        return self.truth.model != "isotropic"
+
+    @property
+    def dwell(self) -> float:
+        """Hold at each waypoint, s (``agent.dwell``, or its default for the truth)."""
+        if self.agent.dwell is not None:
+            return self.agent.dwell
+        return TURBULENT_HOLD if self.time_varying_truth else 1.0
+
+    @property
+    def average(self) -> float:
+        """Seconds each reading averages (``sensor.average``, or its default for the truth)."""
+        if self.sensor.average is not None:
+            return self.sensor.average
+        return self.dwell if self.time_varying_truth else 0.0
+
+    @property
+    def instrument_pd(self) -> float:
+        """P(the simulated instrument reports a concentration above the threshold): 1 −
+        ``sensor.dropout``, or its default for the truth (see :class:`SensorSpec`)."""
+        if self.sensor.dropout is not None:
+            return 1.0 - self.sensor.dropout
+        return 1.0 if self.time_varying_truth else self.sensor.pd
+
+    @property
+    def meander(self) -> float:
+        e = self.estimator
+        return e.meander if e.meander is not None else MEANDER_DEFAULT[e.likelihood]
+
+    @property
+    def outlier(self) -> float:
+        return self.estimator.outlier
+
+    @property
+    def reading_weight(self) -> float:
+        e = self.estimator
+        return (
+            e.reading_weight
+            if e.reading_weight is not None
+            else READING_WEIGHT_DEFAULT[e.likelihood]
+        )
+
+    def resolved_settings(self) -> dict[str, Any]:
+        """The defaults resolved for this truth (stored with every result)."""
+        return {
+            "dwell": self.dwell,
+            "average": self.average,
+            "dropout": round(1.0 - self.instrument_pd, 12),
+            "likelihood": self.estimator.likelihood,
+            "reading_models": "+".join(self.reading_models),
+            "outlier": self.outlier,
+            "meander": self.meander,
+            "reading_weight": self.reading_weight,
+        }
+
+    @property
+    def reading_models(self) -> tuple[str, ...]:
+        """The reading models the filter runs, the preferred first: ``("paper",)``,
+        ``("fluctuation",)``, or with ``estimator.calm_prior`` > 0 ``("fluctuation", "paper")``."""
+        e = self.estimator
+        if e.likelihood == "fluctuation" and e.calm_prior > 0:
+            return ("fluctuation", "paper")
+        return (e.likelihood,)
+
+    @property
+    def reading_model_priors(self) -> tuple[float, ...]:
+        """Prior probability of each of :attr:`reading_models`."""
+        if len(self.reading_models) == 1:
+            return (1.0,)
+        return (1.0 - self.estimator.calm_prior, self.estimator.calm_prior)
+
+    @property
+    def unknown_names(self) -> tuple[str, ...]:
+        loc = ("x", "y", "z") if self.dimensions == 3 else ("x", "y")
+        env = ("q",) if self.unknown == "source" else ("q", "u", "phi", "zeta1", "zeta2")
+        return loc + env
+
+    def with_overrides(self, **changes: Any) -> Scenario:
+        """A re-validated copy; keys are dotted paths, e.g. ``{"search.particles": 2000}``."""
+        scenario = self
+        for path, value in changes.items():
+            if value is None:
+                continue
+            # one at a time, so that a later path may go into what an earlier one set
+            # (e.g. truth.model = "filament", then truth.model.meander_intensity)
+            data = scenario.model_dump()
+            node = data
+            *parents, leaf = path.split(".")
+            for p in parents:
+                if not isinstance(node.get(p), dict):
+                    raise DceeInputError(path, f"no such setting ({p!r} is not a section)")
+                node = node[p]
+            node[leaf] = value
+            scenario = validate_scenario(data)
+        return scenario
+
+
+FIELD_MARK = "@field "
+"""Prefix of a cross-field check's message that names the field at fault (``@field
+agent.step: …``): :func:`validate_scenario` reports that field instead of the model's."""
+
+
+def validate_scenario(data: dict[str, Any]) -> Scenario:
+    """Validate a raw mapping; errors become one-line :class:`DceeInputError`."""
+    try:
+        return Scenario.model_validate(data)
+    except ValidationError as exc:
+        errors = exc.errors()
+        # a union (truth.model) reports every branch; the literal branch's complaint is noise
+        # when a table was given, so report the error of the branch the input was meant for
+        relevant = [e for e in errors if not any(str(p).startswith("literal[") for p in e["loc"])]
+        err = (relevant or errors)[0]
+        # drop pydantic's internal union labels ("tagged-union[...]"), keep the user's field path
+        parts = [str(p) for p in err["loc"] if "[" not in str(p)]
+        if len(parts) > 2 and parts[:2] == ["truth", "model"] and parts[2] in TRUTH_KINDS:
+            del parts[2]  # the union's tag, not a field the user wrote
+        loc = ".".join(parts) or "scenario"
+        msg = err["msg"].removeprefix("Value error, ")
+        if msg.startswith(FIELD_MARK):  # a cross-field check that names its own field
+            loc, _, msg = msg.removeprefix(FIELD_MARK).partition(": ")
+        if err["type"] == "extra_forbidden":
+            msg = "unknown field"
+        elif "input" in err and err["type"] != "value_error":
+            msg = f"{msg} (got {err['input']!r})"
+        raise DceeInputError(loc, msg) from None

@@ -1,0 +1,201 @@
+"""The ``[volume]`` and ``[truth]`` sections: where the search happens, the true source term and
+what the sensor really sees (``truth.model``: the registry of truth kinds)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+from pydantic import BaseModel, Field, field_validator, model_validator
+
+from dcee.scenarios.schema.common import FROZEN, Finite, Positive
+
+TURBULENT_HOLD = 4.0
+"""Default hold (s) at each waypoint for a time-varying truth, over which a reading averages.
+On the filament truth (paper:1 centreline, 5-30 m downwind) a 5 s average cuts the share of
+below-threshold readings from 66-84 % to 10-25 % and the p99/mean ratio from 14-27 to 4-5; a
+longer hold gives fewer readings in the budget. Chosen by search success (infotaxis, filament
+truth, full unknown, 12 × 3, 10,000 particles): hold 2 / 3 / 4 / 5 / 7 s acquired the source in
+4/12 / 5/12 / 33/36 / 26/36 / 23/36 (docs/scenarios.md)."""
+
+
+class Volume(BaseModel):
+    """The search volume (m); the source-location prior is uniform over it."""
+
+    model_config = FROZEN
+    low: tuple[Finite, Finite, Finite]
+    """lower corner (x, y, z), m"""
+    high: tuple[Finite, Finite, Finite]
+    """upper corner (x, y, z), m; moves that leave the volume are inadmissible"""
+
+    @model_validator(mode="after")
+    def _ordered(self) -> Volume:
+        for k, (lo, hi) in enumerate(zip(self.low, self.high, strict=True)):
+            if hi < lo:
+                raise ValueError(f"high[{k}] = {hi} must be >= low[{k}] = {lo}")
+        return self
+
+
+class FilamentSpec(BaseModel):
+    """Turbulent filament (puff) truth after Farrell et al. (2002); see
+    :mod:`dcee.simulation.filament` for the model and docs/scenarios.md for why each default."""
+
+    model_config = FROZEN
+    kind: Literal["filament"] = "filament"
+    puff_rate: Annotated[float, Field(gt=0, le=1000, allow_inf_nan=False)] = 10.0
+    """puffs released per second (Farrell: 10/s)"""
+    dt: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.1
+    """integration step of the puff dynamics, s"""
+    puff_radius: Annotated[float, Field(gt=0, allow_inf_nan=False)] = 0.1
+    """initial puff radius (Gaussian σ), m"""
+    puff_share: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.03
+    """share of the diffusivity ζ1 that grows each puff; the rest moves puff centres at random"""
+    meander_intensity: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] = 0.2
+    """standard deviation of each horizontal meander velocity component / mean wind speed"""
+    meander_bandwidth: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.2
+    """natural frequency ω of the coloured-noise meander process, rad/s (Farrell: 0.2-0.71)"""
+    meander_damping: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.1
+    """damping ratio ζ of the meander process (Farrell: 0.07-0.1)"""
+
+    @property
+    def name(self) -> str:
+        return "filament"
+
+
+class PuffsSpec(BaseModel):
+    """Puff plume in a meandering, spatially correlated wind field after Farrell et al. (2002),
+    written apart from the filament truth; see :mod:`dcee.simulation.puffs` for the model and
+    docs/scenarios.md for why each default. It ignores the truth's ζ1 and ζ2."""
+
+    model_config = FROZEN
+    kind: Literal["puffs"] = "puffs"
+    puff_rate: Annotated[float, Field(gt=0, le=1000, allow_inf_nan=False)] = 10.0
+    """mean puffs released per second, a Poisson process (Farrell: 10/s)"""
+    dt: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.1
+    """integration step of the puffs and the wind field, s"""
+    puff_radius: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.1
+    """initial puff radius (Gaussian σ), m"""
+    puff_diffusivity: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 0.02
+    """growth of each puff, σ² = radius² + 2 · this · age, m²/s"""
+    centre_diffusivity: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 0.6
+    """random walk of the puff centres (Farrell's centre-relative dispersion), m²/s"""
+    meander_intensity: Annotated[float, Field(ge=0, le=2, allow_inf_nan=False)] = 0.5
+    """standard deviation of each boundary wind component's noise / mean wind speed (inside
+    the search area the wind's fluctuation is about half of it: carried in and smoothed)"""
+    meander_time: Annotated[float, Field(gt=0, le=600, allow_inf_nan=False)] = 5.0
+    """correlation time of the boundary wind noise (Ornstein-Uhlenbeck), s"""
+    boundary_spacing: Annotated[float, Field(gt=0, le=1000, allow_inf_nan=False)] = 20.0
+    """distance between independent noise anchors round the wind grid's boundary, m"""
+    wind_spacing: Annotated[float, Field(gt=0, le=100, allow_inf_nan=False)] = 5.0
+    """wind grid spacing, m"""
+    wind_diffusivity: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] = 2.0
+    """diffusivity K_w smoothing the wind field, m²/s"""
+    margin: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] = 20.0
+    """the wind grid extends this far beyond the search area on every side, m"""
+
+    @property
+    def name(self) -> str:
+        return "puffs"
+
+
+class PlaybackSpec(BaseModel):
+    """A recorded or externally simulated plume played back as truth
+    (:mod:`dcee.simulation.playback`)."""
+
+    model_config = FROZEN
+    kind: Literal["playback"] = "playback"
+    file: str = Field(min_length=1)
+    """.npy (metadata in a .json beside it), .h5, or a CF-convention NetCDF file (.nc; or .h5
+    with ``variable`` or ``axes`` set); relative to the scenario file"""
+    variable: str | None = None
+    """NetCDF: the concentration variable; None: found by its units (docs/scenarios.md)"""
+    axes: dict[Literal["t", "x", "y", "z"], str] = Field(default_factory=dict)
+    """NetCDF: dimension name of each axis where the file's CF attributes do not tell, e.g.
+    ``{t = "time", x = "easting"}``"""
+    units: str | None = None
+    """NetCDF: concentration units overriding the file's (g/m3, kg m-3, mg/m3, ug/m3, ppm,
+    ppb, mol/mol)"""
+    molar_mass: Annotated[float | None, Field(gt=0, le=1000, allow_inf_nan=False)] = None
+    """g/mol of the released gas: needed to convert a mixing ratio (ppm, ppb) to g/m³"""
+    temperature: Annotated[float, Field(gt=0, le=1000, allow_inf_nan=False)] = 293.15
+    """K, for a mixing ratio's conversion (ideal gas)"""
+    pressure: Annotated[float, Field(gt=0, le=1e7, allow_inf_nan=False)] = 101325.0
+    """Pa, for a mixing ratio's conversion (ideal gas)"""
+    time_interpolation: Literal["nearest", "linear"] = "linear"
+    loop: bool = False
+    """replay from the first frame when the recording ends (else the budget must fit in it)"""
+
+    @property
+    def name(self) -> str:
+        return f"playback:{Path(self.file).name}"
+
+
+@dataclass
+class TruthKind:
+    """One kind of ``truth.model``: its parameter table (None: a bare name, no parameters) and
+    the factory ``(scenario, seed) -> TruthModel`` that :mod:`dcee.simulation` registers for it
+    with :func:`dcee.simulation.truth.register_truth` (None until that module is imported)."""
+
+    spec: type[BaseModel] | None
+    build: Any = None
+
+
+TRUTH_KINDS: dict[str, TruthKind] = {
+    "isotropic": TruthKind(None),
+    "filament": TruthKind(FilamentSpec),
+    "puffs": TruthKind(PuffsSpec),
+    "playback": TruthKind(PlaybackSpec),
+}
+"""The one registry of truth kinds, by the ``kind`` of ``truth.model`` (``"isotropic"`` for the
+plain string): the scenario schema validates against the specs, :func:`dcee.simulation.make_truth`
+builds with the factories. A new truth adds its spec class here and registers its factory in its
+own module under :mod:`dcee.simulation`."""
+TruthModelSpec = Annotated[FilamentSpec | PuffsSpec | PlaybackSpec, Field(discriminator="kind")]
+
+
+class Truth(BaseModel):
+    """The true source term (what the search must find) and what the sensor sees."""
+
+    model_config = FROZEN
+    x: Finite
+    """source x, m"""
+    y: Finite
+    """source y, m"""
+    z: Finite
+    """source height, m"""
+    q: Positive
+    """release rate, g/s"""
+    u: Annotated[float, Field(ge=0, allow_inf_nan=False)]
+    """mean wind speed, m/s"""
+    phi: Finite = Field(description="wind direction in degrees (wind comes from it)")
+    zeta1: Positive
+    """diffusivity ζ1 of the isotropic plume model, m²/s"""
+    zeta2: Positive
+    """lifetime ζ2 of the released particles, s"""
+    model: Literal["isotropic"] | TruthModelSpec = "isotropic"
+    """what the sensor really sees: "isotropic" (the estimator's own model, the paper's
+    simulation), "filament" or "puffs" (or a table with that kind and parameters: two turbulent
+    truths written apart), or a table ``{file = "plume.h5"}`` to play a recording back"""
+
+    @field_validator("model", mode="before")
+    @classmethod
+    def _model_shorthand(cls, value: Any) -> Any:
+        # "filament" is short for the filament table with every default, so that the resolved
+        # configuration saved beside results records every parameter; {file = ...} needs no kind.
+        if value in ("filament", "puffs"):
+            return {"kind": value}
+        if isinstance(value, dict) and "kind" not in value:
+            kind = "playback" if "file" in value else "filament"
+            return {"kind": kind, **value}
+        if isinstance(value, str) and value != "isotropic":
+            raise ValueError(
+                f'must be "isotropic", "filament", "puffs" or {{file = "..."}} (got {value!r})'
+            )
+        return value
+
+    @property
+    def model_name(self) -> str:
+        """ "isotropic", "filament", "puffs" or "playback:<file name>" (for tables and
+        reports)."""
+        return self.model if isinstance(self.model, str) else self.model.name
