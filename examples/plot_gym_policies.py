@@ -19,7 +19,7 @@ import dcee.gym
 
 env = gymnasium.make(dcee.gym.ENV_ID, scenario="paper:1", particles=2000, budget=300.0)
 obs, info = env.reset(seed=0)
-print({k: round(float(v), 3) for k, v in zip(dcee.gym.env.OBSERVATION_FIELDS, obs, strict=True)})
+print({k: round(float(v), 3) for k, v in zip(dcee.gym.OBSERVATION_FIELDS, obs, strict=True)})
 print("admissible headings:", info["action_mask"])
 
 policies = [

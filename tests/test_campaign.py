@@ -449,7 +449,7 @@ def test_report_on_a_corrupt_campaign_file_is_exit_2(finished, tmp_path, capsys)
 
 def test_plain_progress_lines_for_logs(capsys):
     """Not a terminal: one line per 5% of the searches and the last, with a linear ETA."""
-    from dcee.cli import _log_progress
+    from dcee.cli.bench import _log_progress
 
     for finished in range(1, 41):
         _log_progress("paper", finished, 40, 1, elapsed=3.0 * finished)

@@ -212,12 +212,12 @@ def test_default_run_folder_encodes_the_settings(tmp_path, capsys, monkeypatch):
     assert len(folders) == 2 and folders[0] == "paper-1_mpc_seed0_n300_b10"
     assert folders[1].startswith("paper-1_mpc_seed0_n300_b10_")
     # changes the name says in words get no hash
-    from dcee.cli import _default_run_folder
+    from dcee.runs.folder import default_run_folder
     from dcee.scenarios import load_scenario
 
     base = load_scenario("paper:1")
     changes = {"truth.model": "filament", "unknown": "full", "search.particles": 500}
-    name = _default_run_folder(base.with_overrides(**changes), base, changes, "dcee", 2)
+    name = default_run_folder(base.with_overrides(**changes), base, changes, "dcee", 2)
     assert name == "paper-1_dcee_seed2_n500_full_filament"
 
 

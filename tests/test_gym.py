@@ -43,7 +43,7 @@ def test_same_seed_same_episode_and_observation_fields():
     a, b, c = roll(3), roll(3), roll(4)
     np.testing.assert_array_equal(a, b)
     assert not np.array_equal(a, c)
-    assert a.shape == (11, len(dcee.gym.env.OBSERVATION_FIELDS))
+    assert a.shape == (11, len(dcee.gym.OBSERVATION_FIELDS))
     # the start of paper:1 is (2, 2, 4) m in a 50 × 50 × 5 m area
     np.testing.assert_allclose(a[0, :3], [2 / 50, 2 / 50, 4 / 5], rtol=1e-6)
     np.testing.assert_allclose(a[:, -1] * 60.0, 1.0 + 2.0 * np.arange(11), rtol=1e-6)
@@ -116,7 +116,7 @@ def test_evaluate_scores_policies_on_common_seeds():
 def test_vectorised_envs_step_together():
     envs = gymnasium.make_vec(dcee.gym.ENV_ID, num_envs=2, vectorization_mode="sync", **SMALL)
     obs, _ = envs.reset(seed=[0, 1])
-    assert obs.shape == (2, len(dcee.gym.env.OBSERVATION_FIELDS))
+    assert obs.shape == (2, len(dcee.gym.OBSERVATION_FIELDS))
     obs, reward, terminated, truncated, _ = envs.step(np.array([0, 1]))
     assert reward.shape == terminated.shape == truncated.shape == (2,)
     assert obs.dtype == np.float32

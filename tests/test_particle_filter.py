@@ -2,11 +2,8 @@ import numpy as np
 import pytest
 
 from dcee import DceeInputError, IsotropicPlume, ParticleFilter, Sensor
-from dcee.estimation.filter_kernels import history_log_likelihood
-from dcee.estimation.particle_filter import (
-    history_log_likelihood_reference,
-    systematic_resample,
-)
+from dcee.estimation import Estimator, ModelBank, systematic_resample
+from dcee.estimation.filter_kernels import history_log_likelihood, history_log_likelihood_reference
 from dcee.models.plume import isotropic_concentration_reference
 from tests.helpers import planar_prior, theta_at
 
@@ -197,8 +194,11 @@ def test_nan_reading_is_rejected(sensor, bad):
     ids=["paper", "pd1", "fa+outlier", "lognormal", "lognormal+spread"],
 )
 def test_history_likelihood_and_reading_bounds_against_numpy(sensor):
-    from dcee.estimation.filter_kernels import history_log_likelihood, reading_upper_bounds
-    from dcee.estimation.particle_filter import history_log_likelihood_reference
+    from dcee.estimation.filter_kernels import (
+        history_log_likelihood,
+        history_log_likelihood_reference,
+        reading_upper_bounds,
+    )
     from dcee.models import IsotropicPlume
     from tests.helpers import random_theta
 
@@ -261,3 +261,29 @@ def test_mcmc_move_is_unchanged_by_early_rejection(monkeypatch):
 
     monkeypatch.setattr(pfm, "history_log_likelihood", no_exit)
     np.testing.assert_array_equal(run(), with_exit)
+
+
+def test_both_estimators_implement_the_estimator_interface_and_resample_on_demand():
+    """The particle filter and the model bank answer the same interface (no caller asks which
+    one it holds); resample() keeps the belief (same mean within Monte-Carlo error) and makes
+    the weights uniform."""
+
+    def filt(seed: int) -> ParticleFilter:
+        return ParticleFilter(
+            planar_prior(), Sensor(), IsotropicPlume(), n_particles=4000, seed=seed
+        )
+
+    lone, bank = filt(0), ModelBank([filt(1), filt(2)], ["a", "b"])
+    for est in (lone, bank):
+        assert isinstance(est, Estimator)
+        for x, y in READ_POSITIONS:
+            est.update(np.array([x, y, 1.0]), 0.01)
+        before = est.source_mean().copy()
+        resamples = est.n_resamples
+        est.resample()
+        assert est.n_resamples == resamples + 1
+        np.testing.assert_allclose(est.weights, 1.0 / est.n)
+        assert np.linalg.norm(est.source_mean() - before) < 1.0
+    assert lone.reading_model() is None
+    choice = bank.reading_model()
+    assert choice.name in ("a", "b") and 0.0 < choice.probability <= 1.0

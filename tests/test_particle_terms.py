@@ -92,7 +92,7 @@ def test_the_byte_cap_evicts_old_rows_never_the_current_decisions():
         fresh.sync(theta, SENSOR, PLUME)
         fresh.begin()
         ref = fresh.rows(pts)
-        np.testing.assert_array_equal(cache.terms[2][rows], fresh.terms[2][ref])
+        np.testing.assert_array_equal(cache.terms.loc[rows], fresh.terms.loc[ref])
         assert cache.capacity <= max(16, 8 * (decision + 1))
     # a call that mixes rows cached by earlier decisions with new positions under the cap's
     # pressure keeps the old rows it asks for (they are this decision's now)
@@ -104,7 +104,7 @@ def test_the_byte_cap_evicts_old_rows_never_the_current_decisions():
     fresh.sync(theta, SENSOR, PLUME)
     fresh.begin()
     fresh_rows = fresh.rows(mixed)
-    np.testing.assert_array_equal(cache.terms[2][rows], fresh.terms[2][fresh_rows])
+    np.testing.assert_array_equal(cache.terms.loc[rows], fresh.terms.loc[fresh_rows])
     # one decision needing more rows than the cap grows the buffers instead of evicting its own
     cache.begin()
     many = np.column_stack([rng.uniform(0, 50, (30, 2)), np.full(30, 2.0)])

@@ -427,7 +427,7 @@ def test_info_share_charges_the_information_equivalent_location_variance():
     for p in candidates:
         idx = ctx.position_index(p[None, :])
         z, prob = ctx.readings(idx)
-        conc, dist = ctx.terms[0], ctx.terms[1]  # over the context's merged particles
+        conc, dist = ctx.terms.conc, ctx.terms.dist  # over the context's merged particles
         merged = ctx.belief
         _, _, _, kl = predicted_posterior_stats_reference(
             conc, merged.source, merged.weights, np.repeat(idx[None, :], len(z), 0), z,

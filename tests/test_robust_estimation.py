@@ -12,9 +12,8 @@ import pytest
 
 from dcee import DceeInputError, IsotropicPlume, ParticleFilter, Sensor
 from dcee.estimation import SourcePrior
-from dcee.estimation.filter_kernels import history_log_likelihood
+from dcee.estimation.filter_kernels import history_log_likelihood, history_log_likelihood_reference
 from dcee.estimation.grid import location_grid_posterior
-from dcee.estimation.particle_filter import history_log_likelihood_reference
 from dcee.estimation.priors import Fixed, Uniform
 from dcee.models.plume import isotropic_concentration, isotropic_concentration_reference
 from dcee.planning import get as get_planner

@@ -91,7 +91,7 @@ _INV_LN2 = 1.0 / math.log(2.0)
 
 
 @njit(cache=True, inline="always")
-def vexp(x: float) -> float:
+def exp_scalar(x: float) -> float:
     """exp(x) for x ≤ 0, vectorisable (see above)."""
     x = max(x, -700.0)
     m = math.floor(-x * _INV_LN2 + 0.5)
@@ -115,7 +115,7 @@ def vexp(x: float) -> float:
 
 
 @njit(cache=True, inline="always")
-def vlog1p(x: float) -> float:
+def log1p_scalar(x: float) -> float:
     """log(1 + x) for 0 ≤ x ≤ 1, vectorisable: 2 atanh(t), t = x / (2 + x) ≤ 1/3, by its odd
     series to t^33 (truncation < 3e-17 relative). Used for log-sum-exp of two terms."""
     t = x / (2.0 + x)
@@ -147,21 +147,21 @@ def vlogaddexp(a: float, b: float) -> float:
     lo = min(a, b)
     if hi == -np.inf:
         return hi
-    return hi + vlog1p(vexp(lo - hi))
+    return hi + log1p_scalar(exp_scalar(lo - hi))
 
 
 @njit(cache=True)
 def vexp(x: np.ndarray, out: np.ndarray) -> None:
     """out[i] = exp(x[i]) for x ≤ 0 with the vectorisable exp (exposed for tests)."""
     for i in range(x.shape[0]):
-        out[i] = vexp(x[i])
+        out[i] = exp_scalar(x[i])
 
 
 @njit(cache=True)
 def vlog1p(x: np.ndarray, out: np.ndarray) -> None:
     """out[i] = log1p(x[i]) for 0 ≤ x ≤ 1 with the vectorisable series (exposed for tests)."""
     for i in range(x.shape[0]):
-        out[i] = vlog1p(x[i])
+        out[i] = log1p_scalar(x[i])
 
 
 # --- erfc, Φ and log that the compiler can vectorise (issue 17) -------------------------------
@@ -235,7 +235,7 @@ def _verfc_pos(y: float) -> float:
     b1, b2 = -1.131476849074697 + t2 * b1 - b2, b1
     series = 1.4134382239808718 + t * b1 - b2
     y2 = y * y
-    value = vexp(max(-y2, -700.0)) * series * inv
+    value = exp_scalar(max(-y2, -700.0)) * series * inv
     return value if y2 < 700.0 else 0.0
 
 
@@ -248,13 +248,13 @@ def vndtr_upper(x: float) -> float:
 
 
 @njit(cache=True, inline="always")
-def vlog(x: float) -> float:
+def log_scalar(x: float) -> float:
     """log(x) for a normal float x > 0, vectorisable; relative error < 2e-16. x = 2^m · f
     with f ∈ [1, 2) read from its bits, then log1p(f − 1)."""
     bits = _float_as_int(x)
     m = np.float64((bits >> np.int64(52)) - np.int64(1023))
     x = _int_as_float((bits & _MANTISSA_BITS) | _ONE_BITS)
-    return m * _LN2_HI + (m * _LN2_LO + vlog1p(x - 1.0))
+    return m * _LN2_HI + (m * _LN2_LO + log1p_scalar(x - 1.0))
 
 
 @njit(cache=True, inline="always")
@@ -262,7 +262,7 @@ def vlog1m(y: float) -> float:
     """log(1 − y) for 0 ≤ y < 1 (1 − y a normal float), vectorisable; absolute error < 3e-16
     (a series below y = 1e-3, where 1 − y would round)."""
     series = -y * (1.0 + y * (0.5 + y * (1.0 / 3.0 + y * (0.25 + y * 0.2))))
-    return series if y < 1e-3 else vlog(1.0 - y)
+    return series if y < 1e-3 else log_scalar(1.0 - y)
 
 
 @njit(cache=True, fastmath={"contract"}, error_model="numpy")
@@ -276,4 +276,4 @@ def verfc(x: np.ndarray, out: np.ndarray) -> None:
 def vlog(x: np.ndarray, out: np.ndarray) -> None:
     """out[i] = log(x[i]) for normal floats x > 0 with the vectorisable log (for tests)."""
     for i in range(x.shape[0]):
-        out[i] = vlog(x[i])
+        out[i] = log_scalar(x[i])

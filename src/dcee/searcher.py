@@ -13,8 +13,7 @@ import numpy as np
 
 from dcee.blas import one_blas_thread
 from dcee.errors import DceeInputError
-from dcee.estimation.model_bank import ModelBank
-from dcee.estimation.particle_filter import ParticleFilter, UpdateInfo
+from dcee.estimation.base import Estimator, UpdateInfo
 from dcee.io import write_atomic
 from dcee.models.agent import GridAgent, stall_start
 from dcee.planning.base import Belief, Decision, Planner
@@ -94,7 +93,7 @@ class Searcher:
 
     def __init__(
         self,
-        particle_filter: ParticleFilter | ModelBank,
+        particle_filter: Estimator,
         planner: Planner | None,
         agent: GridAgent,
         rng: np.random.Generator,

@@ -70,7 +70,7 @@ def replay(
         raise DceeInputError("seed", f"must be >= 0, got {seed}")
     if not (math.isfinite(calibration) and calibration > 0):
         raise DceeInputError("calibration", f"must be a finite number > 0, got {calibration}")
-    scenario = load_scenario(scenario_name).withoverrides(
+    scenario = load_scenario(scenario_name).with_overrides(
         **{"search.particles": particles, **overrides(likelihood, settings)}
     )
     check_writable_dir(out_dir, "out")

@@ -97,7 +97,7 @@ def run(
         "agent.count": agents,
         **overrides(likelihood, settings),
     }
-    scenario = base.withoverrides(**changes)
+    scenario = base.with_overrides(**changes)
     if scenario.agent.count > 1:
         from dcee.planning import check_team_planner
 

@@ -1,10 +1,10 @@
 """Compiled (numba) filter kernel; NumPy reference:
-:func:`dcee.estimation.particle_filter.history_log_likelihood_reference`.
+:func:`history_log_likelihood_reference`.
 
 The history likelihood Σ_k m_k log p(z_k | Θ_i) is the cost of the filter's MCMC move (every
 proposal against every reading so far) and of each update (one reading). Particles are taken
 in blocks; for each reading the plume is evaluated for the whole block in a branch-free loop
-that LLVM vectorises (:func:`dcee.numeric.vexp`), then the likelihood: far from a
+that LLVM vectorises (:func:`dcee.numeric.exp_scalar`), then the likelihood: far from a
 hypothesised source the concentration is below the sensor's linearisation point and a
 non-detection costs a multiply-add; the other non-detections are gathered and evaluated in one
 vectorised pass (the paper's sensor; libm otherwise), detections in a scalar loop. Each
@@ -26,6 +26,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from dcee.models.plume import IsotropicPlume, isotropic_concentration_reference
 from dcee.models.plume_kernels import constants_at, plume_at, plume_from_terms, plume_terms
 from dcee.models.sensor import Sensor
 from dcee.models.sensor_kernels import SensorParams, log_likelihood
@@ -222,3 +223,19 @@ def history_log_likelihood(
         remaining,
         out,
     )
+
+
+def history_log_likelihood_reference(
+    theta: np.ndarray,
+    positions: np.ndarray,
+    readings: np.ndarray,
+    multiplicity: np.ndarray,
+    sensor: Sensor,
+    plume: IsotropicPlume,
+) -> np.ndarray:
+    """NumPy reference of the compiled history likelihood: (N,) Σ_k m_k log p(z_k | Θ_i)."""
+    conc = isotropic_concentration_reference(theta, positions, plume.min_distance, plume.meander)
+    d = positions[None, :, :] - theta[:, None, :3]
+    dist = np.maximum(np.sqrt(np.einsum("nki,nki->nk", d, d)), plume.min_distance)
+    ll = sensor.log_likelihood(readings[None, :], conc, dist)
+    return (ll * multiplicity[None, :]).sum(axis=1)

@@ -29,7 +29,8 @@ import numpy as np
 from scipy.special import logsumexp
 
 from dcee.errors import DceeInputError
-from dcee.estimation.particle_filter import ParticleFilter, UpdateInfo
+from dcee.estimation.base import ReadingModelChoice, UpdateInfo
+from dcee.estimation.particle_filter import ParticleFilter
 from dcee.estimation.priors import SourcePrior
 from dcee.models.plume import IsotropicPlume
 from dcee.models.sensor import Sensor
@@ -112,6 +113,15 @@ class ModelBank:
         infos = [f.update(position, reading) for f in self.members]
         self._select()
         return infos[self.selected]
+
+    def resample(self) -> None:
+        """Resample-move every member now (see :meth:`ParticleFilter.resample`)."""
+        for member in self.members:
+            member.resample()
+
+    def reading_model(self) -> ReadingModelChoice:
+        """The selected reading model, its posterior probability and the switches so far."""
+        return ReadingModelChoice(self.selected_name, self.selected_probability, self.switches)
 
     # --- the ParticleFilter interface, answered by the selected member ----------------------
 

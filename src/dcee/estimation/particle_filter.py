@@ -43,61 +43,17 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass
 
 import numpy as np
 from scipy.special import logsumexp
 
 from dcee.errors import DceeInputError
+from dcee.estimation.base import ReadingModelChoice, UpdateInfo
 from dcee.estimation.filter_kernels import history_log_likelihood, reading_upper_bounds
 from dcee.estimation.priors import SourcePrior
-from dcee.models.plume import IsotropicPlume, isotropic_concentration_reference
+from dcee.estimation.resampling import effective_sample_size, systematic_resample
+from dcee.models.plume import IsotropicPlume
 from dcee.models.sensor import Sensor
-
-
-def history_log_likelihood_reference(
-    theta: np.ndarray,
-    positions: np.ndarray,
-    readings: np.ndarray,
-    multiplicity: np.ndarray,
-    sensor: Sensor,
-    plume: IsotropicPlume,
-) -> np.ndarray:
-    """NumPy reference of the compiled history likelihood: (N,) Σ_k m_k log p(z_k | Θ_i)."""
-    conc = isotropic_concentration_reference(theta, positions, plume.min_distance, plume.meander)
-    d = positions[None, :, :] - theta[:, None, :3]
-    dist = np.maximum(np.sqrt(np.einsum("nki,nki->nk", d, d)), plume.min_distance)
-    ll = sensor.log_likelihood(readings[None, :], conc, dist)
-    return (ll * multiplicity[None, :]).sum(axis=1)
-
-
-def systematic_resample(weights: np.ndarray, rng: np.random.Generator, n: int) -> np.ndarray:
-    """n indices drawn ∝ weights by systematic sampling (one uniform, O(N + n), no sorting)."""
-    cumulative = np.cumsum(weights)
-    cumulative[-1] = 1.0  # guard against round-off
-    points = (rng.random() + np.arange(n)) / n
-    return np.searchsorted(cumulative, points, side="right").clip(0, len(weights) - 1)
-
-
-def effective_sample_size(weights: np.ndarray) -> float:
-    return float(1.0 / np.sum(weights * weights))
-
-
-@dataclass(frozen=True)
-class UpdateInfo:
-    """What one :meth:`ParticleFilter.update` did: the ESS the reading left (before any
-    resampling), whether it resampled, the mean Metropolis–Hastings acceptance rate, tempering
-    stages (1 = none), move sweeps, and the distinct particles after the move (N if none)."""
-
-    ess: float
-    resampled: bool
-    acceptance: float
-    tempering_stages: int
-    move_sweeps: int = 0
-    distinct: int = 0
-    rejected: bool = False
-    log_evidence: float = 0.0
-    """log p(z | earlier readings) of this reading under the filter's model (0 if refused)"""
 
 
 class ParticleFilter:
@@ -337,6 +293,16 @@ class ParticleFilter:
             return UpdateInfo(ess, False, math.nan, 1, 0, self.n, log_evidence=log_ev)
         info = self._tempered_update(ll_new, entry, base_mult, ess)
         return dataclasses.replace(info, log_evidence=log_ev)
+
+    def resample(self) -> None:
+        """Resample-move now (systematic resampling, then the MCMC rejuvenation of
+        :meth:`update`), whatever the effective sample size; the weights become uniform."""
+        self._resample()
+        self._rejuvenate()
+
+    def reading_model(self) -> ReadingModelChoice | None:
+        """None: a lone filter has one reading model (see :class:`ModelBank`)."""
+        return None
 
     # --- internals --------------------------------------------------------------------------
 

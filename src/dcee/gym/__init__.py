@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import gymnasium
 
+from dcee.gym.common import OBSERVATION_FIELDS, REWARDS, EnvOptions
 from dcee.gym.env import SourceSearchEnv
 from dcee.gym.multi import MultiSearchEnv, multi_search_env
 from dcee.gym.policy import PlannerPolicy, RandomPolicy, evaluate
@@ -35,6 +36,9 @@ if ENV_ID not in gymnasium.registry:
 __all__ = [
     "ENV_ID",
     "MULTI_ENV_ID",
+    "OBSERVATION_FIELDS",
+    "REWARDS",
+    "EnvOptions",
     "MultiSearchEnv",
     "PlannerPolicy",
     "RandomPolicy",

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
 from typing import Any, ClassVar, SupportsFloat
 
 import gymnasium
@@ -11,35 +9,15 @@ import numpy as np
 from gymnasium import spaces
 
 from dcee.errors import DceeInputError
+from dcee.gym.common import (
+    EnvOptions,
+    action_mask,
+    heading_target,
+    observation_space,
+    observe,
+)
 from dcee.planning.base import Belief
 from dcee.runs import EpisodeResult, SearchSimulation
-from dcee.scenarios import Scenario, truth_choice
-
-REWARDS = ("spread", "rmse")
-"""``spread``: the drop of the posterior spread √tr P over the step (m; what the robot itself
-can compute); ``rmse``: the drop of the particles' RMSE about the true source (m; privileged
-information, only in simulation)."""
-
-MAX_LOG_READING = 20.0
-"""The observation's log(1 + reading) is clipped here (a reading of 4.9e8 g/m³): a finite
-bound for learning code, far above any plausible reading."""
-
-OBSERVATION_FIELDS = (
-    "x",
-    "y",
-    "z",
-    "log_reading",
-    "detection",
-    "mean_x",
-    "mean_y",
-    "mean_z",
-    "sd_x",
-    "sd_y",
-    "sd_z",
-    "ess",
-    "time",
-)
-"""Names of the observation's entries, in order (see :class:`SourceSearchEnv`)."""
 
 
 class SourceSearchEnv(gymnasium.Env):
@@ -83,23 +61,10 @@ class SourceSearchEnv(gymnasium.Env):
 
     metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array"], "render_fps": 4}
 
-    def __init__(
-        self,
-        scenario: str | Scenario = "paper:1",
-        particles: int | None = 2000,
-        unknown: str | None = None,
-        truth: str | None = None,
-        likelihood: str | None = None,
-        budget: float | None = None,
-        reward: str = "spread",
-        time_penalty: float = 0.0,
-        success_bonus: float = 0.0,
-        converged_spread: float = 0.5,
-        render_mode: str | None = None,
-    ) -> None:
-        self.scenario = make_scenario(scenario, particles, unknown, truth, likelihood, budget)
-        self.rules = EpisodeRules.checked(reward, time_penalty, success_bonus, converged_spread)
-        check_render_mode(render_mode)
+    def __init__(self, **options: Any) -> None:
+        self.options = EnvOptions.from_keywords(**options)
+        self.scenario, self.rules = self.options.build()
+        render_mode = self.options.render_mode
         if self.scenario.agent.count != 1:
             raise DceeInputError(
                 "agent.count", "SourceSearchEnv flies one robot; use dcee.gym.multi_search_env"
@@ -199,125 +164,3 @@ class SourceSearchEnv(gymnasium.Env):
             "mean_error": rec["mean_error"],
             "detection": rec["detection"],
         }
-
-
-# -- shared with the multi-robot environment ---------------------------------------------------
-def make_scenario(
-    scenario: str | Scenario,
-    particles: int | None,
-    unknown: str | None,
-    truth: str | None,
-    likelihood: str | None,
-    budget: float | None,
-    count: int | None = None,
-) -> Scenario:
-    """The environment's scenario: a built-in name, a TOML path or a :class:`Scenario`, with
-    the keyword overrides applied (None keeps the scenario's value)."""
-    from dcee.scenarios import load_scenario
-
-    base = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
-    return base.with_overrides(
-        **{
-            "search.particles": particles,
-            "search.budget": budget,
-            "unknown": unknown,
-            "truth.model": truth_choice(truth) if truth is not None else None,
-            "estimator.likelihood": likelihood,
-            "agent.count": count,
-        }
-    )
-
-
-@dataclass(frozen=True)
-class EpisodeRules:
-    """Reward and episode end, shared by the single- and multi-robot environments (see
-    :class:`SourceSearchEnv`); built with :meth:`checked`, which names a bad keyword."""
-
-    reward: str = "spread"
-    time_penalty: float = 0.0
-    success_bonus: float = 0.0
-    converged_spread: float = 0.5
-
-    @classmethod
-    def checked(
-        cls, reward: str, time_penalty: float, success_bonus: float, converged_spread: float
-    ) -> EpisodeRules:
-        if reward not in REWARDS:
-            raise DceeInputError("reward", f"must be one of {', '.join(REWARDS)}, got {reward!r}")
-        for name, value in (
-            ("time_penalty", time_penalty),
-            ("success_bonus", success_bonus),
-            ("converged_spread", converged_spread),
-        ):
-            if isinstance(value, bool) or not (
-                isinstance(value, int | float) and math.isfinite(value) and value >= 0
-            ):
-                raise DceeInputError(name, f"must be a finite number >= 0, got {value!r}")
-        return cls(reward, float(time_penalty), float(success_bonus), float(converged_spread))
-
-    def outcome(
-        self, before: dict[str, Any], after: dict[str, Any], finished: bool
-    ) -> tuple[float, bool, bool]:
-        """(reward, terminated, truncated) of a step from the belief records before and after
-        it; ``finished``: no further move fits the budget."""
-        reward = float(before[self.reward] - after[self.reward]) - self.time_penalty
-        terminated = bool(after["spread"] < self.converged_spread)
-        if terminated:
-            reward += self.success_bonus
-        return reward, terminated, bool(not terminated and finished)
-
-
-def check_render_mode(render_mode: str | None) -> None:
-    """:class:`DceeInputError` unless ``render_mode`` is None or ``"rgb_array"``."""
-    if render_mode not in (None, "rgb_array"):
-        raise DceeInputError("render_mode", f"must be None or 'rgb_array', got {render_mode!r}")
-
-
-def observation_space() -> spaces.Box:
-    """The per-robot observation space (see :data:`OBSERVATION_FIELDS`)."""
-    high = np.ones(len(OBSERVATION_FIELDS), dtype=np.float32)
-    high[OBSERVATION_FIELDS.index("log_reading")] = MAX_LOG_READING
-    return spaces.Box(np.zeros(len(OBSERVATION_FIELDS), np.float32), high, dtype=np.float32)
-
-
-def action_mask(sim: SearchSimulation, position: np.ndarray) -> np.ndarray:
-    """(H,) int8: 1 for the headings from ``position`` that stay inside the area."""
-    mask = np.zeros(sim.agent.n_headings, dtype=np.int8)
-    mask[sim.agent.candidates(position)[1]] = 1
-    return mask
-
-
-def heading_target(sim: SearchSimulation, position: np.ndarray, heading: int) -> np.ndarray | None:
-    """(3,) the position one step from ``position`` along ``heading``; None if it leaves the
-    area."""
-    candidates, headings = sim.agent.candidates(position)
-    hit = np.flatnonzero(headings == heading)
-    return candidates[hit[0]] if len(hit) else None
-
-
-def observe(sim: SearchSimulation, rec: dict[str, Any], position: np.ndarray) -> np.ndarray:
-    """One robot's observation: its ``position`` and the reading of its record ``rec``, and the
-    shared belief after the step's readings (the simulation's last record)."""
-    volume = sim.scenario.volume
-    low = np.asarray(volume.low, dtype=np.float64)
-    size = np.asarray(volume.high, dtype=np.float64) - low
-
-    def fraction(values: np.ndarray) -> np.ndarray:
-        out = np.zeros(3)
-        flat = size <= 0
-        out[~flat] = (values[~flat] - low[~flat]) / size[~flat]
-        return out
-
-    shared = sim.records[-1]
-    sd = np.sqrt(np.maximum([shared["cov_xx"], shared["cov_yy"], shared["cov_zz"]], 0.0))
-    obs = np.concatenate(
-        [
-            fraction(np.asarray(position, dtype=np.float64)),
-            [math.log1p(max(rec["reading"], 0.0)), float(rec["detection"])],
-            fraction(np.array([shared["mean_x"], shared["mean_y"], shared["mean_z"]])),
-            sd / np.where(size > 0, size, np.inf),
-            [shared["ess"] / sim.filter.n, shared["time"] / sim.scenario.search.budget],
-        ]
-    )
-    space = observation_space()
-    return np.clip(obs, space.low, space.high).astype(np.float32)

@@ -10,17 +10,14 @@ from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
 from dcee.errors import DceeInputError
-from dcee.gym.env import (
-    EpisodeRules,
+from dcee.gym.common import (
+    EnvOptions,
     action_mask,
-    check_render_mode,
     heading_target,
-    make_scenario,
     observation_space,
     observe,
 )
 from dcee.runs import SearchSimulation
-from dcee.scenarios import Scenario
 
 
 class MultiSearchEnv(ParallelEnv):
@@ -46,28 +43,12 @@ class MultiSearchEnv(ParallelEnv):
         "is_parallelizable": True,
     }
 
-    def __init__(
-        self,
-        agents: int = 2,
-        scenario: str | Scenario = "paper:1",
-        particles: int | None = 2000,
-        unknown: str | None = None,
-        truth: str | None = None,
-        likelihood: str | None = None,
-        budget: float | None = None,
-        reward: str = "spread",
-        time_penalty: float = 0.0,
-        success_bonus: float = 0.0,
-        converged_spread: float = 0.5,
-        render_mode: str | None = None,
-    ) -> None:
-        if isinstance(agents, bool) or not isinstance(agents, int):
-            raise DceeInputError("agents", f"must be a whole number of robots, got {agents!r}")
-        self.scenario = make_scenario(
-            scenario, particles, unknown, truth, likelihood, budget, agents
-        )
-        self.rules = EpisodeRules.checked(reward, time_penalty, success_bonus, converged_spread)
-        check_render_mode(render_mode)
+    def __init__(self, **options: Any) -> None:
+        options.setdefault("agents", 2)
+        self.options = EnvOptions.from_keywords(**options)
+        self.scenario, self.rules = self.options.build()
+        render_mode = self.options.render_mode
+        agents = self.scenario.agent.count
         self.render_mode = render_mode
         self.possible_agents = [f"robot_{k}" for k in range(agents)]
         self.agents: list[str] = []

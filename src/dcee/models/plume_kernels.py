@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from dcee.numeric import vexp
+from dcee.numeric import exp_scalar
 
 _FOUR_PI = 4.0 * math.pi
 
@@ -117,7 +117,7 @@ def plume_from_terms(
     r = max(math.sqrt(dx * dx + dy * dy + dz * dz), rmin)
     # the exponent is ≤ 0 (1/λ ≥ u/(2ζ1)); min() guards against rounding
     arg = min(-r * inv_lam - dx * ax - dy * ay, 0.0)
-    value = pref / r * vexp(arg)
+    value = pref / r * exp_scalar(arg)
     return (value if arg > -700.0 else 0.0), r
 
 

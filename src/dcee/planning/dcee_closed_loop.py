@@ -174,7 +174,7 @@ class ScenarioTreeDCEEPlanner(ClosedLoopDCEEPlanner):
         seconds = [agent.candidates(p)[0] for p in candidates]
         first_idx = ctx.position_index(candidates)
         ctx.position_index(np.concatenate(seconds))  # every position cached before branching
-        conc, dist = ctx.terms[0], ctx.terms[1]
+        conc, dist = ctx.terms.conc, ctx.terms.dist
         branch_seed = int(rng.integers(2**63))
         with np.errstate(divide="ignore"):
             log_w = np.log(ctx.belief.weights)  # over the context's (merged) particles

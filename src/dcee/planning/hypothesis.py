@@ -23,7 +23,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.estimation.particle_filter import systematic_resample
+from dcee.estimation.resampling import systematic_resample
 from dcee.models.agent import GridAgent
 from dcee.planning.base import Belief, Planner, check_count
 from dcee.planning.predicted import PredictionContext, SequenceStats, check_hypothesis_options

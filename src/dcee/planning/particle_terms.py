@@ -20,6 +20,8 @@ two random projections of its contents, so an edit in place is noticed as well.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from dcee.models.plume import IsotropicPlume
@@ -31,8 +33,28 @@ from dcee.planning.predicted_kernels import (
     probe_sums,
 )
 
-N_TERMS = 6
-"""conc, dist, loc, log_nd, inv_sigma, det_offset (see :attr:`ParticleTerms.terms`)."""
+
+class PositionTerms(NamedTuple):
+    """A particle set's likelihood terms at cached positions, each (R, M): R position rows (as
+    :meth:`ParticleTerms.rows` maps them), M merged particles (see
+    :func:`~dcee.planning.predicted_kernels.position_rows`)."""
+
+    conc: np.ndarray
+    """mean concentration at the position, g/m³"""
+    dist: np.ndarray
+    """distance from the particle's source, m"""
+    loc: np.ndarray
+    """the reading model's location term"""
+    log_nd: np.ndarray
+    """log-probability of a non-detection"""
+    inv_sigma: np.ndarray
+    """1 / the reading model's scale"""
+    det_offset: np.ndarray
+    """the detection log-density's constant"""
+
+
+N_TERMS = len(PositionTerms._fields)
+"""conc, dist, loc, log_nd, inv_sigma, det_offset (see :class:`PositionTerms`)."""
 
 DEFAULT_MAX_BYTES = 32 * 2**20
 """Rows kept across decisions are capped at this many bytes (a decision's own rows always fit)."""
@@ -66,7 +88,7 @@ class ParticleTerms:
         self._index: dict[tuple[float, ...], int] = {}
         self._stamp = np.zeros(0, dtype=np.int64)
         self._clock = 0
-        self._terms: tuple[np.ndarray, ...] | None = None
+        self._terms: PositionTerms | None = None
         self._plume: tuple[float, float] | None = None
         self._sensor_params: tuple | None = None
 
@@ -131,7 +153,7 @@ class ParticleTerms:
         return 0 if self._flat is None else self._flat.shape[1] // max(self.n, 1)
 
     @property
-    def terms(self) -> tuple[np.ndarray, ...]:
+    def terms(self) -> PositionTerms:
         """(conc, dist, loc, log_nd, inv_sigma, det_offset), each (capacity, M) C-contiguous;
         row r holds the terms at the position :meth:`rows` mapped to r (see
         :func:`~dcee.planning.predicted_kernels.position_rows`)."""
@@ -139,7 +161,9 @@ class ParticleTerms:
             self._grow(8)
         if self._terms is None:
             m, cap = max(self.n, 1), self.capacity
-            self._terms = tuple(self._flat[k, : cap * m].reshape(cap, m) for k in range(N_TERMS))
+            self._terms = PositionTerms(
+                *(self._flat[k, : cap * m].reshape(cap, m) for k in range(N_TERMS))
+            )
         return self._terms
 
     def _grow(self, rows: int) -> None:

@@ -25,10 +25,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.estimation.particle_filter import systematic_resample
+from dcee.estimation.resampling import systematic_resample
 from dcee.models.sensor import Sensor
 from dcee.planning.base import Belief
-from dcee.planning.particle_terms import ParticleTerms
+from dcee.planning.particle_terms import ParticleTerms, PositionTerms
 from dcee.planning.predicted_kernels import (
     location_cells,
     location_kl,
@@ -289,7 +289,7 @@ class PredictionContext:
         return self._pt.rows(positions)
 
     @property
-    def terms(self) -> tuple[np.ndarray, ...]:
+    def terms(self) -> PositionTerms:
         """(conc, dist, loc, log_nd, inv_sigma, det_offset), each (R, M) over this context's
         particles, rows as :meth:`position_index` gives them (see
         :func:`~dcee.planning.predicted_kernels.position_rows`). Read it after the last
@@ -299,7 +299,7 @@ class PredictionContext:
     @property
     def conc(self) -> np.ndarray:
         """(R, M) concentrations of every particle at every cached position."""
-        return self.terms[0]
+        return self.terms.conc
 
     def readings(self, pos_idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Hypothesised readings (J', T) along one sequence of cached positions (T,) and the
@@ -310,7 +310,7 @@ class PredictionContext:
             return self._stratified_readings(pos_idx)
         t_count = len(pos_idx)
         c = self.conc[pos_idx][:, self.indices].T  # (J, T)
-        r = self.terms[1][pos_idx][:, self.indices].T
+        r = self.terms.dist[pos_idx][:, self.indices].T
         z = self.sensor.simulate_from(c, self.noise[:, :t_count], r)
         return z, np.full(self._n, 1.0 / self._n)
 
@@ -319,14 +319,14 @@ class PredictionContext:
         the same as :meth:`readings` for each sequence (shared noise), in one NumPy pass."""
         t_count = pos_idx.shape[1]
         c = self.conc[:, self.indices][pos_idx].transpose(0, 2, 1)  # (S, J, T)
-        r = self.terms[1][:, self.indices][pos_idx].transpose(0, 2, 1)
+        r = self.terms.dist[:, self.indices][pos_idx].transpose(0, 2, 1)
         return self.sensor.simulate_from(c, self.noise[None, :, :t_count], r)
 
     def _stratified_readings(self, pos_idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         t_count = len(pos_idx)
         j_count = self._n
         weights = self.belief.weights
-        log_nd = self.terms[3][pos_idx]  # (T, N)
+        log_nd = self.terms.log_nd[pos_idx]  # (T, N)
         log_nd_all = log_nd.sum(axis=0)
         p_detect_i = weights * -np.expm1(log_nd_all)  # w_i P(≥ 1 detection | Θ_i)
         p_detect = float(p_detect_i.sum())
@@ -348,7 +348,7 @@ class PredictionContext:
         target = self._first_u * first_cdf[:, -1]
         first = (first_cdf <= target[:, None]).sum(axis=1).clip(0, t_count - 1)
         conc = self.conc[pos_idx][:, idx].T  # (J, T)
-        dist = self.terms[1][pos_idx][:, idx].T
+        dist = self.terms.dist[pos_idx][:, idx].T
         rows = np.arange(j_count)
         z[1:] = self.sensor.simulate_from(conc, self.noise[:, :t_count], dist)
         stage = np.arange(t_count)[None, :]

@@ -30,8 +30,8 @@ from dcee.models.sensor_kernels import (
 )
 from dcee.numeric import (
     HALF_LOG_2PI,
-    vexp,
-    vlog,
+    exp_scalar,
+    log_scalar,
     logaddexp,
     vlog1m,
     vlogaddexp,
@@ -122,7 +122,7 @@ def _rows_gaussian(
         loc[i] = c
         inv_sigma[i] = inv_s
         log_nd[i] = (lin if c < sp.c_lin else missed) + missed_offset
-        det_offset[i] = sp.log_pd - vlog(sigma)
+        det_offset[i] = sp.log_pd - log_scalar(sigma)
 
 
 @njit(cache=True, parallel=True)
@@ -369,7 +369,7 @@ def _single_stage_weights(
             i = np.uint64(i0 + q)
             lq = log_nd[i]
             ll[np.uint64(q)] = lq
-            e[np.uint64(q)] = weights[i] * vexp(min(lq - bnd, 0.0))
+            e[np.uint64(q)] = weights[i] * exp_scalar(min(lq - bnd, 0.0))
         return
     det_add = sp.log_keep - HALF_LOG_2PI
     if sp.log_outlier > -np.inf:
@@ -378,14 +378,14 @@ def _single_stage_weights(
             r = (v - loc[i]) * inv_sigma[i]
             lq = vlogaddexp(det_offset[i] + det_add - 0.5 * r * r, out)
             ll[np.uint64(q)] = lq
-            e[np.uint64(q)] = weights[i] * vexp(min(lq - bnd, 0.0))
+            e[np.uint64(q)] = weights[i] * exp_scalar(min(lq - bnd, 0.0))
         return
     for q in range(n):
         i = np.uint64(i0 + q)
         r = (v - loc[i]) * inv_sigma[i]
         lq = det_offset[i] + det_add - 0.5 * r * r
         ll[np.uint64(q)] = lq
-        e[np.uint64(q)] = weights[i] * vexp(min(lq - bnd, 0.0))
+        e[np.uint64(q)] = weights[i] * exp_scalar(min(lq - bnd, 0.0))
 
 
 @njit(cache=True, parallel=True, fastmath={"contract"}, error_model="numpy")
@@ -522,7 +522,7 @@ def _grouped_stats(
                         r = (zj - m) * inv_s
                         ll[j] += det_const - 0.5 * r * r if zj >= v_thr else lnd
             for j in range(k):
-                e = wi * vexp(ll[j] - bnd[j])
+                e = wi * exp_scalar(ll[j] - bnd[j])
                 a0[j] += e
                 if want_moments:
                     a1[j] += e * dx

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from dcee.estimation.particle_filter import ParticleFilter
+from dcee.estimation.base import Estimator
 from dcee.planning import get as get_planner
 from dcee.planning.team import check_team_planner
 from dcee.provenance import code_version
@@ -79,6 +79,6 @@ def run_episode(
     return EpisodeResult(records, summary, pf.theta.copy(), pf.weights.copy(), snapshots, config)
 
 
-def _subsample(pf: ParticleFilter, n: int, rng: np.random.Generator) -> np.ndarray:
+def _subsample(pf: Estimator, n: int, rng: np.random.Generator) -> np.ndarray:
     idx = rng.choice(pf.n, size=min(n, pf.n), replace=True, p=pf.weights)
     return pf.source_locations[idx].copy()

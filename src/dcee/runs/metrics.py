@@ -8,8 +8,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from dcee.estimation.model_bank import ModelBank
-
 if TYPE_CHECKING:
     from dcee.scenarios import Scenario
     from dcee.searcher import Searcher
@@ -146,10 +144,11 @@ def search_summary(
     out.update(scenario.resolved_settings())
     out["resamples"] = pf.n_resamples
     out["stall_guard_fired"] = searcher.guard_fired  # decisions the stall guard restricted
-    if isinstance(pf, ModelBank):  # which reading model the readings chose, and how firmly
-        out["model"] = pf.selected_name
-        out["model_probability"] = pf.selected_probability
-        out["model_switches"] = pf.switches
+    choice = pf.reading_model()
+    if choice is not None:  # which reading model the readings chose, and how firmly
+        out["model"] = choice.name
+        out["model_probability"] = choice.probability
+        out["model_switches"] = choice.switches
     out["config"] = scenario.name
     out["parameter_names"] = list(scenario.unknown_names)
     return out

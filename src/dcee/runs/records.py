@@ -9,7 +9,6 @@ from typing import Any
 
 import numpy as np
 
-from dcee.estimation.model_bank import ModelBank
 from dcee.estimation.particle_filter import UpdateInfo
 from dcee.searcher import Searcher
 
@@ -79,8 +78,8 @@ def reading_record(
         "decision_seconds": 0.0,
         "log_evidence": pf.log_evidence,
         **(
-            {"model": pf.selected_name, "model_probability": pf.selected_probability}
-            if isinstance(pf, ModelBank)
+            {"model": choice.name, "model_probability": choice.probability}
+            if (choice := pf.reading_model()) is not None
             else {}
         ),
     }
