@@ -47,7 +47,7 @@ t0 = time.perf_counter()
 run_episode(load_scenario("paper:1"), "dcee", 0)
 out["search-dcee"] = 1e3 * (time.perf_counter() - t0)
 numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
-from dcee.perf.workloads import _filter_update, _resample_move
+from dcee.perf.workloads import _filter_update, _resample_move  # lab script (issue 30: moves to studies)
 u = _filter_update(9)
 m = _resample_move(3)
 out["update"] = u.median

@@ -9,7 +9,10 @@ import pytest
 from dcee.models import Sensor
 from dcee.models.sensor_kernels import log_likelihood
 from dcee.numeric import vexp, vlog1p
-from dcee.planning.predicted import location_kl_reference, predicted_posterior_stats_reference
+from dcee.planning.predicted_kernels import (
+    location_kl_reference,
+    predicted_posterior_stats_reference,
+)
 from tests.helpers import compiled_location_kl, compiled_predicted_stats
 
 
@@ -160,7 +163,7 @@ def test_position_rows_match_the_numpy_plume_and_likelihood(sensor, meander):
     others the libm one."""
     from dcee.estimation.priors import Gamma, SourcePrior, Uniform
     from dcee.models.plume import isotropic_concentration_reference
-    from dcee.planning.predicted_kernels import plume_constants, position_rows
+    from dcee.planning.position_kernels import plume_constants, position_rows
 
     prior = SourcePrior.from_dict(
         {

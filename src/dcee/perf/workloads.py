@@ -9,12 +9,10 @@ process; the machine is shared, so compare ratios measured in the same run.
 from __future__ import annotations
 
 import copy
-import math
 import os
 import time
 import tracemalloc
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -24,99 +22,14 @@ from dcee.estimation import ParticleFilter
 from dcee.models import isotropic_concentration
 from dcee.models.plume import isotropic_concentration_reference
 from dcee.perf.floor import floor_decision
+from dcee.perf.timing import RATIO_TO_FLOOR_TARGETS, Timing, times_ms
 from dcee.planning import get as get_planner
 from dcee.planning.particle_terms import ParticleTerms
-from dcee.planning.predicted import PredictionContext, predicted_posterior_stats_reference
+from dcee.planning.predicted import PredictionContext
+from dcee.planning.predicted_kernels import predicted_posterior_stats_reference
 from dcee.runs import run_episode, streams
 from dcee.scenarios import load_scenario
 from dcee.searcher import Searcher
-
-
-@dataclass
-class Timing:
-    """One workload's repeated measurements (milliseconds, or MB for memory workloads)."""
-
-    name: str
-    description: str
-    target: float | None
-    values: list[float] = field(default_factory=list)
-    unit: str = "ms"
-    note: str = ""
-    ratio_to: dict[str, float] = field(default_factory=dict)
-    """Median of this workload over the median of each named reference timed in the same run
-    (``floor``: the plain compiled loop, ``numpy``: the NumPy reference, ``filter-update``,
-    ``full-import``)."""
-    ratio_target: tuple[str, float] | None = None
-    """(reference, bound): the target as a ratio, ratio_to[reference] ≤ bound. On this shared
-    machine absolute times swing 3-5× between days, so a workload with a reference timed in the
-    same run is judged by the ratio; ``target`` then stays None."""
-
-    @property
-    def median(self) -> float:
-        return float(np.median(self.values)) if self.values else math.nan
-
-    @property
-    def passed(self) -> bool | None:
-        """True/False against the target (the ratio target if there is one); None when the
-        workload has no target."""
-        if not self.values:
-            return None
-        if self.ratio_target is not None:
-            reference, bound = self.ratio_target
-            ratio = self.ratio_to.get(reference)
-            return None if ratio is None else ratio <= bound
-        if self.target is None:
-            return None
-        return self.median <= self.target
-
-    @property
-    def target_text(self) -> str:
-        """The target as the table prints it: "5 ms", "≤ 1.5× floor" or "—"."""
-        if self.ratio_target is not None:
-            return f"≤ {self.ratio_target[1]:g}× {self.ratio_target[0]}"
-        return f"{self.target:.3g} {self.unit}" if self.target is not None else "—"
-
-    def as_dict(self) -> dict:
-        out = {
-            "name": self.name,
-            "description": self.description,
-            "unit": self.unit,
-            "median": self.median,
-            "min": float(np.min(self.values)) if self.values else None,
-            "max": float(np.max(self.values)) if self.values else None,
-            "target": self.target,
-            "ratio_target": list(self.ratio_target) if self.ratio_target else None,
-            "passed": self.passed,
-            "repeats": len(self.values),
-            "note": self.note,
-            "ratio_to": dict(self.ratio_to),
-        }
-        if self.unit == "ms":
-            out["median_ms"] = out["median"]
-            out["target_ms"] = self.target
-        return out
-
-
-RATIO_TO_FLOOR_TARGETS = {
-    "dcee-decision-20k": 1.5,
-    "entrotaxis-decision-20k": 1.5,
-    "infotaxis-decision-20k": 1.5,
-}
-"""Issue 17: a paper-scale decision costs at most 1.5× the plain compiled loop of the same
-arithmetic timed in the same run (it replaced issue 3's absolute 5 ms)."""
-
-
-def _times_ms(fn: Callable[[], object], repeats: int, setup: Callable[[], None] | None = None):
-    fn_setup = setup or (lambda: None)
-    fn_setup()
-    fn()  # warm-up: compilation caches, allocator
-    out = []
-    for _ in range(repeats):
-        fn_setup()
-        t0 = time.perf_counter()
-        fn()
-        out.append(1e3 * (time.perf_counter() - t0))
-    return out
 
 
 def posterior_filter(n_particles: int, n_readings: int = 5, seed: int = 0) -> ParticleFilter:
@@ -151,7 +64,7 @@ def _decision(
     if strategy == "mpc":
         desc = f"one mpc decision, {n:,} particles, 8 moves"
     forget = searcher.planning_cache.forget  # every decision computes its own terms
-    return Timing(name, desc, target, _times_ms(searcher.ask, repeats, forget))
+    return Timing(name, desc, target, times_ms(searcher.ask, repeats, forget))
 
 
 def stall_filter(n_particles: int, seed: int = 1) -> ParticleFilter:
@@ -181,7 +94,7 @@ def _reference_inputs(searcher: Searcher, n_hypotheses: int = 40):
 
 def _numpy_decision(belief, candidates: np.ndarray, readings: np.ndarray) -> None:
     """The NumPy reference of the same statistics: the plume and the predicted posteriors
-    (:func:`~dcee.planning.predicted.predicted_posterior_stats_reference`)."""
+    (:func:`~dcee.planning.predicted_kernels.predicted_posterior_stats_reference`)."""
     plume = belief.plume
     conc = isotropic_concentration_reference(
         belief.theta, candidates, plume.min_distance, plume.meander
@@ -291,7 +204,7 @@ def _filter_update(repeats: int) -> Timing:
         work[:] = [copy.deepcopy(pf)]
 
     far = np.array([45.0, 45.0, 4.0])  # a non-detection that does not trigger resampling
-    times = _times_ms(lambda: work[0].update(far, 0.0), repeats, setup)
+    times = times_ms(lambda: work[0].update(far, 0.0), repeats, setup)
     return Timing(
         "filter-update-20k", "filter update for one reading, 20,000 particles", 1.0, times
     )
@@ -316,7 +229,7 @@ def _resample_move(repeats: int) -> Timing:
         work[0]._resample()
         work[0]._mh_sweep()  # one sweep, as before the adaptive rejuvenation (comparable)
 
-    times = _times_ms(resample_and_sweep, repeats, setup)
+    times = times_ms(resample_and_sweep, repeats, setup)
     return Timing(
         "resample-mcmc-500-readings-20k",
         "systematic resampling + full-history MCMC move, 500 readings, 20,000 particles",

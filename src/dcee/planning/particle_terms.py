@@ -26,7 +26,7 @@ import numpy as np
 
 from dcee.models.plume import IsotropicPlume
 from dcee.models.sensor import Sensor
-from dcee.planning.predicted_kernels import (
+from dcee.planning.position_kernels import (
     N_PLUME_CONSTANTS,
     plume_constants,
     position_rows,
@@ -37,7 +37,7 @@ from dcee.planning.predicted_kernels import (
 class PositionTerms(NamedTuple):
     """A particle set's likelihood terms at cached positions, each (R, M): R position rows (as
     :meth:`ParticleTerms.rows` maps them), M merged particles (see
-    :func:`~dcee.planning.predicted_kernels.position_rows`)."""
+    :func:`~dcee.planning.position_kernels.position_rows`)."""
 
     conc: np.ndarray
     """mean concentration at the position, g/m³"""
@@ -156,7 +156,7 @@ class ParticleTerms:
     def terms(self) -> PositionTerms:
         """(conc, dist, loc, log_nd, inv_sigma, det_offset), each (capacity, M) C-contiguous;
         row r holds the terms at the position :meth:`rows` mapped to r (see
-        :func:`~dcee.planning.predicted_kernels.position_rows`)."""
+        :func:`~dcee.planning.position_kernels.position_rows`)."""
         if self._flat is None:
             self._grow(8)
         if self._terms is None:

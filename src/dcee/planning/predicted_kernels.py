@@ -1,5 +1,6 @@
-"""Compiled (numba) predicted-posterior statistics; NumPy reference:
-:func:`dcee.planning.predicted.predicted_posterior_stats_reference`.
+"""Compiled (numba) predicted-posterior statistics (:func:`predicted_posterior_stats`,
+:func:`location_kl`) beside their NumPy references (:func:`predicted_posterior_stats_reference`,
+:func:`location_kl_reference`): one family of kernels, tested against its references.
 
 Readings arrive in the sensor's transformed frame (:mod:`dcee.models.sensor_kernels`,
 :meth:`dcee.models.sensor.Sensor.transformed_readings`): per task and stage the transformed
@@ -16,189 +17,19 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from dcee.models.plume_kernels import (
-    constants_at,
-    plume_at,
-    plume_from_terms,
-    plume_terms,
-)
+from dcee.models.sensor import Sensor
 from dcee.models.sensor_kernels import (
     SensorParams,
-    log_detection_probability,
-    log_likelihood,
-    transform,
 )
 from dcee.numeric import (
     HALF_LOG_2PI,
     exp_scalar,
-    log_scalar,
     logaddexp,
-    vlog1m,
     vlogaddexp,
-    vndtr_upper,
 )
 
 _BLOCK = 512  # particles per work item; fixed, so the summation order never depends on threads
 _N_ACC = 6  # accumulated sums per task: Σe, Σe·dx, Σe·dy, Σe·dz, Σe·|d|², Σe·ll
-
-
-@njit(cache=True)
-def probe_sums(flat: np.ndarray, probe: np.ndarray) -> tuple[float, float]:
-    """(Σ flat·probe[:n], Σ flat·probe[n:2n]) for flat (n,): a fingerprint of an array's
-    contents. Compiled and sequential, not a BLAS dot: OpenBLAS threads that spin after a call
-    take the cores from the numba threads of the kernels that follow."""
-    n = flat.shape[0]
-    a = 0.0
-    b = 0.0
-    for i in range(n):
-        a += flat[i] * probe[i]
-        b += flat[i] * probe[n + i]
-    return a, b
-
-
-N_PLUME_CONSTANTS = 10
-"""Per-particle plume constants (:func:`~dcee.models.plume_kernels.plume_terms`)."""
-
-
-@njit(cache=True, parallel=True)
-def plume_constants(theta: np.ndarray, out: np.ndarray) -> None:
-    """out[:, i] = :func:`~dcee.models.plume_kernels.plume_terms` of particle i (the source
-    location, q/(4π ζ1), 1/λ, u cosφ/(2ζ1), u sinφ/(2ζ1), cos φ, sin φ, u/(2ζ1)): the square
-    root, cosine and sine of a particle, computed once per particle set instead of at every
-    new position. theta (N, 8); out (10, N)."""
-    for i in prange(theta.shape[0]):
-        terms = plume_terms(theta, i)
-        for k in range(N_PLUME_CONSTANTS):
-            out[k, i] = terms[k]
-
-
-_ROW_BLOCK = 256  # particles per work item of position_rows
-
-
-@njit(cache=True, fastmath={"contract"}, error_model="numpy")
-def _rows_gaussian(
-    plume: np.ndarray,
-    i0: int,
-    i1: int,
-    px: float,
-    py: float,
-    pz: float,
-    rmin: float,
-    sp: SensorParams,
-    conc: np.ndarray,
-    dist: np.ndarray,
-    loc: np.ndarray,
-    log_nd: np.ndarray,
-    inv_sigma: np.ndarray,
-    det_offset: np.ndarray,
-) -> None:
-    """:func:`position_rows` for particles i0..i1−1 at one position, into 1-D rows, in the
-    common case (Gaussian family, constant Pd < 1, no meander): one loop without branches
-    (selects only), so that LLVM vectorises it, exp, log and erfc included."""
-    missed_offset = sp.log_not_false_alarm + sp.log_keep
-    for j in range(i1 - i0):
-        # an unsigned index: numba then emits no negative-index wraparound, which would keep
-        # LLVM from vectorising the loop
-        i = np.uint64(i0 + j)
-        c, r = plume_from_terms(
-            plume[0, i],
-            plume[1, i],
-            plume[2, i],
-            plume[3, i],
-            plume[4, i],
-            plume[5, i],
-            plume[6, i],
-            px,
-            py,
-            pz,
-            rmin,
-        )
-        sigma = sp.sigma_frac * c + sp.sigma_min
-        inv_s = 1.0 / sigma
-        missed = vlog1m(sp.pd * vndtr_upper((sp.v_threshold - c) * inv_s))  # log(1 − Pd Φ(−x))
-        lin = sp.lin0 + sp.lin1 * c
-        conc[i] = c
-        dist[i] = r
-        loc[i] = c
-        inv_sigma[i] = inv_s
-        log_nd[i] = (lin if c < sp.c_lin else missed) + missed_offset
-        det_offset[i] = sp.log_pd - log_scalar(sigma)
-
-
-@njit(cache=True, parallel=True)
-def position_rows(
-    plume: np.ndarray,
-    positions: np.ndarray,
-    rows: np.ndarray,
-    rmin: float,
-    meander: float,
-    sp: SensorParams,
-    conc: np.ndarray,
-    dist: np.ndarray,
-    loc: np.ndarray,
-    log_nd: np.ndarray,
-    inv_sigma: np.ndarray,
-    det_offset: np.ndarray,
-) -> None:
-    """Row rows[k] of each (R, N) output = the terms of every particle at positions[k] that do
-    not depend on the reading: the concentration C and the clamped source distance r (as
-    :func:`~dcee.models.plume_kernels.concentration_distance_grid`), the transformed location,
-    log p(non-detection | C, r), 1/σ and log Pd(r) − log σ (see
-    :mod:`dcee.models.sensor_kernels`). With them a hypothesised reading costs a lookup
-    (non-detection) or a few flops (detection). plume (10, N) from :func:`plume_constants`;
-    positions (K, 3); rows (K,) distinct. NumPy references:
-    :func:`~dcee.models.plume.isotropic_concentration_reference`,
-    :meth:`~dcee.models.sensor.Sensor.log_likelihood`.
-
-    Blocks of particles run in parallel. The paper's sensor (Gaussian family, constant Pd < 1)
-    without meander takes :func:`_rows_gaussian`, vectorised with the ``exp``, ``log`` and
-    ``erfc`` of :mod:`dcee.numeric`; every other case the scalar formulas with libm (with
-    Pd = 1, log Φ needs relative accuracy far in the tail).
-    """
-    n = plume.shape[1]
-    n_blocks = (n + _ROW_BLOCK - 1) // _ROW_BLOCK
-    fast = (
-        sp.lognormal == 0.0
-        and sp.pd < 1.0
-        and sp.near_length == 0.0
-        and meander == 0.0
-        and sp.sigma_min >= 2.0**-60  # σ within the range of the vectorised log
-    )
-    for b in prange(n_blocks):
-        i0 = b * _ROW_BLOCK
-        i1 = min(n, i0 + _ROW_BLOCK)
-        for k in range(positions.shape[0]):
-            px = positions[k, 0]
-            py = positions[k, 1]
-            pz = positions[k, 2]
-            row = rows[k]
-            if fast:
-                _rows_gaussian(
-                    plume,
-                    i0,
-                    i1,
-                    px,
-                    py,
-                    pz,
-                    rmin,
-                    sp,
-                    conc[row],
-                    dist[row],
-                    loc[row],
-                    log_nd[row],
-                    inv_sigma[row],
-                    det_offset[row],
-                )
-                continue
-            for i in range(i0, i1):
-                c, r = plume_at(constants_at(plume, i), px, py, pz, rmin, meander)
-                m, sigma = transform(c, r, sp)
-                conc[row, i] = c
-                dist[row, i] = r
-                loc[row, i] = m
-                inv_sigma[row, i] = 1.0 / sigma
-                log_nd[row, i] = log_likelihood(0.0, c, r, sp)
-                det_offset[row, i] = log_detection_probability(r, sp) - math.log(sigma)
 
 
 @njit(cache=True, inline="always")
@@ -818,3 +649,84 @@ def location_kl(
                 total += a
                 acc += a * (math.log(a) - log_cell_weight[c])
         kl[s] = max(acc / total - math.log(total), 0.0)
+
+
+# --- NumPy references -------------------------------------------------------------------
+
+
+def _predicted_weights_reference(
+    conc: np.ndarray,
+    dist: np.ndarray,
+    weights: np.ndarray,
+    positions: np.ndarray,
+    readings: np.ndarray,
+    sensor: Sensor,
+) -> tuple[np.ndarray, float]:
+    """Unnormalised predicted weights (N,) w_i Π_t p(z_t | C_i(p_t)) / e^mx after the readings
+    (T,) at position rows (T,), and mx, the largest log-likelihood of a particle with weight."""
+    ll = np.zeros(conc.shape[1])
+    for p, z in zip(positions, readings, strict=True):
+        ll += sensor.log_likelihood(z, conc[p], dist[p])
+    mx = ll[weights > 0].max()
+    # zero-weight particles may exceed mx; clip them so that 0 · exp(·) stays 0
+    return weights * np.exp(np.minimum(ll - mx, 0.0)), float(mx)
+
+
+def predicted_posterior_stats_reference(
+    conc: np.ndarray,
+    source: np.ndarray,
+    weights: np.ndarray,
+    task_positions: np.ndarray,
+    task_readings: np.ndarray,
+    sensor: Sensor,
+    dist: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """NumPy reference of :func:`dcee.planning.predicted_kernels.predicted_posterior_stats`
+    from concentrations (P, N), source distances (P, N; None: far) and raw readings (S, T).
+    Returns (log_evidence, mean, trace_cov, kl)."""
+    dist = np.full_like(conc, np.inf) if dist is None else dist
+    s_count = task_positions.shape[0]
+    log_ev = np.empty(s_count)
+    mean = np.empty((s_count, 3))
+    trace = np.empty(s_count)
+    kl = np.empty(s_count)
+    for s in range(s_count):
+        e, mx = _predicted_weights_reference(
+            conc, dist, weights, task_positions[s], task_readings[s], sensor
+        )
+        w_post = e / e.sum()
+        log_ev[s] = mx + np.log(e.sum())
+        mean[s] = w_post @ source
+        d = source - mean[s]
+        trace[s] = w_post @ np.einsum("ij,ij->i", d, d)
+        pos = w_post > 0
+        kl[s] = np.sum(w_post[pos] * (np.log(w_post[pos]) - np.log(weights[pos])))
+    return log_ev, mean, trace, kl
+
+
+def location_kl_reference(
+    conc: np.ndarray,
+    source: np.ndarray,
+    weights: np.ndarray,
+    task_positions: np.ndarray,
+    task_readings: np.ndarray,
+    sensor: Sensor,
+    cell: float,
+    dist: np.ndarray | None = None,
+) -> np.ndarray:
+    """NumPy reference of :func:`dcee.planning.predicted_kernels.location_kl`: (S,) KL
+    divergences of the source location's distribution over cubes of side ``cell`` (m), from
+    concentrations (P, N), sources (N, 3), weights (N,), positions (S, T) and readings (S, T)."""
+    dist = np.full_like(conc, np.inf) if dist is None else dist
+    _, cell_of = np.unique(np.floor(source / cell), axis=0, return_inverse=True)
+    cell_of = cell_of.reshape(-1)
+    prior = np.bincount(cell_of, weights=weights)
+    out = np.empty(task_positions.shape[0])
+    for s in range(task_positions.shape[0]):
+        e, _ = _predicted_weights_reference(
+            conc, dist, weights, task_positions[s], task_readings[s], sensor
+        )
+        post = np.bincount(cell_of, weights=e / e.sum(), minlength=len(prior))
+        pos = post > 0
+        out[s] = np.sum(post[pos] * np.log(post[pos] / prior[pos]))
+    return out
