@@ -170,7 +170,7 @@ FUZZ_SENSORS = {
 
 def fuzz_stream(sensor: Sensor, stream: int, readings: int = 6) -> ParticleFilter:
     """A filter fed random positions and readings from 0 up to the physical maximum
-    (log-uniform over eight decades), as ``scripts/fuzz_filter.py`` does at scale."""
+    (log-uniform over eight decades), as ``studies/fuzz_filter.py`` does at scale."""
     rng = np.random.default_rng(stream)
     pf = ParticleFilter(_xy_prior(), sensor, n_particles=100, seed=stream, max_sweeps=2)
     for _ in range(readings):
@@ -193,7 +193,7 @@ def filter_is_alive(pf: ParticleFilter, need_diversity: bool) -> bool:
 def test_no_fuzzed_stream_kills_the_filter(name):
     """The paper's model (no outlier component) may legitimately collapse onto one point for a
     reading only one location can explain, but never to NaN or −inf; with the outlier component
-    every filter also stays diverse. (1,000 streams per model: scripts/fuzz_filter.py.)"""
+    every filter also stays diverse. (1,000 streams per model: studies/fuzz_filter.py.)"""
     dead = [
         s
         for s in range(150)
@@ -257,7 +257,7 @@ def _adaptive_path(config: str, seed: int, n: int = 60):
 def test_filters_on_adaptive_paths_match_the_exact_grid_posterior(config):
     """Readings chosen by a planner (DCEE) on configurations where it searches far from the
     plume; 5,000-particle filters replayed on the same readings end within 0.3 exact sd of the
-    exact grid posterior's mean (the study, scripts/replay_study.py, runs 20,000 particles)."""
+    exact grid posterior's mean (the study, studies/replay_study.py, runs 20,000 particles)."""
     scenario, ps, zs = _adaptive_path(config, 0)
     sensor = scenario.make_sensor()
     exact = location_grid_posterior(

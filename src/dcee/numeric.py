@@ -166,7 +166,7 @@ def vlog1p(x: np.ndarray, out: np.ndarray) -> None:
 
 # --- erfc, Φ and log that the compiler can vectorise (issue 17) -------------------------------
 # erfc(y) = e^(−y²) · erfcx(y) for y ≥ 0, with (y + K) · erfcx(y) a Chebyshev series in
-# t = (y − K)/(y + K) ∈ [−1, 1) (K = 3; coefficients from scripts/fit_erfcx.py, relative error
+# t = (y − K)/(y + K) ∈ [−1, 1) (K = 3; coefficients from studies/fit_erfcx.py, relative error
 # < 1e-14 against scipy.special.erfcx on [0, 1e6]). log(x) = m ln 2 + log1p(x 2^−m − 1) with m
 # and x 2^−m ∈ [1, 2) read from the float's bits (no frexp, which numba only has as a scalar call).
 _ERFCX_K = 3.0

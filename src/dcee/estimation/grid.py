@@ -1,5 +1,5 @@
 """Exact posterior of the source location on a grid: the reference the particle filter is
-checked against (tests and ``scripts/replay_study.py``).
+checked against (tests and ``studies/replay_study.py``).
 
 With only the horizontal location (x, y) unknown and every other parameter known, the posterior
 is a two-dimensional density that can be evaluated everywhere: on a grid of spacing h over the

@@ -52,6 +52,7 @@ from dcee.estimation.base import ReadingModelChoice, UpdateInfo
 from dcee.estimation.filter_kernels import history_log_likelihood, reading_upper_bounds
 from dcee.estimation.priors import SourcePrior
 from dcee.estimation.resampling import effective_sample_size, systematic_resample
+from dcee.estimation.summaries import in_credible_ellipsoid, weighted_rmse
 from dcee.models.plume import IsotropicPlume
 from dcee.models.sensor import Sensor
 
@@ -183,34 +184,18 @@ class ParticleFilter:
 
     def rmse(self, true_location: np.ndarray) -> float:
         """√(Σ wᵢ ‖sᵢ − s‖²): RMSE of the particles' source locations about ``true_location``."""
-        d = self.source_locations - np.asarray(true_location)[None, :]
-        return float(math.sqrt(self.weights @ np.einsum("ij,ij->i", d, d)))
+        return weighted_rmse(self.source_locations, self.weights, true_location)
 
     def in_credible_region(self, true_location: np.ndarray, level: float = 0.95) -> bool:
         """Whether ``true_location`` (3,) lies in the posterior's ``level`` credible region of
-        the unknown location coordinates.
-
-        The region is the ellipsoid, shaped by the posterior covariance, that holds ``level`` of
-        the posterior mass: the truth is inside when its Mahalanobis distance is at most the
-        weighted ``level`` quantile of the particles' distances (no Gaussian assumption on the
-        radial profile). Over many searches a calibrated filter contains the truth ``level`` of
-        the time.
-        """
+        the unknown location coordinates (see
+        :func:`~dcee.estimation.summaries.in_credible_ellipsoid`)."""
         cols = self._loc_block  # unknown location columns, in order
         if not cols:
             return True
         x = self.theta[:, cols]
-        w = self.weights
-        mean = w @ x
-        cov = np.atleast_2d(np.cov(x, rowvar=False, aweights=w, ddof=0))
-        inv = np.linalg.pinv(cov)
-        d = x - mean
-        dist = np.einsum("ij,jk,ik->i", d, inv, d)
-        t = np.asarray(true_location, dtype=np.float64)[cols] - mean
-        order = np.argsort(dist)
-        cum = np.cumsum(w[order])
-        cutoff = dist[order][min(int(np.searchsorted(cum, level)), len(cum) - 1)]
-        return bool(t @ inv @ t <= cutoff)
+        truth = np.asarray(true_location, dtype=np.float64)[cols]
+        return in_credible_ellipsoid(x, self.weights, truth, level)
 
     @property
     def ess(self) -> float:

@@ -124,7 +124,7 @@ def _lab(start: str) -> dict[str, Any]:
         # the fluctuation likelihood fitted at this room's scale (the defaults are the 50 m
         # paper plume's): 4 s holds of the filament truth in lab:upwind, 24 points 0.1-2.7 m
         # downwind, readings without random misses (sensor.dropout's default on a turbulent
-        # truth), `scripts/fluctuation_stats.py --scenario lab:upwind --hold 4 --seconds 900
+        # truth), `studies/fluctuation_stats.py --scenario lab:upwind --hold 4 --seconds 900
         # --pd 1`: log-sd 0.72, intermittency 0.96 (the averaged plume is hardly intermittent
         # at this scale) and no near-source fall (fitted length 0.00 m); read only with
         # likelihood = "fluctuation"

@@ -109,7 +109,7 @@ OUTLIER_DEFAULT = 0.01
 """Outlier weight ``estimator.outlier`` for every likelihood, the paper's included, so that one
 reading no hypothesis can explain (a spike, a stuck or saturated sensor) never captures the
 posterior. Chosen on the tuning configurations (random:1-6, dcee-cl, one 10⁶ × reading at 40,
-60 or 100 s, ``scripts/spike_study.py``): weight 0 lost 14 of 18 acquired searches to the spike,
+60 or 100 s, ``studies/spike_study.py``): weight 0 lost 14 of 18 acquired searches to the spike,
 0.001 and 0.01 none; 0.01, the larger, bounds a reading's likelihood ratio 10× tighter. Set 0
 for the paper's exact likelihood (docs/scenarios.md: the held-out check and the public study
 with this default). Before issue 29 the default was 0 for the paper's likelihood and 0.01 for
@@ -144,7 +144,7 @@ class EstimatorSpec(BaseModel):
     threshold, ``intermittency``, ``log_sd`` and ``near_source_length`` (intermittency and
     log_sd fitted by maximum likelihood to 4 s hold averages of the filament truth, readings as
     the instrument reports them there — without random misses, ``sensor.dropout``'s default on
-    a turbulent truth: ``scripts/fluctuation_stats.py --hold 4 --pd 1``; the near-source length
+    a turbulent truth: ``studies/fluctuation_stats.py --hold 4 --pd 1``; the near-source length
     chosen by the searches' calibration, docs/scenarios.md).
     With ``calm_prior`` > 0 the fluctuation likelihood estimates the turbulence level online: a
     second filter runs the paper's calm model (the ``[sensor]`` parameters, no meander) on the

@@ -3,7 +3,7 @@ lab-note check before a campaign (docs/held-out.md). Prints, per variant, how ma
 source, the median time to RMSE < 1 m (9999: never), the longest stall and the mean decision
 time, then per configuration ``K:final RMSE/longest stall``.
 
-    .venv/bin/python scripts/quick_variants.py 'SPEC1;SPEC2' random:1,random:3 \\
+    .venv/bin/python studies/quick_variants.py 'SPEC1;SPEC2' random:1,random:3 \\
         [source|full] [isotropic|filament] [paper|fluctuation]
 """
 

@@ -9,9 +9,9 @@ share of non-detections, and the log-sd of the detected readings about ln C. It 
 fluctuation likelihood's intermittency γ(r) = γ∞ (1 − exp(−r / r_γ)) by maximum likelihood, then
 the same with a log-sd that grows near the source, s(r) = s∞ + s_near exp(−r / r_s).
 
-    .venv/bin/python scripts/fluctuation_stats.py [--hold 5] [--seconds 1800] [--seeds 3]
-    .venv/bin/python scripts/fluctuation_stats.py --scenario lab:upwind --hold 4
-    .venv/bin/python scripts/fluctuation_stats.py --hold 4 --pd 1   # no random misses
+    .venv/bin/python studies/fluctuation_stats.py [--hold 5] [--seconds 1800] [--seeds 3]
+    .venv/bin/python studies/fluctuation_stats.py --scenario lab:upwind --hold 4
+    .venv/bin/python studies/fluctuation_stats.py --hold 4 --pd 1   # no random misses
 
 Another scenario (``--scenario``) gets the same pattern of points scaled to its area (the
 distances above × area width / 50 m) at its sensor height.

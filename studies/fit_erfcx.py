@@ -2,7 +2,7 @@
 :func:`dcee.numeric._verfc` (issue 17): (y + K) · erfcx(y) on y ∈ [0, ∞) as a Chebyshev series
 in t = (y − K)/(y + K) ∈ [−1, 1), K = 3, interpolated at 25 Chebyshev nodes from
 ``scipy.special.erfcx``. Prints the coefficients and the largest relative error of the
-series against scipy on y ∈ [0, 1e6]. Run: .venv/bin/python scripts/fit_erfcx.py
+series against scipy on y ∈ [0, 1e6]. Run: .venv/bin/python studies/fit_erfcx.py
 """
 
 import numpy as np

@@ -5,8 +5,8 @@ RMSE < 1 m (a search that never gets there counts as later than the budget, so t
 censored, not conditional), and an exact McNemar test against a reference strategy on searches
 paired by (configuration, repeat).
 
-    .venv/bin/python scripts/dual_control_table.py results/dual-ablation [--reference dcee]
-    .venv/bin/python scripts/dual_control_table.py results/paper-source-cl --study \
+    .venv/bin/python studies/dual_control_table.py results/dual-ablation [--reference dcee]
+    .venv/bin/python studies/dual_control_table.py results/paper-source-cl --study \
         --reference infotaxis
 
 ``--study`` pools every configuration instead: acquired with its Wilson interval, median final

@@ -7,8 +7,8 @@ before the source was acquired; how many searches stalled > 60 s).
 A folder may hold several strategies: ``DIR=STRATEGY`` picks one (the strategy spec as stored,
 e.g. ``results/filament-calm=infotaxis``); a folder without ``=`` must hold just one.
 
-    .venv/bin/python scripts/ablation_table.py results/ablation/all results/ablation/*
-    .venv/bin/python scripts/ablation_table.py results/paper-full-cl2=infotaxis \\
+    .venv/bin/python studies/ablation_table.py results/ablation/all results/ablation/*
+    .venv/bin/python studies/ablation_table.py results/paper-full-cl2=infotaxis \\
         results/paper-full-info-loc results/paper-full-cl2=dcee-cl
 """
 

@@ -13,7 +13,7 @@ D=.venv/bin/dcee
 HO="--suite held-out --repeats 1 --particles 10000 --allow-code-change"
 FIL="--unknown full --truth filament --likelihood fluctuation"
 # the two one-step planners the done-when compares, on the three studies. The wind-known study
-# ran before the stall guard existed (search.stall_guard = 0); scripts/guard_replay.py finds
+# ran before the stall guard existed (search.stall_guard = 0); studies/guard_replay.py finds
 # the searches in which the guard would have fired and reruns those with it
 # (results/held-out-wind-known-guard): every other search is the same with and without it.
 # (on 2026-11-25 it ran with the code before the guard, which this --set reproduces; a folder

@@ -7,7 +7,7 @@ air is ``factor`` × threshold; capped below ``sensor.max_reading``, above which
 refused as a fault rather than assimilated). A search "captured" by the spike is one acquired
 without it and not with it.
 
-    .venv/bin/python scripts/spike_study.py --strategy dcee-cl --scenarios random:1-10 \\
+    .venv/bin/python studies/spike_study.py --strategy dcee-cl --scenarios random:1-10 \\
         --seeds 2 --at 60 200 --outlier 0 0.01 [--particles 10000] [--csv out.csv]
 
 Prints one line per flight and a table per outlier weight (``--outlier default`` uses the

@@ -3,7 +3,7 @@ STE example (dcee.perf.stonesoup_mcts), seeds 0-9, side by side in one process. 
 `bench` extra (Stone Soup). Resumable: one JSON per seed in OUT; rerun to finish, then it prints
 the table (median final x-y RMSE and median ms per decision, with the ratio).
 
-    .venv/bin/python scripts/stonesoup_mcts_study.py results/stonesoup-mcts [STRATEGY]
+    .venv/bin/python studies/stonesoup_mcts_study.py results/stonesoup-mcts [STRATEGY]
 """
 
 import json

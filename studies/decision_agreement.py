@@ -4,7 +4,7 @@ Flies searches with the fast path and, before every decision, decides again on t
 with the reference path (no merged particles, no terms kept across decisions), same random
 numbers; prints one line per (configuration, strategy, seed) and the totals.
 
-Usage: .venv/bin/python scripts/decision_agreement.py [--particles N] [--steps S]
+Usage: .venv/bin/python studies/decision_agreement.py [--particles N] [--steps S]
 """
 
 from __future__ import annotations

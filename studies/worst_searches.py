@@ -3,7 +3,7 @@
 longest stall, then the final RMSE), drawn from their stored results (trajectory, detections,
 final particles, the truth's plume), one row per strategy.
 
-    .venv/bin/python scripts/worst_searches.py results/held-out-wind-known=dcee-cl \\
+    .venv/bin/python studies/worst_searches.py results/held-out-wind-known=dcee-cl \\
         results/held-out-wind-known=infotaxis --out docs/figures/held-out-worst-wind-known.png
 """
 

@@ -8,7 +8,7 @@ final posterior mean is compared with the exact grid posterior's
 |mean − exact mean| ≤ 0.3 exact sd on both coordinates. Also reported: the exact posterior mass
 within 3 m of the truth and the filters' mass there.
 
-    .venv/bin/python scripts/replay_study.py [--paths 6] [--filters 10] [--out FILE.csv]
+    .venv/bin/python studies/replay_study.py [--paths 6] [--filters 10] [--out FILE.csv]
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """What each change of issue 17 bought: the same workloads timed for several commits, each in
 fresh processes, the commits alternated round by round so that all see the same machine load.
 
-Usage: .venv/bin/python scripts/perf_history.py COMMIT [COMMIT ...] [--rounds N]
+Usage: .venv/bin/python studies/perf_history.py COMMIT [COMMIT ...] [--rounds N]
 Each commit is checked out into a temporary git worktree (its numba kernels are compiled there
 once, in a warm-up run). Workloads, per commit and round:
 
@@ -47,7 +47,7 @@ t0 = time.perf_counter()
 run_episode(load_scenario("paper:1"), "dcee", 0)
 out["search-dcee"] = 1e3 * (time.perf_counter() - t0)
 numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
-from dcee.perf.workloads import _filter_update, _resample_move  # lab script (issue 30: moves to studies)
+from dcee.perf.workloads import _filter_update, _resample_move
 u = _filter_update(9)
 m = _resample_move(3)
 out["update"] = u.median

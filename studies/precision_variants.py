@@ -7,7 +7,7 @@ unless overridden). Prints per variant and truth: acquired (final RMSE < 3 m), m
 the share with the truth in the 95 % region, and the median signed along-wind and absolute
 cross-wind error of the final mean (m; along > 0 means the estimate lies downwind).
 
-    .venv/bin/python scripts/precision_variants.py --configs random:1-12 --truths puffs filament \\
+    .venv/bin/python studies/precision_variants.py --configs random:1-12 --truths puffs filament \\
         --variant base: --variant hold8:agent.dwell=8 --variant n20k:search.particles=20000 \\
         [--strategy dcee-cl] [--seeds 1] [--workers 2] [--csv out.csv]
 """

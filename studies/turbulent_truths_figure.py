@@ -3,7 +3,7 @@
 Top row: the instantaneous field at t = 200 s; bottom row: its mean over 300 s, at the source
 height, for the filament truth and the independent puff truth (log colour scale, g/m³).
 
-    .venv/bin/python scripts/turbulent_truths_figure.py [--scenario paper:1] [--seed 0] \\
+    .venv/bin/python studies/turbulent_truths_figure.py [--scenario paper:1] [--seed 0] \\
         [--out docs/figures/turbulent-truths.png]
 """
 

@@ -1,7 +1,7 @@
 """The robots-vs-time table of the team study (issue 16): time to RMSE < 1 m and final RMSE
 against the number of robots sharing one belief, per planner, on common (configuration, seed).
 
-    .venv/bin/python scripts/team_table.py results/paper-source-cl2 results/team-a2 results/team-a3
+    .venv/bin/python studies/team_table.py results/paper-source-cl2 results/team-a2 results/team-a3
 
 Each folder holds `dcee bench` searches (1, 2 or 3 robots; the count is read from the summaries,
 searches from before team support count as 1). Only (configuration, seed) pairs present for

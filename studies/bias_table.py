@@ -1,7 +1,7 @@
 """Where the estimate ends, relative to the wind, for the searches of one or more campaigns: a
 Markdown table row per folder (the turbulent-plume sweeps of docs/scenarios.md).
 
-    .venv/bin/python scripts/bias_table.py results/sweep3/c0-20k results/sweep3/c0-n10-20k
+    .venv/bin/python studies/bias_table.py results/sweep3/c0-20k results/sweep3/c0-n10-20k
 
 Columns: searches, source acquired (Wilson 95 % interval), median final RMSE, median error of
 the posterior mean, median posterior spread, the median error of the mean *downwind* (positive:

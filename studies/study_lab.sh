@@ -8,7 +8,7 @@
 # sensor.dropout, with the instrument missing 30 % of the readings on the filament truth too and
 # intermittencies 0.67 / 0.63 fitted to such readings: add --set sensor.dropout=0.3 and those
 # values to reproduce them.) Resumable: rerun to finish; add
-# --allow-code-change to resume with newer code. Tables: scripts/lab_table.py.
+# --allow-code-change to resume with newer code. Tables: studies/lab_table.py.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 D=.venv/bin/dcee
@@ -26,5 +26,5 @@ $D bench --suite lab-robot --repeats 10 --strategies $S --workers "$W" "${FLUCT[
 for c in lab-robot lab-grid lab-robot-filament-fit lab-robot-filament; do
     $D report results/$c --out results/report-$c
 done
-.venv/bin/python scripts/lab_table.py results/lab-robot results/lab-grid \
+.venv/bin/python studies/lab_table.py results/lab-robot results/lab-grid \
     results/lab-robot-filament-fit results/lab-robot-filament

@@ -8,7 +8,7 @@ exactly what the guarded code flies (same seed, same draws), and one in which it
 again with the guard. The result is a copy of the campaign (hard links) with those searches
 replaced:
 
-    .venv/bin/python scripts/guard_replay.py results/held-out-wind-known \\
+    .venv/bin/python studies/guard_replay.py results/held-out-wind-known \\
         results/held-out-wind-known-guard [--guard 30]
 """
 

@@ -1,7 +1,7 @@
 """Trajectories at a stall (docs/dual-control.md): paper:12, seed 0, 10,000 particles, wind
 known, with mpc, dcee, dcee-cl and infotaxis side by side on the same truth.
 
-    .venv/bin/python scripts/stall_figure.py [--out docs/figures/dual-control-stall.png]
+    .venv/bin/python studies/stall_figure.py [--out docs/figures/dual-control-stall.png]
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Fuzz the particle filter: N random streams per reading model, count dead filters.
 
-    .venv/bin/python scripts/fuzz_filter.py [--streams 1000]
+    .venv/bin/python studies/fuzz_filter.py [--streams 1000]
 
 A filter is dead when a weight is not finite, a live particle's history likelihood is not
 finite, or (for the models with an outlier component) every live particle is identical.

@@ -1,7 +1,7 @@
 """The lab-experiment table (issue 15): the paper's indoor search in simulation with the
 unicycle robot against the idealised grid agent, per start and planner, paired by seed.
 
-    .venv/bin/python scripts/lab_table.py results/lab-robot results/lab-grid \
+    .venv/bin/python studies/lab_table.py results/lab-robot results/lab-grid \
         [results/lab-robot-filament]
 
 prints the per-start table (robot against grid, paired) and a compact one pooled over both

@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# Reproduce a published table: `bash studies/run.sh NAME` runs the study's campaigns (resumable:
+# rerun to finish; finished searches are skipped) and then the step that prints its tables.
+# `bash studies/run.sh --list` lists the names; studies/README.md says which table each makes.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+D=.venv/bin/dcee
+P=.venv/bin/python
+[ -x "$D" ] || bash scripts/setup.sh
+report() { for dir in "$@"; do $D report "results/$dir"; cat "results/$dir/report/metrics.md"; done; }
+
+case "${1:---list}" in
+  first-look)  # docs/results.md "First look": paper:1-12, seed 0, every planner
+    mkdir -p results/first-look
+    for K in $(seq 1 12); do for S in dcee mpc entrotaxis infotaxis dcee-ms; do
+      out="results/first-look/paper-$K-$S"
+      [ -f "$out/summary.json" ] || $D run --scenario "paper:$K" --strategy "$S" --seed 0 --out "$out" --no-figure -q
+    done; done
+    $D report results/first-look ;;
+  paper-source)  # section 5: the paper's five planners, wind known, 12 x 10
+    $D bench --suite paper --repeats 10 --out results/paper-source
+    report paper-source ;;
+  paper-full)  # section 4.1.1: all eight parameters unknown, 12 x 10
+    $D bench --suite paper --repeats 10 --unknown full --out results/paper-full
+    report paper-full ;;
+  model-mismatch)  # filament truth, the isotropic estimator
+    $D bench --suite paper --strategies dcee,entrotaxis,mpc --repeats 10 --unknown full \
+      --truth filament --out results/paper-filament
+    report paper-filament ;;
+  dual-control)  # closed-loop DCEE: reach, the four planners, the ablation (docs/dual-control.md)
+    bash studies/study_dual_control.sh
+    $P studies/dual_control_table.py --study results/paper-source-cl
+    $P studies/dual_control_table.py results/dual-ablation
+    report paper-source-cl2 paper-full-cl paper-full-cl2 ;;
+  team)  # several robots, one belief
+    bash studies/study_team.sh
+    $P studies/team_table.py results/team10k-a1 results/team10k-a2 results/team10k-a3
+    $P studies/team_table.py results/paper-source-cl2 results/team-a2 results/team-a3 ;;
+  turbulent)  # the filament truth with hold-averaged readings and the fluctuation likelihood
+    bash studies/study_turbulent.sh
+    report filament-fluct ;;
+  turbulent-calm)  # the same with the calm model, its ablation and the wind-known price
+    bash studies/study_turbulent_calm.sh
+    report filament-calm paper-source-calm
+    $P studies/bias_table.py results/filament-calm
+    $P studies/ablation_table.py results/filament-calm=infotaxis results/filament-info-loc=infotaxis ;;
+  turbulent-held-out)  # both turbulent truths on held-out configurations (docs/turbulent.md)
+    bash studies/study_turbulent_held_out.sh
+    report turbulent-filament-held-out-24 turbulent-puffs-held-out-24 ;;
+  held-out)  # random configurations of the reporting range (docs/held-out.md)
+    bash studies/study_held_out.sh
+    report held-out-wind-known held-out-full held-out-filament ;;
+  replay)  # filters that keep every mode, against the exact grid posterior
+    $P studies/replay_study.py ;;
+  spike)  # one absurd reading inside a search (outlier safety)
+    $P studies/spike_study.py ;;
+  fuzz)  # random reading streams: no dead filter
+    $P studies/fuzz_filter.py ;;
+  lab)  # the paper's indoor experiment in simulation (section 6)
+    bash studies/study_lab.sh
+    $P studies/lab_table.py results/lab-robot results/lab-grid
+    report lab-robot-filament-fit lab-robot-filament ;;
+  precision)  # where a turbulent search's final error comes from (docs/turbulent.md)
+    $P studies/precision_variants.py ;;
+  stonesoup-mcts)  # our tree search against Stone Soup's MCTS on its own example
+    $P studies/stonesoup_mcts_study.py ;;
+  perf)  # docs/performance.md
+    $D perf ;;
+  --list)
+    sed -n 's/^  \([a-z-]*\)) *# \(.*\)/\1\t\2/p' "$0" ;;
+  *)
+    echo "studies/run.sh: error: unknown study ${1@Q}; see bash studies/run.sh --list" >&2
+    exit 2 ;;
+esac
