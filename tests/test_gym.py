@@ -129,6 +129,7 @@ def test_bad_keywords_are_user_errors():
         ({"time_penalty": -1.0}, "time_penalty"),
         ({"render_mode": "human"}, "render_mode"),
         ({"particles": 0}, "particles"),
+        ({"particle": 100}, "particle"),  # a misspelt keyword names itself and the allowed ones
     ]:
         with pytest.raises(DceeInputError, match=field):
             dcee.gym.SourceSearchEnv(**{**SMALL, **kwargs})

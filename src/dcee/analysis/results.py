@@ -1,6 +1,6 @@
 """Load saved searches: one ``dcee run`` folder, a folder of them, or a whole campaign.
 
-Every search is a folder written by :meth:`dcee.simulation.EpisodeResult.save`
+Every search is a folder written by :meth:`dcee.runs.EpisodeResult.save`
 (``summary.json``, ``config.json``, ``steps.parquet``, ``posterior.npz``); a campaign keeps them
 under ``runs/config=…/strategy=…/seed=…/``. These readers find every complete search below a
 folder, so the same call loads either.

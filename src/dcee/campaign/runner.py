@@ -11,7 +11,7 @@ Layout of a campaign folder (hive-style partitions, values URI-encoded: ``paper:
         posterior.npz                   final posterior sample (+ snapshots, repeat 0)
         error.json                      why a search failed (retried on the next run)
 
-Every search folder is the one :meth:`dcee.simulation.EpisodeResult.save` writes (``dcee run``
+Every search folder is the one :meth:`dcee.runs.EpisodeResult.save` writes (``dcee run``
 writes the same), so one reader serves both: :func:`dcee.analysis.results.load_summaries` and
 ``load_steps`` load a whole study in one call, and ``pyarrow.dataset.dataset(DIR / "runs",
 format="parquet", partitioning="hive", exclude_invalid_files=True)`` reads every record with
