@@ -43,14 +43,22 @@ def cli_reference() -> str:
 def scenario_reference() -> str:
     from pydantic import BaseModel
 
-    from dcee.scenarios import config
+    from dcee.scenarios import schema as config
 
+    # one section per truth kind with a parameter table, from the one registry of truth kinds
+    truth_kinds = [
+        (
+            f'[truth] model: kind = "{kind}"' + (" (or file = …)" if kind == "playback" else ""),
+            k.spec,
+        )
+        for kind, k in config.TRUTH_KINDS.items()
+        if k.spec is not None
+    ]
     sections = [
         ("top level", config.Scenario),
         ("[volume]", config.Volume),
         ("[truth]", config.Truth),
-        ('[truth] model: a filament table (kind = "filament")', config.FilamentSpec),
-        ("[truth] model: a recording (file = …)", config.PlaybackSpec),
+        *truth_kinds,
         ("[prior] NAME: one parameter's prior", config.PriorSpec),
         ("[sensor]", config.SensorSpec),
         ("[estimator]", config.EstimatorSpec),
