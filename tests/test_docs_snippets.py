@@ -1,0 +1,54 @@
+"""Every fenced Python block in the documentation runs: the blocks of one page run in order in
+one fresh interpreter (a later block may use what an earlier one defined), in a temporary folder
+that holds a small study under ``results/study`` for the pages that load one. A page whose
+snippet fails fails the suite."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+DOCS = Path(__file__).resolve().parent.parent / "docs"
+FENCE = re.compile(r"^```python\n(.*?)^```", re.S | re.M)
+
+
+def python_blocks(page: Path) -> list[str]:
+    return FENCE.findall(page.read_text(encoding="utf-8"))
+
+
+PAGES = sorted(p for p in DOCS.rglob("*.md") if "generated" not in p.parts and python_blocks(p))
+
+
+def test_the_pages_with_python_are_found():
+    names = {p.name for p in PAGES}
+    assert {"python-api.md", "learning.md", "robot.md"} <= names
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A folder with a small finished study in results/study (2 searches at toy scale)."""
+    root = tmp_path_factory.mktemp("docs")
+    subprocess.run(
+        [sys.executable, "-m", "dcee.cli", "bench", "--suite", "smoke", "--strategies", "mpc",
+         "--repeats", "1", "--workers", "1", "--out", "results/study"],
+        cwd=root, check=True, capture_output=True, timeout=300,
+    )  # fmt: skip
+    return root
+
+
+@pytest.mark.parametrize("page", PAGES, ids=[str(p.relative_to(DOCS)) for p in PAGES])
+def test_every_python_block_of_a_page_runs(page: Path, workdir: Path):
+    code = "\n\n".join(python_blocks(page))
+    proc = subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=workdir,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env={"MPLBACKEND": "Agg", "PATH": "/usr/bin:/bin", "HOME": str(workdir)},
+    )
+    assert proc.returncode == 0, f"{page.name}:\n{proc.stderr[-3000:]}"
