@@ -334,3 +334,54 @@ def test_show_prints_every_setting_that_changes_results(capsys):
         "# dropout = 0.3",
     ):
         assert line in out
+
+
+def test_misspellings_get_one_line_with_the_closest_match(tmp_path, capsys):
+    out = tmp_path / "o"
+    for args, needle in [
+        (["--strategy", "dcee-cl:raech=6"], "no option 'raech'; did you mean 'reach'?"),
+        (["--set", "search.particle=100"], "search.particle: unknown field; did you mean"),
+        (["--set", "prior.q.shap=3"], "prior.q.shap: unknown field; did you mean 'shape'?"),
+        (["--set", "sensor.treshold=1e-3"], "did you mean 'threshold'?"),
+    ]:
+        code, _, err = run_cli(["run", "--scenario", "paper:1", "--out", str(out), *args], capsys)
+        assert code == 2 and needle in err and err.count("\n") == 1, err
+        assert not out.exists()
+
+
+def test_a_run_that_fails_after_creating_its_folder_leaves_no_folder(tmp_path, capsys):
+    bad = tmp_path / "plume.npy"
+    bad.write_text("not a recording")  # found, so the folder is made, then refused
+    out = tmp_path / "new" / "run"
+    code, _, err = run_cli(
+        ["run", "--scenario", "paper:1", "--truth", str(bad), "--out", str(out)], capsys
+    )
+    assert code == 2 and "truth.model" in err and err.count("\n") == 1
+    assert not out.exists()
+    existing = tmp_path / "mine"
+    existing.mkdir()
+    run_cli(["run", "--scenario", "paper:1", "--truth", str(bad), "--out", str(existing)], capsys)
+    assert existing.is_dir()  # a folder the user made is left as it was
+
+
+def test_ros_entry_points_without_rclpy_say_how_to_set_up(capsys):
+    import importlib.util
+
+    from dcee.ros.launch import demo_main, node_main
+
+    if importlib.util.find_spec("rclpy") is not None:
+        pytest.skip("rclpy is installed here (tests/ros runs the entry points)")
+    for main, program in ((node_main, "dcee-ros-node"), (demo_main, "dcee-ros-demo")):
+        with pytest.raises(SystemExit) as exit_:
+            main([])
+        err = capsys.readouterr().err
+        assert exit_.value.code == 2 and err.count("\n") == 1
+        assert err.startswith(f"{program}: error: rclpy") and "scripts/setup-ros.sh" in err
+
+
+def test_help_lists_every_command_without_truncating(capsys, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "80")
+    code, out, _ = run_cli(["--help"], capsys)
+    commands = out.split("Commands:")[1].strip().splitlines()
+    assert code == 0 and len(commands) == 9
+    assert not any(line.rstrip().endswith("...") for line in commands), commands

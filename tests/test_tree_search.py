@@ -109,5 +109,9 @@ def test_tree_search_plans_for_each_robot_of_a_team():
 
 
 def test_a_misspelt_tree_option_names_the_tree():
-    with pytest.raises(DceeInputError, match="dcee-mcts: unknown option among"):
+    with pytest.raises(
+        DceeInputError, match="dcee-mcts: no option 'simulatons'; did you mean 'simulations'"
+    ):
         planners.get("dcee-mcts:simulatons=3")
+    with pytest.raises(DceeInputError, match="dcee-cl:raech=6: no option 'raech'; did you mean"):
+        planners.get("dcee-cl:raech=6")

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
+import shutil
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -70,3 +72,18 @@ def jsonable(obj: Any) -> Any:
     if isinstance(obj, np.ndarray):
         return obj.tolist()
     raise TypeError(f"not JSON serialisable: {type(obj)}")
+
+
+@contextlib.contextmanager
+def folder_kept_only_on_success(path: Path) -> Iterator[None]:
+    """A folder this block creates is removed again when the block fails (a user mistake
+    found late, an interruption), so a failed command leaves no empty or half-filled folder
+    behind; a folder that existed before is left as it was."""
+    path = Path(path)
+    existed = path.exists()
+    try:
+        yield
+    except BaseException:
+        if not existed:
+            shutil.rmtree(path, ignore_errors=True)
+        raise

@@ -22,7 +22,7 @@ from dcee.console import clock, compile_notice
 from dcee.io import check_writable_dir
 
 
-@click.command()
+@click.command(short_help="Run a campaign of searches (resumable).")
 @click.option(
     "--suite",
     default="paper",
@@ -152,7 +152,7 @@ def _log_progress(suite: str, finished: int, todo: int, failed: int, elapsed: fl
     )
 
 
-@click.command()
+@click.command(short_help="Tables, paired tests, figures and HTML.")
 @click.argument("results_dir", type=click.Path(file_okay=False, path_type=Path))
 @click.option(
     "--out",

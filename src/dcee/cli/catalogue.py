@@ -7,7 +7,7 @@ import json
 import click
 
 
-@click.command()
+@click.command(short_help="List the built-in scenarios.")
 def scenarios() -> None:
     """List the built-in scenarios."""
     from dcee.scenarios import builtin_scenarios
@@ -22,7 +22,7 @@ def scenarios() -> None:
     click.echo(f"{'random-start:K':14s} The same as random:K with a start drawn over the area.")
 
 
-@click.command()
+@click.command(short_help="List the planners and their options.")
 def strategies() -> None:
     """List the registered planners with their options and defaults (use as NAME:KEY=VALUE)."""
     from dcee.planning import get, names
@@ -36,7 +36,7 @@ def strategies() -> None:
             click.echo(f"{'':12s} options: {opts}")
 
 
-@click.command()
+@click.command(short_help="Print a scenario's resolved configuration.")
 @click.argument("scenario_name")
 @click.option(
     "--format",
@@ -58,7 +58,7 @@ def show(scenario_name: str, fmt: str) -> None:
         click.echo(json.dumps(scenario.model_dump(mode="json"), indent=2))
 
 
-@click.command()
+@click.command(short_help="Print the JSON Schema of scenario files.")
 def schema() -> None:
     """Print the JSON Schema of scenario files (from the validating models), for editors and
     other tools."""

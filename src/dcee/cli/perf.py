@@ -12,7 +12,7 @@ from dcee.errors import DceeInputError
 from dcee.io import check_writable_file, write_json
 
 
-@click.command()
+@click.command(short_help="Time the standard workloads against targets.")
 @click.option("--json", "json_path", type=click.Path(dir_okay=False), help="Also write JSON here.")
 @click.option("--quick", is_flag=True, help="Fewer repeats; skip the whole-search workloads.")
 @click.option(

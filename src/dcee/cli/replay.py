@@ -9,10 +9,10 @@ import click
 from dcee.cli.options import LIKELIHOOD_OPTION, SET_OPTION, overrides
 from dcee.console import compile_notice, print_summary
 from dcee.errors import DceeInputError
-from dcee.io import check_writable_dir, write_atomic
+from dcee.io import check_writable_dir, folder_kept_only_on_success, write_atomic
 
 
-@click.command()
+@click.command(short_help="Re-run the estimator over a recorded ROS 2 bag.")
 @click.argument("bag", type=click.Path(path_type=Path))
 @click.option(
     "--scenario",
@@ -73,18 +73,19 @@ def replay(
     scenario = load_scenario(scenario_name).with_overrides(
         **{"search.particles": particles, **overrides(likelihood, settings)}
     )
-    check_writable_dir(out_dir, "out")
-    topics = {"concentration": concentration_topic, "pose": pose_topic, "goal": goal_topic}
-    read_events(bag, topics)  # a missing or unreadable bag fails here, before any work
-    compile_notice(False)
-    result = replay_bag(bag, scenario, seed, topics, calibration)
-    (out_dir / "figure.png").unlink(missing_ok=True)
-    if not no_figure:
-        from dcee.analysis.figures import search_figure
+    with folder_kept_only_on_success(out_dir):  # a failed replay leaves no folder
+        check_writable_dir(out_dir, "out")
+        topics = {"concentration": concentration_topic, "pose": pose_topic, "goal": goal_topic}
+        read_events(bag, topics)  # a missing or unreadable bag fails here, before any work
+        compile_notice(False)
+        result = replay_bag(bag, scenario, seed, topics, calibration)
+        (out_dir / "figure.png").unlink(missing_ok=True)
+        if not no_figure:
+            from dcee.analysis.figures import search_figure
 
-        truth_model = make_truth(scenario, seed)
-        write_atomic(
-            out_dir / "figure.png", lambda p: search_figure(result, scenario, truth_model, p)
-        )
-    result.save(out_dir)
+            truth_model = make_truth(scenario, seed)
+            write_atomic(
+                out_dir / "figure.png", lambda p: search_figure(result, scenario, truth_model, p)
+            )
+        result.save(out_dir)
     print_summary(result.summary, out_dir)

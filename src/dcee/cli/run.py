@@ -9,10 +9,16 @@ import click
 from dcee.cli.options import LIKELIHOOD_OPTION, SET_OPTION, TRUTH_OPTION, overrides
 from dcee.console import compile_notice, print_summary, run_with_progress
 from dcee.errors import DceeInputError
-from dcee.io import check_writable_dir, check_writable_file, write_atomic, write_json
+from dcee.io import (
+    check_writable_dir,
+    check_writable_file,
+    folder_kept_only_on_success,
+    write_atomic,
+    write_json,
+)
 
 
-@click.command()
+@click.command(short_help="One simulated search: record, summary and figure.")
 @click.option(
     "--scenario",
     "scenario_name",
@@ -105,44 +111,45 @@ def run(
     out_dir = out_dir or Path("results") / default_run_folder(
         scenario, base, changes, strategy, seed
     )
-    check_writable_dir(out_dir, "out")
-    check_same_run(out_dir, scenario, strategy, seed)
-    if json_file is not None:
-        check_writable_file(json_file, "json")
-    truth_model = make_truth(scenario, seed)  # a bad recording fails here, before the search
-    tune_allocator()  # this process is the command line's own (see dcee.allocator)
-    compile_notice(quiet)
-    dense = np.linspace(0.0, scenario.search.budget, 41) if animate else ()
-    result = run_with_progress(
-        lambda progress: run_episode(
-            scenario,
-            strategy,
-            seed,
-            truth=truth_model,
-            progress=progress,
-            snapshot_at=sorted({*snapshot_times(scenario.search.budget), *dense}),
-        ),
-        scenario.search.budget,
-        quiet,
-    )
-    # stale artefacts of an earlier identical run that this one does not write
-    for name, wanted in (("figure.png", not no_figure), ("animation.gif", animate)):
-        if not wanted:
-            (out_dir / name).unlink(missing_ok=True)
-    if not no_figure:
-        from dcee.analysis.figures import search_figure
-
-        write_atomic(
-            out_dir / "figure.png", lambda p: search_figure(result, scenario, truth_model, p)
+    with folder_kept_only_on_success(out_dir):  # a failed run leaves no folder
+        check_writable_dir(out_dir, "out")
+        check_same_run(out_dir, scenario, strategy, seed)
+        if json_file is not None:
+            check_writable_file(json_file, "json")
+        truth_model = make_truth(scenario, seed)  # a bad recording fails here, before the search
+        tune_allocator()  # this process is the command line's own (see dcee.allocator)
+        compile_notice(quiet)
+        dense = np.linspace(0.0, scenario.search.budget, 41) if animate else ()
+        result = run_with_progress(
+            lambda progress: run_episode(
+                scenario,
+                strategy,
+                seed,
+                truth=truth_model,
+                progress=progress,
+                snapshot_at=sorted({*snapshot_times(scenario.search.budget), *dense}),
+            ),
+            scenario.search.budget,
+            quiet,
         )
-    if animate:
-        from dcee.analysis.figures import search_animation
+        # stale artefacts of an earlier identical run that this one does not write
+        for name, wanted in (("figure.png", not no_figure), ("animation.gif", animate)):
+            if not wanted:
+                (out_dir / name).unlink(missing_ok=True)
+        if not no_figure:
+            from dcee.analysis.figures import search_figure
 
-        write_atomic(
-            out_dir / "animation.gif",
-            lambda p: search_animation(result, scenario, truth_model, p),
-        )
-    result.save(out_dir)  # summary.json last: marks a complete result
-    if json_file is not None:
-        write_json(json_file, result.summary)
+            write_atomic(
+                out_dir / "figure.png", lambda p: search_figure(result, scenario, truth_model, p)
+            )
+        if animate:
+            from dcee.analysis.figures import search_animation
+
+            write_atomic(
+                out_dir / "animation.gif",
+                lambda p: search_animation(result, scenario, truth_model, p),
+            )
+        result.save(out_dir)  # summary.json last: marks a complete result
+        if json_file is not None:
+            write_json(json_file, result.summary)
     print_summary(result.summary, out_dir)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import difflib
+import inspect
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -243,7 +245,35 @@ def get(spec: str, **defaults: Any) -> Planner:
     try:
         return cls(**options)
     except TypeError as exc:
-        raise DceeInputError("planner_options", f"{spec}: {exc}") from None
+        unknown = [k for k in options if k not in constructor_options(cls)]
+        if not unknown:
+            raise DceeInputError("planner_options", f"{spec}: {exc}") from None
+        raise unknown_option(spec, unknown[0], constructor_options(cls)) from None
+
+
+def unknown_option(spec: str, key: str, allowed: set[str]) -> DceeInputError:
+    """The one-line error of a planner option that does not exist, with the closest match."""
+    close = difflib.get_close_matches(key, sorted(allowed), n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    return DceeInputError(
+        "strategy",
+        f"{spec}: no option {key!r}{hint} (options: {', '.join(sorted(allowed))})",
+    )
+
+
+def constructor_options(cls: type[Planner]) -> set[str]:
+    """The keyword options a planner class accepts: its constructor's named parameters and,
+    where it forwards ``**kwargs`` to a base class, the base's."""
+    out: set[str] = set()
+    for klass in cls.__mro__:
+        init = klass.__dict__.get("__init__")
+        if init is None:
+            continue
+        params = inspect.signature(init).parameters.values()
+        out |= {p.name for p in params if p.name != "self" and p.kind is not p.VAR_KEYWORD}
+        if not any(p.kind is p.VAR_KEYWORD for p in params):
+            break
+    return out
 
 
 def names() -> list[str]:

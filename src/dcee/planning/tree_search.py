@@ -46,7 +46,16 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.models.agent import GridAgent
-from dcee.planning.base import Belief, Planner, check_count, get, planner_class, register
+from dcee.planning.base import (
+    Belief,
+    Planner,
+    check_count,
+    constructor_options,
+    get,
+    planner_class,
+    register,
+    unknown_option,
+)
 from dcee.planning.hypothesis import HypothesisPlanner
 
 DEFAULT_SIMULATIONS = 48
@@ -181,20 +190,14 @@ class TreeSearchPlanner(Planner):
         self.cost_name = cost
         # the tree asks the cost planner for one context of `depth` stages; its own horizon
         # (beam search) is not used
-        try:
-            self.cost: HypothesisPlanner = get(  # type: ignore[assignment]
-                cost, subsample=subsample, n_hypotheses=n_hypotheses, **cost_options
-            )
-        except DceeInputError as exc:
-            if exc.field != "planner_options":
-                raise
-            # name the tree, whose spec the user wrote, not the cost planner it builds
-            raise DceeInputError(
-                "planner_options",
-                f"{self.name}: unknown option among {sorted(cost_options)} (options: "
-                "cost, simulations, depth, exploration, subsample, n_hypotheses, and the "
-                f"cost planner's; `dcee strategies` lists them)",
-            ) from None  # type: ignore[assignment]
+        own = {"cost", "simulations", "depth", "exploration", "subsample", "n_hypotheses"}
+        allowed = own | constructor_options(planner_class(cost))
+        for key in cost_options:  # name the tree, whose spec the user wrote
+            if key not in allowed:
+                raise unknown_option(self.name, key, allowed)
+        self.cost: HypothesisPlanner = get(  # type: ignore[assignment]
+            cost, subsample=subsample, n_hypotheses=n_hypotheses, **cost_options
+        )
 
     def options(self) -> dict[str, Any]:
         cost_options = self.cost.options()

@@ -4,7 +4,8 @@ errors of a bad file (:func:`validate_scenario`). How a scenario becomes model o
 
 from __future__ import annotations
 
-from typing import Any, Literal
+import difflib
+from typing import Any, Literal, get_args, get_origin
 
 import numpy as np
 from pydantic import BaseModel, Field, ValidationError, model_validator
@@ -238,7 +239,48 @@ def validate_scenario(data: dict[str, Any]) -> Scenario:
         if msg.startswith(FIELD_MARK):  # a cross-field check that names its own field
             loc, _, msg = msg.removeprefix(FIELD_MARK).partition(": ")
         if err["type"] == "extra_forbidden":
-            msg = "unknown field"
+            msg = _unknown_field(parts)
         elif "input" in err and err["type"] != "value_error":
             msg = f"{msg} (got {err['input']!r})"
         raise DceeInputError(loc, msg) from None
+
+
+def _unknown_field(parts: list[str]) -> str:
+    """The message for a misspelt field at ``parts`` (its dotted path): the closest field of its
+    section and the section's fields."""
+    fields = _fields_at(parts[:-1])
+    if not fields:
+        return "unknown field"
+    close = difflib.get_close_matches(parts[-1], sorted(fields), n=1)
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    section = ".".join(parts[:-1]) or "the top level"
+    return f"unknown field{hint} (fields of {section}: {', '.join(sorted(fields))})"
+
+
+def _fields_at(parents: list[str]) -> set[str]:
+    """The field names of the section at a dotted path (a union's members' together; a table
+    by name, such as ``prior.q``, is its values' section); empty where it is not a section."""
+    models: list[type[BaseModel]] = [Scenario]
+    keyed = False  # the previous part named a table by name: this part is one of its keys
+    for name in parents:
+        if keyed:
+            keyed = False
+            continue
+        nxt: list[type[BaseModel]] = []
+        for model in models:
+            field = model.model_fields.get(name)
+            if field is None:
+                continue
+            if get_origin(field.annotation) is dict:
+                keyed = True
+                nxt += [m for a in get_args(field.annotation)[1:] for m in _models_in(a)]
+            else:
+                nxt += _models_in(field.annotation)
+        models = nxt
+    return {f for m in models for f in m.model_fields}
+
+
+def _models_in(annotation: Any) -> list[type[BaseModel]]:
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    return [m for a in get_args(annotation) if a is not None for m in _models_in(a)]
