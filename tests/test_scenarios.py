@@ -190,3 +190,27 @@ def test_expand_names_expands_integer_ranges_only():
         "my-file.toml",
         "lab:down-wind",
     ]
+
+
+def test_one_angle_convention_checked_on_input():
+    """phi: degrees in scenario files and on the command line (within ±360), radians in the
+    Python API (within ±2π); a value in the wrong unit is refused with one line naming it."""
+    import math
+
+    from dcee.estimation.priors import Fixed, Normal, SourcePrior, Uniform
+    from dcee.models.plume import PARAMETER_NAMES
+
+    base = load_scenario("paper:1")
+    with pytest.raises(DceeInputError, match=r"truth\.phi"):
+        base.with_overrides(**{"truth.phi": 400.0})
+    with pytest.raises(DceeInputError, match=r"prior.phi.sd: degrees in scenario files"):
+        base.with_overrides(**{"unknown": "full", "prior.phi.sd": 500.0})
+    full = base.with_overrides(unknown="full")
+    assert full.make_prior().distributions[5].mean == pytest.approx(math.radians(base.truth.phi))
+
+    dists = {name: Fixed(1.0) for name in PARAMETER_NAMES}
+    dists["x"] = Uniform(0.0, 10.0)
+    for phi, key in ((Fixed(90.0), "value"), (Normal(0.0, 20.0), "sd")):
+        with pytest.raises(DceeInputError, match=rf"prior.phi.{key}: .*radians.*math.radians"):
+            SourcePrior.from_dict({**dists, "phi": phi})
+    SourcePrior.from_dict({**dists, "phi": Fixed(math.radians(90.0))})  # radians: accepted

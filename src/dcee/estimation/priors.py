@@ -144,6 +144,7 @@ class SourcePrior:
             raise DceeInputError("prior", f"needs {len(PARAMETER_NAMES)} distributions")
         if not self.unknown:
             raise DceeInputError("prior", "at least one parameter must be unknown")
+        _check_radians(self.distributions[PARAMETER_NAMES.index("phi")])
 
     @classmethod
     def from_dict(cls, dists: dict[str, Distribution]) -> SourcePrior:
@@ -200,3 +201,22 @@ class SourcePrior:
             bad = col <= low if strict else col < low
             total[bad] = -np.inf
         return total
+
+
+def _check_radians(phi: Distribution) -> None:
+    """The wind direction is in radians here (degrees only in scenario files and on the command
+    line): a value beyond ±2π is almost surely degrees, so it is refused with a hint."""
+    values = {
+        "value": getattr(phi, "value", None),
+        "low": getattr(phi, "low", None),
+        "high": getattr(phi, "high", None),
+        "mean": getattr(phi, "mean", None),
+        "sd": getattr(phi, "sd", None),
+    }
+    for key, v in values.items():
+        if v is not None and math.isfinite(v) and abs(v) > 2 * math.pi + 1e-9:
+            raise DceeInputError(
+                f"prior.phi.{key}",
+                f"the Python API takes the wind direction in radians (|phi| <= 2π), got {v:g}; "
+                f"degrees? use math.radians({v:g})",
+            )

@@ -78,6 +78,14 @@ class Scenario(ScenarioBuilders, BaseModel):
         missing = [p for p in unknown_env if p not in self.prior]
         if missing:
             raise ValueError(f"prior: missing a prior for unknown parameter(s) {missing}")
+        phi = self.prior.get("phi")
+        for key in ("mean", "sd", "low", "high"):  # degrees here, radians in the Python API
+            value = getattr(phi, key, None) if phi is not None else None
+            if value is not None and abs(value) > 360.0:
+                raise ValueError(
+                    f"{FIELD_MARK}prior.phi.{key}: degrees in scenario files, within "
+                    f"[-360, 360], got {value:g}"
+                )
         extra = [p for p in self.prior if p not in PARAMETER_NAMES]
         if extra:
             raise ValueError(f"prior: unknown parameter name(s) {extra}; allowed {PARAMETER_NAMES}")

@@ -168,7 +168,9 @@ class Truth(BaseModel):
     """release rate, g/s"""
     u: Annotated[float, Field(ge=0, allow_inf_nan=False)]
     """mean wind speed, m/s"""
-    phi: Finite = Field(description="wind direction in degrees (wind comes from it)")
+    phi: Annotated[float, Field(ge=-360.0, le=360.0, allow_inf_nan=False)] = Field(
+        description="wind direction in degrees, in [-360, 360] (wind comes from it)"
+    )
     zeta1: Positive
     """diffusivity ζ1 of the isotropic plume model, m²/s"""
     zeta2: Positive
