@@ -251,7 +251,7 @@ def test_unwritable_json_and_report_out_are_exit_2(tmp_path, capsys):
     blocker.write_text("x")
     out = tmp_path / "o"
     code, _, err = run_cli([*_tiny(), "--out", str(out), "--json", f"{blocker}/s.json"], capsys)
-    assert code == 2 and "json" in err and err.count("\n") == 1 and not out.exists()  # no folder left
+    assert code == 2 and "json" in err and err.count("\n") == 1 and not out.exists()
     code, _, err = run_cli([*_tiny(), "--out", str(out), "--json", str(tmp_path)], capsys)
     assert code == 2 and "json" in err and "directory" in err
     assert run_cli([*_tiny(), "--out", str(out)], capsys)[0] == 0
