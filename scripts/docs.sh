@@ -5,4 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 MPLBACKEND=Agg .venv/bin/mkdocs build --strict --clean --site-dir "${DOCS_OUT:-site}"
+# equations typeset and no console error, in headless Chromium with the network off (skipped,
+# with a note, where no Chromium is installed)
+.venv/bin/python scripts/docs_browser_check.py "${DOCS_OUT:-site}"
 echo "documentation: ${DOCS_OUT:-site}/index.html"
