@@ -52,3 +52,20 @@ def test_every_python_block_of_a_page_runs(page: Path, workdir: Path):
         env={"MPLBACKEND": "Agg", "PATH": "/usr/bin:/bin", "HOME": str(workdir)},
     )
     assert proc.returncode == 0, f"{page.name}:\n{proc.stderr[-3000:]}"
+
+
+def test_the_api_reference_rewrites_sphinx_markup_to_markdown():
+    """The Griffe extension of the API reference (scripts/griffe_docstrings.py)."""
+    sys.path.insert(0, str(DOCS.parent / "scripts"))
+    try:
+        from griffe_docstrings import markdown
+    finally:
+        sys.path.pop(0)
+    doc = (
+        "See :meth:`~dcee.searcher.Searcher.ask` and :class:`dcee.runs.EpisodeResult`, ``x``::\n"
+        "\n    a = 1\n    b = 2\n\nThen\n\n>>> run()\n>>> stop()\n\nEnd."
+    )
+    assert markdown(doc) == (
+        "See `ask` and `dcee.runs.EpisodeResult`, `x`:\n\n```python\na = 1\nb = 2\n```\n\n"
+        "Then\n\n```pycon\n>>> run()\n>>> stop()\n```\n\nEnd."
+    )
