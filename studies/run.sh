@@ -61,7 +61,20 @@ case "${1:---list}" in
     $P studies/lab_table.py results/lab-robot results/lab-grid
     report lab-robot-filament-fit lab-robot-filament ;;
   precision)  # where a turbulent search's final error comes from (docs/turbulent.md)
-    $P studies/precision_variants.py ;;
+    # the table's rows, with the defaults of the session that measured it written out
+    # (near_source_length 10 m, reading_weight 1), so it reproduces with today's defaults
+    old=estimator.near_source_length=10,estimator.reading_weight=1.0
+    mkdir -p docs/results
+    $P studies/precision_variants.py --configs random:1-12 --truths puffs filament \
+      --variant "defaults:$old" --variant "hold8:$old,agent.dwell=8" \
+      --variant "logsd2:$old,estimator.log_sd=2.0" \
+      --variant "intermittency0.8:$old,estimator.intermittency=0.8" \
+      --variant "n20k:$old,search.particles=20000" \
+      --variant "nsl5:estimator.near_source_length=5,estimator.reading_weight=1.0" \
+      --variant "nsl7:estimator.near_source_length=7,estimator.reading_weight=1.0" \
+      --variant "rw0.5:estimator.near_source_length=10,estimator.reading_weight=0.5" \
+      --variant "nsl5rw0.5:estimator.near_source_length=5,estimator.reading_weight=0.5" \
+      --csv docs/results/precision-tune.csv ;;
   stonesoup-mcts)  # our tree search against Stone Soup's MCTS on its own example
     $P studies/stonesoup_mcts_study.py ;;
   perf)  # docs/performance.md
