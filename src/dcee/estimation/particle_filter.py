@@ -51,7 +51,11 @@ from dcee.errors import DceeInputError
 from dcee.estimation.base import ReadingModelChoice, UpdateInfo
 from dcee.estimation.filter_kernels import history_log_likelihood, reading_upper_bounds
 from dcee.estimation.priors import SourcePrior
-from dcee.estimation.resampling import effective_sample_size, systematic_resample
+from dcee.estimation.resampling import (
+    effective_sample_size,
+    normalised_weights,
+    systematic_resample,
+)
 from dcee.estimation.summaries import in_credible_ellipsoid, weighted_rmse
 from dcee.models.plume import IsotropicPlume
 from dcee.models.sensor import Sensor
@@ -409,7 +413,8 @@ class ParticleFilter:
         while beta < 1.0:
             stages += 1
             if stages >= self.max_tempering_stages or (
-                effective_sample_size(_normalise(self._logw + (1.0 - beta) * ll_new)) >= target
+                effective_sample_size(normalised_weights(self._logw + (1.0 - beta) * ll_new))
+                >= target
             ):
                 new_beta = 1.0
             else:
@@ -417,7 +422,9 @@ class ParticleFilter:
                 for _ in range(40):
                     mid = 0.5 * (lo + hi)
                     if (
-                        effective_sample_size(_normalise(self._logw + (mid - beta) * ll_new))
+                        effective_sample_size(
+                            normalised_weights(self._logw + (mid - beta) * ll_new)
+                        )
                         >= target
                     ):
                         lo = mid
@@ -449,8 +456,3 @@ class ParticleFilter:
             }
         )
         return UpdateInfo(ess0, True, float(np.mean(acc)), stages, sweeps, distinct)
-
-
-def _normalise(logw: np.ndarray) -> np.ndarray:
-    w = np.exp(logw - logw.max())
-    return w / w.sum()

@@ -16,3 +16,9 @@ def systematic_resample(weights: np.ndarray, rng: np.random.Generator, n: int) -
 def effective_sample_size(weights: np.ndarray) -> float:
     """1 / Σ w², of normalised weights (N for equal weights, 1 for one particle)."""
     return float(1.0 / np.sum(weights * weights))
+
+
+def normalised_weights(logw: np.ndarray) -> np.ndarray:
+    """(N,) weights summing to 1 from (N,) log-weights (shifted by their maximum first)."""
+    w = np.exp(logw - logw.max())
+    return w / w.sum()
