@@ -20,6 +20,11 @@ case "${1:---list}" in
   paper-source)  # section 5: the paper's five planners, wind known, 12 x 10
     $D bench --suite paper --repeats 10 --out results/paper-source
     report paper-source ;;
+  public-wind-known)  # dcee-cl, current defaults, wind known, 12 x 10 (README, docs/turbulent.md)
+    $D bench --suite paper --repeats 10 --strategies dcee-cl --out results/public-wind-known
+    $D report results/public-wind-known
+    cp results/public-wind-known/report/{metrics,per_configuration}.{csv,md} \
+      docs/results/public-wind-known-dcee-cl/ ;;
   paper-full)  # section 4.1.1: all eight parameters unknown, 12 x 10
     $D bench --suite paper --repeats 10 --unknown full --out results/paper-full
     report paper-full ;;
