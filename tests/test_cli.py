@@ -385,3 +385,23 @@ def test_help_lists_every_command_without_truncating(capsys, monkeypatch):
     commands = out.split("Commands:")[1].strip().splitlines()
     assert code == 0 and len(commands) == 9
     assert not any(line.rstrip().endswith("...") for line in commands), commands
+
+
+def test_an_edited_scenario_carries_a_derived_name_and_its_edits(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert run_cli([*_tiny(), "--set", "sensor.pd=0.6"], capsys)[0] == 0
+    assert run_cli([*_tiny(), "--set", "sensor.pd=0.6"], capsys)[0] == 0  # reruns in place
+    assert run_cli(_tiny(), capsys)[0] == 0
+    summaries = {
+        p.parent.name: json.loads(p.read_text())
+        for p in (tmp_path / "results").glob("*/summary.json")
+    }
+    assert len(summaries) == 2
+    plain = summaries.pop("paper-1_mpc_seed0_n300_b10")
+    ((folder, edited),) = summaries.items()
+    digest = folder.rsplit("_", 1)[1]
+    assert plain["scenario"] == "paper:1" and "edits" not in plain
+    assert edited["scenario"] == f"paper:1+{digest}"
+    assert edited["edits"] == {"sensor.pd": 0.6}
+    config = json.loads((tmp_path / "results" / folder / "config.json").read_text())
+    assert config["edits"] == {"sensor.pd": 0.6}

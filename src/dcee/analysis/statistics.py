@@ -264,5 +264,8 @@ def pairwise_table(runs: pd.DataFrame) -> pd.DataFrame:
 
 
 def config_key(name: str) -> tuple:
+    """Sort key of a configuration name: ``paper:2`` before ``paper:10``, an edited
+    ``paper:2+3fa2c1d0`` right after ``paper:2``."""
     head, _, tail = name.partition(":")
-    return (head, int(tail) if tail.isdigit() else tail)
+    number, _, rest = tail.partition("+")
+    return (head, int(number) if number.isdigit() else -1, number, rest)

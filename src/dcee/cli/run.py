@@ -84,7 +84,7 @@ def run(
     from dcee.allocator import tune_allocator
     from dcee.planning import get as get_planner
     from dcee.runs import run_episode, snapshot_times
-    from dcee.runs.folder import check_same_run, default_run_folder
+    from dcee.runs.folder import check_same_run, default_run_folder, edited_name, edits
     from dcee.scenarios import load_scenario, truth_choice
     from dcee.simulation import make_truth
 
@@ -111,6 +111,9 @@ def run(
     out_dir = out_dir or Path("results") / default_run_folder(
         scenario, base, changes, strategy, seed
     )
+    # an edited scenario's results carry a derived name (paper:1+3fa2c1d0) and the edits
+    scenario = scenario.with_overrides(name=edited_name(scenario, base, changes))
+    run_edits = edits(changes)
     with folder_kept_only_on_success(out_dir):  # a failed run leaves no folder
         check_writable_dir(out_dir, "out")
         check_same_run(out_dir, scenario, strategy, seed)
@@ -149,6 +152,9 @@ def run(
                 out_dir / "animation.gif",
                 lambda p: search_animation(result, scenario, truth_model, p),
             )
+        if run_edits:
+            result.summary["edits"] = run_edits
+            result.config = {**(result.config or {}), "edits": run_edits}
         result.save(out_dir)  # summary.json last: marks a complete result
         if json_file is not None:
             write_json(json_file, result.summary)

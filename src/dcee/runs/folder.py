@@ -23,6 +23,28 @@ NAMED_CHANGES = (
 """Overrides that the default run folder names in words; any other change adds a hash."""
 
 
+def edits(changes: dict[str, Any]) -> dict[str, Any]:
+    """The changes a run's folder name cannot say in words (``--set``, ``--likelihood``), as
+    dotted settings: recorded with its results."""
+    return {k: v for k, v in changes.items() if k not in NAMED_CHANGES and v is not None}
+
+
+def edited_name(scenario: Scenario, base: Scenario, changes: dict[str, Any]) -> str:
+    """The name a run's results carry: the built-in's (``paper:1``) when only settings the
+    folder names in words changed, else the built-in's with a short hash of the resolved
+    scenario (``paper:1+3fa2c1d0``), so an edited scenario never passes for the built-in."""
+    named_only = base.with_overrides(**{k: v for k, v in changes.items() if k in NAMED_CHANGES})
+    if scenario.model_copy(update={"name": base.name}) == named_only:
+        return base.name
+    return f"{base.name}+{_digest(scenario.model_copy(update={'name': base.name}))}"
+
+
+def _digest(scenario: Scenario) -> str:
+    return hashlib.sha256(
+        json.dumps(scenario.model_dump(mode="json"), sort_keys=True).encode()
+    ).hexdigest()[:8]
+
+
 def default_run_folder(
     scenario: Scenario, base: Scenario, changes: dict[str, Any], strategy: str, seed: int
 ) -> str:
@@ -31,7 +53,7 @@ def default_run_folder(
     robots, and a short
     hash of the resolved scenario when anything else changed (``--likelihood``, ``--set``), so
     two different runs never share a default folder."""
-    parts = [scenario.name.replace(":", "-"), strategy.replace(":", "+"), f"seed{seed}"]
+    parts = [base.name.replace(":", "-"), strategy.replace(":", "+"), f"seed{seed}"]
     s, b = scenario.search, base.search
     if s.particles != b.particles:
         parts.append(f"n{s.particles}")
@@ -45,12 +67,8 @@ def default_run_folder(
         parts.append(scenario.truth.model_name)
     if scenario.agent.count != base.agent.count:
         parts.append(f"a{scenario.agent.count}")
-    named_only = base.with_overrides(**{k: v for k, v in changes.items() if k in NAMED_CHANGES})
-    if scenario != named_only:
-        digest = hashlib.sha256(
-            json.dumps(scenario.model_dump(mode="json"), sort_keys=True).encode()
-        ).hexdigest()[:8]
-        parts.append(digest)
+    if edited_name(scenario, base, changes) != base.name:
+        parts.append(_digest(scenario.model_copy(update={"name": base.name})))
     return "_".join(parts)
 
 
