@@ -245,10 +245,11 @@ def get(spec: str, **defaults: Any) -> Planner:
     try:
         return cls(**options)
     except TypeError as exc:
-        unknown = [k for k in options if k not in constructor_options(cls)]
+        allowed = constructor_options(cls)
+        unknown = [k for k in options if k not in allowed]
         if not unknown:
             raise DceeInputError("planner_options", f"{spec}: {exc}") from None
-        raise unknown_option(spec, unknown[0], constructor_options(cls)) from None
+        raise unknown_option(spec, unknown[0], allowed) from None
 
 
 def unknown_option(spec: str, key: str, allowed: set[str]) -> DceeInputError:

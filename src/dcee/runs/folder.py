@@ -36,13 +36,9 @@ def edited_name(scenario: Scenario, base: Scenario, changes: dict[str, Any]) -> 
     named_only = base.with_overrides(**{k: v for k, v in changes.items() if k in NAMED_CHANGES})
     if scenario.model_copy(update={"name": base.name}) == named_only:
         return base.name
-    return f"{base.name}+{_digest(scenario.model_copy(update={'name': base.name}))}"
-
-
-def _digest(scenario: Scenario) -> str:
-    return hashlib.sha256(
-        json.dumps(scenario.model_dump(mode="json"), sort_keys=True).encode()
-    ).hexdigest()[:8]
+    resolved = scenario.model_copy(update={"name": base.name}).model_dump(mode="json")
+    digest = hashlib.sha256(json.dumps(resolved, sort_keys=True).encode()).hexdigest()[:8]
+    return f"{base.name}+{digest}"
 
 
 def default_run_folder(
@@ -67,8 +63,9 @@ def default_run_folder(
         parts.append(scenario.truth.model_name)
     if scenario.agent.count != base.agent.count:
         parts.append(f"a{scenario.agent.count}")
-    if edited_name(scenario, base, changes) != base.name:
-        parts.append(_digest(scenario.model_copy(update={"name": base.name})))
+    _, edited, digest = edited_name(scenario, base, changes).partition("+")
+    if edited:  # the same hash the results' scenario name carries
+        parts.append(digest)
     return "_".join(parts)
 
 
