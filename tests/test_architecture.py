@@ -31,6 +31,7 @@ LAYERS = {
     "dcee.blas": 0,
     "dcee.models": 1,
     "dcee.estimation": 2,
+    "dcee.stopping": 2,  # when the posterior is narrow enough to end a search
     "dcee.planning": 3,
     "dcee.planners": 3,  # the public alias of dcee.planning
     "dcee.scenarios": 3,  # configuration: builds models and priors, knows no planner

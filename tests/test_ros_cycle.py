@@ -48,7 +48,7 @@ def _fly(scenario, strategy="infotaxis", seed=0, max_time=None):
 
 
 def test_cycle_finds_the_source_with_a_unicycle_robot() -> None:
-    sc = _lab()
+    sc = _lab(**{"search.stop_spread": 0.0})  # fly the whole budget
     cycle, goals = _fly(sc)
     rec = cycle.records
     assert cycle.state == "done"
@@ -61,6 +61,25 @@ def test_cycle_finds_the_source_with_a_unicycle_robot() -> None:
     # readings are taken where the robot settled, on its goal
     pos = np.array([[r["x"], r["y"]] for r in rec[1:]])
     assert np.hypot(*(pos - np.array(goals)[: len(pos), :2]).T).max() <= 0.05
+    assert rec[-1]["rmse"] < sc.search.acquired_rmse
+
+
+def test_a_robot_stops_once_localised_by_default() -> None:
+    """On a robot the default stop rule ends the search: the spread has stayed below
+    0.1 x acquired_rmse for the rule's hold, at a reading where the source is located."""
+    sc = _lab()
+    rule = sc.stop_rule(on_robot=True)
+    assert rule is not None and rule.spread == pytest.approx(0.1 * sc.search.acquired_rmse)
+    cycle, _ = _fly(sc)
+    rec = cycle.records
+    assert cycle.state == "done" and cycle.searcher.localised
+    assert rec[-1]["time"] < sc.search.budget - 60  # well before the budget
+    times = np.array([r["time"] for r in rec])
+    spreads = np.array([r["spread"] for r in rec])
+    # the recorded search stops at the first reading where the rule holds, no sooner or later
+    assert rule.stop_index(times, spreads) == len(rec) - 1
+    held = times >= times[-1] - rule.hold
+    assert np.all(spreads[held] < rule.spread)
     assert rec[-1]["rmse"] < sc.search.acquired_rmse
 
 

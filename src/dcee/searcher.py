@@ -19,6 +19,7 @@ from dcee.models.agent import GridAgent, stall_start
 from dcee.planning.base import Belief, Decision, Planner
 from dcee.planning.particle_terms import ParticleTerms
 from dcee.planning.team import decide_team
+from dcee.stopping import DEFAULT_STOP_RULE, StopRule
 
 
 @dataclass(frozen=True)
@@ -86,6 +87,13 @@ class Searcher:
     never fires in a search that does not pace, so such searches are unchanged. It guards
     :meth:`ask` (one robot); a team's :meth:`ask_team` is not guarded.
 
+    Stopping when localised (``stop_rule``, :class:`~dcee.stopping.StopRule`; None = never):
+    :attr:`localised` turns True once the spread √tr P has stayed below the rule's threshold
+    for its hold (by default :data:`~dcee.stopping.DEFAULT_STOP_RULE`, 0.3 m for 30 s at the
+    paper's scale; :func:`dcee.runs.make_searcher` scales it to the scenario). A robot's loop
+    ends there (``while not searcher.localised``); :meth:`ask` still answers for a robot that
+    keeps refining.
+
     A Searcher changes no process-wide state: a program of its own may apply
     :func:`dcee.allocator.tune_allocator` (the command line, campaign workers and the ROS node
     do), and ``tell``/``ask`` limit BLAS to one thread only while they run.
@@ -99,12 +107,18 @@ class Searcher:
         rng: np.random.Generator,
         stall_guard: float = DEFAULT_STALL_GUARD,
         guard_spread: float = 3.0,
+        stop_rule: StopRule | None = DEFAULT_STOP_RULE,
     ) -> None:
         for name, value in (("stall_guard", stall_guard), ("guard_spread", guard_spread)):
             if isinstance(value, bool) or not (
                 isinstance(value, int | float) and math.isfinite(value) and value >= 0
             ):
                 raise DceeInputError(name, f"must be a number >= 0, got {value!r}")
+        if stop_rule is not None and not isinstance(stop_rule, StopRule):
+            raise DceeInputError("stop_rule", f"must be a StopRule or None, got {stop_rule!r}")
+        self.stop_rule = stop_rule
+        self.below_since = math.nan
+        """time s of the first told reading of the current run below the stop threshold"""
         self.stall_guard = float(stall_guard)
         self.guard_spread = float(guard_spread)
         self.recent: list[tuple[float, np.ndarray]] = []
@@ -146,7 +160,25 @@ class Searcher:
         if time is not None:
             self.time = float(time)
         self.recent = [*self.recent[-(STALL_HISTORY - 1) :], (self.time, self.position.copy())]
+        if self.stop_rule is not None:
+            if self.estimate().spread < self.stop_rule.spread:
+                if math.isnan(self.below_since):
+                    self.below_since = self.time
+            else:
+                self.below_since = math.nan
         return self.last_update
+
+    @property
+    def localised(self) -> bool:
+        """True once the stop rule holds: the spread has stayed below its threshold for its
+        hold (always False without a rule). The same test as
+        :meth:`dcee.stopping.StopRule.stop_index` on the told readings."""
+        rule = self.stop_rule
+        return (
+            rule is not None
+            and not math.isnan(self.below_since)
+            and self.time - self.below_since >= rule.hold - 1e-9
+        )
 
     def ask(self) -> np.ndarray:
         """Next waypoint (3,) in m, chosen by the planner from the last told position."""
@@ -213,7 +245,16 @@ class Searcher:
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         # checkpoints written before the stall guard: it was off
-        state = {"stall_guard": 0.0, "guard_spread": 3.0, "recent": [], "guard_fired": 0, **state}
+        # and before the stop rule: none
+        state = {
+            "stall_guard": 0.0,
+            "guard_spread": 3.0,
+            "recent": [],
+            "guard_fired": 0,
+            "stop_rule": None,
+            "below_since": math.nan,
+            **state,
+        }
         self.__dict__.update(state)
         self.planning_cache = ParticleTerms()
 

@@ -91,12 +91,14 @@ class CycleSettings:
 @dataclass
 class CycleOutput:
     """What one message caused: a new ``goal`` (3,) m to publish, a ``record`` of an
-    assimilated reading (the per-reading record of a search), ``finished`` when the budget
-    leaves no further move."""
+    assimilated reading (the per-reading record of a search), ``finished`` when the search
+    is over, and why (``reason``: "budget", no further move fits it; "localised", the
+    searcher's stop rule holds, :attr:`~dcee.searcher.Searcher.localised`)."""
 
     goal: np.ndarray | None = None
     record: dict[str, Any] | None = None
     finished: bool = False
+    reason: str = ""
 
 
 @dataclass
@@ -173,7 +175,7 @@ class SearchCycle:
         s = self.settings
         if self.state != "done" and self.search_time > s.budget + 1e-9:
             self.state = "done"  # the budget ran out on the way: no reading is taken
-            return CycleOutput(finished=True)
+            return CycleOutput(finished=True, reason="budget")
         still = abs(pose.v) <= s.settle_speed and abs(pose.omega) <= s.settle_turn_rate
         if self.state == "driving":
             near = self.goal is None or math.hypot(
@@ -220,7 +222,10 @@ class SearchCycle:
         self.records.append(record)
         out = CycleOutput(record=record)
         if time + s.shortest_move + s.hold > s.budget + 1e-9:
-            self.state, out.finished = "done", True
+            self.state, out.finished, out.reason = "done", True, "budget"
+            return out
+        if self.plan and self.searcher.localised:  # a replay follows the recorded goals
+            self.state, out.finished, out.reason = "done", True, "localised"
             return out
         self._drive_started = pose.t
         if self.plan:

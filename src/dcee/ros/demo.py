@@ -134,6 +134,7 @@ def run_demo(
     )
     summary.update(
         transport="ros2",
+        finish_reason=search.finish_reason,
         wall_seconds=wall,
         goals_received=sim.goals,
         dropped_readings=cycle.dropped_readings,

@@ -20,7 +20,10 @@ Parameters
     it at start), ``marker_particles`` (500); when the robot has settled for a reading:
     ``goal_tolerance`` (0.05 m), ``settle_speed`` (0.02 m/s), ``settle_turn_rate`` (5 °/s),
     ``settle_time`` (0.2 s). The hold and the averaging are the scenario's (``agent.dwell``,
-    ``sensor.average``).
+    ``sensor.average``). The search ends when the budget is spent or, by default, once the
+    source is localised (:mod:`dcee.stopping`): ``stop_spread`` m and ``stop_hold`` s (< 0:
+    the scenario's ``search.stop_spread``/``stop_hold``, unset there: spread below
+    0.1 × ``search.acquired_rmse`` for 30 s; ``stop_spread`` 0: never).
 
 Conventions (docs/guide/robot.md): frames are REP-103 ENU (x east, y north, yaw
 counter-clockwise from +x); dcee's wind direction φ is the direction the wind comes *from*,
@@ -79,6 +82,10 @@ PARAMETERS: dict[str, Any] = {
     "settle_speed": 0.02,
     "settle_turn_rate": 5.0,
     "settle_time": 0.2,
+    # when the search ends early (dcee.stopping): < 0 keeps the scenario's search.stop_spread /
+    # search.stop_hold (unset: spread below 0.1 x acquired_rmse for 30 s); stop_spread 0: never
+    "stop_spread": -1.0,
+    "stop_hold": -1.0,
 }
 
 
@@ -90,7 +97,9 @@ class SearchNode(Node):
     """The search cycle as a ROS 2 node. ``true_location`` (3,) m, when known (a simulation),
     gives the records an RMSE; ``scenario`` (a :class:`~dcee.scenarios.Scenario`)
     replaces the ``scenario`` and ``particles`` parameters when the node is built from Python.
-    :attr:`done` is set when the budget is spent."""
+    :attr:`done` is set when the search is over: the budget is spent or the source localised
+    (the scenario's stop rule, on by default on a robot: ``search.stop_spread``;
+    :attr:`finish_reason` says which)."""
 
     def __init__(
         self,
@@ -111,6 +120,9 @@ class SearchNode(Node):
             scenario = load_scenario(str(p["scenario"]))
         if int(p["particles"]) > 0:
             scenario = scenario.with_overrides(**{"search.particles": int(p["particles"])})
+        for key in ("stop_spread", "stop_hold"):
+            if float(p[key]) >= 0:
+                scenario = scenario.with_overrides(**{f"search.{key}": float(p[key])})
         if p["pose_type"] not in ("odometry", "pose_with_covariance"):
             raise DceeInputError("pose_type", "must be odometry or pose_with_covariance")
         self.scenario = scenario
@@ -138,6 +150,8 @@ class SearchNode(Node):
         )
         self.cycle = SearchCycle(searcher, settings, true_location=true_location)
         self.done = threading.Event()
+        self.finish_reason = ""
+        """why the search ended: "budget" or "localised" (the stop rule; docs/guide/robot.md)"""
         self._lock = threading.Lock()
         self._last_pose: Pose | None = None
         self._marker_rng = np.random.default_rng(int(p["seed"]) + 1)
@@ -216,8 +230,10 @@ class SearchNode(Node):
             self._publish_goal(out.goal, pose)
         if out.finished:
             est = self.searcher.estimate()
+            self.finish_reason = out.reason
+            why = "source localised" if out.reason == "localised" else "budget spent"
             self.get_logger().info(
-                f"search finished: {len(self.cycle.records)} readings, source estimate "
+                f"search finished ({why}): {len(self.cycle.records)} readings, source estimate "
                 f"({est.mean[0]:.2f}, {est.mean[1]:.2f}) m, spread {est.spread:.2f} m"
             )
             self.done.set()

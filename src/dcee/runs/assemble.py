@@ -21,10 +21,13 @@ def make_searcher(
     planner: Planner | None,
     filter_rng: np.random.Generator,
     planner_rng: np.random.Generator,
+    on_robot: bool = True,
 ) -> Searcher:
     """The scenario's filter (prior, estimator reading model, plume model, scale) and
     ``planner`` in a :class:`~dcee.searcher.Searcher`; the simulation, the ROS node and
-    ``dcee replay`` build theirs here (with the generators of :func:`streams`)."""
+    ``dcee replay`` build theirs here (with the generators of :func:`streams`). ``on_robot``:
+    the scenario's stop rule as a robot applies it (:meth:`Scenario.stop_rule`: the default
+    rule unless ``search.stop_spread`` says otherwise); False, as a simulated study does."""
     search = scenario.search
     models = scenario.reading_models
     # the first (preferred) model draws from filter_rng itself, as a lone filter does; the others
@@ -59,6 +62,7 @@ def make_searcher(
         planner_rng,
         stall_guard=search.stall_guard,
         guard_spread=search.acquired_rmse,
+        stop_rule=scenario.stop_rule(on_robot),
     )
 
 

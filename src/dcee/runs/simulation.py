@@ -48,7 +48,7 @@ class SearchSimulation:
         self.sensor: Sensor = scenario.make_sensor()  # the instrument: makes the real readings
         self.truth = truth or make_truth(scenario, seed)
         self.true_location = scenario.truth_theta()[:3]
-        self.searcher = make_searcher(scenario, planner, filter_rng, planner_rng)
+        self.searcher = make_searcher(scenario, planner, filter_rng, planner_rng, on_robot=False)
         self.agent = self.searcher.agent
         self.filter = self.searcher.filter
         self.motion = scenario.make_motion()
@@ -106,14 +106,11 @@ class SearchSimulation:
     @property
     def finished(self) -> bool:
         """True when no further move can fit the budget (the fastest possible drive plus the
-        hold), or the posterior spread fell below the scenario's ``stop_spread``."""
+        hold), or the scenario's stop rule holds (``search.stop_spread``; none by default in a
+        simulation: :meth:`~dcee.scenarios.Scenario.stop_rule`)."""
         search = self.scenario.search
         shortest = self.motion.shortest_move_time(self.agent.step) + self.agent.dwell
-        return self.time + shortest > search.budget + 1e-9 or (
-            search.stop_spread > 0
-            and bool(self.records)
-            and self.records[-1]["spread"] < search.stop_spread
-        )
+        return self.time + shortest > search.budget + 1e-9 or self.searcher.localised
 
     @property
     def over_budget(self) -> bool:

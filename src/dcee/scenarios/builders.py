@@ -19,6 +19,7 @@ from dcee.models.plume import PARAMETER_NAMES, IsotropicPlume
 from dcee.models.sensor import Sensor
 from dcee.scenarios.schema.agent import team_starts
 from dcee.scenarios.schema.estimator import PHYSICAL_TRUNCATION, PriorSpec
+from dcee.stopping import StopRule
 
 if TYPE_CHECKING:
     from dcee.scenarios.schema.scenario import Scenario
@@ -109,6 +110,17 @@ class ScenarioBuilders:
         """(8,) true source term (φ in radians)."""
         t = self.truth
         return np.array([t.x, t.y, t.z, t.q, t.u, math.radians(t.phi), t.zeta1, t.zeta2])
+
+    def stop_rule(self: Scenario, on_robot: bool) -> StopRule | None:
+        """When this search ends early (:class:`~dcee.stopping.StopRule`): ``search.stop_spread``
+        held for ``search.stop_hold`` s; unset, the default rule on a robot (``on_robot``) and
+        none in a simulation; 0, none."""
+        search = self.search
+        if search.stop_spread is None:
+            return StopRule.for_scale(search.acquired_rmse, search.stop_hold) if on_robot else None
+        if search.stop_spread == 0:
+            return None
+        return StopRule(search.stop_spread, search.stop_hold)
 
     def make_prior(self: Scenario) -> SourcePrior:
         truth = self.truth_theta()

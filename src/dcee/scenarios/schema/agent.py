@@ -9,6 +9,7 @@ import numpy as np
 from pydantic import BaseModel, Field
 
 from dcee.scenarios.schema.common import FROZEN, Finite, Positive
+from dcee.stopping import DEFAULT_STOP_HOLD
 
 
 def team_starts(
@@ -92,8 +93,15 @@ class SearchSpec(BaseModel):
     """s of flight (the paper's 900)"""
     acquired_rmse: Positive = 3.0
     """m: "source acquired" when the final RMSE is below it"""
-    stop_spread: Annotated[float, Field(ge=0, allow_inf_nan=False)] = 0.0
-    """m: > 0 stops the search once the posterior spread is below it"""
+    stop_spread: Annotated[float | None, Field(ge=0, allow_inf_nan=False)] = None
+    """m: the search ends once the posterior spread √tr P has stayed below this for
+    ``stop_hold`` s (:class:`dcee.stopping.StopRule`). None: on a robot (the ROS 2 node, a
+    :class:`~dcee.searcher.Searcher` from :func:`dcee.runs.make_searcher`) the default rule,
+    :data:`~dcee.stopping.DEFAULT_STOP_SHARE` × ``acquired_rmse``; in a simulated search or
+    study no rule (the whole budget is flown, the paper's protocol, so studies compare equal
+    budgets). 0: never stop early, anywhere"""
+    stop_hold: Annotated[float, Field(ge=0, le=1e6, allow_inf_nan=False)] = DEFAULT_STOP_HOLD
+    """s the spread must stay below ``stop_spread`` before the search ends"""
     stall_guard: Annotated[float, Field(ge=0, le=1e6, allow_inf_nan=False)] = 30.0
     """s: after this long within one step of one position while the posterior spread exceeds
     ``acquired_rmse``, the next move must leave that position (0: off; docs/held-out.md)"""
