@@ -151,12 +151,7 @@ def main(argv: list[str] | None = None) -> int:
                     flat[k] = v
             rows.append(flat)
     if args.csv:
-        frame = pd.DataFrame(rows)
-        frame = frame.astype(
-            {c: float for c in frame.columns if frame[c].dtype == object and c != "folder"},
-            errors="ignore",
-        )
-        frame.to_csv(args.csv, index=False, float_format="%.6g")
+        pd.DataFrame(rows).to_csv(args.csv, index=False, float_format="%.6g")
     return 0 if rows and not any(math.isnan(r["diff"]) for r in rows) else 1
 
 
