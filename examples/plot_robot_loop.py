@@ -7,7 +7,10 @@ for the robot's (`sensor.simulate_from` on the true concentration); on a robot t
 comes from the instrument and the position from localisation. Everything random comes from
 explicit seeded generators, so the run is reproducible. Half-way, the robot "restarts": it
 checkpoints the searcher and carries on with the restored one, which decides exactly as the
-uninterrupted one would have.
+uninterrupted one would have. The loop ends when the searcher says the source is localised
+(`searcher.localised`: the posterior spread has stayed below the stop rule's threshold for its
+hold, here the scenario's default, 0.15 × its 0.5 m "acquired" bar for 60 s) or the budget is
+spent.
 """
 
 import tempfile
@@ -33,6 +36,7 @@ searcher = dcee.Searcher(
     dcee.planners.get("dcee-cl", n_hypotheses=20),
     scenario.make_agent(),
     np.random.default_rng(2),
+    stop_rule=scenario.stop_rule(on_robot=True),  # the lab's scale; None: never stop early
 )
 
 truth = IsotropicTruth(scenario.truth_theta())  # what the robot's sensor really sees
@@ -42,7 +46,8 @@ position = np.array(scenario.agent.start, dtype=float)
 t, step_time = 0.0, scenario.make_agent().step_time
 path, spreads = [position.copy()], []
 checkpoint = Path(tempfile.mkdtemp()) / "search.ckpt"
-for k in range(80):
+k = 0
+while not searcher.localised and t + step_time <= scenario.search.budget:
     if k == 40:  # a restart mid-search: save, then carry on with the restored searcher
         searcher.save(checkpoint)
         searcher = dcee.Searcher.load(checkpoint)
@@ -55,11 +60,13 @@ for k in range(80):
     position = searcher.ask()  # the next waypoint (m); a robot would drive there
     path.append(position.copy())
     t += step_time
+    k += 1
 
 est = searcher.estimate()
 source = scenario.truth_theta()[:3]
 print(f"estimate {np.round(est.mean, 2)} m, truth {source}, spread {est.spread:.2f} m")
 print(f"error of the mean: {np.linalg.norm(est.mean - source):.2f} m after {len(spreads)} readings")
+print("stopped:", "source localised" if searcher.localised else "budget spent", f"at {t:.0f} s")
 
 # %%
 # The particles' source locations (weighted sample), the path and the true source; right, the

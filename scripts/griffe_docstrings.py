@@ -1,13 +1,18 @@
 """A Griffe extension for the API reference (mkdocs.yml): dcee's docstrings use Sphinx-style
 roles (``:func:`~dcee.runs.run_episode```), double-backtick literals and ``::`` literal blocks;
 rendered as Markdown these show raw roles and turn code into block quotes. This rewrites them at
-build time: a role becomes inline code (the short name for ``~``), a double-backtick literal
-single backticks, a ``::`` block a fenced Python block and a doctest a fenced console block."""
+build time: a role becomes a cross-reference (an autorefs link, ``[`run_episode`][dcee.runs.
+episode.run_episode]``) when its target is an object the API pages document, else inline code
+(the short name for ``~``); a double-backtick literal becomes single backticks, a ``::`` block
+a fenced Python block and a doctest a fenced console block. Targets resolve as Python names
+would: relative to the object's class, then its module, then its package, then ``dcee``;
+names re-exported by a package resolve to where they are defined."""
 
 from __future__ import annotations
 
 import re
 import textwrap
+from pathlib import Path
 from typing import Any
 
 import griffe
@@ -16,9 +21,75 @@ ROLE = re.compile(r":(?:py:)?(?:func|class|meth|attr|data|mod|obj|exc|const):`(~
 LITERAL = re.compile(r"``([^`]+)``")
 
 
-def markdown(doc: str) -> str:
-    """The docstring with roles, literals and literal blocks in Markdown."""
-    doc = ROLE.sub(lambda m: f"`{m.group(2).split('.')[-1] if m.group(1) else m.group(2)}`", doc)
+API_PAGES = Path("docs/reference/api")
+DIRECTIVE = re.compile(r"^::: ([\w.]+)\s*$", re.M)
+
+
+def documented_paths(root: griffe.Object) -> set[str]:
+    """Every object path the API pages render: each ``::: path`` directive's object and its
+    public members, recursively (what mkdocstrings gives an anchor)."""
+    out: set[str] = set()
+
+    def walk(obj: griffe.Object | griffe.Alias) -> None:
+        if obj.path in out:
+            return
+        out.add(obj.path)
+        for name, member in obj.members.items():
+            if name.startswith("_"):
+                continue
+            try:
+                if member.is_alias and not obj.is_module:
+                    continue
+                target = member.final_target if member.is_alias else member
+            except (griffe.AliasResolutionError, griffe.CyclicAliasError):
+                continue
+            if target.path.startswith(obj.path + "."):  # defined here, not imported
+                walk(target)
+            elif obj.is_module and target.path.startswith("dcee."):
+                out.add(f"{obj.path}.{name}")
+
+    for page in sorted(API_PAGES.glob("*.md")) if API_PAGES.is_dir() else []:
+        for path in DIRECTIVE.findall(page.read_text(encoding="utf-8")):
+            try:
+                walk(root.modules_collection[path])
+            except (KeyError, ValueError, griffe.AliasResolutionError):
+                continue
+    return out
+
+
+def resolve(name: str, obj: griffe.Object, documented: set[str]) -> str | None:
+    """The documented object path ``name`` refers to from inside ``obj``, or None."""
+    scopes = []
+    node: Any = obj
+    while node is not None:
+        scopes.append(node.path)
+        node = node.parent
+    for scope in [*scopes, "dcee", ""]:
+        path = f"{scope}.{name}" if scope else name
+        try:
+            target = obj.modules_collection[path]
+            if target.is_alias:
+                target = target.final_target
+        except (KeyError, ValueError, griffe.AliasResolutionError, griffe.CyclicAliasError):
+            continue
+        for candidate in (target.path, path):
+            if candidate in documented:
+                return candidate
+        return None
+    return None
+
+
+def markdown(doc: str, obj: griffe.Object | None = None, documented: set[str] = frozenset()) -> str:
+    """The docstring with roles, literals and literal blocks in Markdown (roles as links where
+    ``obj`` and ``documented`` let them resolve)."""
+
+    def role(m: re.Match[str]) -> str:
+        name = m.group(2).strip()
+        label = name.split(".")[-1] if m.group(1) else name
+        target = resolve(name, obj, documented) if obj is not None else None
+        return f"[`{label}`][{target}]" if target else f"`{label}`"
+
+    doc = ROLE.sub(role, doc)
     doc = LITERAL.sub(r"`\1`", doc)
     lines = doc.split("\n")
     out: list[str] = []
@@ -53,8 +124,17 @@ def markdown(doc: str) -> str:
 
 
 class DceeDocstrings(griffe.Extension):
-    """Rewrite every docstring of the loaded package (see the module docstring)."""
+    """Rewrite every docstring of the loaded package (see the module docstring), once the
+    whole package is loaded so that every cross-reference can be resolved."""
 
-    def on_object(self, *, obj: griffe.Object, **kwargs: Any) -> None:
-        if obj.docstring is not None:
-            obj.docstring.value = markdown(obj.docstring.value)
+    def on_package(self, *, pkg: griffe.Module, **kwargs: Any) -> None:
+        documented = documented_paths(pkg)
+
+        def walk(obj: griffe.Object) -> None:
+            if obj.docstring is not None:
+                obj.docstring.value = markdown(obj.docstring.value, obj, documented)
+            for member in obj.members.values():
+                if not member.is_alias:
+                    walk(member)
+
+        walk(pkg)

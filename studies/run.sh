@@ -80,6 +80,16 @@ case "${1:---list}" in
       --variant "rw0.5:estimator.near_source_length=10,estimator.reading_weight=0.5" \
       --variant "nsl5rw0.5:estimator.near_source_length=5,estimator.reading_weight=0.5" \
       --csv docs/results/precision-tune.csv ;;
+  stop-rule)  # the stop-when-localised rule: tuning and held-out replays (docs/results.md §7)
+    bash studies/study_stop_rule.sh
+    $P studies/stop_rule_table.py results/stop-tune-wind-known results/stop-tune-full \
+      results/stop-tune-filament --grid
+    mkdir -p docs/results/stop-rule
+    $P studies/stop_rule_table.py results/stop-held-out-wind-known results/stop-held-out-full \
+      results/stop-held-out-filament --csv docs/results/stop-rule/stop_rule.csv
+    $P studies/publish_tables.py ;;
+  publish)  # the tables of README.md, docs/index.md, docs/results.md from docs/results/
+    $P studies/publish_tables.py ;;
   stonesoup-mcts)  # our tree search against Stone Soup's MCTS on its own example
     $P studies/stonesoup_mcts_study.py ;;
   perf)  # docs/performance.md

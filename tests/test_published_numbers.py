@@ -1,8 +1,10 @@
 """Numbers quoted on the pages agree with the stored results they cite.
 
+docs/results/<study>/ hold the stored study results; studies/publish_tables.py writes the
+tables of the README, docs/index.md and docs/results.md from them (checked here).
 docs/results/public-wind-known-dcee-cl holds the `dcee report` tables of the public wind-known
-`dcee-cl` study (`bash studies/run.sh public-wind-known` regenerates them); the README's row and
-docs/turbulent.md's row are formatted from them here and must appear verbatim."""
+`dcee-cl` study (`bash studies/run.sh public-wind-known` regenerates them); docs/turbulent.md's
+row is formatted from them here and must appear verbatim."""
 
 from __future__ import annotations
 
@@ -23,16 +25,6 @@ def _pct(x: float) -> str:
     return f"{100 * x:.0f}"
 
 
-def test_readme_quotes_the_stored_public_study():
-    s = _study()
-    n = int(s["searches"])
-    acquired = round(s["source_acquired_rate"] * n)
-    row = f"| {acquired}/{n} | {s['median_final_rmse']:.2f} m | {s['time_to_1m']:.0f} s |"
-    readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    line = next(x for x in readme.splitlines() if "current defaults (2026-11-25" in x)
-    assert line.endswith(row), (line, row)
-
-
 def test_turbulent_page_quotes_the_stored_public_study():
     s = _study()
     n = int(s["searches"])
@@ -48,3 +40,48 @@ def test_turbulent_page_quotes_the_stored_public_study():
     )
     page = (ROOT / "docs" / "turbulent.md").read_text(encoding="utf-8")
     assert row in page, row
+
+
+def _publisher():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "publish_tables", ROOT / "studies" / "publish_tables.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_generated_tables_agree_with_the_stored_results():
+    """Every table between generated markers on the README, docs/index.md and
+    docs/results.md is what studies/publish_tables.py writes from docs/results/."""
+    pub = _publisher()
+    used = set()
+    for page in pub.PAGES:
+        text = (ROOT / page).read_text(encoding="utf-8")
+        names = [m.group("name") for m in pub.MARKER.finditer(text)]
+        assert names, f"{page} has no generated table"
+        used.update(names)
+        _, stale = pub.render(text)
+        assert not stale, f"{page}: {stale} disagree (run python studies/publish_tables.py)"
+    assert used == set(pub.TABLES), "every table is published, every marker known"
+    assert pub.main(["--check"]) == 0
+
+
+def test_the_check_catches_a_number_typed_by_hand():
+    pub = _publisher()
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    body = next(pub.MARKER.finditer(text)).group("body")
+    edited = text.replace(body, body.replace("120/120", "119/120", 1))
+    assert edited != text
+    _, stale = pub.render(edited)
+    assert stale == ["what-we-found"]
+
+
+def test_every_stored_study_says_where_it_came_from():
+    for folder in sorted((ROOT / "docs" / "results").iterdir()):
+        if folder.is_dir():
+            readme = (folder / "README.md").read_text(encoding="utf-8")
+            assert "studies/run.sh" in readme, folder.name
+            assert any(folder.glob("*.csv")), folder.name

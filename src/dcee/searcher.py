@@ -89,7 +89,7 @@ class Searcher:
 
     Stopping when localised (``stop_rule``, :class:`~dcee.stopping.StopRule`; None = never):
     :attr:`localised` turns True once the spread √tr P has stayed below the rule's threshold
-    for its hold (by default :data:`~dcee.stopping.DEFAULT_STOP_RULE`, 0.3 m for 30 s at the
+    for its hold (by default :data:`~dcee.stopping.DEFAULT_STOP_RULE`, 0.45 m for 60 s at the
     paper's scale; :func:`dcee.runs.make_searcher` scales it to the scenario). A robot's loop
     ends there (``while not searcher.localised``); :meth:`ask` still answers for a robot that
     keeps refining.

@@ -23,7 +23,7 @@ Parameters
     ``sensor.average``). The search ends when the budget is spent or, by default, once the
     source is localised (:mod:`dcee.stopping`): ``stop_spread`` m and ``stop_hold`` s (< 0:
     the scenario's ``search.stop_spread``/``stop_hold``, unset there: spread below
-    0.1 × ``search.acquired_rmse`` for 30 s; ``stop_spread`` 0: never).
+    0.15 × ``search.acquired_rmse`` for 60 s; ``stop_spread`` 0: never).
 
 Conventions (docs/guide/robot.md): frames are REP-103 ENU (x east, y north, yaw
 counter-clockwise from +x); dcee's wind direction φ is the direction the wind comes *from*,
@@ -83,7 +83,7 @@ PARAMETERS: dict[str, Any] = {
     "settle_turn_rate": 5.0,
     "settle_time": 0.2,
     # when the search ends early (dcee.stopping): < 0 keeps the scenario's search.stop_spread /
-    # search.stop_hold (unset: spread below 0.1 x acquired_rmse for 30 s); stop_spread 0: never
+    # search.stop_hold (unset: spread below 0.15 x acquired_rmse for 60 s); stop_spread 0: never
     "stop_spread": -1.0,
     "stop_hold": -1.0,
 }

@@ -63,8 +63,8 @@ A scenario is a TOML file (or a built-in, see :mod:`dcee.scenarios.builtin`)::
     hypotheses = 40                # hypothesised readings per candidate move
     budget = 900.0                 # s of flight
     acquired_rmse = 3.0            # m; "source acquired" when the final RMSE is below this
-    # stop_spread = 0.3            # m; end once the posterior spread stays below it for
-    # stop_hold = 30.0             # s [default: a robot stops at 0.1 x acquired_rmse, a
+    # stop_spread = 0.45           # m; end once the posterior spread stays below it for
+    # stop_hold = 60.0             # s [default: a robot stops at 0.15 x acquired_rmse, a
                                    #  simulated study flies the whole budget; 0: never stop]
     stall_guard = 30.0             # s within one step of one spot before a move must leave it
 

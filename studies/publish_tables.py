@@ -1,0 +1,464 @@
+"""Write the result tables of the README, docs/index.md and docs/results.md from the stored
+study results in docs/results/ (issue 31, item 5): numbers come from results, not typing.
+
+Every generated table sits between two markers on its page::
+
+    <!-- generated: NAME (studies/publish_tables.py) -->
+    | … the table … |
+    <!-- end generated -->
+
+and this script rewrites what is between them from the study folders under docs/results/
+(each a `dcee report` ``metrics.csv``, optionally a ``paired.csv``, and a README that says
+where it came from). ``--check`` rewrites nothing and exits 1 naming every table that
+disagrees with its results (tests/test_published_numbers.py runs it).
+
+    python studies/publish_tables.py           # rewrite the tables
+    python studies/publish_tables.py --check   # exit 1 if a page disagrees with its results
+    bash studies/run.sh publish                # the same as the first
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import re
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parent.parent
+RESULTS = ROOT / "docs" / "results"
+PAGES = ("README.md", "docs/index.md", "docs/results.md")
+MARKER = re.compile(
+    r"(<!-- generated: (?P<name>[a-z0-9-]+) \(studies/publish_tables\.py\) -->\n)"
+    r"(?P<body>.*?)"
+    r"(<!-- end generated -->)",
+    re.S,
+)
+
+
+def study(name: str) -> pd.DataFrame:
+    return pd.read_csv(RESULTS / name / "metrics.csv")
+
+
+def paired(name: str) -> pd.DataFrame:
+    return pd.read_csv(RESULTS / name / "paired.csv")
+
+
+def pick(frame: pd.DataFrame, strategy: str, **where: object) -> pd.Series:
+    rows = frame[frame["strategy"] == strategy]
+    for key, value in where.items():
+        rows = rows[rows[key] == value]
+    if len(rows) != 1:
+        raise KeyError(f"{strategy} {where}: {len(rows)} rows")
+    return rows.iloc[0]
+
+
+# --- cell formats --------------------------------------------------------------------------
+
+
+def count(r: pd.Series) -> str:
+    """acquired k/n"""
+    n = int(r["searches"])
+    return f"{round(r['source_acquired_rate'] * n)}/{n}"
+
+
+def share(r: pd.Series, key: str) -> str:
+    """ "82 % [75, 88]" from a rate and its interval"""
+    v, lo, hi = (r[f"{key}_rate"], r[f"{key}_lo"], r[f"{key}_hi"])
+    if math.isnan(v):
+        return "—"
+    return f"{100 * v:.0f} % [{100 * lo:.0f}, {100 * hi:.0f}]"
+
+
+def acquired(r: pd.Series) -> str:
+    return f"{count(r)}, {share(r, 'source_acquired')}"
+
+
+def interval(r: pd.Series, key: str, fmt: str) -> str:
+    v, lo, hi = r[key], r.get(f"{key}_lo", math.nan), r.get(f"{key}_hi", math.nan)
+
+    def one(x: float) -> str:
+        return "> budget" if math.isinf(x) else format(x, fmt)
+
+    if math.isnan(lo) or math.isnan(hi):
+        return one(v)
+    return f"{one(v)} [{one(lo)}, {one(hi)}]"
+
+
+def rmse(r: pd.Series) -> str:
+    return interval(r, "median_final_rmse", ".2f")
+
+
+def time_to_1m(r: pd.Series) -> str:
+    if math.isnan(r["reached_1m"]):
+        return "—"  # not in the published table the results were transcribed from
+    if r["reached_1m"] == 0:
+        return "never"
+    v = interval(r, "time_to_1m", ".0f")
+    if r["reached_1m"] < 1:
+        v += f" ({100 * r['reached_1m']:.0f} % got there)"
+    return v
+
+
+def stall(r: pd.Series) -> str:
+    longest, stalled = r.get("longest_stall", math.nan), r.get("stalled", math.nan)
+    if math.isnan(stalled):
+        return "—"
+    if math.isnan(longest):
+        return f"{int(stalled)} > 60 s"
+    return f"{longest:.0f} ({int(stalled)} > 60 s)"
+
+
+def table(header: list[str], rows: list[list[str]]) -> str:
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(row) + " |" for row in rows]
+    return "\n".join(lines) + "\n"
+
+
+# --- the tables ----------------------------------------------------------------------------
+
+
+def _pair_note(name: str) -> str:
+    p = paired(name).iloc[0]
+    if math.isnan(p["time_to_1m_difference"]):
+        return ""
+    sooner = -p["time_to_1m_difference"]
+    return f" (paired: {sooner:.0f} s sooner, Wilcoxon p = {p['time_wilcoxon_p']:.1g})"
+
+
+def what_we_found() -> str:
+    """The headline table (README and docs/index.md)."""
+    cur = pick(study("public-wind-known-dcee-cl"), "dcee-cl")
+    ps = study("paper-source")
+    rows = [
+        [
+            "`dcee-cl` (closed-loop DCEE, this project), current defaults "
+            "(`public-wind-known-dcee-cl`)",
+            count(cur),
+            f"{rmse(cur).split(' ')[0]} m",
+            f"{time_to_1m(cur).split(' ')[0]} s",
+        ]
+    ]
+    for strategy, label in (
+        ("dcee-cl", "`dcee-cl` with the previous fixed 8 m reach (`paper-source`)"),
+        ("infotaxis", "`infotaxis` (`paper-source`)"),
+        ("dcee", "`dcee` (the paper's theorem 1, as written; `paper-source`)"),
+        ("mpc", "`mpc` (`paper-source`)"),
+    ):
+        r = pick(ps, strategy)
+        t = r["time_to_1m"]
+        when = "> 900 s" if math.isinf(t) else f"{t:.0f} s"
+        if r["reached_1m"] < 1:
+            when += f" ({100 * r['reached_1m']:.0f} % ever get there)"
+        rows.append([label, count(r), f"{r['median_final_rmse']:.2f} m", when])
+
+    def pair_row(label: str, name: str, **where: object) -> list[str]:
+        frame = study(name)
+        a, b = pick(frame, "dcee-cl", **where), pick(frame, "infotaxis", **where)
+        ta, tb = a["time_to_1m"], b["time_to_1m"]
+        if math.isnan(a["reached_1m"]) or math.isnan(b["reached_1m"]):
+            when = "—"
+        elif a["reached_1m"] == 0 and b["reached_1m"] == 0:
+            when = "never"
+        else:
+            when = f"{ta:.0f} / {tb:.0f} s"
+            if (RESULTS / name / "paired.csv").exists():
+                when += _pair_note(name)
+        return [
+            label,
+            f"{count(a)} / {count(b)}",
+            f"{a['median_final_rmse']:.2f} / {b['median_final_rmse']:.2f} m",
+            when,
+        ]
+
+    rows += [
+        pair_row(
+            "**held-out**, wind known: 200 random configurations never tuned on "
+            "(`held-out-wind-known`), `dcee-cl` / `infotaxis`",
+            "held-out-wind-known",
+        ),
+        pair_row(
+            "**held-out**, all eight parameters unknown, the same 200 (`held-out-full`)",
+            "held-out-full",
+        ),
+        pair_row(
+            "**held-out**, filament truth, all eight unknown, fluctuation likelihood (its "
+            "settings before issue 29; `held-out-filament`)",
+            "held-out-filament",
+        ),
+        pair_row(
+            "**held-out**, the independent puff truth, all eight unknown, fluctuation "
+            "likelihood, current defaults, 24 configurations (small sample; "
+            "`turbulent-held-out-24`)",
+            "turbulent-held-out-24",
+            truth_model="puffs",
+        ),
+        pair_row(
+            "**held-out**, filament truth, the same 24 configurations and settings",
+            "turbulent-held-out-24",
+            truth_model="filament",
+        ),
+    ]
+    return table(
+        [
+            "study (stored in docs/results/…)",
+            "source acquired",
+            "median final RMSE",
+            "median time to RMSE < 1 m",
+        ],
+        rows,
+    )
+
+
+FULL_HEADER = [
+    "planner",
+    "n",
+    "source acquired (RMSE < 3 m)",
+    "truth in 95 % region",
+    "median final RMSE (m)",
+    "median time to RMSE < 1 m (s)",
+    "longest stall (s)",
+]
+
+
+def full_row(label: str, r: pd.Series) -> list[str]:
+    return [
+        label,
+        str(int(r["searches"])),
+        acquired(r),
+        share(r, "truth_in_95"),
+        rmse(r),
+        time_to_1m(r),
+        stall(r),
+    ]
+
+
+def public_table(name: str, current: str | None) -> Callable[[], str]:
+    def make() -> str:
+        rows = []
+        if current is not None:
+            rows.append(
+                full_row(
+                    f"`dcee-cl`, current defaults (`{current}`)", pick(study(current), "dcee-cl")
+                )
+            )
+        frame = study(name)
+        for strategy in ("dcee-cl", "infotaxis", "dcee", "mpc"):
+            label = (
+                f"`dcee-cl`, fixed 8 m reach (`{name}`)"
+                if strategy == "dcee-cl"
+                else f"`{strategy}` (`{name}`)"
+            )
+            rows.append(full_row(label, pick(frame, strategy)))
+        return table(FULL_HEADER, rows)
+
+    return make
+
+
+def held_out_table() -> str:
+    rows = []
+    for name, what in (
+        ("held-out-wind-known", "wind known"),
+        ("held-out-full", "all eight unknown"),
+        ("held-out-filament", "filament truth, all eight unknown"),
+    ):
+        frame = study(name)
+        for strategy in ("dcee-cl", "infotaxis"):
+            rows.append(full_row(f"{what}: `{strategy}` (`{name}`)", pick(frame, strategy)))
+    return table(FULL_HEADER, rows)
+
+
+def paired_table() -> str:
+    rows = []
+    for name in ("held-out-wind-known", "held-out-full", "held-out-filament"):
+        p = paired(name).iloc[0]
+        diff = p["time_to_1m_difference"]
+        rows.append(
+            [
+                f"`{name}`",
+                str(int(p["pairs"])),
+                f"{int(p['acquired_a_only'])} / {int(p['acquired_b_only'])}",
+                f"{p['mcnemar_p']:.2g}",
+                "—" if math.isnan(diff) else f"{diff:+.0f} s",
+                "—" if math.isnan(diff) else f"{p['time_wilcoxon_p']:.2g}",
+            ]
+        )
+    return table(
+        [
+            "study",
+            "pairs",
+            "acquired only by `dcee-cl` / only by infotaxis",
+            "McNemar p",
+            "median paired difference in time to 1 m (`dcee-cl` − infotaxis)",
+            "Wilcoxon p",
+        ],
+        rows,
+    )
+
+
+def turbulent_table() -> str:
+    rows = []
+    frame = study("filament-public")
+    for strategy in ("dcee-cl", "infotaxis"):
+        rows.append(
+            full_row(
+                f"filament, 12 public × 10: `{strategy}` (`filament-public`)", pick(frame, strategy)
+            )
+        )
+    frame = study("turbulent-held-out-24")
+    for truth in ("puffs", "filament"):
+        for strategy in ("dcee-cl", "infotaxis"):
+            r = pick(frame, strategy, truth_model=truth)
+            rows.append(
+                full_row(f"{truth}, 24 held-out: `{strategy}` (`turbulent-held-out-24`)", r)
+            )
+    return table(FULL_HEADER, rows)
+
+
+def team_table() -> str:
+    frame = study("team")
+    rows = []
+    for strategy in ("infotaxis", "dcee-cl"):
+        for k in (1, 2, 3):
+            r = pick(frame, strategy, robots=k)
+            d = r["rmse_difference_to_one_robot"]
+            rows.append(
+                [
+                    f"`{strategy}`",
+                    str(k),
+                    count(r),
+                    rmse(r),
+                    interval(r, "time_to_1m", ".0f"),
+                    interval(r, "time_to_0_5m", ".0f"),
+                    "—" if math.isnan(d) else f"{d:+.3f} m, p = {r['wilcoxon_p']:.2g}",
+                ]
+            )
+    return table(
+        [
+            "planner",
+            "robots",
+            "source acquired",
+            "median final RMSE (m)",
+            "median time to RMSE < 1 m (s)",
+            "to < 0.5 m (s)",
+            "final RMSE vs 1 robot: median paired difference, Wilcoxon p",
+        ],
+        rows,
+    )
+
+
+def lab_table() -> str:
+    frame = study("lab")
+    settings = {
+        "robot-isotropic": "unicycle robot, isotropic truth",
+        "grid-isotropic": "grid agent (the paper's idealisation), same seeds",
+        "robot-filament-room": "unicycle robot, turbulent filament truth, fluctuation "
+        "likelihood fitted at the room's scale",
+        "robot-filament-50m": "the same with the fluctuation parameters of the 50 m plume",
+    }
+    rows = []
+    for strategy in sorted(frame["strategy"].unique()):
+        cells = [f"`{strategy}`"]
+        for setting in settings:
+            r = pick(frame, strategy, setting=setting)
+            t = r["time_to_0_5m"]
+            when = "> 450 s" if math.isinf(t) else f"{t:.0f} s"
+            cells.append(
+                f"{count(r)}, {r['median_final_rmse']:.2f} m, {when}, {int(r['readings'])}"
+            )
+        rows.append(cells)
+    return table(["planner", *settings.values()], rows)
+
+
+def stop_rule_table() -> str:
+    frame = pd.read_csv(RESULTS / "stop-rule" / "stop_rule.csv")
+    rows = []
+    labels = {
+        "stop-held-out-wind-known": "isotropic, wind known",
+        "stop-held-out-full": "isotropic, all eight unknown",
+        "stop-held-out-filament": "filament, all eight unknown, fluctuation likelihood",
+    }
+    for _, r in frame.iterrows():
+        rows.append(
+            [
+                labels.get(r["folder"], r["folder"]),
+                str(int(r["searches"])),
+                f"{100 * r['stopped']:.0f} % [{100 * r['stopped_lo']:.0f}, "
+                f"{100 * r['stopped_hi']:.0f}]",
+                f"{r['stop_time']:.0f} [{r['stop_time_lo']:.0f}, {r['stop_time_hi']:.0f}]",
+                f"{r['saved_mean']:.0f}",
+                f"{r['rmse_at_stop']:.2f} (whole budget: {r['rmse_full']:.2f})",
+                f"{round(r['acquired'] * r['searches']):.0f}/{int(r['searches'])} "
+                f"(whole budget: {int(r['acquired_full'])})",
+                f"{int(r['early'])}/{int(r['early_of'])}",
+            ]
+        )
+    return table(
+        [
+            "held-out study (`dcee-cl`, reporting range)",
+            "searches",
+            "stopped before the budget",
+            "median stop time (s)",
+            "mean time saved (s)",
+            "median RMSE at the stop (m)",
+            "acquired at the stop",
+            "stopped with RMSE ≥ 1 m / stopped",
+        ],
+        rows,
+    )
+
+
+TABLES: dict[str, Callable[[], str]] = {
+    "what-we-found": what_we_found,
+    "wind-known": public_table("paper-source", "public-wind-known-dcee-cl"),
+    "full-unknown": public_table("paper-full", None),
+    "held-out": held_out_table,
+    "held-out-paired": paired_table,
+    "turbulent": turbulent_table,
+    "team": team_table,
+    "lab": lab_table,
+    "stop-rule": stop_rule_table,
+}
+
+
+def render(text: str) -> tuple[str, list[str]]:
+    """``text`` with every generated region rewritten, and the names of those that changed."""
+    changed: list[str] = []
+
+    def one(m: re.Match[str]) -> str:
+        name = m.group("name")
+        if name not in TABLES:
+            raise KeyError(f"unknown generated table {name!r} (studies/publish_tables.py)")
+        body = TABLES[name]()
+        if body != m.group("body"):
+            changed.append(name)
+        return m.group(1) + body + m.group(4)
+
+    return MARKER.sub(one, text), changed
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--check", action="store_true", help="exit 1 if a page disagrees")
+    args = ap.parse_args(argv)
+    stale = []
+    for page in PAGES:
+        path = ROOT / page
+        text = path.read_text(encoding="utf-8")
+        new, changed = render(text)
+        stale += [f"{page}: {name}" for name in changed]
+        if changed and not args.check:
+            path.write_text(new, encoding="utf-8")
+    if args.check and stale:
+        print("pages disagree with the stored results (run python studies/publish_tables.py):")
+        print("\n".join(f"  {s}" for s in stale))
+        return 1
+    print(("checked" if args.check else "wrote") + f" the generated tables of {', '.join(PAGES)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
