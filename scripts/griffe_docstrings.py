@@ -22,38 +22,37 @@ LITERAL = re.compile(r"``([^`]+)``")
 
 
 API_PAGES = Path("docs/reference/api")
-DIRECTIVE = re.compile(r"^::: ([\w.]+)\s*$", re.M)
+DIRECTIVE = re.compile(r"^::: ([\w.]+)[ \t]*\n((?:[ \t]+\S.*\n?)*)", re.M)
+MEMBERS = re.compile(r"members:\s*\[([^\]]*)\]")
 
 
 def documented_paths(root: griffe.Object) -> set[str]:
-    """Every object path the API pages render: each ``::: path`` directive's object and its
-    public members, recursively (what mkdocstrings gives an anchor)."""
+    """Every object path the API pages render, so has an anchor: each ``::: path``
+    directive's object and, recursively, its public members that have a docstring (the only
+    ones mkdocstrings shows) and are defined there (imports are not rendered), restricted to a
+    directive's ``members: [...]`` option where it has one."""
     out: set[str] = set()
 
-    def walk(obj: griffe.Object | griffe.Alias) -> None:
-        if obj.path in out:
-            return
+    def walk(obj: griffe.Object, only: set[str] | None = None) -> None:
         out.add(obj.path)
         for name, member in obj.members.items():
-            if name.startswith("_"):
+            if name.startswith("_") or member.is_alias or (only is not None and name not in only):
                 continue
-            try:
-                if member.is_alias and not obj.is_module:
-                    continue
-                target = member.final_target if member.is_alias else member
-            except (griffe.AliasResolutionError, griffe.CyclicAliasError):
-                continue
-            if target.path.startswith(obj.path + "."):  # defined here, not imported
-                walk(target)
-            elif obj.is_module and target.path.startswith("dcee."):
-                out.add(f"{obj.path}.{name}")
+            if member.has_docstring:
+                walk(member)
 
     for page in sorted(API_PAGES.glob("*.md")) if API_PAGES.is_dir() else []:
-        for path in DIRECTIVE.findall(page.read_text(encoding="utf-8")):
+        for path, options in DIRECTIVE.findall(page.read_text(encoding="utf-8")):
+            m = MEMBERS.search(options)
+            only = {x.strip() for x in m.group(1).split(",")} if m else None
             try:
-                walk(root.modules_collection[path])
-            except (KeyError, ValueError, griffe.AliasResolutionError):
+                target = root.modules_collection[path]
+                if target.is_alias:
+                    target = target.final_target
+            except (KeyError, ValueError, griffe.AliasResolutionError, griffe.CyclicAliasError):
                 continue
+            walk(target, only)
+            out.add(path)  # a re-exported path renders under the name the page gives
     return out
 
 
@@ -72,10 +71,7 @@ def resolve(name: str, obj: griffe.Object, documented: set[str]) -> str | None:
                 target = target.final_target
         except (KeyError, ValueError, griffe.AliasResolutionError, griffe.CyclicAliasError):
             continue
-        for candidate in (target.path, path):
-            if candidate in documented:
-                return candidate
-        return None
+        return target.path if target.path in documented else None
     return None
 
 

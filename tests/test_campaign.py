@@ -284,6 +284,8 @@ def test_report_tables_and_figures(finished, tmp_path):
         assert last["median_lo"] == pytest.approx(min(finals))  # n = 4: the sample range
     html = (tmp_path / "report/report.html").read_text()
     assert html.count("data:image/png;base64,") == 4
+    # the campaign's edit of every configuration is named, so it is not read as the built-ins
+    assert "settings changed from the configurations' own: search.particles = 300" in html
     # Paired comparison recounted by hand: searches acquired by one strategy and not the other.
     pairs = pd.read_csv(tmp_path / "report/pairwise.csv")
     assert len(pairs) == 1 and pairs.loc[0, "pairs"] == 4

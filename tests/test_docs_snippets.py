@@ -69,3 +69,26 @@ def test_the_api_reference_rewrites_sphinx_markup_to_markdown():
         "See `ask` and `dcee.runs.EpisodeResult`, `x`:\n\n```python\na = 1\nb = 2\n```\n\n"
         "Then\n\n```pycon\n>>> run()\n>>> stop()\n```\n\nEnd."
     )
+
+
+def test_the_api_reference_links_roles_to_documented_objects(monkeypatch):
+    """A role whose target the API pages render becomes an autorefs link, resolved as Python
+    would from where it is written; one whose target is not rendered stays inline code."""
+    import griffe
+
+    sys.path.insert(0, str(DOCS.parent / "scripts"))
+    try:
+        from griffe_docstrings import documented_paths, markdown
+    finally:
+        sys.path.pop(0)
+    monkeypatch.chdir(DOCS.parent)  # the API pages are read from docs/reference/api
+    pkg = griffe.load("dcee", search_paths=[str(DOCS.parent / "src")], resolve_aliases=False)
+    documented = documented_paths(pkg)
+    assert "dcee.searcher.Searcher.ask" in documented
+    assert "dcee.numeric.exp_scalar" not in documented  # not on an API page
+    searcher = pkg.modules_collection["dcee.searcher.Searcher"]
+    doc = ":meth:`ask`, :class:`~dcee.stopping.StopRule`, :func:`dcee.numeric.exp_scalar`"
+    assert markdown(doc, searcher, documented) == (
+        "[`ask`][dcee.searcher.Searcher.ask], [`StopRule`][dcee.stopping.StopRule], "
+        "`dcee.numeric.exp_scalar`"
+    )

@@ -189,6 +189,18 @@ def write_report(results_dir: Path, out_dir: Path) -> list[Path]:
         {json.dumps(c, sort_keys=True): c for c in runs.get("code", []) if c}.values()
     )
     code_text = "; ".join(describe(c) for c in codes) or "unknown"
+    # a campaign's --set/--likelihood/--particles edits apply to every configuration: the
+    # report names them so an edited campaign is never read as the built-in configurations
+    edits = {
+        **({"search.particles": s["particles"]} if s.get("particles") else {}),
+        **(s.get("overrides") or {}),
+    }
+    edits_text = (
+        "; settings changed from the configurations' own: "
+        + ", ".join(f"{k} = {v}" for k, v in sorted(edits.items()))
+        if edits
+        else ""
+    )
     html = [
         "<!doctype html><html><head><meta charset='utf-8'><title>dcee report</title>",
         "<style>body{font-family:sans-serif;max-width:1100px;margin:auto}table{border-collapse:"
@@ -196,7 +208,8 @@ def write_report(results_dir: Path, out_dir: Path) -> list[Path]:
         f"<h1>Report: {s['suite']}</h1>",
         f"<p>{len(runs)} finished searches ({failed} failed), {runs['scenario'].nunique()} "
         f"configurations, strategies: {', '.join(sorted(runs['strategy'].unique()))}; unknowns: "
-        f"{s.get('unknown') or 'as configured'}; ground truth: {', '.join(truths)}; code: "
+        f"{s.get('unknown') or 'as configured'}; ground truth: {', '.join(truths)}{edits_text}; "
+        "code: "
         f"dcee {code_text}. Intervals are 95%; times to an RMSE level are Kaplan–Meier "
         "medians with searches that never got there censored at the budget.</p>",
         _md_to_html(md),
