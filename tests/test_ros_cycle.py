@@ -10,7 +10,7 @@ import pytest
 
 from dcee.errors import DceeInputError
 from dcee.planning import get as get_planner
-from dcee.robot.cycle import CycleSettings, Pose, SearchCycle
+from dcee.robot.cycle import REJECTION_REASONS, CycleSettings, Pose, SearchCycle
 from dcee.robot.simulated import SimulatedRobot
 from dcee.runs import make_searcher, planner_defaults, streams
 from dcee.scenarios import load_scenario
@@ -137,3 +137,58 @@ def test_cycle_settings_validation() -> None:
         CycleSettings.from_scenario(sc, calibration=math.nan)
     with pytest.raises(DceeInputError, match="average"):
         CycleSettings.from_scenario(sc, average=10.0)
+
+
+def test_hostile_messages_are_dropped_counted_and_never_reach_the_estimator() -> None:
+    """Readings above the maximum, inf/NaN/negative, NaN or far-away poses and stamps going
+    backwards, each injected in bursts into a search with a robot at rest at every goal:
+    the cycle drops and counts every one, the estimator sees only the good readings, and the
+    search finishes as the clean one does (the same readings, so the same result)."""
+    sc = _lab(**{"search.budget": 120.0})
+    clean, _ = _fly(sc)
+    robot = SimulatedRobot(sc, 0)
+    _, filter_rng, planner_rng, _ = streams(0)
+    planner = get_planner("infotaxis", **planner_defaults("infotaxis", sc, None))
+    cycle = SearchCycle(
+        make_searcher(sc, planner, filter_rng, planner_rng),
+        CycleSettings.from_scenario(sc),
+        true_location=sc.truth_theta()[:3],
+    )
+    max_reading = cycle.searcher.filter.sensor.max_reading
+    bad_readings = [1e9, max_reading * 2, math.inf, -math.inf, math.nan, -1.0, True]
+    k = 0
+    while robot.time < sc.search.budget + 60:
+        s = robot.odometry()
+        good = Pose(robot.time, s.x, s.y, s.heading, s.v, s.omega)
+        if k % 7 == 3:  # a burst of hostile messages between two good ones
+            for value in bad_readings:
+                cycle.on_reading(robot.time, value)
+            for bad in (
+                Pose(robot.time, math.nan, s.y),
+                Pose(robot.time, s.x, s.y, math.nan),
+                Pose(math.inf, s.x, s.y),
+                Pose(robot.time, 1e6, -1e6),
+                Pose(robot.time - 5.0, s.x, s.y),
+            ):
+                assert cycle.on_pose(bad).goal is None
+        cycle.on_reading(robot.time, robot.sample())
+        out = cycle.on_pose(good)
+        if out.goal is not None:
+            robot.set_goal(out.goal)
+        if out.finished:
+            break
+        robot.step()
+        k += 1
+    bursts = (k + 3) // 7
+    assert bursts > 5
+    assert cycle.rejected["reading above max_reading"] == 2 * bursts
+    assert cycle.rejected["reading not finite"] == 3 * bursts
+    assert cycle.rejected["reading negative"] == bursts
+    assert cycle.rejected["reading not a number"] == bursts
+    assert cycle.rejected["pose not finite"] == 3 * bursts
+    assert cycle.rejected["pose far outside the area"] == bursts
+    assert cycle.rejected["pose stamp went backwards"] == bursts
+    assert set(cycle.rejected) <= set(REJECTION_REASONS)
+    # the estimator saw exactly the clean search's readings
+    assert [r["reading"] for r in cycle.records] == [r["reading"] for r in clean.records]
+    assert cycle.records[-1]["rmse"] == clean.records[-1]["rmse"]

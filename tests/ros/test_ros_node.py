@@ -182,3 +182,111 @@ def test_node_with_pose_with_covariance_input_takes_readings_and_publishes_a_goa
         assert rec["reading"] == 0.0 and rec["time"] >= node.scenario.dwell - 1e-9
     finally:
         rclpy.try_shutdown(context=context)
+
+
+def test_node_keeps_planning_through_hostile_message_streams() -> None:
+    """A robot at rest at each goal, readings at 20 Hz, and between them bursts of hostile
+    messages: readings above the sensor's maximum (a glitch reporting 1e9), inf, NaN and
+    negative readings; odometry with a NaN position, a NaN orientation, a pose 1 km away and
+    a stamp going backwards; plus one unexpected error inside the planner. Fails if the node
+    raises out of a callback (spin_once would re-raise it) or stops planning."""
+    import time
+
+    import rclpy
+    from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+    from geometry_msgs.msg import PoseStamped
+    from nav_msgs.msg import Odometry
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    from std_msgs.msg import Float32
+
+    from dcee.robot.cycle import REJECTION_REASONS
+    from dcee.ros.node import LATCHED, RELIABLE, SearchNode
+    from dcee.ros.sim_node import stamp_of
+
+    context = rclpy.Context()
+    rclpy.init(context=context, args=[], domain_id=_domain())
+    try:
+        node = SearchNode(
+            context=context,
+            parameter_overrides=[
+                Parameter("particles", value=300),
+                Parameter("strategy", value="mpc"),
+                Parameter("stop_spread", value=0.0),  # plan on; this test is about inputs
+            ],
+        )
+        ask = node.searcher.ask
+        failures = {"left": 1}
+
+        def flaky_ask():  # one unexpected error inside a callback
+            if failures["left"]:
+                failures["left"] -= 1
+                raise RuntimeError("planner failure injected by the test")
+            return ask()
+
+        node.searcher.ask = flaky_ask
+        robot = rclpy.create_node("robot", context=context)
+        odom_pub = robot.create_publisher(Odometry, "odom", RELIABLE)
+        conc_pub = robot.create_publisher(Float32, "concentration", RELIABLE)
+        goals, diagnostics = [], []
+        robot.create_subscription(PoseStamped, "goal_pose", goals.append, LATCHED)
+        robot.create_subscription(DiagnosticArray, "/diagnostics", diagnostics.append, RELIABLE)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+        executor.add_node(robot)
+        max_reading = node.searcher.filter.sensor.max_reading
+
+        def odom(t: float, x: float, y: float, qw: float = 1.0) -> Odometry:
+            msg = Odometry()
+            msg.header.stamp = stamp_of(t)
+            msg.header.frame_id = "map"
+            msg.pose.pose.position.x, msg.pose.pose.position.y = x, y
+            msg.pose.pose.orientation.w = qw
+            return msg
+
+        here = list(node.scenario.agent.start[:2])
+        t, k = 1.0, 0
+        deadline = time.monotonic() + 90
+        while len(goals) < 12 and time.monotonic() < deadline:
+            if goals:  # at rest on the latest goal
+                here = [goals[-1].pose.position.x, goals[-1].pose.position.y]
+            if k % 10 == 5:  # a burst of hostile messages
+                for value in (1e9, 2 * max_reading, math.inf, -math.inf, math.nan, -1.0):
+                    conc_pub.publish(Float32(data=float(value)))
+                odom_pub.publish(odom(t, math.nan, here[1]))
+                odom_pub.publish(odom(t, here[0], here[1], qw=math.nan))
+                odom_pub.publish(odom(t, 1000.0, -1000.0))
+                odom_pub.publish(odom(t - 10.0, here[0], here[1]))
+            conc_pub.publish(Float32(data=0.0))
+            odom_pub.publish(odom(t, *here))
+            for _ in range(6):
+                executor.spin_once(timeout_sec=0.005)
+            t += 0.05
+            k += 1
+        for _ in range(30):  # let the diagnostics timer fire
+            executor.spin_once(timeout_sec=0.05)
+        assert len(goals) >= 12, f"the node stopped planning after {len(goals)} goals"
+        assert not node.done.is_set()
+        assert node.callback_errors == 1  # the injected failure: logged, the search went on
+        rejected = node.cycle.rejected
+        for reason in (
+            "reading above max_reading",
+            "reading not finite",
+            "reading negative",
+            "pose not finite",
+            "pose far outside the area",
+            "pose stamp went backwards",
+        ):
+            assert rejected.get(reason, 0) > 0, (reason, rejected)
+        assert set(rejected) <= set(REJECTION_REASONS)
+        # no impossible value reached the estimator
+        readings = [r["reading"] for r in node.cycle.records]
+        assert all(0 <= v <= max_reading for v in readings)
+        assert diagnostics, "no diagnostics published"
+        status = diagnostics[-1].status[0]
+        assert status.level == DiagnosticStatus.ERROR  # a callback failed once
+        values = {kv.key: kv.value for kv in status.values}
+        assert int(values["dropped: reading above max_reading"]) > 0
+        assert int(values["readings used"]) == len(node.cycle.records)
+    finally:
+        rclpy.try_shutdown(context=context)

@@ -120,6 +120,9 @@ class SearchCycle:
     start_time: float | None = None
     records: list[dict[str, Any]] = field(default_factory=list)
     dropped_readings: int = 0
+    rejected: dict[str, int] = field(default_factory=dict)
+    """messages dropped before they could reach the estimator, by reason (see
+    :data:`REJECTION_REASONS`)"""
     path_length: float = 0.0
     _pose: Pose | None = None
     _since: float = 0.0
@@ -152,11 +155,51 @@ class SearchCycle:
         else:  # published while this replay still holds (clock skew): the next goal
             self._pending_goal = goal
 
+    def _reject(self, reason: str) -> None:
+        self.rejected[reason] = self.rejected.get(reason, 0) + 1
+
+    def reading_problem(self, value: object) -> str | None:
+        """Why a sample (sensor units) cannot be a measurement, or None: not a real number,
+        not finite, negative, or above the sensor's physical maximum (``sensor.max_reading``
+        g/m³ after ``calibration``: a glitch, a saturated or stuck sensor)."""
+        if isinstance(value, bool) or not isinstance(value, Real):
+            return "reading not a number"
+        if not math.isfinite(value):
+            return "reading not finite"
+        if value < 0:
+            return "reading negative"
+        if value * self.settings.calibration > self.searcher.filter.sensor.max_reading:
+            return "reading above max_reading"
+        return None
+
+    def pose_problem(self, pose: Pose) -> str | None:
+        """Why a pose cannot be the robot's, or None: a non-finite time, position, heading or
+        speed; a position farther outside the search area than the area is wide; a stamp
+        earlier than the last accepted pose's."""
+        values = (pose.t, pose.x, pose.y, pose.heading, pose.v, pose.omega)
+        if not all(isinstance(v, Real) and math.isfinite(v) for v in values):
+            return "pose not finite"
+        volume = self.searcher.agent.volume
+        lo, hi = np.asarray(volume.low, float), np.asarray(volume.high, float)
+        margin = float(np.max(hi[:2] - lo[:2]))
+        if not (
+            lo[0] - margin <= pose.x <= hi[0] + margin
+            and lo[1] - margin <= pose.y <= hi[1] + margin
+        ):
+            return "pose far outside the area"
+        if self._pose is not None and pose.t < self._pose.t:
+            return "pose stamp went backwards"
+        return None
+
     def on_reading(self, t: float, value: float) -> None:
         """A concentration sample (sensor units) received at ``t`` s; kept while holding.
-        Non-finite or negative samples are dropped and counted (:attr:`dropped_readings`)."""
-        if not (isinstance(value, Real) and math.isfinite(value) and value >= 0):
+        A sample that cannot be a measurement (:meth:`reading_problem`) is dropped and
+        counted (:attr:`rejected`, :attr:`dropped_readings`); it never reaches the
+        estimator."""
+        problem = self.reading_problem(value)
+        if problem is not None:
             self.dropped_readings += 1
+            self._reject(problem)
             return
         if self.state == "holding":
             # arrived while holding: part of this hold, even when its stamp lags the pose's
@@ -164,7 +207,12 @@ class SearchCycle:
             self._samples.append((max(float(t), self._since), float(value)))
 
     def on_pose(self, pose: Pose) -> CycleOutput:
-        """A pose sample: advances the cycle; returns what to publish."""
+        """A pose sample: advances the cycle; returns what to publish. A pose that cannot be
+        the robot's (:meth:`pose_problem`) is dropped and counted (:attr:`rejected`)."""
+        problem = self.pose_problem(pose)
+        if problem is not None:
+            self._reject(problem)
+            return CycleOutput()
         out = CycleOutput()
         if self._pose is not None:
             self.path_length += math.hypot(pose.x - self._pose.x, pose.y - self._pose.y)
@@ -229,6 +277,9 @@ class SearchCycle:
             return out
         self._drive_started = pose.t
         if self.plan:
+            # moved on before asking: should ask fail (the node logs it), the robot is taken
+            # to be at its goal and reads again where it stands, then asks again
+            self.goal, self.state = None, "driving"
             self.goal = self.searcher.ask()
             record["decision_seconds"] = self.searcher.last_decision_seconds
             self.state = "driving"
@@ -240,4 +291,16 @@ class SearchCycle:
         return out
 
 
-__all__ = ["CycleOutput", "CycleSettings", "Pose", "SearchCycle"]
+REJECTION_REASONS = (
+    "reading not a number",
+    "reading not finite",
+    "reading negative",
+    "reading above max_reading",
+    "pose not finite",
+    "pose far outside the area",
+    "pose stamp went backwards",
+)
+"""Every reason :class:`SearchCycle` drops an input message for (the keys of
+:attr:`SearchCycle.rejected`)."""
+
+__all__ = ["REJECTION_REASONS", "CycleOutput", "CycleSettings", "Pose", "SearchCycle"]

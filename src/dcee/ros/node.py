@@ -11,7 +11,15 @@ Publishes
     of the source), ``dcee/estimate_covariance`` (geometry_msgs/PoseWithCovarianceStamped, the
     same mean with the 3 × 3 location covariance in the position block), ``dcee/particles``
     (visualization_msgs/MarkerArray, a weighted sample of source hypotheses), ``dcee/path``
-    (nav_msgs/Path, where the readings were taken).
+    (nav_msgs/Path, where the readings were taken), ``/diagnostics``
+    (diagnostic_msgs/DiagnosticArray, once a second: the search's state, readings used and every
+    input message dropped, by reason).
+Inputs are validated (:meth:`dcee.robot.cycle.SearchCycle.reading_problem`, ``pose_problem``):
+    an impossible reading or pose is dropped, counted and reported (a throttled warning and
+    the diagnostics) and never reaches the estimator; an unexpected error inside a callback
+    is logged and the search continues, and after :data:`MAX_CONSECUTIVE_ERRORS` in a row it
+    ends cleanly with its estimate (``finish_reason`` "error"). The node never exits because
+    of its inputs.
 Parameters
     ``scenario`` (name or TOML path), ``strategy``, ``seed``, ``particles`` (0: the
     scenario's), ``frame_id`` ("map"), ``calibration`` (1.0), ``concentration_topic``,
@@ -40,6 +48,7 @@ from typing import Any
 
 import numpy as np
 import rclpy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PointStamped, PoseStamped, PoseWithCovarianceStamped
 from nav_msgs.msg import Odometry
 from nav_msgs.msg import Path as PathMsg
@@ -87,6 +96,10 @@ PARAMETERS: dict[str, Any] = {
     "stop_spread": -1.0,
     "stop_hold": -1.0,
 }
+
+
+MAX_CONSECUTIVE_ERRORS = 20
+"""Unexpected callback errors in a row after which the search ends cleanly (reason "error")."""
 
 
 def seconds(stamp: Any) -> float:
@@ -151,7 +164,12 @@ class SearchNode(Node):
         self.cycle = SearchCycle(searcher, settings, true_location=true_location)
         self.done = threading.Event()
         self.finish_reason = ""
-        """why the search ended: "budget" or "localised" (the stop rule; docs/guide/robot.md)"""
+        """why the search ended: "budget", "localised" (the stop rule; docs/guide/robot.md) or
+        "error" (:data:`MAX_CONSECUTIVE_ERRORS` unexpected callback errors in a row)"""
+        self.callback_errors = 0
+        """unexpected errors caught inside callbacks (each logged; the search went on)"""
+        self._errors_in_a_row = 0
+        self._rejected_reported = 0
         self._lock = threading.Lock()
         self._last_pose: Pose | None = None
         self._marker_rng = np.random.default_rng(int(p["seed"]) + 1)
@@ -163,6 +181,8 @@ class SearchNode(Node):
         )
         self.particles_pub = self.create_publisher(MarkerArray, "dcee/particles", RELIABLE)
         self.path_pub = self.create_publisher(PathMsg, "dcee/path", RELIABLE)
+        self.diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE)
+        self.create_timer(1.0, lambda: self._guarded("diagnostics", self._publish_diagnostics))
         self.path_msg = PathMsg()
         self.path_msg.header.frame_id = self.frame_id
         self.create_subscription(
@@ -180,11 +200,43 @@ class SearchNode(Node):
     def _now(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
 
+    def _guarded(self, what: str, callback: Any, *args: Any) -> None:
+        """Run a callback; an unexpected error is logged (throttled) and counted, the search
+        goes on, and after MAX_CONSECUTIVE_ERRORS in a row it ends cleanly."""
+        try:
+            callback(*args)
+            self._errors_in_a_row = 0
+        except Exception as exc:  # a search node must never exit because of its inputs
+            self.callback_errors += 1
+            self._errors_in_a_row += 1
+            self.get_logger().error(
+                f"{what}: {type(exc).__name__}: {exc} (message ignored, the search continues)",
+                throttle_duration_sec=5.0,
+            )
+            if self._errors_in_a_row >= MAX_CONSECUTIVE_ERRORS and not self.done.is_set():
+                self._finish("error")
+        self._report_rejections()
+
+    def _report_rejections(self) -> None:
+        total = sum(self.cycle.rejected.values())
+        if total > self._rejected_reported:
+            self._rejected_reported = total
+            counts = ", ".join(f"{k}: {v}" for k, v in sorted(self.cycle.rejected.items()))
+            self.get_logger().warning(
+                f"dropped {total} input messages so far ({counts})", throttle_duration_sec=5.0
+            )
+
     def _on_concentration(self, msg: Float32) -> None:
+        self._guarded("concentration", self._reading, msg)
+
+    def _reading(self, msg: Float32) -> None:
         with self._lock:
             self.cycle.on_reading(self._now(), float(msg.data))
 
     def _on_odometry(self, msg: Odometry) -> None:
+        self._guarded("odometry", self._odometry, msg)
+
+    def _odometry(self, msg: Odometry) -> None:
         p = msg.pose.pose
         t = seconds(msg.header.stamp) or self._now()
         self._step(
@@ -199,22 +251,28 @@ class SearchNode(Node):
         )
 
     def _on_pose_cov(self, msg: PoseWithCovarianceStamped) -> None:
+        self._guarded("pose", self._pose_cov, msg)
+
+    def _pose_cov(self, msg: PoseWithCovarianceStamped) -> None:
         p = msg.pose.pose
         t = seconds(msg.header.stamp) or self._now()
         x, y, yaw = p.position.x, p.position.y, yaw_of(p.orientation)
         v = w = 0.0
         last = self._last_pose
-        if last is not None and t > last.t:  # speeds from successive poses
+        if last is not None and t > last.t and math.isfinite(t - last.t):
+            # speeds from successive poses
             v = math.hypot(x - last.x, y - last.y) / (t - last.t)
             w = math.remainder(yaw - last.heading, 2 * math.pi) / (t - last.t)
         self._step(Pose(t, x, y, yaw, v, w))
 
     def _step(self, pose: Pose) -> None:
         with self._lock:
-            self._last_pose = pose
             if self.done.is_set():
                 return
+            dropped = sum(self.cycle.rejected.values())
             out = self.cycle.on_pose(pose)
+            if sum(self.cycle.rejected.values()) == dropped:  # accepted: speeds start from it
+                self._last_pose = pose
             starved = self.cycle.starved
         if starved:
             topic = self.params["concentration_topic"]
@@ -229,14 +287,54 @@ class SearchNode(Node):
         if out.goal is not None:
             self._publish_goal(out.goal, pose)
         if out.finished:
-            est = self.searcher.estimate()
-            self.finish_reason = out.reason
-            why = "source localised" if out.reason == "localised" else "budget spent"
-            self.get_logger().info(
-                f"search finished ({why}): {len(self.cycle.records)} readings, source estimate "
-                f"({est.mean[0]:.2f}, {est.mean[1]:.2f}) m, spread {est.spread:.2f} m"
-            )
-            self.done.set()
+            self._finish(out.reason)
+
+    def _finish(self, reason: str) -> None:
+        """End the search: log why and the estimate, publish the diagnostics, set :attr:`done`."""
+        self.finish_reason = reason
+        self.cycle.state = "done"
+        why = {"localised": "source localised", "budget": "budget spent"}.get(
+            reason, f"{MAX_CONSECUTIVE_ERRORS} callback errors in a row"
+        )
+        est = self.searcher.estimate()
+        self.get_logger().info(
+            f"search finished ({why}): {len(self.cycle.records)} readings, source estimate "
+            f"({est.mean[0]:.2f}, {est.mean[1]:.2f}) m, spread {est.spread:.2f} m"
+        )
+        self.done.set()
+        self._publish_diagnostics()
+
+    def diagnostics(self) -> DiagnosticStatus:
+        """The search's state and its input health as one DiagnosticStatus: WARN once input
+        messages were dropped, ERROR once a callback failed."""
+        status = DiagnosticStatus()
+        status.name = f"{self.get_name()}: source search"
+        status.hardware_id = "dcee"
+        rejected = self.cycle.rejected
+        if self.callback_errors:
+            status.level = DiagnosticStatus.ERROR
+            status.message = f"{self.callback_errors} callback errors (messages ignored)"
+        elif rejected:
+            status.level = DiagnosticStatus.WARN
+            status.message = f"{sum(rejected.values())} input messages dropped"
+        else:
+            status.level = DiagnosticStatus.OK
+            status.message = "inputs healthy"
+        values = {
+            "state": self.cycle.state,
+            "finish_reason": self.finish_reason,
+            "readings used": str(len(self.cycle.records)),
+            "callback errors": str(self.callback_errors),
+            **{f"dropped: {k}": str(v) for k, v in sorted(rejected.items())},
+        }
+        status.values = [KeyValue(key=k, value=v) for k, v in values.items()]
+        return status
+
+    def _publish_diagnostics(self) -> None:
+        msg = DiagnosticArray()
+        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.status = [self.diagnostics()]
+        self.diagnostics_pub.publish(msg)
 
     # --- outputs ------------------------------------------------------------------------------
 
