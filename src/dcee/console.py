@@ -102,6 +102,18 @@ def print_summary(summary: dict[str, Any], out_dir: Path | None, where: str = "r
             else []
         ),
         ("steps", str(summary["steps"])),
+        *(
+            [
+                (
+                    "search ended",
+                    {"localised": "source localised (stop rule)"}.get(
+                        summary["finish_reason"], str(summary["finish_reason"])
+                    ),
+                )
+            ]
+            if summary.get("finish_reason")  # a robot's search (dcee-ros-demo)
+            else []
+        ),
         ("path length (m)", f"{summary['path_length']:.1f}"),
         ("mean decision time (ms)", f"{1e3 * summary['decision_seconds_mean']:.2f}"),
         ("total compute (s)", f"{summary['compute_seconds_total']:.2f}"),
