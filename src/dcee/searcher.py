@@ -297,7 +297,9 @@ class Searcher:
 
     def belief(self) -> Belief:
         f = self.filter
-        return Belief(f.theta, f.weights, f.sensor, f.plume, self.planning_cache)
+        return Belief(
+            f.theta, f.weights, f.sensor, f.plume, self.planning_cache, site=self.agent.site
+        )
 
     def estimate(self) -> SourceEstimate:
         """Posterior mean and covariance of the source location."""

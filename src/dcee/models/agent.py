@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from dcee.errors import DceeInputError
+
+if TYPE_CHECKING:
+    from dcee.models.site import SiteMap
 
 
 @dataclass(frozen=True)
@@ -29,8 +33,10 @@ class GridAgent:
     """Mobile sensor that moves ``step`` metres along one of ``headings`` directions.
 
     Headings are measured from +x towards +y (0°, 45°, …, 315° by default). Moves that would leave
-    the search volume are inadmissible. Each move takes ``step / speed + dwell`` seconds: travel
-    plus the sampling dwell the sensor needs for a reading.
+    the search volume, or enter or cross a blocked cell of the ``site``
+    (:class:`~dcee.models.site.SiteMap`: obstacles and no-go zones), are inadmissible. Each move
+    takes ``step / speed + dwell`` seconds: travel plus the sampling dwell the sensor needs for
+    a reading.
     """
 
     volume: SearchVolume
@@ -38,6 +44,7 @@ class GridAgent:
     speed: float = 2.0
     dwell: float = 1.0
     n_headings: int = 8
+    site: SiteMap | None = None
 
     def __post_init__(self) -> None:
         if not self.step > 0:
@@ -65,9 +72,28 @@ class GridAgent:
 
     def candidates(self, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Admissible next positions from ``position``: ((M, 3) positions, (M,) heading indices)."""
-        nxt = np.asarray(position, dtype=np.float64)[None, :] + self.moves
+        position = np.asarray(position, dtype=np.float64)
+        nxt = position[None, :] + self.moves
         ok = self.volume.contains(nxt)
+        if self.site is not None and ok.any():
+            ok[ok] = self.site.segment_clear(position, nxt[ok])
         return nxt[ok], np.flatnonzero(ok)
+
+    def travel_xy(self, start: np.ndarray, points: np.ndarray) -> np.ndarray:
+        """Horizontal travel distance (m) from ``start`` (3,) to ``points`` (..., 3): around
+        the site's blocked cells (:meth:`SiteMap.travel_distance`), straight without a site."""
+        return travel_xy(self.site, start, points)
+
+
+def travel_xy(site: SiteMap | None, start: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Horizontal travel distance (m) from ``start`` (2,) or (3,) to ``points`` (..., 2|3):
+    the straight line without a ``site`` or where the way is clear, else the path around its
+    blocked cells (:meth:`dcee.models.site.SiteMap.travel_distance`)."""
+    start = np.asarray(start, dtype=np.float64)
+    points = np.asarray(points, dtype=np.float64)
+    if site is None or not site.blocked.any():
+        return np.hypot(points[..., 0] - start[0], points[..., 1] - start[1])
+    return site.travel_distance(start, points)
 
 
 def stall_start(xy: np.ndarray, step: float) -> int:

@@ -17,6 +17,7 @@ from dcee.models.plume import IsotropicPlume
 from dcee.models.sensor import Sensor
 
 if TYPE_CHECKING:
+    from dcee.models.site import SiteMap
     from dcee.planning.particle_terms import ParticleTerms
 
 
@@ -35,6 +36,9 @@ class Belief:
     sensor: Sensor
     plume: IsotropicPlume
     cache: ParticleTerms | None = field(default=None, compare=False, repr=False)
+    site: SiteMap | None = field(default=None, compare=False, repr=False)
+    """the site's obstacles and no-go zones (:class:`~dcee.models.site.SiteMap`): distance
+    costs are travel distances around them; None: open terrain"""
 
     def __post_init__(self) -> None:
         # a wrong shape would otherwise be read as other columns and give silent nonsense

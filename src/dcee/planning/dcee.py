@@ -24,7 +24,7 @@ class DCEEPlanner(HypothesisPlanner):
     needs_kl = False
 
     def loss(self, final_positions: np.ndarray, stats: SequenceStats, belief: Belief) -> np.ndarray:
-        return squared_distance(final_positions, stats) + stats.trace_cov
+        return squared_distance(final_positions, stats, belief.site) + stats.trace_cov
 
 
 @register("dcee-ms")

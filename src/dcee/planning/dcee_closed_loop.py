@@ -42,7 +42,7 @@ import numpy as np
 from dcee.errors import DceeInputError
 from dcee.models.agent import GridAgent
 from dcee.planning.base import Belief, check_count, register
-from dcee.planning.hypothesis import HypothesisPlanner
+from dcee.planning.hypothesis import HypothesisPlanner, horizontal_distance
 from dcee.planning.predicted import PredictionContext, SequenceStats
 
 DEFAULT_REACH = 8.0
@@ -130,7 +130,7 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
 
     def loss(self, final_positions: np.ndarray, stats: SequenceStats, belief: Belief) -> np.ndarray:
         d = stats.mean - final_positions[:, None, :]
-        horizontal = np.hypot(d[..., 0], d[..., 1])
+        horizontal = horizontal_distance(final_positions, stats.mean, belief.site)
         beyond = np.maximum(horizontal - self.effective_reach(belief), 0.0)
         return beyond * beyond + d[..., 2] * d[..., 2] + self.uncertainty(stats, belief)
 

@@ -24,7 +24,8 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.estimation.resampling import systematic_resample
-from dcee.models.agent import GridAgent
+from dcee.models.agent import GridAgent, travel_xy
+from dcee.models.site import SiteMap
 from dcee.planning.base import Belief, Planner, check_count
 from dcee.planning.predicted import PredictionContext, SequenceStats, check_hypothesis_options
 
@@ -113,7 +114,13 @@ class HypothesisPlanner(Planner):
         if self.subsample < 1.0:
             n = max(1, round(self.subsample * len(belief.weights)))
             idx = systematic_resample(belief.weights, rng, n)
-            belief = Belief(belief.theta[idx], np.full(n, 1.0 / n), belief.sensor, belief.plume)
+            belief = Belief(
+                belief.theta[idx],
+                np.full(n, 1.0 / n),
+                belief.sensor,
+                belief.plume,
+                site=belief.site,
+            )
         ctx = PredictionContext(
             belief, self.n_hypotheses, stages, rng, self.expectation, self.noise, self.readings
         )
@@ -152,7 +159,23 @@ class HypothesisPlanner(Planner):
         return best, {"sequences_evaluated": evaluated}
 
 
-def squared_distance(final_positions: np.ndarray, stats: SequenceStats) -> np.ndarray:
-    """(S, J) ‖p − s̄'_j‖² for (S, 3) final positions."""
+def squared_distance(
+    final_positions: np.ndarray, stats: SequenceStats, site: SiteMap | None = None
+) -> np.ndarray:
+    """(S, J) ‖p − s̄'_j‖² for (S, 3) final positions; with a ``site``, the horizontal part is
+    the travel distance around its obstacles and no-go zones (:func:`travel_xy`)."""
     d = final_positions[:, None, :] - stats.mean
-    return np.einsum("sjk,sjk->sj", d, d)
+    if site is None or not site.blocked.any():
+        return np.einsum("sjk,sjk->sj", d, d)
+    return horizontal_distance(final_positions, stats.mean, site) ** 2 + d[..., 2] ** 2
+
+
+def horizontal_distance(
+    final_positions: np.ndarray, points: np.ndarray, site: SiteMap | None
+) -> np.ndarray:
+    """(S, J) horizontal travel distance from each of (S, 3) positions to its (S, J, 3)
+    points: straight without a site, around its blocked cells with one."""
+    if site is None or not site.blocked.any():
+        d = points - final_positions[:, None, :]
+        return np.hypot(d[..., 0], d[..., 1])
+    return np.stack([travel_xy(site, p, q) for p, q in zip(final_positions, points, strict=True)])

@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from dcee.models.agent import GridAgent
+from dcee.models.agent import GridAgent, travel_xy
 from dcee.planning.base import Belief, Planner, register
 
 
@@ -25,5 +25,10 @@ class MPCPlanner(Planner):
         agent: GridAgent,
         rng: np.random.Generator,
     ) -> tuple[np.ndarray, dict[str, Any]]:
-        d = candidates - belief.source_mean()[None, :]
-        return np.einsum("mk,mk->m", d, d), {}
+        mean = belief.source_mean()
+        d = candidates - mean[None, :]
+        if belief.site is None:
+            return np.einsum("mk,mk->m", d, d), {}
+        # around obstacles: the travel distance from each candidate to the mean
+        xy = np.array([travel_xy(belief.site, c, mean) for c in candidates])
+        return xy * xy + d[:, 2] * d[:, 2], {}

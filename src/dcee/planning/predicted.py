@@ -141,7 +141,11 @@ class PredictionContext:
         self._pt.begin()
         # the merged particles (see dcee.planning.particle_terms): same statistics, less work
         belief = Belief(
-            self._pt.theta, self._pt.weights(belief.weights), belief.sensor, belief.plume
+            self._pt.theta,
+            self._pt.weights(belief.weights),
+            belief.sensor,
+            belief.plume,
+            site=belief.site,
         )
         self.belief = belief
         self.sensor = belief.sensor
@@ -192,7 +196,7 @@ class PredictionContext:
             theta, weights = theta[keep], weights[keep] / weights[keep].sum()
             other._pt = self._pt.subset(keep)
             other._source = np.ascontiguousarray(theta[:, :3])
-        other.belief = Belief(theta, weights, self.sensor, self.belief.plume)
+        other.belief = Belief(theta, weights, self.sensor, self.belief.plume, site=self.belief.site)
         other._n, other._horizon, other._rng = int(n_hypotheses), 1, rng
         other._center = other.belief.source_mean()
         other._cell_cache = {}

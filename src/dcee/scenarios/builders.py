@@ -6,7 +6,9 @@ validates."""
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -17,9 +19,30 @@ from dcee.models.agent import GridAgent, SearchVolume
 from dcee.models.motion import MotionModel, make_motion
 from dcee.models.plume import PARAMETER_NAMES, IsotropicPlume
 from dcee.models.sensor import Sensor
+from dcee.models.site import SiteMap, compose_site, load_ros_map
 from dcee.scenarios.schema.agent import team_starts
 from dcee.scenarios.schema.estimator import PHYSICAL_TRUNCATION, PriorSpec
 from dcee.stopping import StopRule
+
+
+@functools.lru_cache(maxsize=16)
+def _site(
+    low: tuple[float, float], high: tuple[float, float], world_json: str, mtime: float
+) -> SiteMap:
+    from dcee.scenarios.schema.world import WorldSpec, shapes_of
+
+    world = WorldSpec.model_validate_json(world_json)
+    maps = [load_ros_map(world.map)] if world.map is not None else []
+    return compose_site(
+        low,
+        high,
+        shapes_of(world.obstacles) + shapes_of(world.no_go),
+        maps,
+        world.resolution,
+        world.clearance,
+        name=Path(world.map).name if world.map else "world",
+    )
+
 
 if TYPE_CHECKING:
     from dcee.scenarios.schema.scenario import Scenario
@@ -84,9 +107,11 @@ class ScenarioBuilders:
         return out
 
     def make_agent(self: Scenario) -> GridAgent:
-        """The planner's move set."""
+        """The planner's move set (clear of the ``[world]``'s obstacles and no-go zones)."""
         a = self.agent
-        return GridAgent(self.search_volume(), a.step, a.speed, self.dwell, a.headings)
+        return GridAgent(
+            self.search_volume(), a.step, a.speed, self.dwell, a.headings, site=self.make_site()
+        )
 
     def make_motion(self: Scenario) -> MotionModel:
         """How the robots drive to the planner's waypoints (``agent.model``)."""
@@ -110,6 +135,26 @@ class ScenarioBuilders:
         """(8,) true source term (φ in radians)."""
         t = self.truth
         return np.array([t.x, t.y, t.z, t.q, t.u, math.radians(t.phi), t.zeta1, t.zeta2])
+
+    def make_site(self: Scenario) -> SiteMap | None:
+        """The ``[world]`` section's obstacles, no-go zones and map as one
+        :class:`~dcee.models.site.SiteMap` over the search area (None when the section is
+        empty: open terrain, and every search exactly as without it). Built once per distinct
+        world and area and shared (its path fields are cached inside it)."""
+        if self.world.empty:
+            return None
+        mtime = 0.0
+        if self.world.map is not None:
+            try:
+                mtime = Path(self.world.map).stat().st_mtime
+            except OSError:
+                mtime = -1.0  # missing: load_ros_map names the problem
+        return _site(
+            tuple(self.volume.low[:2]),
+            tuple(self.volume.high[:2]),
+            self.world.model_dump_json(),
+            mtime,
+        )
 
     def stop_rule(self: Scenario, on_robot: bool) -> StopRule | None:
         """When this search ends early (:class:`~dcee.stopping.StopRule`): ``search.stop_spread``

@@ -1,5 +1,6 @@
 """Built-in scenarios: the paper's simulation study (``paper:1`` … ``paper:12``), its indoor
-experiment in simulation (``lab:downwind``, ``lab:upwind``) and the family of random held-out
+experiment in simulation (``lab:downwind``, ``lab:upwind``), sites with obstacles
+(``site:wall``, ``site:passage``, ``site:nogo``) and the family of random held-out
 configurations (``random:K``, ``random-start:K``, K any integer ≥ 1).
 
 The paper does not give the search area, the 12 source configurations, the sampling dwell or the
@@ -206,9 +207,56 @@ def random_family_name(name: str) -> tuple[str, int] | None:
     return family, int(k)
 
 
+# --- sites with obstacles ---------------------------------------------------------------------
+# The paper's area, sensor, start and budget with a [world]: a wall between the start and the
+# source, a narrow passage, and a no-go zone around the source itself (the robot must localise
+# it from outside). The gas ignores the walls (the isotropic truth is an open-terrain plume).
+SITES: dict[str, dict[str, Any]] = {
+    "wall": {
+        "description": "a 35 m wall between the start and the source: the way round is over its "
+        "north end",
+        "source": (37.5, 12.5, 0.0),
+        "world": {"obstacles": [{"kind": "rectangle", "low": [20.0, 0.0], "high": [21.0, 35.0]}]},
+    },
+    "passage": {
+        "description": "a wall across the whole area with a 4 m passage (y 21-25 m) to the "
+        "source's side",
+        "source": (40.0, 30.0, 0.0),
+        "world": {
+            "obstacles": [
+                {"kind": "rectangle", "low": [24.0, 0.0], "high": [25.0, 21.0]},
+                {"kind": "rectangle", "low": [24.0, 25.0], "high": [25.0, 50.0]},
+            ]
+        },
+    },
+    "nogo": {
+        "description": "a no-go zone of radius 5 m around the source: the robot localises it from "
+        "outside",
+        "source": (30.0, 30.0, 45.0),
+        "world": {"no_go": [{"kind": "circle", "center": [30.0, 30.0], "radius": 5.0}]},
+    },
+}
+
+
+def _site(kind: str) -> dict[str, Any]:
+    spec = SITES[kind]
+    x, y, phi = spec["source"]
+    base = _paper(1)
+    base["name"] = f"site:{kind}"
+    base["description"] = (
+        f"Site with obstacles, {spec['description']}: source ({x}, {y}, 1) m, wind from "
+        f"{phi:g} deg at 4 m/s; UAV at 4 m from (2, 2)."
+    )
+    base["truth"] = {**base["truth"], "x": x, "y": y, "phi": phi}
+    base["prior"] = {**base["prior"], "phi": {**base["prior"]["phi"], "mean": phi}}
+    base["world"] = spec["world"]
+    return base
+
+
 def builtin_scenarios() -> dict[str, dict[str, Any]]:
     """Raw (unvalidated) built-in scenarios by name."""
     out = {f"paper:{k}": _paper(k) for k in range(1, len(PAPER_SOURCES) + 1)}
     out.update({f"paper75:{k}": _paper(k, PAPER75_SCALE) for k in range(1, len(PAPER_SOURCES) + 1)})
     out.update({f"lab:{s}": _lab(s) for s in LAB_STARTS})
+    out.update({f"site:{k}": _site(k) for k in SITES})
     return out

@@ -25,6 +25,7 @@ from dcee.scenarios.schema.estimator import (
     default_priors,
 )
 from dcee.scenarios.schema.truth import TRUTH_KINDS, TURBULENT_HOLD, Truth, Volume
+from dcee.scenarios.schema.world import WorldSpec
 
 
 class Scenario(ScenarioBuilders, BaseModel):
@@ -54,6 +55,8 @@ class Scenario(ScenarioBuilders, BaseModel):
     """the mobile sensor, see [agent]"""
     search: SearchSpec = SearchSpec()
     """scale, budget and success criterion, see [search]"""
+    world: WorldSpec = WorldSpec()
+    """obstacles, no-go zones and an occupancy-grid map, see [world]"""
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario:
@@ -89,18 +92,25 @@ class Scenario(ScenarioBuilders, BaseModel):
         extra = [p for p in self.prior if p not in PARAMETER_NAMES]
         if extra:
             raise ValueError(f"prior: unknown parameter name(s) {extra}; allowed {PARAMETER_NAMES}")
+        site = self._checked_site(start, src)
         agent = GridAgent(
             SearchVolume(tuple(lo), tuple(hi)),
             self.agent.step,
             self.agent.speed,
             self.dwell,
             self.agent.headings,
+            site=site,
         )
         starts = team_starts(start, self.agent.step, self.agent.count, lo, hi)
         if starts is None:
             raise ValueError(
                 f"{FIELD_MARK}agent.count: {self.agent.count} robots {self.agent.step:g} m apart "
                 f"along y from agent.start {tuple(self.agent.start)} do not fit in the area"
+            )
+        if len(agent.candidates(start)[0]) == 0 and site is not None:
+            raise ValueError(
+                f"{FIELD_MARK}agent.start: every move from {tuple(self.agent.start)} enters or "
+                "crosses an obstacle or no-go zone ([world])"
             )
         if len(agent.candidates(start)[0]) == 0:
             raise ValueError(
@@ -121,6 +131,44 @@ class Scenario(ScenarioBuilders, BaseModel):
         if self.sensor.max_reading <= self.sensor.threshold:
             raise ValueError("sensor.max_reading must be above sensor.threshold")
         return self
+
+    def _checked_site(self, start: np.ndarray, src: np.ndarray) -> Any:
+        """The ``[world]`` map, with the start outside every blocked cell, the source outside
+        every obstacle (a no-go zone may hold it) and reachable from the start."""
+        if self.world.empty:
+            return None
+        try:
+            site = self.make_site()
+        except DceeInputError as exc:
+            raise ValueError(f"{FIELD_MARK}{exc.field}: {exc.message}") from None
+        if site.is_blocked(start[None, :2])[0]:
+            raise ValueError(
+                f"{FIELD_MARK}agent.start: {tuple(self.agent.start)} lies inside an obstacle or "
+                f"no-go zone of [world] (or within world.clearance of one)"
+            )
+        from dcee.scenarios.schema.world import shapes_of
+
+        inside = [s for s in shapes_of(self.world.obstacles) if s.contains(src[None, :2])[0]]
+        if inside or (self.world.map is not None and self._map_blocks(src)):
+            raise ValueError(
+                f"{FIELD_MARK}truth: the source ({src[0]:g}, {src[1]:g}) lies inside an "
+                "obstacle of [world]; a source the robot must keep away from belongs in "
+                "world.no_go"
+            )
+        if not site.reachable(start, src[None, :2])[0]:
+            raise ValueError(
+                f"{FIELD_MARK}world: the source area around ({src[0]:g}, {src[1]:g}) cannot be "
+                f"reached from agent.start {tuple(self.agent.start)}: obstacles enclose it"
+            )
+        return site
+
+    def _map_blocks(self, src: np.ndarray) -> bool:
+        from dcee.models.site import load_ros_map
+
+        try:
+            return bool(load_ros_map(self.world.map).is_blocked(src[None, :2])[0])
+        except DceeInputError:
+            return False
 
     # --- settings that depend on the truth ----------------------------------------------------
 
