@@ -18,6 +18,8 @@ if os.environ.get("DCEE_REQUIRE_ROS"):
 else:
     pytest.importorskip("rclpy")
 
+import itertools
+
 from dcee.errors import DceeInputError
 from dcee.robot.replay import replay_bag
 from dcee.ros.demo import run_demo
@@ -288,5 +290,94 @@ def test_node_keeps_planning_through_hostile_message_streams() -> None:
         values = {kv.key: kv.value for kv in status.values}
         assert int(values["dropped: reading above max_reading"]) > 0
         assert int(values["readings used"]) == len(node.cycle.records)
+    finally:
+        rclpy.try_shutdown(context=context)
+
+
+def test_node_plans_around_a_map_from_the_map_topic() -> None:
+    """A wall arrives on ``map`` (nav_msgs/OccupancyGrid, transient local): every later goal
+    and every move to it stays clear of it; a map that does not cover the search area is
+    logged and ignored, the node keeps running."""
+    import time
+
+    import rclpy
+    from geometry_msgs.msg import PoseStamped
+    from nav_msgs.msg import OccupancyGrid, Odometry
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    from std_msgs.msg import Float32
+
+    from dcee.models.site import Rectangle, SiteMap
+    from dcee.ros.node import LATCHED, RELIABLE, SearchNode
+    from dcee.ros.sim_node import stamp_of
+
+    context = rclpy.Context()
+    rclpy.init(context=context, args=[], domain_id=_domain())
+    try:
+        node = SearchNode(
+            context=context,
+            parameter_overrides=[
+                Parameter("particles", value=300),
+                Parameter("strategy", value="mpc"),
+                Parameter("stop_spread", value=0.0),
+            ],
+        )
+        robot = rclpy.create_node("robot", context=context)
+        map_pub = robot.create_publisher(OccupancyGrid, "map", LATCHED)
+        odom_pub = robot.create_publisher(Odometry, "odom", RELIABLE)
+        conc_pub = robot.create_publisher(Float32, "concentration", RELIABLE)
+        goals = []
+        robot.create_subscription(PoseStamped, "goal_pose", goals.append, LATCHED)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+        executor.add_node(robot)
+
+        def grid(width: float, height: float) -> OccupancyGrid:
+            res = 0.05
+            wall = Rectangle((0.0, 1.0), (3.0, 1.2))  # across the room below the start
+            site = SiteMap.from_shapes((0.0, 0.0), (width, height), [wall], res)
+            msg = OccupancyGrid()
+            msg.header.frame_id = "map"
+            msg.info.resolution = res
+            msg.info.width, msg.info.height = site.shape[1], site.shape[0]
+            msg.info.origin.orientation.w = 1.0
+            msg.data = [100 if b else 0 for b in site.blocked.ravel()]
+            return msg
+
+        map_pub.publish(grid(2.0, 2.0))  # too small: logged, ignored
+        for _ in range(20):
+            executor.spin_once(timeout_sec=0.02)
+        assert node.maps_received == 0 and node.callback_errors == 1
+        map_pub.publish(grid(4.5, 3.5))
+        deadline = time.monotonic() + 30
+        while node.maps_received == 0 and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.02)
+        assert node.maps_received == 1
+        site = node.searcher.agent.site
+        assert site is not None and site.is_blocked(np.array([[1.5, 1.1]]))[0]
+
+        here = np.array(node.scenario.agent.start[:2], float)
+        t = 1.0
+        visited = [here.copy()]
+        deadline = time.monotonic() + 60
+        while len(goals) < 25 and time.monotonic() < deadline:
+            if goals:
+                here = np.array([goals[-1].pose.position.x, goals[-1].pose.position.y])
+                if not np.allclose(here, visited[-1]):
+                    visited.append(here.copy())
+            msg = Odometry()
+            msg.header.stamp = stamp_of(t)
+            msg.pose.pose.position.x, msg.pose.pose.position.y = float(here[0]), float(here[1])
+            msg.pose.pose.orientation.w = 1.0
+            conc_pub.publish(Float32(data=0.0))
+            odom_pub.publish(msg)
+            for _ in range(4):
+                executor.spin_once(timeout_sec=0.005)
+            t += 0.1
+        assert len(goals) >= 25
+        pts = np.array(visited)
+        assert not site.is_blocked(pts).any()
+        for a, b in itertools.pairwise(pts):
+            assert site.segment_clear(a, b[None])[0]
     finally:
         rclpy.try_shutdown(context=context)

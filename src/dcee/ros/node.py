@@ -4,7 +4,10 @@ Subscribes
     ``concentration`` (std_msgs/Float32, sensor units × ``calibration`` = g/m³), stamped on
     arrival with the node's clock (set ``use_sim_time`` to follow ``/clock``);
     ``odom`` (nav_msgs/Odometry; or geometry_msgs/PoseWithCovarianceStamped with
-    ``pose_type:=pose_with_covariance``, speeds then from successive poses).
+    ``pose_type:=pose_with_covariance``, speeds then from successive poses);
+    ``map`` (nav_msgs/OccupancyGrid, transient local as Nav2's map server publishes it):
+    occupied and unknown cells become obstacles for every later decision, on top of the
+    scenario's own ``[world]`` (:func:`dcee.models.site.compose_site`).
 Publishes
     ``goal_pose`` (geometry_msgs/PoseStamped, what Nav2's bt_navigator accepts; its
     orientation faces the move), ``dcee/estimate`` (geometry_msgs/PointStamped, posterior mean
@@ -50,7 +53,7 @@ import numpy as np
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import PointStamped, PoseStamped, PoseWithCovarianceStamped
-from nav_msgs.msg import Odometry
+from nav_msgs.msg import OccupancyGrid, Odometry
 from nav_msgs.msg import Path as PathMsg
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -82,6 +85,7 @@ PARAMETERS: dict[str, Any] = {
     "calibration": 1.0,
     "concentration_topic": "concentration",
     "pose_topic": "odom",
+    "map_topic": "map",
     "goal_topic": "goal_pose",
     "pose_type": "odometry",
     "checkpoint": "",
@@ -188,6 +192,9 @@ class SearchNode(Node):
         self.create_subscription(
             Float32, str(p["concentration_topic"]), self._on_concentration, RELIABLE
         )
+        self.create_subscription(OccupancyGrid, str(p["map_topic"]), self._on_map, LATCHED)
+        self.maps_received = 0
+        """occupancy grids applied from the ``map`` topic"""
         if p["pose_type"] == "odometry":
             self.create_subscription(Odometry, str(p["pose_topic"]), self._on_odometry, RELIABLE)
         else:
@@ -232,6 +239,47 @@ class SearchNode(Node):
     def _reading(self, msg: Float32) -> None:
         with self._lock:
             self.cycle.on_reading(self._now(), float(msg.data))
+
+    def _on_map(self, msg: OccupancyGrid) -> None:
+        self._guarded("map", self._map, msg)
+
+    def _map(self, msg: OccupancyGrid) -> None:
+        """Apply an occupancy grid: a map that cannot be used (rotated, not covering the
+        search area, malformed) is logged and ignored; the search goes on with the last map."""
+        import dataclasses
+
+        from dcee.models.site import SiteMap, compose_site
+        from dcee.robot.bag import yaw_of
+
+        info = msg.info
+        if info.width == 0 or info.height == 0 or len(msg.data) != info.width * info.height:
+            raise DceeInputError("map", f"{len(msg.data)} cells for {info.width} x {info.height}")
+        if abs(yaw_of(info.origin.orientation)) > 1e-6:
+            raise DceeInputError("map", "a rotated map (origin yaw != 0) is not supported")
+        occ = np.asarray(msg.data, dtype=float).reshape(info.height, info.width)
+        occ = np.where(occ < 0, np.nan, occ / 100.0)
+        grid = SiteMap.from_occupancy(
+            occ, (info.origin.position.x, info.origin.position.y), info.resolution, name="map topic"
+        )
+        sc = self.scenario
+        site = compose_site(
+            tuple(sc.volume.low[:2]),
+            tuple(sc.volume.high[:2]),
+            maps=[grid],
+            resolution=sc.world.resolution,
+            clearance=sc.world.clearance,
+            name="map topic",
+        )
+        own = sc.make_site()  # the scenario's own obstacles, zones and map file stay
+        if own is not None:
+            site.blocked |= own.blocked
+        with self._lock:
+            self.searcher.agent = dataclasses.replace(self.searcher.agent, site=site)
+        self.maps_received += 1
+        self.get_logger().info(
+            f"map applied: {info.width} x {info.height} cells of {info.resolution:g} m, "
+            f"{int(site.blocked.sum())} of {site.blocked.size} planning cells blocked"
+        )
 
     def _on_odometry(self, msg: Odometry) -> None:
         self._guarded("odometry", self._odometry, msg)

@@ -4,6 +4,7 @@ them with a planner, :mod:`dcee.gym` with a policy)."""
 
 from __future__ import annotations
 
+import itertools
 import math
 from typing import Any
 
@@ -17,6 +18,18 @@ from dcee.runs.records import reading_record
 from dcee.runs.streams import motion_stream, streams
 from dcee.scenarios import Scenario
 from dcee.simulation.truth import TruthModel, make_truth
+
+
+def dense_path(path: np.ndarray, spacing: float = 0.05) -> np.ndarray:
+    """(K, 2) points along a drive's (n, 4) (t, x, y, heading) samples, at most ``spacing`` m
+    apart (a straight grid move has only its two ends)."""
+    xy = path[:, 1:3]
+    out = [xy[:1]]
+    for a, b in itertools.pairwise(xy):
+        n = max(1, int(np.ceil(np.hypot(*(b - a)) / spacing)))
+        t = np.linspace(0.0, 1.0, n + 1)[1:, None]
+        out.append(a + t * (b - a))
+    return np.concatenate(out)
 
 
 class SearchSimulation:
@@ -59,6 +72,8 @@ class SearchSimulation:
         self.travel_time = 0.0  # s, the last move's drive (the slowest robot's)
         self.records: list[dict[str, Any]] = []
         self.path_length = 0.0
+        self.site = scenario.make_site()
+        self.drives_into_obstacles = 0
 
     @property
     def position(self) -> np.ndarray:
@@ -131,12 +146,27 @@ class SearchSimulation:
             durations.append(travel.duration)
             steps = np.diff(travel.path[:, 1:3], axis=0)
             self.path_length += float(np.hypot(steps[:, 0], steps[:, 1]).sum())
+            if self.site is not None:  # the drive itself, every 5 cm, against the raw shapes
+                self.drives_into_obstacles += int(
+                    self.scenario.in_obstacle(dense_path(travel.path)).any()
+                )
         self.positions = new
         self.travel_time = max(durations)
         self.time += self.travel_time + self.agent.dwell
 
     def summary(self, strategy: str) -> dict[str, Any]:
-        """The search's summary (:func:`search_summary`) under the name ``strategy``."""
-        return search_summary(
+        """The search's summary (:func:`search_summary`) under the name ``strategy``; with a
+        ``[world]``, ``drives_into_obstacles`` (moves whose drive touched an obstacle or no-go
+        zone: 0 unless something is wrong) and ``start_to_source_travel`` (m, the shortest way
+        round the obstacles, against which ``path_length`` compares)."""
+        out = search_summary(
             self.records, self.scenario, strategy, self.seed, self.path_length, self.searcher
         )
+        if self.site is not None:
+            out["drives_into_obstacles"] = self.drives_into_obstacles
+            out["start_to_source_travel"] = float(
+                self.site.travel_distance(
+                    np.asarray(self.scenario.agent.start), self.true_location[None, :2]
+                )[0]
+            )
+        return out

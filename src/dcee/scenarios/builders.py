@@ -44,6 +44,11 @@ def _site(
     )
 
 
+@functools.lru_cache(maxsize=4)
+def _raw_map(path: str) -> SiteMap:
+    return load_ros_map(path)
+
+
 if TYPE_CHECKING:
     from dcee.scenarios.schema.scenario import Scenario
 
@@ -155,6 +160,20 @@ class ScenarioBuilders:
             self.world.model_dump_json(),
             mtime,
         )
+
+    def in_obstacle(self: Scenario, xy: np.ndarray) -> np.ndarray:
+        """(K,) bool: the (K, 2) points lie inside an obstacle or no-go zone itself (the shapes
+        as given, not grown by the grid's half cell or ``clearance``) or in an occupied or
+        unknown cell of the map file: what a robot's drive must never touch."""
+        from dcee.scenarios.schema.world import shapes_of
+
+        xy = np.atleast_2d(np.asarray(xy, dtype=float))[:, :2]
+        out = np.zeros(len(xy), bool)
+        for shape in shapes_of(self.world.obstacles) + shapes_of(self.world.no_go):
+            out |= shape.contains(xy)
+        if self.world.map is not None:
+            out |= _raw_map(self.world.map).is_blocked(xy)
+        return out
 
     def stop_rule(self: Scenario, on_robot: bool) -> StopRule | None:
         """When this search ends early (:class:`~dcee.stopping.StopRule`): ``search.stop_spread``
