@@ -168,6 +168,13 @@ class Searcher:
                 self.below_since = math.nan
         return self.last_update
 
+    def tell_wind(self, speed: float, direction: float) -> UpdateInfo:
+        """Assimilate an anemometer reading: wind ``speed`` m/s from ``direction`` rad
+        (counter-clockwise from +x, as the source term's φ; in a scenario's degrees: convert).
+        The filter must have an anemometer model (``[anemometer] enabled``)."""
+        with one_blas_thread():
+            return self.filter.update_wind(speed, direction)
+
     @property
     def localised(self) -> bool:
         """True once the stop rule holds: the spread has stayed below its threshold for its

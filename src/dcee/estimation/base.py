@@ -91,6 +91,10 @@ class Estimator(Protocol):
         effective sample size; the weights become uniform."""
         ...
 
+    def update_wind(self, speed: float, direction: float) -> UpdateInfo:
+        """Assimilate one anemometer reading: ``speed`` m/s, from ``direction`` rad."""
+        ...
+
     def log_likelihood(self, theta: np.ndarray, position: np.ndarray, reading: float) -> np.ndarray:
         """(M,) log p(reading | theta) of (M, 8) source terms for a reading at ``position``."""
         ...

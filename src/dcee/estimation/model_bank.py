@@ -114,6 +114,12 @@ class ModelBank:
         self._select()
         return infos[self.selected]
 
+    def update_wind(self, speed: float, direction: float) -> UpdateInfo:
+        """Assimilate one anemometer reading into every member (it does not change which
+        model the readings select: every member predicts the wind alike)."""
+        infos = [f.update_wind(speed, direction) for f in self.members]
+        return infos[self.selected]
+
     def resample(self) -> None:
         """Resample-move every member now (see :meth:`ParticleFilter.resample`)."""
         for member in self.members:

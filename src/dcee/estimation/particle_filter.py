@@ -57,6 +57,7 @@ from dcee.estimation.resampling import (
     systematic_resample,
 )
 from dcee.estimation.summaries import in_credible_ellipsoid, weighted_rmse
+from dcee.models.anemometer import PHI_COLUMN, U_COLUMN, Anemometer, WindEvidence
 from dcee.models.plume import IsotropicPlume
 from dcee.models.sensor import Sensor
 
@@ -78,6 +79,11 @@ class ParticleFilter:
     max_sweeps: most sweeps after one resampling.
     """
 
+    # checkpoints written before the anemometer existed restore with these
+    anemometer: Anemometer | None = None
+    wind: WindEvidence = WindEvidence()
+    wind_log_evidence: float = 0.0
+
     def __init__(
         self,
         prior: SourcePrior,
@@ -93,6 +99,7 @@ class ParticleFilter:
         diversify: float = 0.5,
         max_sweeps: int = 8,
         reading_weight: float = 1.0,
+        anemometer: Anemometer | None = None,
     ) -> None:
         if not (isinstance(reading_weight, int | float) and 0 < reading_weight <= 1):
             raise DceeInputError(
@@ -145,6 +152,10 @@ class ParticleFilter:
         self.n_resamples = 0
         self.log_evidence = 0.0
         """log p(every assimilated reading | model), the SMC estimate (see the module doc)"""
+        self.anemometer = anemometer
+        """the wind readings' model (:meth:`update_wind`); None: this filter takes none"""
+        self.wind = WindEvidence()
+        """sufficient statistics of the wind readings assimilated so far"""
 
     # --- public state -----------------------------------------------------------------------
 
@@ -283,6 +294,44 @@ class ParticleFilter:
         info = self._tempered_update(ll_new, entry, base_mult, ess)
         return dataclasses.replace(info, log_evidence=log_ev)
 
+    def update_wind(self, speed: float, direction: float) -> UpdateInfo:
+        """Assimilate one anemometer reading: wind ``speed`` m/s from ``direction`` rad
+        (counter-clockwise from +x, as φ). Its likelihood (:mod:`dcee.models.anemometer`)
+        multiplies the weights; from then on the resample-move target includes every wind
+        reading (through their sufficient statistics). With u and φ both known a reading
+        carries no information and only counts."""
+        if self.anemometer is None:
+            raise DceeInputError("anemometer", "this filter was built without an anemometer model")
+        speed, direction = self.anemometer.check(speed, direction)
+        new = WindEvidence.of(speed, direction)
+        self.wind = self.wind + new
+        if not ({U_COLUMN, PHI_COLUMN} & {int(i) for i in self._unknown}):
+            return UpdateInfo(self.ess, False, math.nan, 1, 0, self.n)
+        ll = new.log_likelihood(self.theta, self.anemometer)
+        logw = self._logw + ll
+        top = logw.max()
+        scaled = np.exp(logw - top)
+        log_ev = float(top + math.log(scaled.sum()) - logsumexp(self._logw))
+        # kept apart from log_evidence: every reading model predicts the wind alike, so the
+        # model bank compares its members on the concentration readings only
+        self.wind_log_evidence += log_ev
+        ess = effective_sample_size(scaled / scaled.sum())
+        self._set_logw(logw)
+        if ess < self.resample_threshold * self.n:
+            self._resample()
+            acc, sweeps, distinct = self._rejuvenate()
+            return UpdateInfo(ess, True, acc, 1, sweeps, distinct, log_evidence=log_ev)
+        return UpdateInfo(ess, False, math.nan, 1, 0, self.n, log_evidence=log_ev)
+
+    def _log_prior(self, theta: np.ndarray) -> np.ndarray:
+        """(N,) log prior density times the wind readings' likelihood (the part of the target
+        that does not depend on the concentration readings)."""
+        lp = self.prior.log_density(theta)
+        if self.wind.n and self.anemometer is not None:
+            with np.errstate(invalid="ignore"):
+                lp = lp + self.wind.log_likelihood(theta, self.anemometer)
+        return lp
+
     def resample(self) -> None:
         """Resample-move now (systematic resampling, then the MCMC rejuvenation of
         :meth:`update`), whatever the effective sample size; the weights become uniform."""
@@ -371,8 +420,8 @@ class ParticleFilter:
                 log_q_ratio[jump] += dists[col].log_pdf(self.theta[jump, col]) - dists[col].log_pdf(
                     proposal[jump, col]
                 )
-        lp_prop = self.prior.log_density(proposal)
-        lp_cur = self.prior.log_density(self.theta)
+        lp_prop = self._log_prior(proposal)
+        lp_cur = self._log_prior(self.theta)
         active = np.isfinite(lp_prop)
         ll_prop = np.empty(self.n)
         pos, z, mult = self.history()

@@ -47,6 +47,7 @@ def make_searcher(
             diversify=search.diversify,
             max_sweeps=search.max_sweeps,
             reading_weight=scenario.reading_weight,
+            anemometer=scenario.make_anemometer(),
         )
         for model, rng in zip(models, rngs, strict=True)
     ]

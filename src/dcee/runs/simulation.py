@@ -15,7 +15,7 @@ from dcee.planning.base import Planner
 from dcee.runs.assemble import make_searcher
 from dcee.runs.metrics import search_summary
 from dcee.runs.records import reading_record
-from dcee.runs.streams import motion_stream, streams
+from dcee.runs.streams import anemometer_stream, motion_stream, streams
 from dcee.scenarios import Scenario
 from dcee.simulation.truth import TruthModel, make_truth
 
@@ -74,6 +74,10 @@ class SearchSimulation:
         self.path_length = 0.0
         self.site = scenario.make_site()
         self.drives_into_obstacles = 0
+        self.anemometer = scenario.make_anemometer()
+        self._wind_rng = anemometer_stream(seed)
+        self._wind_time = 0.0  # s, the last wind reading's time
+        self.wind_readings = 0
 
     @property
     def position(self) -> np.ndarray:
@@ -81,9 +85,23 @@ class SearchSimulation:
         return self.positions[0]
 
     def sense(self) -> list[dict[str, Any]]:
-        """Take, assimilate and record every robot's reading at the current time; returns the
+        """Take, assimilate and record every robot's reading at the current time (after the
+        anemometer's readings since the last step, when the robot has one); returns the
         step's records, one per robot."""
+        self._sense_wind()
         return [self._sense_one(k) for k in range(len(self.positions))]
+
+    def _sense_wind(self) -> None:
+        """The anemometer's readings of the truth's mean wind, one per ``period`` s up to now."""
+        if self.anemometer is None:
+            return
+        period = self.scenario.anemometer.period
+        truth = self.scenario.truth_theta()
+        while self._wind_time + period <= self.time + 1e-9:
+            self._wind_time += period
+            speed, direction = self.anemometer.simulate(truth[4], truth[5], self._wind_rng)
+            self.searcher.tell_wind(speed, direction)
+            self.wind_readings += 1
 
     def _sense_one(self, robot: int) -> dict[str, Any]:
         scenario, t = self.scenario, self.time

@@ -26,6 +26,16 @@ MOTION_STREAM = 4
 stochastic truth's), so adding localisation noise changes no other draw."""
 
 
+ANEMOMETER_STREAM = 5
+"""Child of the seed that draws the anemometer's noise (so a measured wind changes no other
+draw: a search with and without it is paired exactly up to the first wind reading)."""
+
+
+def anemometer_stream(seed: int) -> np.random.Generator:
+    """The generator of the simulated anemometer's noise for episode ``seed``."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(ANEMOMETER_STREAM,)))
+
+
 def motion_stream(seed: int) -> np.random.Generator:
     """The generator of the robots' localisation errors for episode ``seed``."""
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(MOTION_STREAM,)))

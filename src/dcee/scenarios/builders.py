@@ -16,6 +16,7 @@ import numpy as np
 from dcee.errors import DceeInputError
 from dcee.estimation.priors import Distribution, Fixed, Gamma, Normal, SourcePrior, Uniform
 from dcee.models.agent import GridAgent, SearchVolume
+from dcee.models.anemometer import Anemometer
 from dcee.models.motion import MotionModel, make_motion
 from dcee.models.plume import PARAMETER_NAMES, IsotropicPlume
 from dcee.models.sensor import Sensor
@@ -140,6 +141,13 @@ class ScenarioBuilders:
         """(8,) true source term (φ in radians)."""
         t = self.truth
         return np.array([t.x, t.y, t.z, t.q, t.u, math.radians(t.phi), t.zeta1, t.zeta2])
+
+    def make_anemometer(self: Scenario) -> Anemometer | None:
+        """The ``[anemometer]``'s reading model, or None when the robot has none."""
+        a = self.anemometer
+        if not a.enabled:
+            return None
+        return Anemometer(a.speed_sd, math.radians(a.direction_sd))
 
     def make_site(self: Scenario) -> SiteMap | None:
         """The ``[world]`` section's obstacles, no-go zones and map as one

@@ -19,6 +19,7 @@ from dcee.scenarios.schema.common import FROZEN
 from dcee.scenarios.schema.estimator import (
     MEANDER_DEFAULT,
     READING_WEIGHT_DEFAULT,
+    AnemometerSpec,
     EstimatorSpec,
     PriorSpec,
     SensorSpec,
@@ -49,6 +50,8 @@ class Scenario(ScenarioBuilders, BaseModel):
     the volume unless given); defaults: the paper's table 1 (phi has none)"""
     sensor: SensorSpec = SensorSpec()
     """the instrument, see [sensor]"""
+    anemometer: AnemometerSpec = AnemometerSpec()
+    """a measured wind, see [anemometer]"""
     estimator: EstimatorSpec = EstimatorSpec()
     """the reading model of the filter and the planners, see [estimator]"""
     agent: AgentSpec
