@@ -192,3 +192,27 @@ def test_hostile_messages_are_dropped_counted_and_never_reach_the_estimator() ->
     # the estimator saw exactly the clean search's readings
     assert [r["reading"] for r in cycle.records] == [r["reading"] for r in clean.records]
     assert cycle.records[-1]["rmse"] == clean.records[-1]["rmse"]
+
+
+def test_wind_samples_are_averaged_into_anemometer_readings() -> None:
+    """20 Hz wind samples become one reading per anemometer period, their mean; impossible
+    samples are dropped and counted."""
+    sc = _lab(**{"anemometer.enabled": True, "anemometer.period": 1.0})
+    cycle = SearchCycle(
+        make_searcher(sc, None, *streams(0)[1:3]),
+        CycleSettings.from_scenario(sc),
+        wind_period=sc.anemometer.period,
+    )
+    told = []
+    for k in range(41):  # 2 s at 20 Hz: air moving towards +x at 1.4-1.6 m/s
+        vx = 1.5 + (0.1 if k % 2 else -0.1)
+        if cycle.on_wind(0.05 * k, vx, 0.0):
+            told.append(cycle.searcher.filter.wind)
+    for bad in ((math.nan, 0.0), (0.0, math.inf), (150.0, 0.0)):
+        assert not cycle.on_wind(2.1, *bad)
+    assert cycle.wind_readings == 2 and len(told) == 2
+    w = cycle.searcher.filter.wind
+    assert w.n == 2
+    assert w.sum_speed == pytest.approx(3.0, abs=0.02)  # two means of about 1.5 m/s
+    assert w.sum_cos == pytest.approx(-2.0, abs=1e-6)  # from -x: phi = pi
+    assert cycle.rejected == {"wind not finite": 2, "wind above 100 m/s": 1}

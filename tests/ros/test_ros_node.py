@@ -381,3 +381,55 @@ def test_node_plans_around_a_map_from_the_map_topic() -> None:
             assert site.segment_clear(a, b[None])[0]
     finally:
         rclpy.try_shutdown(context=context)
+
+
+def test_node_takes_wind_from_the_wind_topic() -> None:
+    """Vector3Stamped wind samples at 20 Hz become anemometer readings (one per period) when
+    the scenario's [anemometer] is enabled; without it they are ignored, never fatal."""
+    import time
+
+    import rclpy
+    from geometry_msgs.msg import Vector3Stamped
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+
+    from dcee.ros.node import RELIABLE, SearchNode
+    from dcee.ros.sim_node import stamp_of
+
+    for enabled in (True, False):
+        context = rclpy.Context()
+        rclpy.init(context=context, args=[], domain_id=_domain())
+        try:
+            sc = load_scenario("lab:upwind").with_overrides(
+                **{"anemometer.enabled": enabled, "search.particles": 300}
+            )
+            node = SearchNode(
+                context=context,
+                scenario=sc,
+                parameter_overrides=[Parameter("strategy", value="mpc")],
+            )
+            robot = rclpy.create_node("robot", context=context)
+            wind_pub = robot.create_publisher(Vector3Stamped, "wind", RELIABLE)
+            executor = SingleThreadedExecutor(context=context)
+            executor.add_node(node)
+            executor.add_node(robot)
+            t = 1.0
+            deadline = time.monotonic() + 20
+            while t < 4.0 and time.monotonic() < deadline:
+                msg = Vector3Stamped()
+                msg.header.stamp = stamp_of(t)
+                msg.header.frame_id = "map"
+                msg.vector.x, msg.vector.y = 1.5, 0.0  # air moving east: wind from phi = pi
+                wind_pub.publish(msg)
+                for _ in range(3):
+                    executor.spin_once(timeout_sec=0.005)
+                t += 0.05
+            for _ in range(20):
+                executor.spin_once(timeout_sec=0.01)
+            if enabled:
+                assert node.cycle.wind_readings >= 2
+                assert node.searcher.filter.wind.n == node.cycle.wind_readings
+            else:
+                assert node.cycle.wind_readings == 0 and node.callback_errors == 0
+        finally:
+            rclpy.try_shutdown(context=context)

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from dcee.errors import DceeInputError
+from dcee.models.anemometer import wind_from_vector
 from dcee.runs import reading_record
 from dcee.scenarios import Scenario
 from dcee.searcher import Searcher
@@ -120,6 +121,11 @@ class SearchCycle:
     start_time: float | None = None
     records: list[dict[str, Any]] = field(default_factory=list)
     dropped_readings: int = 0
+    wind_period: float = 1.0
+    """s over which wind samples are averaged into one anemometer reading (the scenario's
+    ``anemometer.period``)"""
+    wind_readings: int = 0
+    """anemometer readings told to the searcher"""
     rejected: dict[str, int] = field(default_factory=dict)
     """messages dropped before they could reach the estimator, by reason (see
     :data:`REJECTION_REASONS`)"""
@@ -129,6 +135,8 @@ class SearchCycle:
     _samples: list[tuple[float, float]] = field(default_factory=list)
     _drive_started: float = 0.0
     _pending_goal: np.ndarray | None = None
+    _wind: list[tuple[float, float]] = field(default_factory=list)
+    _wind_since: float | None = None
 
     @property
     def search_time(self) -> float:
@@ -205,6 +213,31 @@ class SearchCycle:
             # arrived while holding: part of this hold, even when its stamp lags the pose's
             # (a subscriber's clock behind the odometry's)
             self._samples.append((max(float(t), self._since), float(value)))
+
+    def on_wind(self, t: float, vx: float, vy: float) -> bool:
+        """A wind sample received at ``t`` s: the air's velocity (vx, vy) m/s in the map frame.
+        Samples are averaged over ``wind_period`` s and the mean told to the searcher as one
+        anemometer reading (so a 20 Hz sensor does not count as 20 independent readings).
+        A sample that cannot be a wind (not finite, faster than 100 m/s) is dropped and
+        counted. Returns True when a reading was told."""
+        values = (t, vx, vy)
+        if not all(isinstance(v, Real) and math.isfinite(v) for v in values):
+            self._reject("wind not finite")
+            return False
+        if math.hypot(vx, vy) > MAX_WIND:
+            self._reject("wind above 100 m/s")
+            return False
+        if self._wind_since is None or t < self._wind_since:
+            self._wind_since, self._wind = float(t), []
+        self._wind.append((float(vx), float(vy)))
+        if t - self._wind_since < self.wind_period - 1e-9:
+            return False
+        mean = np.mean(self._wind, axis=0)
+        self._wind_since, self._wind = float(t), []
+        speed, direction = wind_from_vector(float(mean[0]), float(mean[1]))
+        self.searcher.tell_wind(speed, direction)
+        self.wind_readings += 1
+        return True
 
     def on_pose(self, pose: Pose) -> CycleOutput:
         """A pose sample: advances the cycle; returns what to publish. A pose that cannot be
@@ -291,6 +324,9 @@ class SearchCycle:
         return out
 
 
+MAX_WIND = 100.0
+"""m/s: a faster wind sample is a sensor fault."""
+
 REJECTION_REASONS = (
     "reading not a number",
     "reading not finite",
@@ -299,6 +335,8 @@ REJECTION_REASONS = (
     "pose not finite",
     "pose far outside the area",
     "pose stamp went backwards",
+    "wind not finite",
+    "wind above 100 m/s",
 )
 """Every reason :class:`SearchCycle` drops an input message for (the keys of
 :attr:`SearchCycle.rejected`)."""

@@ -5,6 +5,9 @@ Subscribes
     arrival with the node's clock (set ``use_sim_time`` to follow ``/clock``);
     ``odom`` (nav_msgs/Odometry; or geometry_msgs/PoseWithCovarianceStamped with
     ``pose_type:=pose_with_covariance``, speeds then from successive poses);
+    ``wind`` (geometry_msgs/Vector3Stamped, the air's velocity in m/s in the map frame, from
+    the robot's anemometer; averaged over ``anemometer.period`` s into one reading; used when
+    the scenario's ``[anemometer]`` is enabled, else ignored with one warning);
     ``map`` (nav_msgs/OccupancyGrid, transient local as Nav2's map server publishes it):
     occupied and unknown cells become obstacles for every later decision, on top of the
     scenario's own ``[world]`` (:func:`dcee.models.site.compose_site`).
@@ -52,7 +55,12 @@ from typing import Any
 import numpy as np
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from geometry_msgs.msg import PointStamped, PoseStamped, PoseWithCovarianceStamped
+from geometry_msgs.msg import (
+    PointStamped,
+    PoseStamped,
+    PoseWithCovarianceStamped,
+    Vector3Stamped,
+)
 from nav_msgs.msg import OccupancyGrid, Odometry
 from nav_msgs.msg import Path as PathMsg
 from rclpy.node import Node
@@ -86,6 +94,7 @@ PARAMETERS: dict[str, Any] = {
     "concentration_topic": "concentration",
     "pose_topic": "odom",
     "map_topic": "map",
+    "wind_topic": "wind",
     "goal_topic": "goal_pose",
     "pose_type": "odometry",
     "checkpoint": "",
@@ -165,7 +174,12 @@ class SearchNode(Node):
             settle_turn_rate=math.radians(float(p["settle_turn_rate"])),
             settle_time=float(p["settle_time"]),
         )
-        self.cycle = SearchCycle(searcher, settings, true_location=true_location)
+        self.cycle = SearchCycle(
+            searcher,
+            settings,
+            true_location=true_location,
+            wind_period=scenario.anemometer.period,
+        )
         self.done = threading.Event()
         self.finish_reason = ""
         """why the search ended: "budget", "localised" (the stop rule; docs/guide/robot.md) or
@@ -193,6 +207,8 @@ class SearchNode(Node):
             Float32, str(p["concentration_topic"]), self._on_concentration, RELIABLE
         )
         self.create_subscription(OccupancyGrid, str(p["map_topic"]), self._on_map, LATCHED)
+        self.create_subscription(Vector3Stamped, str(p["wind_topic"]), self._on_wind, RELIABLE)
+        self._wind_warned = False
         self.maps_received = 0
         """occupancy grids applied from the ``map`` topic"""
         if p["pose_type"] == "odometry":
@@ -239,6 +255,21 @@ class SearchNode(Node):
     def _reading(self, msg: Float32) -> None:
         with self._lock:
             self.cycle.on_reading(self._now(), float(msg.data))
+
+    def _on_wind(self, msg: Vector3Stamped) -> None:
+        self._guarded("wind", self._wind, msg)
+
+    def _wind(self, msg: Vector3Stamped) -> None:
+        if not self.scenario.anemometer.enabled:
+            if not self._wind_warned:
+                self._wind_warned = True
+                self.get_logger().warning(
+                    "wind readings ignored: the scenario has no [anemometer] (enabled = true)"
+                )
+            return
+        t = seconds(msg.header.stamp) or self._now()
+        with self._lock:
+            self.cycle.on_wind(t, msg.vector.x, msg.vector.y)
 
     def _on_map(self, msg: OccupancyGrid) -> None:
         self._guarded("map", self._map, msg)

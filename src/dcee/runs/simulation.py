@@ -176,10 +176,13 @@ class SearchSimulation:
         """The search's summary (:func:`search_summary`) under the name ``strategy``; with a
         ``[world]``, ``drives_into_obstacles`` (moves whose drive touched an obstacle or no-go
         zone: 0 unless something is wrong) and ``start_to_source_travel`` (m, the shortest way
-        round the obstacles, against which ``path_length`` compares)."""
+        round the obstacles, against which ``path_length`` compares); with an anemometer,
+        ``wind_readings``."""
         out = search_summary(
             self.records, self.scenario, strategy, self.seed, self.path_length, self.searcher
         )
+        if self.anemometer is not None:
+            out["wind_readings"] = self.wind_readings
         if self.site is not None:
             out["drives_into_obstacles"] = self.drives_into_obstacles
             out["start_to_source_travel"] = float(
