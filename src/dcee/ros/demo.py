@@ -3,8 +3,12 @@
     dcee-ros-demo --scenario lab:upwind --strategy infotaxis --seed 0 --particles 3000 \\
         --json s.json --record bag
 
-runs both nodes (one process, their own ROS context, simulated time on ``/clock``), prints the
-usual summary when the budget is spent, optionally writes it as JSON and records every topic
+runs both nodes (one process, their own ROS context, simulated time on ``/clock``) the way a
+robot's software would: the search node is a managed node that a mission client configures
+and activates through its lifecycle services, sends the scenario's obstacles as an occupancy
+grid on ``map``, and starts through ``dcee/start``; the simulated robot publishes odometry,
+readings and (with ``[anemometer]``) the wind. It prints the usual summary when the search
+ends (source localised or budget spent), optionally writes it as JSON and records every topic
 the search exchanges to an MCAP bag that ``dcee replay`` reprocesses. Keep it on this machine
 with ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`` (the demo sets it unless already set).
 """
@@ -44,6 +48,7 @@ def run_demo(
     domain_id: int | None = None,
     truth: str | None = None,
     likelihood: str | None = None,
+    overrides: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """Run the search node against the simulated robot until the budget is spent; returns the
     summary (:func:`dcee.runs.metrics.summarise` plus the message counts, the driven
@@ -67,6 +72,7 @@ def run_demo(
             "search.budget": budget,
             "truth.model": truth_choice(truth) if truth is not None else None,
             "estimator.likelihood": likelihood,
+            **(overrides or {}),
         }
     )
     if not speedup > 0:
@@ -77,7 +83,9 @@ def run_demo(
     nodes: list[Any] = []
     executor: Any = None
     try:
-        sim = SimRobotNode(scenario, seed, speedup=speedup, context=context)
+        # the robot's clock starts when the search does (the mission's dcee/start)
+        sim = SimRobotNode(scenario, seed, speedup=speedup, context=context, paused=True)
+        # the node learns the obstacles from the map topic, not from its scenario
         search = SearchNode(
             context=context,
             parameter_overrides=[
@@ -85,11 +93,13 @@ def run_demo(
                 Parameter("scenario", value=scenario_name),
                 Parameter("strategy", value=strategy),
                 Parameter("seed", value=seed),
+                Parameter("autostart", value=False),
             ],
             true_location=scenario.truth_theta()[:3],
-            scenario=scenario,
+            scenario=scenario.with_overrides(world={}),
         )
-        nodes = [sim, search]
+        mission = Mission(context, search.get_name(), scenario)
+        nodes = [sim, search, mission.node]
         counts = dict.fromkeys(RECORDED, 0)
         if writer is not None:
             recorder = rclpy.create_node("dcee_recorder", context=context)
@@ -113,7 +123,10 @@ def run_demo(
 
         spinner = threading.Thread(target=spin, daemon=True)
         spinner.start()
+        mission.start(timeout=min(timeout, 60.0))  # configure, activate, map, dcee/start
+        sim.paused = False
         search.done.wait(timeout)
+        mission.wait_for_result(timeout=10.0)
         sim.stop()  # no publication after this: the context can go
         context.try_shutdown()  # ends spin() between callbacks
         spinner.join(timeout=10.0)
@@ -135,6 +148,12 @@ def run_demo(
     summary.update(
         transport="ros2",
         finish_reason=search.finish_reason,
+        lifecycle=mission.transitions,
+        map_applied=search.maps_received,
+        wind_readings=cycle.wind_readings,
+        wind_messages=sim.wind_messages,
+        feedback_messages=mission.feedback,
+        result=mission.result,
         wall_seconds=wall,
         goals_received=sim.goals,
         dropped_readings=cycle.dropped_readings,
@@ -143,6 +162,94 @@ def run_demo(
     )
     summary["records"] = cycle.records
     return summary
+
+
+class Mission:
+    """What a robot's mission software does with the search node, over ROS: configure and
+    activate it through its lifecycle services (``<node>/change_state``), publish the site's
+    obstacles on ``map`` (latched), start a search with ``dcee/start``, count the
+    ``dcee/feedback`` messages and keep the ``dcee/result``."""
+
+    def __init__(self, context: Any, target: str, scenario: Any) -> None:
+        import rclpy
+        from lifecycle_msgs.srv import ChangeState
+        from nav_msgs.msg import OccupancyGrid
+        from std_msgs.msg import String
+        from std_srvs.srv import Trigger
+
+        from dcee.ros.node import LATCHED, RELIABLE
+
+        self.node = rclpy.create_node("dcee_mission", context=context)
+        self.scenario = scenario
+        self.change_state = self.node.create_client(ChangeState, f"{target}/change_state")
+        self.start_search = self.node.create_client(Trigger, "dcee/start")
+        self.map_pub = self.node.create_publisher(OccupancyGrid, "map", LATCHED)
+        self.transitions: list[str] = []
+        self.feedback = 0
+        self.result: dict[str, Any] | None = None
+        self._result_event = threading.Event()
+        self.node.create_subscription(String, "dcee/feedback", self._on_feedback, RELIABLE)
+        self.node.create_subscription(String, "dcee/result", self._on_result, LATCHED)
+
+    def _on_feedback(self, msg: Any) -> None:
+        self.feedback += 1
+
+    def _on_result(self, msg: Any) -> None:
+        import json
+
+        self.result = json.loads(msg.data)
+        self._result_event.set()
+
+    def _call(self, client: Any, request: Any, timeout: float) -> Any:
+        if not client.wait_for_service(timeout_sec=timeout):
+            raise DceeInputError("ros", f"service {client.srv_name} is not available")
+        future = client.call_async(request)
+        deadline = time.monotonic() + timeout
+        while not future.done() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        if not future.done():
+            raise DceeInputError("ros", f"service {client.srv_name} did not answer")
+        return future.result()
+
+    def start(self, timeout: float) -> None:
+        from lifecycle_msgs.msg import Transition
+        from lifecycle_msgs.srv import ChangeState
+        from std_srvs.srv import Trigger
+
+        for label, tid in (
+            ("configure", Transition.TRANSITION_CONFIGURE),
+            ("activate", Transition.TRANSITION_ACTIVATE),
+        ):
+            reply = self._call(
+                self.change_state, ChangeState.Request(transition=Transition(id=tid)), timeout
+            )
+            if not reply.success:
+                raise DceeInputError("ros", f"the search node refused to {label}")
+            self.transitions.append(label)
+        site = self.scenario.make_site()
+        if site is not None:
+            self.map_pub.publish(occupancy_grid(site))
+            time.sleep(0.2)  # latched: the node has it before the first decision
+        reply = self._call(self.start_search, Trigger.Request(), timeout)
+        if not reply.success:
+            raise DceeInputError("ros", f"dcee/start: {reply.message}")
+
+    def wait_for_result(self, timeout: float) -> None:
+        self._result_event.wait(timeout)
+
+
+def occupancy_grid(site: Any, frame_id: str = "map") -> Any:
+    """A :class:`~dcee.models.site.SiteMap` as a nav_msgs/OccupancyGrid (100 blocked, 0 free)."""
+    from nav_msgs.msg import OccupancyGrid
+
+    msg = OccupancyGrid()
+    msg.header.frame_id = frame_id
+    msg.info.resolution = float(site.resolution)
+    msg.info.height, msg.info.width = (int(v) for v in site.shape)
+    msg.info.origin.position.x, msg.info.origin.position.y = (float(v) for v in site.origin)
+    msg.info.origin.orientation.w = 1.0
+    msg.data = [100 if b else 0 for b in site.blocked.ravel()]
+    return msg
 
 
 def _record_topics(node: Any, writer: Any, counts: dict[str, int]) -> None:
@@ -195,6 +302,14 @@ def _record_topics(node: Any, writer: Any, counts: dict[str, int]) -> None:
     type=click.Choice(["paper", "fluctuation"]),
     help="The estimator's reading model (override estimator.likelihood).",
 )
+@click.option(
+    "--set",
+    "settings",
+    multiple=True,
+    metavar="PATH=VALUE",
+    help="Override any scenario setting (repeatable; VALUE is TOML), e.g. "
+    "--set anemometer.enabled=true.",
+)
 @click.option("--timeout", default=600.0, show_default=True, type=float, help="Wall s at most.")
 def cli(
     scenario_name: str,
@@ -207,10 +322,12 @@ def cli(
     budget: float | None,
     truth: str | None,
     likelihood: str | None,
+    settings: tuple[str, ...],
     timeout: float,
 ) -> None:
     """Search over ROS 2 topics: the dcee node against a simulated unicycle robot."""
     from dcee.io import check_writable_file, write_json
+    from dcee.scenarios.files import parse_setting
 
     if seed < 0:
         raise DceeInputError("seed", f"must be >= 0, got {seed}")
@@ -232,6 +349,7 @@ def cli(
         timeout,
         truth=truth,
         likelihood=likelihood,
+        overrides=dict(parse_setting(s) for s in settings),
     )
     summary.pop("records")
     if json_file is not None:
@@ -244,4 +362,4 @@ def main(argv: list[str] | None = None) -> None:
     run_command(cli, "dcee-ros-demo", argv)
 
 
-__all__ = ["RECORDED", "main", "run_demo"]
+__all__ = ["RECORDED", "Mission", "main", "occupancy_grid", "run_demo"]

@@ -47,6 +47,7 @@ concentrations are g/m³.
 
 from __future__ import annotations
 
+import json
 import math
 import threading
 from pathlib import Path
@@ -63,10 +64,11 @@ from geometry_msgs.msg import (
 )
 from nav_msgs.msg import OccupancyGrid, Odometry
 from nav_msgs.msg import Path as PathMsg
-from rclpy.node import Node
+from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSDurabilityPolicy, QoSProfile, QoSReliabilityPolicy
-from std_msgs.msg import Float32
+from std_msgs.msg import Float32, String
+from std_srvs.srv import Trigger
 from visualization_msgs.msg import Marker, MarkerArray
 
 from dcee.console import error_exit
@@ -108,6 +110,8 @@ PARAMETERS: dict[str, Any] = {
     # search.stop_hold (unset: spread below 0.15 x acquired_rmse for 60 s); stop_spread 0: never
     "stop_spread": -1.0,
     "stop_hold": -1.0,
+    # configure and activate at start (a node without a lifecycle manager); false: wait for one
+    "autostart": True,
 }
 
 
@@ -119,13 +123,30 @@ def seconds(stamp: Any) -> float:
     return stamp.sec + stamp.nanosec * 1e-9
 
 
-class SearchNode(Node):
-    """The search cycle as a ROS 2 node. ``true_location`` (3,) m, when known (a simulation),
-    gives the records an RMSE; ``scenario`` (a :class:`~dcee.scenarios.Scenario`)
-    replaces the ``scenario`` and ``particles`` parameters when the node is built from Python.
-    :attr:`done` is set when the search is over: the budget is spent or the source localised
-    (the scenario's stop rule, on by default on a robot: ``search.stop_spread``;
-    :attr:`finish_reason` says which)."""
+class SearchNode(LifecycleNode):
+    """The search cycle as a managed (lifecycle) ROS 2 node.
+
+    Lifecycle: *configure* reads the parameters and the scenario (a bad value fails the
+    transition with a one-line log); *activate* starts processing inputs; *deactivate* pauses
+    the search (inputs are ignored, nothing is published); *cleanup* drops it. With
+    ``autostart`` (the default) the node configures and activates itself at start and
+    searches at once, as a node without a lifecycle manager; with ``-p autostart:=false`` a
+    lifecycle manager (Nav2's ``lifecycle_manager``, ``ros2 lifecycle set``) drives it and a
+    search starts on ``dcee/start``.
+
+    The search contract, the service-and-topic form of ``action/SearchSource.action``:
+    ``dcee/start`` (std_srvs/Trigger) begins a new search with a fresh belief once the last
+    one is over; ``dcee/cancel`` (Trigger) ends the running one; ``dcee/feedback``
+    (std_msgs/String, JSON: state, readings, mean, spread, elapsed) after every reading;
+    ``dcee/result`` (std_msgs/String, JSON, latched: success, reason, mean, covariance,
+    readings) when a search ends. The area and budget are the scenario's.
+
+    ``true_location`` (3,) m, when known (a simulation), gives the records an RMSE;
+    ``scenario`` (a :class:`~dcee.scenarios.Scenario`) replaces the ``scenario`` and
+    ``particles`` parameters when the node is built from Python. :attr:`done` is set when a
+    search is over: the budget is spent, the source localised (the scenario's stop rule, on by
+    default on a robot: ``search.stop_spread``), it was cancelled or failed
+    (:attr:`finish_reason` says which)."""
 
     def __init__(
         self,
@@ -140,8 +161,79 @@ class SearchNode(Node):
         for key, default in PARAMETERS.items():
             if not self.has_parameter(key):
                 self.declare_parameter(key, default)
+        self._true_location = true_location
+        self._given_scenario = scenario
+        self.searcher: Searcher | None = None
+        self.cycle: SearchCycle | None = None
+        self.active = False
+        """inputs are processed and outputs published only while active"""
+        self.done = threading.Event()
+        self.finish_reason = ""
+        """why the last search ended: "budget", "localised" (the stop rule), "cancelled" or
+        "error" (:data:`MAX_CONSECUTIVE_ERRORS` unexpected callback errors in a row)"""
+        self.searches_started = 0
+        self.callback_errors = 0
+        """unexpected errors caught inside callbacks (each logged; the search went on)"""
+        self.maps_received = 0
+        """occupancy grids applied from the ``map`` topic"""
+        self.configure_error: str | None = None
+        """why the last configure transition failed (one line)"""
+        self._errors_in_a_row = 0
+        self._rejected_reported = 0
+        self._wind_warned = False
+        self._lock = threading.Lock()
+        self._last_pose: Pose | None = None
+        self._map_site: Any = None
+        self.create_service(Trigger, "dcee/start", self._on_start)
+        self.create_service(Trigger, "dcee/cancel", self._on_cancel)
+        self._autostarting = bool(self.get_parameter("autostart").value)
+        if self._autostarting:
+            self.trigger_configure()  # a failure raises below: one line, no log
+            if self.configure_error is not None:
+                raise DceeInputError(*self.configure_error.split(": ", 1))
+            self.trigger_activate()
+        self._autostarting = False
+
+    # --- lifecycle ------------------------------------------------------------------------------
+
+    def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
+        try:
+            self._configure()
+        except DceeInputError as exc:
+            self.configure_error = f"{exc.field}: {exc.message}"
+            if not self._autostarting:
+                self.get_logger().error(f"cannot configure: {self.configure_error}")
+            return TransitionCallbackReturn.FAILURE
+        self.configure_error = None
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.active = True
+        if self._autostarting and self.searches_started == 0:
+            self._new_search()  # a node on its own searches at once; a managed one on dcee/start
+        return super().on_activate(state)
+
+    def on_deactivate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.active = False
+        return super().on_deactivate(state)
+
+    def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.active = False
+        self.searcher = self.cycle = None
+        self.searches_started = 0
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
+        if self.cycle is not None and not self.done.is_set():
+            self._finish("cancelled")
+        self.active = False
+        return TransitionCallbackReturn.SUCCESS
+
+    def _configure(self) -> None:
+        """Read the parameters and the scenario, create the publishers and subscriptions."""
         p = {key: self.get_parameter(key).value for key in PARAMETERS}
         self.params = p
+        scenario = self._given_scenario
         if scenario is None:
             scenario = load_scenario(str(p["scenario"]))
         if int(p["particles"]) > 0:
@@ -151,22 +243,7 @@ class SearchNode(Node):
                 scenario = scenario.with_overrides(**{f"search.{key}": float(p[key])})
         if p["pose_type"] not in ("odometry", "pose_with_covariance"):
             raise DceeInputError("pose_type", "must be odometry or pose_with_covariance")
-        self.scenario = scenario
-        self.frame_id = str(p["frame_id"])
-        checkpoint = str(p["checkpoint"])
-        self.checkpoint = Path(checkpoint) if checkpoint else None
-        if self.checkpoint is not None and self.checkpoint.exists():
-            searcher = Searcher.load(self.checkpoint)
-            self.get_logger().info(f"resumed the search from {self.checkpoint}")
-        else:
-            from dcee.planning import get as get_planner
-
-            strategy = str(p["strategy"])
-            planner = get_planner(strategy, **planner_defaults(strategy, scenario, None))
-            _, filter_rng, planner_rng, _ = streams(int(p["seed"]))
-            searcher = make_searcher(scenario, planner, filter_rng, planner_rng)
-        self.searcher = searcher
-        settings = CycleSettings.from_scenario(
+        self.settings = CycleSettings.from_scenario(
             scenario,
             calibration=float(p["calibration"]),
             goal_tolerance=float(p["goal_tolerance"]),
@@ -174,24 +251,13 @@ class SearchNode(Node):
             settle_turn_rate=math.radians(float(p["settle_turn_rate"])),
             settle_time=float(p["settle_time"]),
         )
-        self.cycle = SearchCycle(
-            searcher,
-            settings,
-            true_location=true_location,
-            wind_period=scenario.anemometer.period,
-        )
-        self.done = threading.Event()
-        self.finish_reason = ""
-        """why the search ended: "budget", "localised" (the stop rule; docs/guide/robot.md) or
-        "error" (:data:`MAX_CONSECUTIVE_ERRORS` unexpected callback errors in a row)"""
-        self.callback_errors = 0
-        """unexpected errors caught inside callbacks (each logged; the search went on)"""
-        self._errors_in_a_row = 0
-        self._rejected_reported = 0
-        self._lock = threading.Lock()
-        self._last_pose: Pose | None = None
+        self.scenario = scenario
+        self.frame_id = str(p["frame_id"])
+        checkpoint = str(p["checkpoint"])
+        self.checkpoint = Path(checkpoint) if checkpoint else None
         self._marker_rng = np.random.default_rng(int(p["seed"]) + 1)
-
+        if getattr(self, "goal_pub", None) is not None:
+            return  # reconfigured after a cleanup: the topics are already there
         self.goal_pub = self.create_publisher(PoseStamped, str(p["goal_topic"]), LATCHED)
         self.estimate_pub = self.create_publisher(PointStamped, "dcee/estimate", RELIABLE)
         self.cov_pub = self.create_publisher(
@@ -199,24 +265,74 @@ class SearchNode(Node):
         )
         self.particles_pub = self.create_publisher(MarkerArray, "dcee/particles", RELIABLE)
         self.path_pub = self.create_publisher(PathMsg, "dcee/path", RELIABLE)
+        self.feedback_pub = self.create_publisher(String, "dcee/feedback", RELIABLE)
+        self.result_pub = self.create_publisher(String, "dcee/result", LATCHED)
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE)
         self.create_timer(1.0, lambda: self._guarded("diagnostics", self._publish_diagnostics))
-        self.path_msg = PathMsg()
-        self.path_msg.header.frame_id = self.frame_id
         self.create_subscription(
             Float32, str(p["concentration_topic"]), self._on_concentration, RELIABLE
         )
         self.create_subscription(OccupancyGrid, str(p["map_topic"]), self._on_map, LATCHED)
         self.create_subscription(Vector3Stamped, str(p["wind_topic"]), self._on_wind, RELIABLE)
-        self._wind_warned = False
-        self.maps_received = 0
-        """occupancy grids applied from the ``map`` topic"""
         if p["pose_type"] == "odometry":
             self.create_subscription(Odometry, str(p["pose_topic"]), self._on_odometry, RELIABLE)
         else:
             self.create_subscription(
                 PoseWithCovarianceStamped, str(p["pose_topic"]), self._on_pose_cov, RELIABLE
             )
+
+    def _new_search(self) -> None:
+        """A fresh search (resumed from the checkpoint file when there is one, the first time)."""
+        p, scenario = self.params, self.scenario
+        if self.searches_started == 0 and self.checkpoint is not None and self.checkpoint.exists():
+            searcher = Searcher.load(self.checkpoint)
+            self.get_logger().info(f"resumed the search from {self.checkpoint}")
+        else:
+            from dcee.planning import get as get_planner
+
+            strategy = str(p["strategy"])
+            planner = get_planner(strategy, **planner_defaults(strategy, scenario, None))
+            seed = int(p["seed"]) + self.searches_started
+            _, filter_rng, planner_rng, _ = streams(seed)
+            searcher = make_searcher(scenario, planner, filter_rng, planner_rng)
+        if self._map_site is not None:  # the map topic's obstacles outlive a search
+            import dataclasses
+
+            searcher.agent = dataclasses.replace(searcher.agent, site=self._map_site)
+        with self._lock:
+            self.searcher = searcher
+            self.cycle = SearchCycle(
+                searcher,
+                self.settings,
+                true_location=self._true_location,
+                wind_period=scenario.anemometer.period,
+            )
+            self.path_msg = PathMsg()
+            self.path_msg.header.frame_id = self.frame_id
+            self.finish_reason = ""
+            self.done.clear()
+            self._last_pose = None
+            self._rejected_reported = 0
+        self.searches_started += 1
+
+    def _on_start(self, request: Any, response: Any) -> Any:
+        if not self.active:
+            response.success, response.message = False, "not active (configure and activate)"
+        elif self.cycle is not None and not self.done.is_set():
+            response.success, response.message = False, "a search is running (cancel it first)"
+        else:
+            self._new_search()
+            response.success, response.message = True, f"search {self.searches_started} started"
+        return response
+
+    def _on_cancel(self, request: Any, response: Any) -> Any:
+        if self.cycle is None or self.done.is_set():
+            response.success, response.message = False, "no search is running"
+        else:
+            with self._lock:
+                self._finish("cancelled")
+            response.success, response.message = True, "search cancelled"
+        return response
 
     # --- inputs -------------------------------------------------------------------------------
 
@@ -241,6 +357,8 @@ class SearchNode(Node):
         self._report_rejections()
 
     def _report_rejections(self) -> None:
+        if self.cycle is None:
+            return
         total = sum(self.cycle.rejected.values())
         if total > self._rejected_reported:
             self._rejected_reported = total
@@ -254,7 +372,8 @@ class SearchNode(Node):
 
     def _reading(self, msg: Float32) -> None:
         with self._lock:
-            self.cycle.on_reading(self._now(), float(msg.data))
+            if self.active and self.cycle is not None:
+                self.cycle.on_reading(self._now(), float(msg.data))
 
     def _on_wind(self, msg: Vector3Stamped) -> None:
         self._guarded("wind", self._wind, msg)
@@ -269,7 +388,8 @@ class SearchNode(Node):
             return
         t = seconds(msg.header.stamp) or self._now()
         with self._lock:
-            self.cycle.on_wind(t, msg.vector.x, msg.vector.y)
+            if self.active and self.cycle is not None:
+                self.cycle.on_wind(t, msg.vector.x, msg.vector.y)
 
     def _on_map(self, msg: OccupancyGrid) -> None:
         self._guarded("map", self._map, msg)
@@ -297,7 +417,7 @@ class SearchNode(Node):
             tuple(sc.volume.low[:2]),
             tuple(sc.volume.high[:2]),
             maps=[grid],
-            resolution=sc.world.resolution,
+            resolution=sc.site_resolution,
             clearance=sc.world.clearance,
             name="map topic",
         )
@@ -305,7 +425,9 @@ class SearchNode(Node):
         if own is not None:
             site.blocked |= own.blocked
         with self._lock:
-            self.searcher.agent = dataclasses.replace(self.searcher.agent, site=site)
+            self._map_site = site
+            if self.searcher is not None:
+                self.searcher.agent = dataclasses.replace(self.searcher.agent, site=site)
         self.maps_received += 1
         self.get_logger().info(
             f"map applied: {info.width} x {info.height} cells of {info.resolution:g} m, "
@@ -346,7 +468,7 @@ class SearchNode(Node):
 
     def _step(self, pose: Pose) -> None:
         with self._lock:
-            if self.done.is_set():
+            if not self.active or self.cycle is None or self.done.is_set():
                 return
             dropped = sum(self.cycle.rejected.values())
             out = self.cycle.on_pose(pose)
@@ -361,6 +483,7 @@ class SearchNode(Node):
             )
         if out.record is not None:
             self._publish_belief(out.record)
+            self._publish_feedback(out.record)
             if self.checkpoint is not None:
                 self.searcher.save(self.checkpoint)
         if out.goal is not None:
@@ -369,19 +492,50 @@ class SearchNode(Node):
             self._finish(out.reason)
 
     def _finish(self, reason: str) -> None:
-        """End the search: log why and the estimate, publish the diagnostics, set :attr:`done`."""
+        """End the search: log why and the estimate, publish the result and the diagnostics,
+        set :attr:`done`."""
         self.finish_reason = reason
         self.cycle.state = "done"
-        why = {"localised": "source localised", "budget": "budget spent"}.get(
-            reason, f"{MAX_CONSECUTIVE_ERRORS} callback errors in a row"
-        )
+        why = {
+            "localised": "source localised",
+            "budget": "budget spent",
+            "cancelled": "cancelled",
+        }.get(reason, f"{MAX_CONSECUTIVE_ERRORS} callback errors in a row")
         est = self.searcher.estimate()
         self.get_logger().info(
             f"search finished ({why}): {len(self.cycle.records)} readings, source estimate "
             f"({est.mean[0]:.2f}, {est.mean[1]:.2f}) m, spread {est.spread:.2f} m"
         )
+        self.result_pub.publish(String(data=json.dumps(self.result())))
         self.done.set()
         self._publish_diagnostics()
+
+    def result(self) -> dict[str, Any]:
+        """The search's result (the ``dcee/result`` message): ``success`` (the source was
+        localised or the budget spent with a reading; False when cancelled or failed),
+        ``reason``, the estimate's ``mean`` (3,) m and location ``covariance`` (3 × 3) m²,
+        ``spread`` m, ``readings``."""
+        est = self.searcher.estimate()
+        readings = len(self.cycle.records)
+        return {
+            "success": self.finish_reason in ("localised", "budget") and readings > 0,
+            "reason": self.finish_reason,
+            "mean": [float(v) for v in est.mean],
+            "covariance": [[float(v) for v in row] for row in est.cov],
+            "spread": float(est.spread),
+            "readings": readings,
+        }
+
+    def _publish_feedback(self, record: dict[str, Any]) -> None:
+        est = self.searcher.estimate()
+        feedback = {
+            "state": self.cycle.state,
+            "readings": len(self.cycle.records),
+            "mean": [float(v) for v in est.mean],
+            "spread": float(est.spread),
+            "elapsed": float(record["time"]),
+        }
+        self.feedback_pub.publish(String(data=json.dumps(feedback)))
 
     def diagnostics(self) -> DiagnosticStatus:
         """The search's state and its input health as one DiagnosticStatus: WARN once input
@@ -389,6 +543,11 @@ class SearchNode(Node):
         status = DiagnosticStatus()
         status.name = f"{self.get_name()}: source search"
         status.hardware_id = "dcee"
+        if self.cycle is None:
+            status.level = DiagnosticStatus.OK
+            status.message = "configured, no search yet" if self.active else "inactive"
+            status.values = [KeyValue(key="state", value="inactive")]
+            return status
         rejected = self.cycle.rejected
         if self.callback_errors:
             status.level = DiagnosticStatus.ERROR

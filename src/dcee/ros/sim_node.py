@@ -11,11 +11,12 @@ elsewhere delays the timer, and simulated time then simply waits: the robot neve
 
 from __future__ import annotations
 
+import math
 import threading
 from typing import Any
 
 import numpy as np
-from geometry_msgs.msg import PoseStamped
+from geometry_msgs.msg import PoseStamped, Vector3Stamped
 from nav_msgs.msg import Odometry
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
@@ -24,6 +25,7 @@ from std_msgs.msg import Float32
 from dcee.robot.bag import quaternion_of
 from dcee.robot.simulated import SimulatedRobot
 from dcee.ros.node import LATCHED, RELIABLE
+from dcee.runs.streams import anemometer_stream
 from dcee.scenarios import Scenario
 
 
@@ -47,6 +49,7 @@ class SimRobotNode(Node):
         context: Any = None,
         truth: Any = None,
         name: str = "dcee_sim_robot",
+        paused: bool = False,
     ) -> None:
         super().__init__(name, context=context)
         self.robot = SimulatedRobot(scenario, seed, truth)
@@ -54,11 +57,21 @@ class SimRobotNode(Node):
         self.clock_pub = self.create_publisher(Clock, "/clock", 10)
         self.odom_pub = self.create_publisher(Odometry, "odom", RELIABLE)
         self.conc_pub = self.create_publisher(Float32, "concentration", RELIABLE)
+        # the anemometer (when the scenario has one): the truth's mean wind with its noise,
+        # as the air's velocity in the map frame, at 10 Hz of simulated time
+        self.anemometer = scenario.make_anemometer()
+        self.wind_pub = self.create_publisher(Vector3Stamped, "wind", RELIABLE)
+        self._wind_rng = anemometer_stream(seed)
+        self._next_wind = 0.0
+        self.wind_messages = 0
         self.create_subscription(PoseStamped, "goal_pose", self._on_goal, LATCHED)
         self.goals = 0
         self._lock = threading.Lock()
         self._stopped = False
-        self._publish()
+        self.paused = paused
+        """while True the robot's clock stands still and nothing is published"""
+        if not paused:
+            self._publish()
         self.timer = self.create_timer(self.robot.control_dt / speedup, self._tick)
 
     def _on_goal(self, msg: Any) -> None:
@@ -68,7 +81,7 @@ class SimRobotNode(Node):
 
     def _tick(self) -> None:
         with self._lock:
-            if self._stopped:
+            if self._stopped or self.paused:
                 return
             self.robot.step()
             self._publish()
@@ -99,6 +112,18 @@ class SimRobotNode(Node):
         odom.pose.covariance = [float(v) for v in cov.ravel()]
         odom.twist.twist.linear.x = s.v
         odom.twist.twist.angular.z = s.omega
+        if self.anemometer is not None and r.time >= self._next_wind - 1e-9:
+            self._next_wind = r.time + 0.1
+            truth = r.scenario.truth_theta()
+            speed, direction = self.anemometer.simulate(truth[4], truth[5], self._wind_rng)
+            wind = Vector3Stamped()
+            wind.header.stamp = stamp
+            wind.header.frame_id = self.frame_id
+            # from direction phi: the air moves towards phi + pi
+            wind.vector.x = -speed * math.cos(direction)
+            wind.vector.y = -speed * math.sin(direction)
+            self.wind_pub.publish(wind)
+            self.wind_messages += 1
         # the reading first: the search node completes a hold on the pose that follows it
         self.conc_pub.publish(Float32(data=r.sample()))
         self.odom_pub.publish(odom)

@@ -39,7 +39,7 @@ def _site(
         high,
         shapes_of(world.obstacles) + shapes_of(world.no_go),
         maps,
-        world.resolution,
+        float(world.resolution),
         world.clearance,
         name=Path(world.map).name if world.map else "world",
     )
@@ -165,9 +165,14 @@ class ScenarioBuilders:
         return _site(
             tuple(self.volume.low[:2]),
             tuple(self.volume.high[:2]),
-            self.world.model_dump_json(),
+            self.world.model_copy(update={"resolution": self.site_resolution}).model_dump_json(),
             mtime,
         )
+
+    @property
+    def site_resolution(self: Scenario) -> float:
+        """m, the cell side of the site's grid: ``world.resolution``, or a quarter step."""
+        return self.world.resolution or self.agent.step / 4.0
 
     def in_obstacle(self: Scenario, xy: np.ndarray) -> np.ndarray:
         """(K,) bool: the (K, 2) points lie inside an obstacle or no-go zone itself (the shapes

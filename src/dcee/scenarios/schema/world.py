@@ -85,9 +85,10 @@ class WorldSpec(BaseModel):
     ``resolution``, ``origin``, ``negate``, ``occupied_thresh``, ``free_thresh``) beside its
     PGM/PNG; occupied and unknown cells are obstacles (a relative path is taken from the
     working directory)"""
-    resolution: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.5
+    resolution: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] | None = None
     """m: cell side of the grid the shapes are drawn on and the paths are found on (a cell is
-    blocked when a shape comes within half a cell of its centre)"""
+    blocked when a shape comes within half a cell of its centre); None: a quarter of
+    ``agent.step`` (0.5 m at the paper's 2 m steps, 0.075 m in the lab)"""
     clearance: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 0.0
     """m: every obstacle and zone grown by this much (the robot's radius plus a margin)"""
 
