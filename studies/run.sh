@@ -88,6 +88,18 @@ case "${1:---list}" in
     $P studies/stop_rule_table.py results/stop-held-out-wind-known results/stop-held-out-full \
       results/stop-held-out-filament --csv docs/results/stop-rule/stop_rule.csv
     $P studies/publish_tables.py ;;
+  sites)  # every planner around obstacles (wall, passage, no-go zone), grid and unicycle
+    bash studies/study_sites.sh
+    mkdir -p docs/results/sites
+    $P studies/sites_table.py results/sites results/sites-mcts results/sites-robot \
+      --csv docs/results/sites/sites.csv
+    $P studies/publish_tables.py ;;
+  anemometer)  # the full-unknown study with and without a measured wind (paired)
+    bash studies/study_anemometer.sh
+    mkdir -p docs/results/anemometer
+    $P studies/anemometer_table.py results/anemometer-off results/anemometer-on \
+      --csv docs/results/anemometer/anemometer.csv
+    $P studies/publish_tables.py ;;
   publish)  # the tables of README.md, docs/index.md, docs/results.md from docs/results/
     $P studies/publish_tables.py ;;
   stonesoup-mcts)  # our tree search against Stone Soup's MCTS on its own example

@@ -44,6 +44,13 @@ SUITES: dict[str, dict] = {
         "configs": ["lab:downwind", "lab:upwind"],
         "overrides": {"agent.model": "unicycle"},
     },
+    # sites with obstacles (issue 32): a wall, a narrow passage, a no-go zone around the source;
+    # designed for the study, no default chosen on them; "sites-robot" with the unicycle robot
+    "sites": {"configs": ["site:wall", "site:passage", "site:nogo"], "overrides": {}},
+    "sites-robot": {
+        "configs": ["site:wall", "site:passage", "site:nogo"],
+        "overrides": {"agent.model": "unicycle"},
+    },
     "random-tune": {"configs": [f"random:{k}" for k in range(1, 41)], "overrides": {}},
     "held-out": {
         "configs": [
