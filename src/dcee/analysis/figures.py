@@ -32,6 +32,30 @@ def plume_map(
     return xs, ys, truth.field(pts, time).reshape(gy.shape)
 
 
+def _draw_site(ax: plt.Axes, scenario: Scenario) -> None:
+    """The ``[world]``'s blocked cells (obstacles and no-go zones, grown by the grid's half
+    cell and the clearance, as the planners see them), hatched grey."""
+    site = scenario.make_site()
+    if site is None or not site.blocked.any():
+        return
+    ny, nx = site.shape
+    r = site.resolution
+    xs = site.origin[0] + np.arange(nx + 1) * r
+    ys = site.origin[1] + np.arange(ny + 1) * r
+    ax.pcolormesh(
+        xs,
+        ys,
+        np.ma.masked_where(~site.blocked, np.ones(site.shape)),
+        cmap="Greys",
+        vmin=0,
+        vmax=1.6,
+        shading="flat",
+        rasterized=True,
+        zorder=2,
+    )
+    ax.plot([], [], "s", color="0.6", label="obstacle / no-go zone")
+
+
 def _draw_map(
     ax: plt.Axes,
     result: EpisodeResult,
@@ -54,6 +78,7 @@ def _draw_map(
     )
     if conc.min() < thr < conc.max():
         ax.contour(xs, ys, conc, levels=[thr], colors="k", linewidths=0.6, linestyles="--")
+    _draw_site(ax, scenario)
     recs = [r for r in result.records if r["time"] <= until + 1e-9]
     ax.scatter(
         particles[:, 0],
