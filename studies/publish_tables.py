@@ -411,6 +411,62 @@ def stop_rule_table() -> str:
     )
 
 
+def sites_table() -> str:
+    frame = pd.read_csv(RESULTS / "sites" / "sites.csv")
+    rows = []
+    for _, r in frame.iterrows():
+        rows.append(
+            [
+                f"`{r['scenario']}`",
+                f"`{r['strategy']}`",
+                str(r["motion"]),
+                acquired(r),
+                rmse(r),
+                f"{r['straight']:.0f} / {r['round']:.0f}",
+                f"{r['path_length']:.0f}",
+                f"{int(r['positions_inside'])} / {int(r['drives_into_obstacles'])}",
+                f"{r['longest_stall']:.0f}",
+            ]
+        )
+    return table(
+        [
+            "site",
+            "planner",
+            "motion",
+            "source acquired",
+            "median final RMSE (m)",
+            "start → source: straight / round the obstacles (m)",
+            "median path flown (m)",
+            "positions / drives inside an obstacle",
+            "longest stall (s)",
+        ],
+        rows,
+    )
+
+
+def anemometer_table() -> str:
+    frame = pd.read_csv(RESULTS / "anemometer" / "anemometer.csv")
+    p = pd.read_csv(RESULTS / "anemometer" / "paired.csv").iloc[0]
+    rows = []
+    for _, r in frame.iterrows():
+        rows.append([str(r["arm"]), acquired(r), rmse(r), time_to_1m(r)])
+    out = table(
+        [
+            "`dcee-cl`, all eight unknown",
+            "source acquired",
+            "median final RMSE (m)",
+            "median time to RMSE < 1 m (s)",
+        ],
+        rows,
+    )
+    return out + (
+        f"\nPaired over {int(p['pairs'])} searches (with − without): time to 1 m "
+        f"{p['time_to_1m_difference']:+.0f} s median (Wilcoxon p = {p['time_wilcoxon_p']:.2g}; "
+        f"sooner in {int(p['sooner'])}, later in {int(p['later'])}); final RMSE "
+        f"{p['final_rmse_difference']:+.3f} m (p = {p['rmse_wilcoxon_p']:.2g}).\n"
+    )
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "what-we-found": what_we_found,
     "wind-known": public_table("paper-source", "public-wind-known-dcee-cl"),

@@ -231,3 +231,49 @@ def test_the_unicycle_stays_clear_of_the_raw_shapes():
         travel = motion.travel(pose, np.array(goal))
         assert not WALL.contains(travel.path[:, 1:3]).any()
         pose = travel.pose
+
+
+@pytest.mark.parametrize(
+    ("setting", "field"),
+    [
+        ('world.map="missing.yaml"', "world.map"),
+        ("world.obstacles=[{kind='circle',center=[2,2],radius=1}]", "agent.start"),
+        ("world.obstacles=[{kind='circle',center=[37.5,12.5],radius=1}]", "truth"),
+        (
+            "world.obstacles=[{kind='rectangle',low=[30,5],high=[45,6]},"
+            "{kind='rectangle',low=[30,19],high=[45,20]},{kind='rectangle',low=[30,5],high=[31,20]},"
+            "{kind='rectangle',low=[44,5],high=[45,20]}]",
+            "world",
+        ),
+    ],
+)
+def test_a_bad_world_is_one_line_exit_2_before_any_work(tmp_path, capsys, setting, field):
+    from tests.helpers import run_cli
+
+    out = tmp_path / "run"
+    code, _, err = run_cli(
+        ["run", "--scenario", "paper:1", "--set", setting, "--out", str(out)], capsys
+    )
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and f"error: {field}" in lines[0]
+    assert not out.exists()
+
+
+def test_a_malformed_map_file_is_one_line_exit_2(tmp_path, capsys):
+    from tests.helpers import run_cli
+
+    (tmp_path / "site.yaml").write_text("image: site.pgm\nresolution: 0.1\norigin: [0, 0, 0]\n")
+    (tmp_path / "site.pgm").write_bytes(b"not an image")
+    code, _, err = run_cli(
+        [
+            "run",
+            "--scenario",
+            "paper:1",
+            "--set",
+            f'world.map="{tmp_path / "site.yaml"}"',
+            "--out",
+            str(tmp_path / "run"),
+        ],
+        capsys,
+    )
+    assert code == 2 and "cannot be read" in err and len(err.strip().splitlines()) == 1
