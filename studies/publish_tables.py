@@ -97,6 +97,8 @@ def time_to_1m(r: pd.Series) -> str:
         return "—"  # not in the published table the results were transcribed from
     if r["reached_1m"] == 0:
         return "never"
+    if math.isinf(r["time_to_1m"]):  # fewer than half got there: no median within the budget
+        return f"> budget ({100 * r['reached_1m']:.0f} % got there)"
     v = interval(r, "time_to_1m", ".0f")
     if r["reached_1m"] < 1:
         v += f" ({100 * r['reached_1m']:.0f} % got there)"
