@@ -333,8 +333,20 @@ def test_show_prints_every_setting_that_changes_results(capsys):
         "# dwell = 1.0",
         "# average = 0.0",
         "# dropout = 0.3",
+        "# stop_spread =  (unset: on a robot 0.15 x acquired_rmse = 0.45 m",
+        "# resolution = 0.5",
+        "# map =  (unset",
+        "stop_hold = 60.0",
     ):
         assert line in out
+    # every field of every section of the schema is printed, set or as a comment
+    from dcee.scenarios import load_scenario
+
+    sc = load_scenario("paper:1")
+    for section, model in sc:
+        if hasattr(type(model), "model_fields") and section not in ("truth", "prior"):
+            for field in type(model).model_fields:
+                assert f"\n{field} = " in out or f"\n# {field} = " in out, (section, field)
 
 
 def test_misspellings_get_one_line_with_the_closest_match(tmp_path, capsys):

@@ -12,6 +12,7 @@ from typing import Any
 from dcee.errors import DceeInputError
 from dcee.scenarios.builtin import builtin_scenarios, random_configuration, random_family_name
 from dcee.scenarios.schema import Scenario, validate_scenario
+from dcee.stopping import DEFAULT_STOP_SHARE
 
 
 def expand_names(names: list[str]) -> list[str]:
@@ -115,6 +116,15 @@ def to_toml(scenario: Scenario) -> str:
         ("estimator", "meander"): scenario.meander,
         ("estimator", "reading_weight"): scenario.reading_weight,
         ("agent", "dwell"): scenario.dwell,
+        ("world", "resolution"): scenario.site_resolution,
+    }
+    # unset with no single resolved value: what unset means, in words
+    unset = {
+        ("search", "stop_spread"): (
+            f"unset: on a robot {DEFAULT_STOP_SHARE:g} x acquired_rmse = "
+            f"{DEFAULT_STOP_SHARE * scenario.search.acquired_rmse:g} m, in a simulation never"
+        ),
+        ("world", "map"): "unset: no occupancy-grid map",
     }
     lines = [f"# dcee scenario {scenario.name}"]
     tables = []
@@ -131,6 +141,9 @@ def to_toml(scenario: Scenario) -> str:
         for (section, k), v in resolved.items():
             if section == key and k not in table:
                 lines.append(f"# {k} = {_toml_value(v)}  (unset: the default for this scenario)")
+        for (section, k), words in unset.items():
+            if section == key and k not in table:
+                lines.append(f"# {k} =  ({words})")
     return "\n".join(lines) + "\n"
 
 
