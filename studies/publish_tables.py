@@ -425,7 +425,7 @@ def sites_table() -> str:
                 acquired(r),
                 rmse(r),
                 f"{r['straight']:.0f} / {r['round']:.0f}",
-                f"{r['path_length']:.0f}",
+                f"{r['to_near']:.0f} ({100 * r['reached_near']:.0f} % got there)",
                 f"{int(r['positions_inside'])} / {int(r['drives_into_obstacles'])}",
                 f"{r['longest_stall']:.0f}",
             ]
@@ -438,7 +438,7 @@ def sites_table() -> str:
             "source acquired",
             "median final RMSE (m)",
             "start → source: straight / round the obstacles (m)",
-            "median path flown (m)",
+            "median way flown until within 8 m of it (m)",
             "positions / drives inside an obstacle",
             "longest stall (s)",
         ],
