@@ -5,8 +5,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-.venv/bin/ruff check src tests examples studies scripts
-.venv/bin/ruff format --check src tests examples studies scripts
+.venv/bin/ruff check src tests examples studies scripts ros
+.venv/bin/ruff format --check src tests examples studies scripts ros
 .venv/bin/python -m pytest -q "$@"
 bash scripts/test-ros.sh
 DOCS_OUT=${DOCS_OUT:-$(mktemp -d)/site} bash scripts/docs.sh
