@@ -55,12 +55,12 @@ def test_open_space_distances_are_exactly_straight():
 
 
 def test_the_way_round_a_wall_within_the_grid_error():
-    """From (10, 10) to (30, 10) round the north end of the wall x 20-21, y 0-40 (grown by
-    half a cell): the shortest path touches the wall's two top corners. The 16-connected grid
-    path is at most 2.7 % longer than it and never shorter."""
+    """From (10, 10) to (30, 10) round the north end of the wall x 20-21, y 0-40 (grown by a
+    cell's circumradius): the shortest path touches the wall's two top corners. The
+    16-connected grid path is at most 2.7 % longer than it and never shorter."""
     r = 0.25
     site = _wall_site(r)
-    m = 0.5 * r  # the half cell the shapes are grown by
+    m = math.sqrt(2) / 2 * r  # the cell circumradius the shapes are grown by
     c1, c2 = (20.0 - m, 40.0 + m), (21.0 + m, 40.0 + m)
     exact = math.dist((10, 10), c1) + math.dist(c1, c2) + math.dist(c2, (30, 10))
     d = float(site.travel_distance(np.array([10.0, 10.0]), np.array([[30.0, 10.0]]))[0])
@@ -221,7 +221,7 @@ def test_no_search_enters_or_crosses_a_blocked_cell(name, strategy):
 
 def test_the_unicycle_stays_clear_of_the_raw_shapes():
     """The unicycle's pure-pursuit drive between two clear waypoints deviates from the straight
-    segment by centimetres: with the half-cell margin every sample of its path stays outside
+    segment by centimetres: with every touched cell blocked every sample of its path stays outside
     the shapes themselves."""
     site = _wall_site(0.5)
     motion = UnicycleMotion(max_speed=2.0, max_accel=2.0, time_limit=30.0)
@@ -277,3 +277,19 @@ def test_a_malformed_map_file_is_one_line_exit_2(tmp_path, capsys):
         capsys,
     )
     assert code == 2 and "cannot be read" in err and len(err.strip().splitlines()) == 1
+
+
+def test_every_point_of_a_shape_lies_in_a_blocked_cell():
+    """The rasterisation is conservative: random points inside a disk, a thin diagonal polygon
+    and a rectangle all fall in blocked cells (else a robot could stand inside a shape)."""
+    rng = np.random.default_rng(0)
+    shapes = [
+        Circle((30.0, 30.0), 5.0),
+        Polygon(((5.0, 5.0), (20.0, 19.0), (20.3, 18.7), (5.3, 4.7))),  # a 0.4 m diagonal wall
+        Rectangle((40.0, 2.0), (41.0, 12.0)),
+    ]
+    site = SiteMap.from_shapes((0.0, 0.0), (50.0, 50.0), shapes, 0.5)
+    pts = rng.uniform(0.0, 50.0, (200_000, 2))
+    for shape in shapes:
+        inside = pts[shape.contains(pts)]
+        assert len(inside) > 20 and site.is_blocked(inside).all()

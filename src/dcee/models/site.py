@@ -30,6 +30,9 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 
+CELL_RADIUS = math.sqrt(2.0) / 2.0
+"""A cell's circumradius in cells: a shape that touches a cell comes this close to its centre."""
+
 FIELD_CACHE = 2048
 """Distance fields kept per map (one per start cell; float32, e.g. 160 kB each at 200 × 200)."""
 
@@ -137,16 +140,17 @@ class SiteMap:
         clearance: float = 0.0,
         name: str = "site",
     ) -> SiteMap:
-        """The grid over the rectangle ``low``–``high`` (m) with every cell whose centre lies
-        inside a shape, or within ``clearance`` plus half a cell of one, blocked (the half cell
-        keeps a wall thinner than a cell from slipping between cell centres)."""
+        """The grid over the rectangle ``low``–``high`` (m) with every cell that a shape grown
+        by ``clearance`` touches blocked: a cell whose centre lies within ``clearance`` plus
+        the cell's circumradius (√2/2 of a side) of a shape. So every point of a shape lies in
+        a blocked cell, and no wall thinner than a cell slips between cell centres."""
         nx = max(1, math.ceil((high[0] - low[0]) / resolution - 1e-9))
         ny = max(1, math.ceil((high[1] - low[1]) / resolution - 1e-9))
         site = cls(np.zeros((ny, nx), bool), (float(low[0]), float(low[1])), resolution, name)
         centres = site.cell_centres().reshape(-1, 2)
         blocked = np.zeros(len(centres), bool)
         for shape in shapes:
-            blocked |= shape.contains(centres, clearance + 0.5 * resolution)
+            blocked |= shape.contains(centres, clearance + CELL_RADIUS * resolution)
         site.blocked = blocked.reshape(ny, nx)
         return site
 

@@ -176,7 +176,7 @@ class ScenarioBuilders:
 
     def in_obstacle(self: Scenario, xy: np.ndarray) -> np.ndarray:
         """(K,) bool: the (K, 2) points lie inside an obstacle or no-go zone itself (the shapes
-        as given, not grown by the grid's half cell or ``clearance``) or in an occupied or
+        as given, not grown to the grid's cells or by ``clearance``) or in an occupied or
         unknown cell of the map file: what a robot's drive must never touch."""
         from dcee.scenarios.schema.world import shapes_of
 

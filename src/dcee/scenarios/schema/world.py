@@ -87,7 +87,7 @@ class WorldSpec(BaseModel):
     working directory)"""
     resolution: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] | None = None
     """m: cell side of the grid the shapes are drawn on and the paths are found on (a cell is
-    blocked when a shape comes within half a cell of its centre); None: a quarter of
+    blocked when a shape touches it); None: a quarter of
     ``agent.step`` (0.5 m at the paper's 2 m steps, 0.075 m in the lab)"""
     clearance: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 0.0
     """m: every obstacle and zone grown by this much (the robot's radius plus a margin)"""
