@@ -479,6 +479,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "team": team_table,
     "lab": lab_table,
     "stop-rule": stop_rule_table,
+    "anemometer": anemometer_table,
 }
 
 

@@ -10,3 +10,9 @@ D=.venv/bin/dcee
 C="--suite held-out-24 --repeats 4 --particles 10000 --unknown full --strategies dcee-cl --allow-code-change"
 $D bench $C --out results/anemometer-off
 $D bench $C --set anemometer.enabled=true --out results/anemometer-on
+# the same with no prior knowledge of the wind direction (phi uniform over the circle), seeds
+# 0-1: what the anemometer buys a robot that does not know where the wind comes from
+V="--suite held-out-24 --repeats 2 --particles 10000 --unknown full --strategies dcee-cl --allow-code-change"
+U='prior.phi={kind="uniform",low=-180.0,high=180.0}'
+$D bench $V --set "$U" --out results/anemometer-off-vague
+$D bench $V --set "$U" --set anemometer.enabled=true --out results/anemometer-on-vague
