@@ -293,3 +293,19 @@ def test_every_point_of_a_shape_lies_in_a_blocked_cell():
     for shape in shapes:
         inside = pts[shape.contains(pts)]
         assert len(inside) > 20 and site.is_blocked(inside).all()
+
+
+def test_a_robot_settled_just_inside_a_blocked_cell_can_leave_it():
+    """A unicycle settles within centimetres of its waypoint; next to a no-go zone that can be
+    just inside a blocked cell (the campaign that found this: site:nogo, unicycle, seed 2).
+    It may move out, but not further in or across."""
+    site = SiteMap.from_shapes((0.0, 0.0), (50.0, 50.0), [Circle((30.0, 30.0), 5.0)], 0.5)
+    here = np.array([24.50057715, 29.35436026])
+    assert site.is_blocked(here[None])[0]
+    out_west = here + np.array([-2.0, 0.0])
+    further_in = here + np.array([2.0, 0.0])
+    ok = site.segment_clear(here, np.array([out_west, further_in]))
+    assert ok.tolist() == [True, False]
+    # from a free cell nothing changes: the first blocked sample still forbids the move
+    free = np.array([20.0, 30.0])
+    assert not site.segment_clear(free, np.array([[26.0, 30.0]]))[0]

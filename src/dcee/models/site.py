@@ -215,7 +215,10 @@ class SiteMap:
 
     def segment_clear(self, start: np.ndarray, ends: np.ndarray) -> np.ndarray:
         """(K,) bool: the straight segments from ``start`` (2,) to each of ``ends`` (K, 2)
-        touch no blocked cell (sampled every quarter cell, both ends included)."""
+        touch no blocked cell (sampled every quarter cell, both ends included). A robot that
+        stands in a blocked cell (a unicycle settles a few centimetres off its waypoint, which
+        may be a cell edge) may leave it: blocked samples within a cell's diagonal of the start,
+        before the first free one, are not counted."""
         start = np.asarray(start, dtype=float)[:2]
         ends = np.atleast_2d(np.asarray(ends, dtype=float))[:, :2]
         if not self.blocked.any():
@@ -224,7 +227,12 @@ class SiteMap:
         n = int(np.ceil(length.max() / (0.25 * self.resolution))) + 1 if len(ends) else 1
         t = np.linspace(0.0, 1.0, max(n, 2))
         pts = start[None, None, :] + t[None, :, None] * (ends - start)[:, None, :]  # (K, n, 2)
-        return ~self.is_blocked(pts.reshape(-1, 2)).reshape(len(ends), -1).any(axis=1)
+        blocked = self.is_blocked(pts.reshape(-1, 2)).reshape(len(ends), -1)
+        if blocked[:, 0].any():  # standing in a blocked cell: the way out of it is allowed
+            near = (t[None, :] * length[:, None]) <= math.sqrt(2.0) * self.resolution
+            leaving = np.logical_and.accumulate(blocked & near, axis=1)
+            blocked &= ~leaving
+        return ~blocked.any(axis=1)
 
     def _graph_matrix(self) -> Any:
         """The 16-connected grid graph (the 8 neighbours and the 8 knight moves: grid paths at
