@@ -425,7 +425,9 @@ def sites_table() -> str:
                 acquired(r),
                 rmse(r),
                 f"{r['straight']:.0f} / {r['round']:.0f}",
-                f"{r['to_near']:.0f} ({100 * r['reached_near']:.0f} % got there)",
+                "never"
+                if r["reached_near"] == 0
+                else f"{r['to_near']:.0f} ({100 * r['reached_near']:.0f} % got there)",
                 f"{int(r['positions_inside'])} / {int(r['drives_into_obstacles'])}",
                 f"{r['longest_stall']:.0f}",
             ]
@@ -480,6 +482,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "lab": lab_table,
     "stop-rule": stop_rule_table,
     "anemometer": anemometer_table,
+    "sites": sites_table,
 }
 
 
