@@ -27,13 +27,9 @@ def arm(folder: Path) -> pd.DataFrame:
     return s.set_index(["scenario", "seed"]).sort_index()
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("off", type=Path)
-    ap.add_argument("on", type=Path)
-    ap.add_argument("--csv", type=Path)
-    args = ap.parse_args(argv)
-    off, on = arm(args.off), arm(args.on)
+def compare(off_dir: Path, on_dir: Path, prior: str) -> tuple[list[dict], dict]:
+    """The two arms' rows and the paired comparison, labelled with the wind-direction prior."""
+    off, on = arm(off_dir), arm(on_dir)
     common = off.index.intersection(on.index)
     off, on = off.loc[common], on.loc[common]
     rows = []
@@ -46,6 +42,7 @@ def main(argv: list[str] | None = None) -> int:
         med = median_ci(g["final_rmse"].to_numpy())
         rows.append(
             {
+                "prior": prior,
                 "arm": label,
                 "searches": n,
                 "source_acquired_rate": acq[0],
@@ -67,6 +64,7 @@ def main(argv: list[str] | None = None) -> int:
     rmse_diff = on["final_rmse"].to_numpy() - off["final_rmse"].to_numpy()
     p_rmse = float(stats.wilcoxon(rmse_diff).pvalue) if np.any(rmse_diff != 0) else 1.0
     paired = {
+        "prior": prior,
         "pairs": len(common),
         "time_to_1m_difference": float(np.median(diff)),
         "time_wilcoxon_p": p,
@@ -75,26 +73,50 @@ def main(argv: list[str] | None = None) -> int:
         "final_rmse_difference": float(np.median(rmse_diff)),
         "rmse_wilcoxon_p": p_rmse,
     }
-    print("| arm | n | acquired | median final RMSE (m) | median time to RMSE < 1 m (s) |")
-    print("|---|---|---|---|---|")
+    return rows, paired
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("off", type=Path)
+    ap.add_argument("on", type=Path)
+    ap.add_argument(
+        "--vague",
+        nargs=2,
+        type=Path,
+        metavar=("OFF", "ON"),
+        help="the same pair with no prior on the wind direction",
+    )
+    ap.add_argument("--csv", type=Path)
+    args = ap.parse_args(argv)
+    pairs = [(args.off, args.on, "paper's prior on phi")]
+    if args.vague:
+        pairs.append((*args.vague, "no prior on phi"))
+    rows, paired = [], []
+    for off_dir, on_dir, prior in pairs:
+        r, pr = compare(off_dir, on_dir, prior)
+        rows += r
+        paired.append(pr)
+    print("| prior | arm | n | acquired | median final RMSE (m) | median time to RMSE < 1 m (s) |")
+    print("|---|---|---|---|---|---|")
     for r in rows:
         n = r["searches"]
         print(
-            f"| {r['arm']} | {n} | {round(r['source_acquired_rate'] * n)}/{n} "
-            f"| {r['median_final_rmse']:.2f} [{r['median_final_rmse_lo']:.2f}, "
-            f"{r['median_final_rmse_hi']:.2f}] | {r['time_to_1m']:.0f} [{r['time_to_1m_lo']:.0f}, "
-            f"{r['time_to_1m_hi']:.0f}] ({100 * r['reached_1m']:.0f} % got there) |"
+            f"| {r['prior']} | {r['arm']} | {n} | {round(r['source_acquired_rate'] * n)}/{n} "
+            f"| {r['median_final_rmse']:.2f} | {r['time_to_1m']:.0f} "
+            f"({100 * r['reached_1m']:.0f} % got there) |"
         )
-    print(
-        f"\npaired ({paired['pairs']}): time to 1 m with − without, median "
-        f"{paired['time_to_1m_difference']:+.0f} s (Wilcoxon p = {p:.2g}; sooner in "
-        f"{paired['sooner']}, later in {paired['later']}); final RMSE "
-        f"{paired['final_rmse_difference']:+.3f} m (p = {p_rmse:.2g})"
-    )
+    for pr in paired:
+        print(
+            f"\n{pr['prior']}, paired ({pr['pairs']}): time to 1 m with − without, median "
+            f"{pr['time_to_1m_difference']:+.0f} s (Wilcoxon p = {pr['time_wilcoxon_p']:.2g}; "
+            f"sooner in {pr['sooner']}, later in {pr['later']}); final RMSE "
+            f"{pr['final_rmse_difference']:+.3f} m (p = {pr['rmse_wilcoxon_p']:.2g})"
+        )
     if args.csv:
         args.csv.parent.mkdir(parents=True, exist_ok=True)
         pd.DataFrame(rows).to_csv(args.csv, index=False, float_format="%.6g")
-        pd.DataFrame([paired]).to_csv(args.csv.with_name("paired.csv"), index=False)
+        pd.DataFrame(paired).to_csv(args.csv.with_name("paired.csv"), index=False)
     return 0
 
 

@@ -450,12 +450,13 @@ def sites_table() -> str:
 
 def anemometer_table() -> str:
     frame = pd.read_csv(RESULTS / "anemometer" / "anemometer.csv")
-    p = pd.read_csv(RESULTS / "anemometer" / "paired.csv").iloc[0]
+    pairs = pd.read_csv(RESULTS / "anemometer" / "paired.csv").set_index("prior")
     rows = []
     for _, r in frame.iterrows():
-        rows.append([str(r["arm"]), acquired(r), rmse(r), time_to_1m(r)])
+        rows.append([str(r["prior"]), str(r["arm"]), acquired(r), rmse(r), time_to_1m(r)])
     out = table(
         [
+            "wind-direction prior",
             "`dcee-cl`, all eight unknown",
             "source acquired",
             "median final RMSE (m)",
@@ -463,12 +464,15 @@ def anemometer_table() -> str:
         ],
         rows,
     )
-    return out + (
-        f"\nPaired over {int(p['pairs'])} searches (with − without): time to 1 m "
-        f"{p['time_to_1m_difference']:+.0f} s median (Wilcoxon p = {p['time_wilcoxon_p']:.2g}; "
-        f"sooner in {int(p['sooner'])}, later in {int(p['later'])}); final RMSE "
-        f"{p['final_rmse_difference']:+.3f} m (p = {p['rmse_wilcoxon_p']:.2g}).\n"
-    )
+    for prior, p in pairs.iterrows():
+        out += (
+            f"\n{prior}, paired over {int(p['pairs'])} searches (with − without): time to 1 m "
+            f"{p['time_to_1m_difference']:+.0f} s median (Wilcoxon p = "
+            f"{p['time_wilcoxon_p']:.2g}; sooner in {int(p['sooner'])}, later in "
+            f"{int(p['later'])}); final RMSE {p['final_rmse_difference']:+.3f} m (p = "
+            f"{p['rmse_wilcoxon_p']:.2g}).\n"
+        )
+    return out
 
 
 TABLES: dict[str, Callable[[], str]] = {

@@ -98,6 +98,7 @@ case "${1:---list}" in
     bash studies/study_anemometer.sh
     mkdir -p docs/results/anemometer
     $P studies/anemometer_table.py results/anemometer-off results/anemometer-on \
+      --vague results/anemometer-off-vague results/anemometer-on-vague \
       --csv docs/results/anemometer/anemometer.csv
     $P studies/publish_tables.py ;;
   publish)  # the tables of README.md, docs/index.md, docs/results.md from docs/results/

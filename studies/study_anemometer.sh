@@ -4,6 +4,7 @@
 # sample) x seeds 0-3, 10,000 particles, with and without the anemometer (1 Hz, 0.5 m/s and
 # 10 deg noise), the same seeds: paired by (configuration, seed). Resumable.
 # Table: studies/anemometer_table.py results/anemometer-off results/anemometer-on
+#   --vague results/anemometer-off-vague results/anemometer-on-vague
 set -euo pipefail
 cd "$(dirname "$0")/.."
 D=.venv/bin/dcee
