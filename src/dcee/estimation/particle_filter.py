@@ -275,22 +275,12 @@ class ParticleFilter:
         entry, base_mult = self._add_to_history(position, reading)
         self.n_readings += 1
 
-        logw = self._logw + ll_new
-        top = logw.max()
-        scaled = np.exp(logw - top)
-        total = scaled.sum()
-        # log Σ wᵢ p(z|Θᵢ), wᵢ the normalised weights before z
-        log_ev = float(top + math.log(total) - logsumexp(self._logw))
+        logw, log_ev, ess = self._reweighted(ll_new)
         self.log_evidence += log_ev
-        ess = effective_sample_size(scaled / total)
         if ess >= self.collapse_threshold * self.n:
             self._hist_loglik += ll_new
             self._set_logw(logw)
-            if ess < self.resample_threshold * self.n:
-                self._resample()
-                acc, sweeps, distinct = self._rejuvenate()
-                return UpdateInfo(ess, True, acc, 1, sweeps, distinct, log_evidence=log_ev)
-            return UpdateInfo(ess, False, math.nan, 1, 0, self.n, log_evidence=log_ev)
+            return self._resampled_if_needed(ess, log_ev)
         info = self._tempered_update(ll_new, entry, base_mult, ess)
         return dataclasses.replace(info, log_evidence=log_ev)
 
@@ -307,16 +297,26 @@ class ParticleFilter:
         self.wind = self.wind + new
         if not ({U_COLUMN, PHI_COLUMN} & {int(i) for i in self._unknown}):
             return UpdateInfo(self.ess, False, math.nan, 1, 0, self.n)
-        ll = new.log_likelihood(self.theta, self.anemometer)
-        logw = self._logw + ll
-        top = logw.max()
-        scaled = np.exp(logw - top)
-        log_ev = float(top + math.log(scaled.sum()) - logsumexp(self._logw))
+        logw, log_ev, ess = self._reweighted(new.log_likelihood(self.theta, self.anemometer))
         # kept apart from log_evidence: every reading model predicts the wind alike, so the
         # model bank compares its members on the concentration readings only
         self.wind_log_evidence += log_ev
-        ess = effective_sample_size(scaled / scaled.sum())
         self._set_logw(logw)
+        return self._resampled_if_needed(ess, log_ev)
+
+    def _reweighted(self, ll: np.ndarray) -> tuple[np.ndarray, float, float]:
+        """The log weights after a reading of per-particle log-likelihood ``ll`` (N,), the
+        reading's log evidence log Σ wᵢ p(z|Θᵢ) (wᵢ the normalised weights before it) and the
+        effective sample size after it."""
+        logw = self._logw + ll
+        top = logw.max()
+        scaled = np.exp(logw - top)
+        total = scaled.sum()
+        log_ev = float(top + math.log(total) - logsumexp(self._logw))
+        return logw, log_ev, effective_sample_size(scaled / total)
+
+    def _resampled_if_needed(self, ess: float, log_ev: float) -> UpdateInfo:
+        """Resample-move when the effective sample size fell below the threshold."""
         if ess < self.resample_threshold * self.n:
             self._resample()
             acc, sweeps, distinct = self._rejuvenate()
