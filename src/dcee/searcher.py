@@ -161,11 +161,9 @@ class Searcher:
             self.time = float(time)
         self.recent = [*self.recent[-(STALL_HISTORY - 1) :], (self.time, self.position.copy())]
         if self.stop_rule is not None:
-            if self.estimate().spread < self.stop_rule.spread:
-                if math.isnan(self.below_since):
-                    self.below_since = self.time
-            else:
-                self.below_since = math.nan
+            self.below_since = self.stop_rule.advance(
+                self.below_since, self.time, self.estimate().spread
+            )
         return self.last_update
 
     def tell_wind(self, speed: float, direction: float) -> UpdateInfo:
@@ -180,12 +178,7 @@ class Searcher:
         """True once the stop rule holds: the spread has stayed below its threshold for its
         hold (always False without a rule). The same test as
         :meth:`dcee.stopping.StopRule.stop_index` on the told readings."""
-        rule = self.stop_rule
-        return (
-            rule is not None
-            and not math.isnan(self.below_since)
-            and self.time - self.below_since >= rule.hold - 1e-9
-        )
+        return self.stop_rule is not None and self.stop_rule.holds(self.below_since, self.time)
 
     def ask(self) -> np.ndarray:
         """Next waypoint (3,) in m, chosen by the planner from the last told position."""

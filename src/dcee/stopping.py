@@ -59,6 +59,17 @@ class StopRule:
         """The default rule for a search whose "acquired" bar is ``acquired_rmse`` m."""
         return cls(round(DEFAULT_STOP_SHARE * float(acquired_rmse), 12), hold)
 
+    def advance(self, since: float, time: float, spread: float) -> float:
+        """After a reading at ``time`` s with posterior spread ``spread`` m: the time the current
+        run of readings below the threshold began (``since`` before it; NaN: no run)."""
+        if not spread < self.spread:
+            return math.nan
+        return time if math.isnan(since) else since
+
+    def holds(self, since: float, time: float) -> bool:
+        """The rule holds at ``time`` s for a run below the threshold that began at ``since``."""
+        return not math.isnan(since) and time - since >= self.hold - 1e-9
+
     def stop_index(self, times: np.ndarray, spreads: np.ndarray) -> int | None:
         """Index of the first reading at which the rule holds in a recorded search (``times``
         (n,) s and ``spreads`` (n,) m, in reading order), or None when it never does."""
@@ -66,12 +77,8 @@ class StopRule:
         spreads = np.asarray(spreads, dtype=np.float64)
         since = math.nan
         for i, (t, s) in enumerate(zip(times, spreads, strict=True)):
-            if not s < self.spread:
-                since = math.nan
-                continue
-            if math.isnan(since):
-                since = t
-            if t - since >= self.hold - 1e-9:
+            since = self.advance(since, float(t), float(s))
+            if self.holds(since, float(t)):
                 return i
         return None
 

@@ -79,11 +79,6 @@ class GridAgent:
             ok[ok] = self.site.segment_clear(position, nxt[ok])
         return nxt[ok], np.flatnonzero(ok)
 
-    def travel_xy(self, start: np.ndarray, points: np.ndarray) -> np.ndarray:
-        """Horizontal travel distance (m) from ``start`` (3,) to ``points`` (..., 3): around
-        the site's blocked cells (:meth:`SiteMap.travel_distance`), straight without a site."""
-        return travel_xy(self.site, start, points)
-
 
 def travel_xy(site: SiteMap | None, start: np.ndarray, points: np.ndarray) -> np.ndarray:
     """Horizontal travel distance (m) from ``start`` (2,) or (3,) to ``points`` (..., 2|3):

@@ -174,15 +174,17 @@ class ScenarioBuilders:
         """m, the cell side of the site's grid: ``world.resolution``, or a quarter step."""
         return self.world.resolution or self.agent.step / 4.0
 
-    def in_obstacle(self: Scenario, xy: np.ndarray) -> np.ndarray:
-        """(K,) bool: the (K, 2) points lie inside an obstacle or no-go zone itself (the shapes
-        as given, not grown to the grid's cells or by ``clearance``) or in an occupied or
-        unknown cell of the map file: what a robot's drive must never touch."""
+    def in_obstacle(self: Scenario, xy: np.ndarray, no_go: bool = True) -> np.ndarray:
+        """(K,) bool: the (K, 2) points lie inside an obstacle (or, with ``no_go``, a no-go
+        zone) itself (the shapes as given, not grown to the grid's cells or by
+        ``clearance``) or in an occupied or unknown cell of the map file: what a robot's drive
+        must never touch."""
         from dcee.scenarios.schema.world import shapes_of
 
         xy = np.atleast_2d(np.asarray(xy, dtype=float))[:, :2]
         out = np.zeros(len(xy), bool)
-        for shape in shapes_of(self.world.obstacles) + shapes_of(self.world.no_go):
+        zones = shapes_of(self.world.no_go) if no_go else []
+        for shape in shapes_of(self.world.obstacles) + zones:
             out |= shape.contains(xy)
         if self.world.map is not None:
             out |= _raw_map(self.world.map).is_blocked(xy)

@@ -149,10 +149,7 @@ class Scenario(ScenarioBuilders, BaseModel):
                 f"{FIELD_MARK}agent.start: {tuple(self.agent.start)} lies inside an obstacle or "
                 f"no-go zone of [world] (or within world.clearance of one)"
             )
-        from dcee.scenarios.schema.world import shapes_of
-
-        inside = [s for s in shapes_of(self.world.obstacles) if s.contains(src[None, :2])[0]]
-        if inside or (self.world.map is not None and self._map_blocks(src)):
+        if self.in_obstacle(src[None, :2], no_go=False)[0]:
             raise ValueError(
                 f"{FIELD_MARK}truth: the source ({src[0]:g}, {src[1]:g}) lies inside an "
                 "obstacle of [world]; a source the robot must keep away from belongs in "
@@ -164,14 +161,6 @@ class Scenario(ScenarioBuilders, BaseModel):
                 f"reached from agent.start {tuple(self.agent.start)}: obstacles enclose it"
             )
         return site
-
-    def _map_blocks(self, src: np.ndarray) -> bool:
-        from dcee.models.site import load_ros_map
-
-        try:
-            return bool(load_ros_map(self.world.map).is_blocked(src[None, :2])[0])
-        except DceeInputError:
-            return False
 
     # --- settings that depend on the truth ----------------------------------------------------
 
