@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import csv
 import math
+import os
 import tomllib
 from multiprocessing import Pool
 
@@ -83,13 +84,30 @@ def main() -> None:
         for name in expand_names(args.configs)
         for seed in range(args.seeds)
     ]
+    # Rows are appended to --csv as each search finishes, and a rerun skips the searches the
+    # file already holds: an interrupted study loses no finished search.
+    key = ("variant", "truth", "scenario", "seed")
+    rows: list[dict] = []
+    if args.csv and os.path.exists(args.csv):
+        with open(args.csv, newline="") as fh:
+            rows = [
+                {**r, "seed": int(r["seed"]), "acquired": r["acquired"] == "True",
+                 "truth_in_95": r["truth_in_95"] == "True",
+                 **{k: float(r[k]) for k in ("final_rmse", "along", "cross")}}
+                for r in csv.DictReader(fh)
+            ]  # fmt: skip
+    done = {tuple(str(r[k]) for k in key) for r in rows}
+    todo = [t for t in tasks if (t[0], t[3], t[2], str(t[4])) not in done]
     with Pool(args.workers) as pool:
-        rows = pool.map(one, tasks, chunksize=1)
-    if args.csv:
-        with open(args.csv, "w", newline="") as fh:
-            w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-            w.writeheader()
-            w.writerows(rows)
+        for row in pool.imap_unordered(one, todo, chunksize=1):
+            rows.append(row)
+            if args.csv:
+                new_file = not os.path.exists(args.csv)
+                with open(args.csv, "a", newline="") as fh:
+                    w = csv.DictWriter(fh, fieldnames=list(row))
+                    if new_file:
+                        w.writeheader()
+                    w.writerow(row)
     print("| variant | truth | n | acquired | median final RMSE (m) | truth in 95 % | "
           "median along-wind error (m) | median cross-wind error (m) |")  # fmt: skip
     print("|---|---|---|---|---|---|---|---|")

@@ -190,8 +190,9 @@ def test_nan_reading_is_rejected(sensor, bad):
         Sensor(false_alarm=0.02, outlier=0.01),
         Sensor(family="lognormal", pd=0.6, log_sd=1.3, outlier=0.01),
         Sensor(family="lognormal", pd=0.6, log_sd=1.0, log_sd_near=2.0, log_sd_length=3.0),
+        Sensor(family="lognormal", pd=0.9, log_sd=1.3, near_length=5.0, magnitude=False),
     ],
-    ids=["paper", "pd1", "fa+outlier", "lognormal", "lognormal+spread"],
+    ids=["paper", "pd1", "fa+outlier", "lognormal", "lognormal+spread", "detection-only"],
 )
 def test_history_likelihood_and_reading_bounds_against_numpy(sensor):
     from dcee.estimation.filter_kernels import (

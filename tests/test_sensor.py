@@ -87,12 +87,18 @@ NEAR_PAPER = Sensor(near_length=3.0, false_alarm=0.01)
 SPREAD = Sensor(
     family="lognormal", pd=0.6, log_sd=1.0, log_sd_near=2.0, log_sd_length=3.0, outlier=0.01
 )
+# detection-only readings: a detection's magnitude carries no weight
+DETECTION_ONLY = Sensor(
+    family="lognormal", pd=0.6, log_sd=1.2, outlier=0.01, near_length=5.0, magnitude=False
+)
 FAMILIES = [FLUCTUATION, ROBUST, ROBUST_PAPER, NEAR, NEAR_PAPER, SPREAD]
 FAMILY_IDS = ["ln", "ln+out", "gauss+out", "ln+near", "gauss+near", "ln+spread"]
 
 
 @pytest.mark.parametrize(
-    "s", [FLUCTUATION, ROBUST, ROBUST_PAPER, SPREAD], ids=["ln", "ln+out", "gauss+out", "spread"]
+    "s",
+    [FLUCTUATION, ROBUST, ROBUST_PAPER, SPREAD, DETECTION_ONLY],
+    ids=["ln", "ln+out", "gauss+out", "spread", "detection"],
 )
 @pytest.mark.parametrize("conc", [0.0, 2e-4, 5e-4, 3e-3, 0.5])
 @pytest.mark.parametrize("r", [0.5, 40.0])
@@ -143,7 +149,9 @@ def test_simulated_readings_follow_every_family(s):
 
 
 @pytest.mark.parametrize(
-    "s", [FLUCTUATION, ROBUST, ROBUST_PAPER, SPREAD], ids=["ln", "ln+out", "gauss+out", "spread"]
+    "s",
+    [FLUCTUATION, ROBUST, ROBUST_PAPER, SPREAD, DETECTION_ONLY],
+    ids=["ln", "ln+out", "gauss+out", "spread", "detection"],
 )
 def test_compiled_likelihood_matches_reference_for_every_family(s):
     rng = np.random.default_rng(6)
@@ -219,3 +227,24 @@ def test_detection_draws_follow_the_likelihood_given_a_detection(s, conc):
         )
         p = mass / p_detect
         assert counts[k] / n == pytest.approx(p, abs=5 * math.sqrt(p * (1 - p) / n) + 1e-5)
+
+
+def test_detection_only_readings_by_hand():
+    """Detection only: p(z | C, r) = Pd(r) · P(ln z ≥ ln thr) · g(z) for a detection, g the
+    log-uniform density on [threshold, max_reading]; the non-detection is the magnitude model's.
+    So two detections of different sizes weigh every hypothesis alike."""
+    s = Sensor(family="lognormal", pd=0.8, log_sd=1.5, near_length=4.0, magnitude=False)
+    full = Sensor(family="lognormal", pd=0.8, log_sd=1.5, near_length=4.0)
+    c, r, z = 2e-3, 3.0, 7e-3
+    pd = 0.8 * (1.0 - math.exp(-3.0 / 4.0))
+    x = (math.log(c) - 0.5 * 1.5**2 - math.log(5e-4)) / 1.5
+    p_above = 0.5 * math.erfc(-x / math.sqrt(2.0))
+    g = 1.0 / (z * math.log(1e4 / 5e-4))
+    assert float(s.likelihood(z, c, r)) == pytest.approx(pd * p_above * g, rel=1e-12)
+    assert float(s.likelihood(0.0, c, r)) == pytest.approx(float(full.likelihood(0.0, c, r)))
+    conc = np.array([1e-4, 1e-3, 5e-2])  # three hypotheses
+    ratio_small = s.log_likelihood(6e-4, conc, r) - s.log_likelihood(6e-4, conc[0], r)
+    ratio_large = s.log_likelihood(3.0, conc, r) - s.log_likelihood(3.0, conc[0], r)
+    np.testing.assert_allclose(ratio_small, ratio_large, atol=1e-12)
+    with_size = full.log_likelihood(3.0, conc, r) - full.log_likelihood(3.0, conc[0], r)
+    assert not np.allclose(with_size, ratio_large)  # the magnitude model does tell them apart

@@ -167,7 +167,9 @@ def reading_upper_bounds(readings: np.ndarray, sensor: Sensor) -> np.ndarray:
     z = np.asarray(readings, dtype=np.float64)
     det = z >= sensor.threshold
     zd = np.where(det, z, sensor.threshold)
-    if sensor.lognormal:
+    if not sensor.magnitude:  # detection only: P(detection) ≤ Pd, times g(z)
+        density = sp.log_pd + sp.log_flat - np.log(zd)
+    elif sensor.lognormal:
         density = sp.log_pd - math.log(sensor.log_sd) - HALF_LOG_2PI - np.log(zd)
     else:
         density = np.full(z.shape, sp.log_pd - math.log(sensor.sigma_min) - HALF_LOG_2PI)

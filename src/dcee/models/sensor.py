@@ -78,6 +78,10 @@ class Sensor:
     near_length: float = 0.0
     log_sd_near: float = 0.0
     log_sd_length: float = 0.0
+    magnitude: bool = True
+    """True: a detection weighs by its magnitude's density (the paper's eq. 3, the log-normal
+    family); False: by its probability only, times a log-uniform density on [threshold,
+    max_reading] that every hypothesis shares (detection-only readings)"""
 
     def __post_init__(self) -> None:
         if self.family not in ("gaussian", "lognormal"):
@@ -160,6 +164,8 @@ class Sensor:
             c_lin=c_lin,
             lin0=lin0,
             lin1=lin1,
+            magnitude=1.0 if self.magnitude else 0.0,
+            log_flat=-math.log(math.log(self.max_reading / self.threshold)),
         )
 
     def _log_outlier_times_z(self) -> float:
@@ -245,6 +251,9 @@ class Sensor:
         log_det = np.log(pd) - 0.5 * r * r - np.log(sigma) - 0.5 * np.log(2 * np.pi)
         if self.lognormal:
             log_det = log_det - np.log(zd)
+        if not self.magnitude:  # detection only: P(z ≥ thr | C, r) · g(z), g log-uniform
+            flat = -math.log(math.log(self.max_reading / self.threshold))
+            log_det = np.log(pd) + log_ndtr((loc - v_thr) / sigma) + flat - np.log(zd)
         if self.false_alarm > 0:
             log_fa = (
                 np.log(self.false_alarm)

@@ -14,7 +14,10 @@ lognormal     ln C − s²/2                  s                           ln z
 
 A detection's density is Pd·φ((v − loc)/σ)/σ · |dv/dz| (the Jacobian is 1/z for the log-normal
 family; it is the same for every particle, so the planners add it to the log evidence only) and a
-non-detection has probability (1 − Pd) + Pd·Φ((v_thr − loc)/σ). With near-source
+non-detection has probability (1 − Pd) + Pd·Φ((v_thr − loc)/σ). Detection only
+(``magnitude`` 0): a detection's likelihood is its probability Pd·Φ((loc − v_thr)/σ) times a
+log-uniform density of its magnitude on [threshold, max_reading] that no hypothesis changes,
+so a reading's size, which a turbulent plume decouples from the mean, carries no weight. With near-source
 intermittency Pd depends on the distance r between the sensor and the hypothesised source,
 Pd(r) = Pd · (1 − exp(−r / near_length)), so every function takes r as well as C. Sensor
 parameters arrive as a :class:`SensorParams` record (named fields, all float64).
@@ -58,6 +61,8 @@ class SensorParams(NamedTuple):
     c_lin: float  # below this C, log P(missed | C) ≈ lin0 + lin1 · C
     lin0: float
     lin1: float
+    magnitude: float  # 1.0: a detection's density in its magnitude; 0.0: detection only
+    log_flat: float  # log(z · g(z)), g the log-uniform density on [threshold, max_reading]
 
 
 @njit(cache=True, inline="always")
@@ -123,7 +128,11 @@ def log_likelihood(z: float, c: float, r: float, sp: SensorParams) -> float:
         return log_missed(c, r, sp) + sp.log_not_false_alarm + sp.log_keep
     loc, sigma = transform(c, r, sp)
     log_pd = log_detection_probability(r, sp)
-    if sp.lognormal > 0.0:
+    if sp.magnitude == 0.0:
+        # detection only: P(a detection | C, r) times a density of its magnitude that no
+        # hypothesis changes (log-uniform), so evidences stay comparable with other models
+        ld = log_pd + log_ndtr((loc - sp.v_threshold) / sigma) + sp.log_flat - math.log(z)
+    elif sp.lognormal > 0.0:
         log_z = math.log(z)
         x = (log_z - loc) / sigma
         ld = log_pd - 0.5 * x * x - math.log(sigma) - HALF_LOG_2PI - log_z

@@ -62,7 +62,7 @@ def make_searcher(
         scenario.make_agent(),
         planner_rng,
         stall_guard=search.stall_guard,
-        guard_spread=search.acquired_rmse,
+        guard_spread=search.guard_share * search.acquired_rmse,
         stop_rule=scenario.stop_rule(on_robot),
     )
 

@@ -27,11 +27,15 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("estimator", "calm_prior"): 0.0,
     # no stall guard before issue 28
     ("search", "stall_guard"): 0.0,
+    # the guard acted while the spread exceeded acquired_rmse before the share existed
+    ("search", "guard_share"): 1.0,
     # every reading counted fully before issue 29
     ("estimator", "reading_weight"): 1.0,
     # a constant log-sd before the distance-dependent spread existed
     ("estimator", "log_sd_near"): 0.0,
     ("estimator", "log_sd_length"): 0.0,
+    # every detection weighed by its magnitude before issue 29's detection-only readings
+    ("estimator", "magnitude"): True,
 }
 """Scenario settings added after campaigns were first stored, with the value a stored scenario
 without one ran with, so the two compare equal."""
@@ -44,6 +48,7 @@ FLUCTUATION_ONLY = (
     "log_sd_length",
     "near_source_length",
     "calm_prior",
+    "magnitude",
 )
 """Estimator settings that only the fluctuation likelihood reads: under the paper's likelihood
 they decide nothing, so changing their defaults must not orphan a campaign."""

@@ -85,6 +85,7 @@ class ScenarioBuilders:
             log_sd_near=e.log_sd_near,
             log_sd_length=e.log_sd_length,
             near_length=e.near_source_length,
+            magnitude=e.magnitude,
             outlier=self.outlier,
             max_reading=s.max_reading,
         )

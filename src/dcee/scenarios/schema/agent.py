@@ -104,7 +104,11 @@ class SearchSpec(BaseModel):
     """s the spread must stay below ``stop_spread`` before the search ends"""
     stall_guard: Annotated[float, Field(ge=0, le=1e6, allow_inf_nan=False)] = 30.0
     """s: after this long within one step of one position while the posterior spread exceeds
-    ``acquired_rmse``, the next move must leave that position (0: off; docs/held-out.md)"""
+    ``guard_share`` × ``acquired_rmse``, the next move must leave that position (0: off;
+    docs/held-out.md)"""
+    guard_share: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 1.0
+    """the stall guard acts while the posterior spread √tr P exceeds this share of
+    ``acquired_rmse`` (below it the source counts as located and the robot may stay)"""
     resample_threshold: Annotated[float, Field(gt=0, le=1)] = 0.5
     """resample when the effective sample size falls below this share of the particles"""
     mcmc_steps: Annotated[int, Field(ge=0, le=100)] = 1

@@ -194,6 +194,11 @@ class EstimatorSpec(BaseModel):
     at fixed points gave 5.4 m), chosen with ``reading_weight`` 0.5 on the tuning configurations
     random:1-12 and checked on held-out ones (docs/turbulent.md); 10 m, the value before, set the
     final estimate about 1 m upwind of the source there"""
+    magnitude: bool = True
+    """fluctuation: a detection weighs by its magnitude's log-normal density (True) or only by
+    its probability, whatever its size (False: detection-only readings, as Vergassola et
+    al.'s infotaxis counts hits); the calm member and the paper's likelihood always use the
+    magnitude. The planners predict with the magnitude either way"""
     meander: Annotated[float | None, Field(ge=0, le=2)] = None
     """crosswind turbulence intensity of the plume model's time-mean meander broadening
     (:mod:`dcee.models.plume`); None: the likelihood's default, :data:`MEANDER_DEFAULT`"""
