@@ -63,6 +63,7 @@ def one(task: tuple) -> dict:
         "along": float(err @ down),
         "cross": float(abs(err @ np.array([-down[1], down[0]]))),
         "steps": s["steps"],
+        "longest_stall": s["longest_stall"],
     }
 
 

@@ -17,9 +17,9 @@ family; it is the same for every particle, so the planners add it to the log evi
 non-detection has probability (1 − Pd) + Pd·Φ((v_thr − loc)/σ). Detection only
 (``magnitude`` 0): a detection's likelihood is its probability Pd·Φ((loc − v_thr)/σ) times a
 log-uniform density of its magnitude on [threshold, max_reading] that no hypothesis changes,
-so a reading's size, which a turbulent plume decouples from the mean, carries no weight. With near-source
-intermittency Pd depends on the distance r between the sensor and the hypothesised source,
-Pd(r) = Pd · (1 − exp(−r / near_length)), so every function takes r as well as C. Sensor
+so a reading's size, which a turbulent plume decouples from the mean, carries no weight. With
+near-source intermittency Pd depends on the distance r between the sensor and the hypothesised
+source, Pd(r) = Pd · (1 − exp(−r / near_length)), so every function takes r as well as C. Sensor
 parameters arrive as a :class:`SensorParams` record (named fields, all float64).
 """
 
