@@ -40,6 +40,11 @@ DEFAULT_STALL_GUARD = 30.0
 still wide, its next move must take it further from that position (:class:`Searcher`). Half the
 60 s a stall may last by issue 28's bar; chosen by that bar, not tuned on any configuration."""
 
+DEFAULT_GUARD_SPREAD = 0.45
+"""m: the guard acts while the belief's spread √tr P exceeds this: the default stop rule's
+threshold at the paper's 3 m acquisition bar (:data:`~dcee.stopping.DEFAULT_STOP_SHARE` × 3 m),
+so a robot may hover only where it could also stop (``search.guard_share``, docs/turbulent.md)."""
+
 STALL_HISTORY = 64
 """Told positions the stall guard looks back over (more than 30 s of readings at 1 s)."""
 
@@ -106,7 +111,7 @@ class Searcher:
         agent: GridAgent,
         rng: np.random.Generator,
         stall_guard: float = DEFAULT_STALL_GUARD,
-        guard_spread: float = 3.0,
+        guard_spread: float = DEFAULT_GUARD_SPREAD,
         stop_rule: StopRule | None = DEFAULT_STOP_RULE,
     ) -> None:
         for name, value in (("stall_guard", stall_guard), ("guard_spread", guard_spread)):

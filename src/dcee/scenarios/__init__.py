@@ -67,6 +67,7 @@ A scenario is a TOML file (or a built-in, see :mod:`dcee.scenarios.builtin`)::
     # stop_hold = 60.0             # s [default: a robot stops at 0.15 x acquired_rmse, a
                                    #  simulated study flies the whole budget; 0: never stop]
     stall_guard = 30.0             # s within one step of one spot before a move must leave it
+    guard_share = 0.15             # ... while the spread exceeds this share of acquired_rmse
 
 Normal priors are truncated to physical values (u ≥ 0, ζ1 > 0, ζ2 > 0) automatically.
 """
