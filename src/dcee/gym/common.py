@@ -181,8 +181,9 @@ def observation_space() -> spaces.Box:
 
 
 def action_mask(sim: SearchSimulation, position: np.ndarray) -> np.ndarray:
-    """(H,) int8: 1 for the headings from ``position`` that stay inside the area."""
-    mask = np.zeros(sim.agent.n_headings, dtype=np.int8)
+    """(H,) int8: 1 for the moves from ``position`` that stay inside the area (H: the headings,
+    then climb and descend with ``agent.climb`` > 0)."""
+    mask = np.zeros(sim.agent.n_moves, dtype=np.int8)
     mask[sim.agent.candidates(position)[1]] = 1
     return mask
 

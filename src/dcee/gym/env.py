@@ -30,7 +30,8 @@ class SourceSearchEnv(gymnasium.Env):
     ``dcee run`` makes.
 
     **Actions**: ``Discrete(H)``, H = the scenario's ``agent.n_headings`` (8 in the paper: 0 = +x,
-    then counter-clockwise in 45° steps). ``info["action_mask"]`` (H,) int8 marks the headings
+    then counter-clockwise in 45° steps; with ``agent.climb`` > 0 two more, H − 2 up and H − 1
+    down). ``info["action_mask"]`` (H,) int8 marks the headings
     that stay inside the search area; an inadmissible action keeps the robot in place (time
     passes, a reading is taken there) and sets ``info["inadmissible"]``.
 
@@ -70,7 +71,7 @@ class SourceSearchEnv(gymnasium.Env):
                 "agent.count", "SourceSearchEnv flies one robot; use dcee.gym.multi_search_env"
             )
         self.render_mode = render_mode
-        self.action_space = spaces.Discrete(self.scenario.agent.headings)
+        self.action_space = spaces.Discrete(self.scenario.make_agent().n_moves)
         self.observation_space = observation_space()
         self.simulation: SearchSimulation | None = None
 

@@ -61,7 +61,7 @@ class MultiSearchEnv(ParallelEnv):
 
     @functools.cache  # noqa: B019
     def action_space(self, agent: str) -> spaces.Discrete:
-        return spaces.Discrete(self.scenario.agent.headings)
+        return spaces.Discrete(self.scenario.make_agent().n_moves)
 
     def _sim(self) -> SearchSimulation:
         if self.simulation is None:

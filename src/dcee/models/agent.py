@@ -1,4 +1,5 @@
-"""Agent model p_{k+1} = p_k + u_k (the paper's eq. 1) on eight headings at a fixed altitude."""
+"""Agent model p_{k+1} = p_k + u_k (the paper's eq. 1) on eight headings at a fixed altitude,
+optionally with a climb and a descent (``climb``)."""
 
 from __future__ import annotations
 
@@ -32,7 +33,10 @@ class SearchVolume:
 class GridAgent:
     """Mobile sensor that moves ``step`` metres along one of ``headings`` directions.
 
-    Headings are measured from +x towards +y (0°, 45°, …, 315° by default). Moves that would leave
+    Headings are measured from +x towards +y (0°, 45°, …, 315° by default). With ``climb`` > 0
+    two more moves change the altitude by ±``climb`` m at the same horizontal position (indices
+    ``n_headings`` up and ``n_headings`` + 1 down; a fixed altitude, the paper's agent, with 0).
+    Moves that would leave
     the search volume, or enter or cross a blocked cell of the ``site``
     (:class:`~dcee.models.site.SiteMap`: obstacles and no-go zones), are inadmissible. Each move
     takes ``step / speed + dwell`` seconds: travel plus the sampling dwell the sensor needs for
@@ -45,6 +49,7 @@ class GridAgent:
     dwell: float = 1.0
     n_headings: int = 8
     site: SiteMap | None = None
+    climb: float = 0.0
 
     def __post_init__(self) -> None:
         if not self.step > 0:
@@ -55,19 +60,30 @@ class GridAgent:
             raise DceeInputError("agent.dwell", f"must be >= 0 s, got {self.dwell}")
         if self.n_headings < 1:
             raise DceeInputError("agent.n_headings", f"must be >= 1, got {self.n_headings}")
+        if not self.climb >= 0:
+            raise DceeInputError("agent.climb", f"must be >= 0 m, got {self.climb}")
 
     @property
     def moves(self) -> np.ndarray:
-        """(n_headings, 3) displacement vectors u in m (z component 0)."""
+        """(n_moves, 3) displacement vectors u in m: the headings (z component 0), then, with
+        ``climb`` > 0, (0, 0, +climb) and (0, 0, −climb)."""
         angles = 2 * np.pi * np.arange(self.n_headings) / self.n_headings
-        out = np.zeros((self.n_headings, 3))
-        out[:, 0] = np.round(self.step * np.cos(angles), 12)
-        out[:, 1] = np.round(self.step * np.sin(angles), 12)
+        out = np.zeros((self.n_moves, 3))
+        out[: self.n_headings, 0] = np.round(self.step * np.cos(angles), 12)
+        out[: self.n_headings, 1] = np.round(self.step * np.sin(angles), 12)
+        if self.climb > 0:
+            out[self.n_headings :, 2] = (self.climb, -self.climb)
         return out
 
     @property
+    def n_moves(self) -> int:
+        """Number of moves: ``n_headings``, plus 2 with ``climb`` > 0."""
+        return self.n_headings + (2 if self.climb > 0 else 0)
+
+    @property
     def step_time(self) -> float:
-        """Seconds per move: travel time plus sampling dwell."""
+        """Seconds per move: travel time plus sampling dwell (a climb or a descent is charged
+        the same as a horizontal move)."""
         return self.step / self.speed + self.dwell
 
     def candidates(self, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -62,6 +62,12 @@ class CycleSettings:
     def from_scenario(cls, scenario: Scenario, **changes: Any) -> CycleSettings:
         """The scenario's hold, averaging, budget, altitude and move bound; ``changes``
         (calibration, tolerances) override."""
+        if scenario.agent.climb > 0:  # the cycle tells the estimator a fixed altitude
+            raise DceeInputError(
+                "agent.climb",
+                f"must be 0 on a robot (got {scenario.agent.climb:g} m): the robot cycle reads "
+                "planar poses and flies at agent.start's altitude; climbing is for simulation",
+            )
         motion = scenario.make_motion()
         values: dict[str, Any] = {
             "hold": scenario.dwell,

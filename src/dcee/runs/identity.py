@@ -17,6 +17,8 @@ def _unicycle_defaults() -> dict[str, Any]:
 
 LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("agent", "count"): 1,
+    # a fixed altitude before issue 29's climbing agent
+    ("agent", "climb"): 0.0,
     # the robot's motion (issue 15); the grid agent at these defaults is the one that ran before
     ("agent", "model"): "grid",
     ("agent", "heading"): 0.0,

@@ -164,6 +164,7 @@ class SearchSimulation:
             durations.append(travel.duration)
             steps = np.diff(travel.path[:, 1:3], axis=0)
             self.path_length += float(np.hypot(steps[:, 0], steps[:, 1]).sum())
+            self.path_length += abs(float(goal[2]) - float(p[2]))  # a climb or a descent
             if self.site is not None:  # the drive itself, every 5 cm, against the raw shapes
                 self.drives_into_obstacles += int(
                     self.scenario.in_obstacle(dense_path(travel.path)).any()

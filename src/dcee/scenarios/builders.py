@@ -117,7 +117,13 @@ class ScenarioBuilders:
         """The planner's move set (clear of the ``[world]``'s obstacles and no-go zones)."""
         a = self.agent
         return GridAgent(
-            self.search_volume(), a.step, a.speed, self.dwell, a.headings, site=self.make_site()
+            self.search_volume(),
+            a.step,
+            a.speed,
+            self.dwell,
+            a.headings,
+            site=self.make_site(),
+            climb=a.climb,
         )
 
     def make_motion(self: Scenario) -> MotionModel:

@@ -50,7 +50,7 @@ class UnicycleSpec(BaseModel):
 
 class AgentSpec(BaseModel):
     """The mobile sensor: where it starts and how it moves (one step along one of
-    ``headings`` directions per decision, at the start altitude)."""
+    ``headings`` directions per decision, at the start altitude unless ``climb`` > 0)."""
 
     model_config = FROZEN
     start: tuple[Finite, Finite, Finite]
@@ -64,6 +64,11 @@ class AgentSpec(BaseModel):
     :data:`TURBULENT_HOLD` for a time-varying one"""
     headings: Annotated[int, Field(ge=1, le=64)] = 8
     """number of equally spaced move directions (0°, 45°, … for 8)"""
+    climb: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 0.0
+    """m: with > 0 the agent may also climb or descend this far at its horizontal position (a
+    UAV profiling the plume's height; each such move takes as long as a horizontal one), within
+    the area's altitude range; 0: the start altitude throughout (the paper's agent). Grid agent
+    only (docs/turbulent.md)"""
     count: Annotated[int, Field(ge=1, le=16)] = 1
     """robots searching together with one shared belief; robot k starts k · step metres from
     ``start`` along +y (along −y where +y would leave the area)"""

@@ -103,7 +103,13 @@ class Scenario(ScenarioBuilders, BaseModel):
             self.dwell,
             self.agent.headings,
             site=site,
+            climb=self.agent.climb,
         )
+        if self.agent.climb > 0 and self.agent.model != "grid":
+            raise ValueError(
+                f'{FIELD_MARK}agent.climb: {self.agent.climb:g} m needs agent.model = "grid" '
+                f"(the {self.agent.model} robot drives on the ground); use climb = 0"
+            )
         starts = team_starts(start, self.agent.step, self.agent.count, lo, hi)
         if starts is None:
             raise ValueError(

@@ -1,0 +1,74 @@
+"""The climbing agent (``agent.climb``): two more moves change the altitude, inside the area's
+altitude range, for every consumer of the move set (planners, the simulation, the gym env)."""
+
+import numpy as np
+import pytest
+
+import dcee.gym
+from dcee import GridAgent, SearchVolume
+from dcee.errors import DceeInputError
+from dcee.runs import run_episode
+from dcee.scenarios import load_scenario
+
+
+def test_moves_by_hand():
+    agent = GridAgent(SearchVolume((0, 0, 0), (50, 50, 5)), step=2.0, climb=1.0)
+    assert agent.n_moves == 10
+    np.testing.assert_allclose(agent.moves[8:], [[0, 0, 1.0], [0, 0, -1.0]])
+    np.testing.assert_allclose(agent.moves[0], [2.0, 0, 0])
+    # at the ceiling only the descent is left of the two; on the floor only the climb
+    top, heads = agent.candidates(np.array([10.0, 10.0, 5.0]))
+    assert 8 not in heads and 9 in heads
+    np.testing.assert_allclose(top[heads == 9][0], [10.0, 10.0, 4.0])
+    _, heads = agent.candidates(np.array([10.0, 10.0, 0.0]))
+    assert 8 in heads and 9 not in heads
+    # climb 0 is the paper's agent: eight headings at one altitude
+    flat = GridAgent(SearchVolume((0, 0, 0), (50, 50, 5)), step=2.0)
+    assert flat.n_moves == 8 and not flat.moves[:, 2].any()
+    with pytest.raises(DceeInputError, match=r"agent\.climb"):
+        GridAgent(SearchVolume((0, 0, 0), (50, 50, 5)), climb=-1.0)
+
+
+def test_a_ground_robot_cannot_climb():
+    with pytest.raises(DceeInputError, match=r"agent\.climb"):
+        load_scenario("paper:1").with_overrides(**{"agent.climb": 1.0, "agent.model": "unicycle"})
+
+
+def test_a_climbing_search_flies_other_altitudes_and_counts_them():
+    sc = load_scenario("random:16").with_overrides(
+        **{"search.particles": 1000, "search.hypotheses": 10, "search.budget": 200.0}
+    )
+    flat = run_episode(sc, "infotaxis", 0)
+    assert {r["z"] for r in flat.records} == {4.0}
+    climbing = sc.with_overrides(**{"agent.climb": 1.0})
+    a, b = run_episode(climbing, "infotaxis", 0), run_episode(climbing, "infotaxis", 0)
+    z = np.array([r["z"] for r in a.records])
+    assert np.array_equal(z, [r["z"] for r in b.records])  # reproducible
+    assert len(set(z)) > 1 and z.min() >= 0.0 and z.max() <= 5.0
+    xyz = np.array([[r["x"], r["y"], r["z"]] for r in a.records])
+    steps = np.diff(np.vstack([np.array(sc.agent.start)[None], xyz]), axis=0)
+    by_hand = np.hypot(steps[:, 0], steps[:, 1]).sum() + np.abs(steps[:, 2]).sum()
+    assert a.summary["path_length"] == pytest.approx(by_hand)
+
+
+def test_the_gym_env_offers_the_climb():
+    sc = load_scenario("paper:1").with_overrides(**{"agent.climb": 1.0})
+    env = dcee.gym.SourceSearchEnv(scenario=sc, particles=300, budget=60.0)
+    assert env.action_space.n == 10
+    _, info = env.reset(seed=0)
+    assert info["action_mask"].shape == (10,) and info["action_mask"][8] == 1
+    env.step(8)  # up, from 4 m to the 5 m ceiling
+    np.testing.assert_allclose(env.position, [2.0, 2.0, 5.0])
+    _, _, _, _, info = env.step(9)
+    np.testing.assert_allclose(env.position, [2.0, 2.0, 4.0])
+    env.step(8)
+    _, _, _, _, info = env.step(0)
+    assert info["action_mask"][8] == 0  # no higher than the area
+
+
+def test_the_robot_cycle_refuses_a_climb_it_cannot_see():
+    from dcee.robot.cycle import CycleSettings
+
+    sc = load_scenario("paper:1").with_overrides(**{"agent.climb": 1.0})
+    with pytest.raises(DceeInputError, match=r"agent\.climb"):
+        CycleSettings.from_scenario(sc)
