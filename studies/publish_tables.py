@@ -193,15 +193,29 @@ def what_we_found() -> str:
         ),
         pair_row(
             "**held-out**, the independent puff truth, all eight unknown, fluctuation "
-            "likelihood, current defaults, 24 configurations (small sample; "
-            "`turbulent-held-out-24`)",
-            "turbulent-held-out-24",
+            "likelihood, current defaults, 100 configurations (`turbulent-held-out-100`)",
+            "turbulent-held-out-100",
             truth_model="puffs",
+            climb=0.0,
         ),
         pair_row(
-            "**held-out**, filament truth, the same 24 configurations and settings",
-            "turbulent-held-out-24",
+            "**held-out**, filament truth, the same 100 configurations and settings",
+            "turbulent-held-out-100",
             truth_model="filament",
+            climb=0.0,
+        ),
+        pair_row(
+            "**held-out**, puff truth, the same, the UAV free to change altitude "
+            "(`agent.climb = 1`)",
+            "turbulent-held-out-100",
+            truth_model="puffs",
+            climb=1.0,
+        ),
+        pair_row(
+            "**held-out**, filament truth, the same, `agent.climb = 1`",
+            "turbulent-held-out-100",
+            truth_model="filament",
+            climb=1.0,
         ),
     ]
     return table(
@@ -310,13 +324,13 @@ def turbulent_table() -> str:
                 f"filament, 12 public × 10: `{strategy}` (`filament-public`)", pick(frame, strategy)
             )
         )
-    frame = study("turbulent-held-out-24")
-    for truth in ("puffs", "filament"):
-        for strategy in ("dcee-cl", "infotaxis"):
-            r = pick(frame, strategy, truth_model=truth)
-            rows.append(
-                full_row(f"{truth}, 24 held-out: `{strategy}` (`turbulent-held-out-24`)", r)
-            )
+    frame = study("turbulent-held-out-100")
+    for climb, how in ((0.0, "fixed 4 m altitude"), (1.0, "`agent.climb = 1`")):
+        for truth in ("puffs", "filament"):
+            for strategy in ("dcee-cl", "infotaxis"):
+                r = pick(frame, strategy, truth_model=truth, climb=climb)
+                label = f"{truth}, 100 held-out, {how}: `{strategy}` (`turbulent-held-out-100`)"
+                rows.append(full_row(label, r))
     return table(FULL_HEADER, rows)
 
 

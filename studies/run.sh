@@ -51,7 +51,9 @@ case "${1:---list}" in
     $P studies/ablation_table.py results/filament-calm=infotaxis results/filament-info-loc=infotaxis ;;
   turbulent-held-out)  # both turbulent truths on held-out configurations (docs/turbulent.md)
     bash studies/study_turbulent_held_out.sh
-    report turbulent-filament-held-out-24 turbulent-puffs-held-out-24 ;;
+    SUITE=held-out-100 bash studies/study_turbulent_held_out.sh
+    report turbulent-filament-held-out-24 turbulent-puffs-held-out-24
+    report turbulent-filament-held-out-100 turbulent-puffs-held-out-100 ;;
   held-out)  # random configurations of the reporting range (docs/held-out.md)
     bash studies/study_held_out.sh
     report held-out-wind-known held-out-full held-out-filament ;;
@@ -80,6 +82,21 @@ case "${1:---list}" in
       --variant "rw0.5:estimator.near_source_length=10,estimator.reading_weight=0.5" \
       --variant "nsl5rw0.5:estimator.near_source_length=5,estimator.reading_weight=0.5" \
       --csv docs/results/precision-tune.csv ;;
+  turbulent-tune)  # the second tuning round, random:13-40: guard share, climb (docs/turbulent.md)
+    out=docs/results/tuning-turbulent-13-40
+    $P studies/precision_variants.py --configs random:13-40 --truths filament puffs \
+      --variant base:search.guard_share=1.0 --variant g015:search.guard_share=0.15 \
+      --csv "$out/guard-share.csv"
+    $P studies/precision_variants.py --configs random:13-40 --truths filament puffs \
+      --variant climb1:agent.climb=1.0 --csv "$out/climb.csv"
+    for unk in source full; do
+      $D bench --suite random-tune --strategies dcee-cl --repeats 1 --unknown $unk \
+        --particles 10000 --set search.guard_share=1.0 --out "results/tune-guard-$unk-1"
+      $D bench --suite random-tune --strategies dcee-cl --repeats 1 --unknown $unk \
+        --particles 10000 --set search.guard_share=0.15 --out "results/tune-guard-$unk-015"
+    done
+    $P studies/ablation_table.py results/tune-guard-source-1 results/tune-guard-source-015
+    $P studies/ablation_table.py results/tune-guard-full-1 results/tune-guard-full-015 ;;
   stop-rule)  # the stop-when-localised rule: tuning and held-out replays (docs/results.md §7)
     bash studies/study_stop_rule.sh
     $P studies/stop_rule_table.py results/stop-tune-wind-known results/stop-tune-full \

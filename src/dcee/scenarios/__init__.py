@@ -51,10 +51,12 @@ A scenario is a TOML file (or a built-in, see :mod:`dcee.scenarios.builtin`)::
     calm_prior = 0.1               # fluctuation only: prior probability of a calm plume (0: off)
     meander = 0.15                 # plume broadening [default: 0 paper, 0.15 fluctuation]
     outlier = 0.01                 # outlier weight [default: 0.01 for every likelihood]
+    magnitude = true               # fluctuation only; false: detection-only readings
 
     [agent]
     start = [2.0, 2.0, 4.0]        # m; the agent flies at the start altitude
     step = 2.0                     # m
+    climb = 0.0                    # m per climb or descent move; 0: fixed altitude (the paper)
     speed = 2.0                    # m/s
     dwell = 1.0                    # s held at each waypoint [default: 1, 5 if time-varying]
 
