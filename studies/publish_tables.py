@@ -165,6 +165,9 @@ def what_we_found() -> str:
             when = "—"
         elif a["reached_1m"] == 0 and b["reached_1m"] == 0:
             when = "never"
+        elif math.isinf(ta) or math.isinf(tb):  # the median search never got there
+            got = f"{100 * a['reached_1m']:.0f} % / {100 * b['reached_1m']:.0f} %"
+            when = f"> budget ({got} got there)"
         else:
             when = f"{ta:.0f} / {tb:.0f} s"
             if (RESULTS / name / "paired.csv").exists():

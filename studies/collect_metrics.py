@@ -1,0 +1,57 @@
+"""Gather several campaigns' `dcee report` tables into one stored study (docs/results/<study>/):
+each campaign's ``report/metrics.csv`` and ``report/pairwise.csv`` rows, tagged with the columns
+that tell the campaigns apart, into ``metrics.csv`` and ``pairwise.csv``.
+
+    .venv/bin/python studies/collect_metrics.py --out docs/results/turbulent-held-out-100 \\
+        results/turbulent-puffs-held-out-100=truth_model:puffs,climb:0 \\
+        results/turbulent-puffs-held-out-100-climb=truth_model:puffs,climb:1 …
+
+Run ``dcee report DIR`` on every campaign first (this reads its tables, it computes nothing).
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import pandas as pd
+
+
+def _tagged(arg: str) -> tuple[Path, dict[str, object]]:
+    folder, _, tags = arg.partition("=")
+    values: dict[str, object] = {}
+    for item in filter(None, tags.split(",")):
+        key, _, value = item.partition(":")
+        try:
+            values[key] = float(value)
+        except ValueError:
+            values[key] = value
+    return Path(folder), values
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("campaigns", nargs="+", help="DIR=key:value,key:value")
+    ap.add_argument("--out", required=True, help="the study folder to write")
+    args = ap.parse_args(argv)
+    metrics, pairwise = [], []
+    for arg in args.campaigns:
+        folder, tags = _tagged(arg)
+        for name, into in (("metrics.csv", metrics), ("pairwise.csv", pairwise)):
+            path = folder / "report" / name
+            if not path.exists():
+                raise SystemExit(f"collect_metrics: {path} is missing; run dcee report {folder}")
+            frame = pd.read_csv(path)
+            for i, (key, value) in enumerate(tags.items()):
+                frame.insert(1 + i, key, value)
+            into.append(frame)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    pd.concat(metrics).to_csv(out / "metrics.csv", index=False)
+    pd.concat(pairwise).to_csv(out / "pairwise.csv", index=False)
+    print(f"wrote {out / 'metrics.csv'} and {out / 'pairwise.csv'}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
