@@ -96,7 +96,17 @@ case "${1:---list}" in
         --particles 10000 --set search.guard_share=0.15 --out "results/tune-guard-$unk-015"
     done
     $P studies/ablation_table.py results/tune-guard-source-1 results/tune-guard-source-015
-    $P studies/ablation_table.py results/tune-guard-full-1 results/tune-guard-full-015 ;;
+    $P studies/ablation_table.py results/tune-guard-full-1 results/tune-guard-full-015
+    for unk in source full; do  # the climb on the isotropic truth, each planner against itself
+      $D bench --suite random-tune --strategies dcee-cl,infotaxis --repeats 1 --unknown $unk \
+        --particles 10000 --set agent.climb=1.0 --out "results/tune-climb-$unk"
+      $D bench --suite random-tune --strategies infotaxis --repeats 1 --unknown $unk \
+        --particles 10000 --out "results/tune-info-$unk"
+      $P studies/ablation_table.py "results/tune-guard-$unk-015=dcee-cl" \
+        "results/tune-climb-$unk=dcee-cl"
+      $P studies/ablation_table.py "results/tune-info-$unk=infotaxis" \
+        "results/tune-climb-$unk=infotaxis"
+    done ;;
   stop-rule)  # the stop-when-localised rule: tuning and held-out replays (docs/results.md §7)
     bash studies/study_stop_rule.sh
     $P studies/stop_rule_table.py results/stop-tune-wind-known results/stop-tune-full \
