@@ -167,7 +167,8 @@ def what_we_found() -> str:
             when = "never"
         elif math.isinf(ta) or math.isinf(tb):  # the median search never got there
             got = f"{100 * a['reached_1m']:.0f} % / {100 * b['reached_1m']:.0f} %"
-            when = f"> budget ({got} got there)"
+            each = ["> budget" if math.isinf(t) else f"{t:.0f} s" for t in (ta, tb)]
+            when = f"{each[0]} / {each[1]} ({got} got there)"
         else:
             when = f"{ta:.0f} / {tb:.0f} s"
             if (RESULTS / name / "paired.csv").exists():
@@ -200,25 +201,29 @@ def what_we_found() -> str:
             "turbulent-held-out-100",
             truth_model="puffs",
             climb=0.0,
+            near_source_length=5.0,
         ),
         pair_row(
             "**held-out**, filament truth, the same 100 configurations and settings",
             "turbulent-held-out-100",
             truth_model="filament",
             climb=0.0,
+            near_source_length=5.0,
         ),
         pair_row(
             "**held-out**, puff truth, the same, the UAV free to change altitude "
-            "(`agent.climb = 1`)",
+            "(`agent.climb = 1`, `estimator.near_source_length = 2.5`)",
             "turbulent-held-out-100",
             truth_model="puffs",
             climb=1.0,
+            near_source_length=2.5,
         ),
         pair_row(
-            "**held-out**, filament truth, the same, `agent.climb = 1`",
+            "**held-out**, filament truth, the same, `agent.climb = 1`, near-source length 2.5 m",
             "turbulent-held-out-100",
             truth_model="filament",
             climb=1.0,
+            near_source_length=2.5,
         ),
     ]
     return table(
@@ -328,10 +333,15 @@ def turbulent_table() -> str:
             )
         )
     frame = study("turbulent-held-out-100")
-    for climb, how in ((0.0, "fixed 4 m altitude"), (1.0, "`agent.climb = 1`")):
+    settings = (
+        (0.0, 5.0, "fixed 4 m altitude"),
+        (1.0, 5.0, "`agent.climb = 1`"),
+        (1.0, 2.5, "climb, near-source length 2.5 m"),
+    )
+    for climb, near, how in settings:
         for truth in ("puffs", "filament"):
             for strategy in ("dcee-cl", "infotaxis"):
-                r = pick(frame, strategy, truth_model=truth, climb=climb)
+                r = pick(frame, strategy, truth_model=truth, climb=climb, near_source_length=near)
                 label = f"{truth}, 100 held-out, {how}: `{strategy}` (`turbulent-held-out-100`)"
                 rows.append(full_row(label, r))
     return table(FULL_HEADER, rows)

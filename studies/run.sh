@@ -51,9 +51,29 @@ case "${1:---list}" in
     $P studies/ablation_table.py results/filament-calm=infotaxis results/filament-info-loc=infotaxis ;;
   turbulent-held-out)  # both turbulent truths on held-out configurations (docs/turbulent.md)
     bash studies/study_turbulent_held_out.sh
-    SUITE=held-out-100 bash studies/study_turbulent_held_out.sh
+    export SUITE=held-out-100 WORKERS=${WORKERS:-2}
+    bash studies/study_turbulent_held_out.sh
+    OUT_SUFFIX=-climb bash studies/study_turbulent_held_out.sh --set agent.climb=1.0
+    OUT_SUFFIX=-climb-nsl25 bash studies/study_turbulent_held_out.sh --set agent.climb=1.0 \
+      --set estimator.near_source_length=2.5
     report turbulent-filament-held-out-24 turbulent-puffs-held-out-24
-    report turbulent-filament-held-out-100 turbulent-puffs-held-out-100 ;;
+    out=docs/results/turbulent-held-out-100
+    gathered=()
+    rm -f "$out/climb_vs_fixed.csv" "$out/nsl25_vs_climb.csv"  # the pairs are appended below
+    for t in puffs filament; do
+      for v in "=climb:0,near_source_length:5" "-climb=climb:1,near_source_length:5" \
+        "-climb-nsl25=climb:1,near_source_length:2.5"; do
+        report "turbulent-$t-held-out-100${v%%=*}"
+        gathered+=("results/turbulent-$t-held-out-100${v%%=*}=truth_model:$t,${v#*=}")
+      done
+      $P studies/pair_campaigns.py "results/turbulent-$t-held-out-100" \
+        "results/turbulent-$t-held-out-100-climb" --csv "$out/climb_vs_fixed.csv" --tag truth_model=$t
+      $P studies/pair_campaigns.py "results/turbulent-$t-held-out-100-climb" \
+        "results/turbulent-$t-held-out-100-climb-nsl25" --csv "$out/nsl25_vs_climb.csv" \
+        --tag truth_model=$t
+    done
+    $P studies/collect_metrics.py --out "$out" "${gathered[@]}"
+    $P studies/publish_tables.py ;;
   held-out)  # random configurations of the reporting range (docs/held-out.md)
     bash studies/study_held_out.sh
     report held-out-wind-known held-out-full held-out-filament ;;
@@ -89,6 +109,9 @@ case "${1:---list}" in
       --csv "$out/guard-share.csv"
     $P studies/precision_variants.py --configs random:13-40 --truths filament puffs \
       --variant climb1:agent.climb=1.0 --csv "$out/climb.csv"
+    $P studies/precision_variants.py --configs random:13-40 --truths filament puffs \
+      --variant c1n25:agent.climb=1.0,estimator.near_source_length=2.5 \
+      --csv "$out/climb-nsl25.csv"
     for unk in source full; do
       $D bench --suite random-tune --strategies dcee-cl --repeats 1 --unknown $unk \
         --particles 10000 --set search.guard_share=1.0 --out "results/tune-guard-$unk-1"
