@@ -12,6 +12,7 @@ Run ``dcee report DIR`` on every campaign first (this reads its tables, it compu
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import pandas as pd
@@ -40,7 +41,10 @@ def main(argv: list[str] | None = None) -> int:
         for name, into in (("metrics.csv", metrics), ("pairwise.csv", pairwise)):
             path = folder / "report" / name
             if not path.exists():
-                raise SystemExit(f"collect_metrics: {path} is missing; run dcee report {folder}")
+                print(
+                    f"collect_metrics: {path} is missing; run dcee report {folder}", file=sys.stderr
+                )
+                return 2
             frame = pd.read_csv(path)
             for i, (key, value) in enumerate(tags.items()):
                 frame.insert(1 + i, key, value)

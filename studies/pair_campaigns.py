@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 import pandas as pd
@@ -21,7 +22,8 @@ COLUMNS = ["scenario", "seed", "strategy", "source_acquired", "final_rmse", "tru
 def _load(folder: str) -> pd.DataFrame:
     paths = sorted(Path(folder).glob("runs/**/summary.json"))
     if not paths:
-        raise SystemExit(f"pair_campaigns: no searches under {folder}")
+        print(f"pair_campaigns: no searches under {folder}", file=sys.stderr)
+        raise SystemExit(2)
     return pd.DataFrame([json.loads(p.read_text()) for p in paths])[COLUMNS]
 
 

@@ -15,7 +15,7 @@ from dcee import (
     Sensor,
 )
 from dcee.planning import Planner
-from dcee.runs import run_episode
+from dcee.runs import make_searcher, run_episode, streams
 from dcee.runs.metrics import longest_stall
 from dcee.scenarios import load_scenario
 from tests.helpers import planar_prior
@@ -31,11 +31,14 @@ class _Homing(Planner):
         return np.hypot(candidates[:, 0] - 10.0, candidates[:, 1] - 10.0), {}
 
 
-def _fly(guard: float, prior_box=(0.0, 40.0), moves: int = 120) -> tuple[float, Searcher]:
+def _fly(
+    guard: float, prior_box=(0.0, 40.0), moves: int = 120, **options
+) -> tuple[float, Searcher]:
     pf = ParticleFilter(
         planar_prior(x=prior_box, y=prior_box), Sensor(), IsotropicPlume(), 500, seed=0
     )
-    searcher = Searcher(pf, _Homing(), AGENT, np.random.default_rng(0), stall_guard=guard)
+    rng = np.random.default_rng(0)
+    searcher = Searcher(pf, _Homing(), AGENT, rng, stall_guard=guard, **options)
     position, times, path = np.array([2.0, 2.0, 0.0]), [], []
     for k in range(moves):
         searcher.tell(position, 0.0, 2.0 * k)  # nothing is ever detected
@@ -55,8 +58,22 @@ def test_the_guard_ends_a_stall_that_the_planner_would_never_end():
 
 def test_the_guard_leaves_a_robot_alone_at_a_located_source():
     # a belief concentrated near (10, 10): hovering there is the point of the search
-    stall, searcher = _fly(30.0, prior_box=(9.0, 11.0))
+    stall, searcher = _fly(30.0, prior_box=(9.5, 10.5))
     assert searcher.guard_fired == 0 and stall > 150
+
+
+def test_the_guard_acts_until_the_belief_is_as_narrow_as_the_stop_rule():
+    # a belief 1-2 m wide around the wrong place: with the old threshold (3 m, the acquired
+    # bar) the robot hovered there; with the default (0.45 m, guard_share 0.15) it moves on
+    _, old = _fly(30.0, prior_box=(7.0, 13.0), guard_spread=3.0)
+    assert old.guard_fired == 0 and 0.45 < old.estimate().spread < 3.0
+    _, new = _fly(30.0, prior_box=(7.0, 13.0))
+    assert new.guard_spread == pytest.approx(0.45) and new.guard_fired > 0
+    # the scenario's share reaches the searcher: guard_share × acquired_rmse
+    sc = load_scenario("paper:1").with_overrides(**{"search.particles": 500})
+    assert make_searcher(sc, None, *streams(0)[1:3]).guard_spread == pytest.approx(0.45)
+    wide = sc.with_overrides(**{"search.guard_share": 1.0})
+    assert make_searcher(wide, None, *streams(0)[1:3]).guard_spread == pytest.approx(3.0)
 
 
 def test_the_guard_is_off_in_old_checkpoints_and_checked():

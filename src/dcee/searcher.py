@@ -19,7 +19,7 @@ from dcee.models.agent import GridAgent, stall_start
 from dcee.planning.base import Belief, Decision, Planner
 from dcee.planning.particle_terms import ParticleTerms
 from dcee.planning.team import decide_team
-from dcee.stopping import DEFAULT_STOP_RULE, StopRule
+from dcee.stopping import DEFAULT_STOP_RULE, DEFAULT_STOP_SHARE, StopRule
 
 
 @dataclass(frozen=True)
@@ -40,10 +40,10 @@ DEFAULT_STALL_GUARD = 30.0
 still wide, its next move must take it further from that position (:class:`Searcher`). Half the
 60 s a stall may last by issue 28's bar; chosen by that bar, not tuned on any configuration."""
 
-DEFAULT_GUARD_SPREAD = 0.45
-"""m: the guard acts while the belief's spread √tr P exceeds this: the default stop rule's
-threshold at the paper's 3 m acquisition bar (:data:`~dcee.stopping.DEFAULT_STOP_SHARE` × 3 m),
-so a robot may hover only where it could also stop (``search.guard_share``, docs/turbulent.md)."""
+DEFAULT_GUARD_SPREAD = DEFAULT_STOP_SHARE * 3.0
+"""m (0.45): the guard acts while the belief's spread √tr P exceeds this: the default stop rule's
+threshold at the paper's 3 m acquisition bar, so a robot may hover only where it could also stop
+(``search.guard_share``, docs/turbulent.md)."""
 
 STALL_HISTORY = 64
 """Told positions the stall guard looks back over (more than 30 s of readings at 1 s)."""

@@ -165,14 +165,20 @@ class Sensor:
             lin0=lin0,
             lin1=lin1,
             magnitude=1.0 if self.magnitude else 0.0,
-            log_flat=-math.log(math.log(self.max_reading / self.threshold)),
+            log_flat=self._log_flat,
         )
+
+    @property
+    def _log_flat(self) -> float:
+        """log(g(z) · z), g the log-uniform density on [threshold, max_reading] (the same for
+        every z): the outliers' and the detection-only magnitudes' density."""
+        return -math.log(math.log(self.max_reading / self.threshold))
 
     def _log_outlier_times_z(self) -> float:
         """log(outlier · g(z) · z) with g the log-uniform density on [threshold, max_reading]."""
         if self.outlier == 0:
             return -math.inf
-        return math.log(self.outlier) - math.log(math.log(self.max_reading / self.threshold))
+        return math.log(self.outlier) + self._log_flat
 
     def is_detection(self, reading: np.ndarray | float) -> np.ndarray:
         """True where a reading counts as a detection (at or above the threshold)."""
@@ -247,13 +253,13 @@ class Sensor:
         log_nd = log_missed + math.log1p(-self.false_alarm) + log_keep
         zd = np.maximum(z, self.threshold)  # detections only; the rest is masked below
         v = np.log(zd) if self.lognormal else zd
-        r = (v - loc) / sigma
-        log_det = np.log(pd) - 0.5 * r * r - np.log(sigma) - 0.5 * np.log(2 * np.pi)
-        if self.lognormal:
-            log_det = log_det - np.log(zd)
-        if not self.magnitude:  # detection only: P(z ≥ thr | C, r) · g(z), g log-uniform
-            flat = -math.log(math.log(self.max_reading / self.threshold))
-            log_det = np.log(pd) + log_ndtr((loc - v_thr) / sigma) + flat - np.log(zd)
+        if self.magnitude:
+            r = (v - loc) / sigma
+            log_det = np.log(pd) - 0.5 * r * r - np.log(sigma) - 0.5 * np.log(2 * np.pi)
+            if self.lognormal:
+                log_det = log_det - np.log(zd)
+        else:  # detection only: P(z ≥ thr | C, r) · g(z), g log-uniform
+            log_det = np.log(pd) + log_ndtr((loc - v_thr) / sigma) + self._log_flat - np.log(zd)
         if self.false_alarm > 0:
             log_fa = (
                 np.log(self.false_alarm)
