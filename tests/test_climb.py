@@ -72,3 +72,36 @@ def test_the_robot_cycle_refuses_a_climb_it_cannot_see():
     sc = load_scenario("paper:1").with_overrides(**{"agent.climb": 1.0})
     with pytest.raises(DceeInputError, match=r"agent\.climb"):
         CycleSettings.from_scenario(sc)
+
+
+def test_an_unset_climb_follows_the_expected_plume_and_the_platform():
+    """agent.climb unset: 1 m (AUTO_CLIMB) for the grid UAV with the fluctuation likelihood,
+    0 with the paper's likelihood (the paper's agent), on the ground robot and on a robot's
+    cycle; a value set is kept everywhere."""
+    from dcee.robot.cycle import CycleSettings
+    from dcee.runs import make_searcher, scenario_identity
+    from dcee.scenarios import AUTO_CLIMB, to_toml
+
+    paper = load_scenario("random:16")
+    turbulent = paper.with_overrides(**{"estimator.likelihood": "fluctuation"})
+    assert paper.agent.climb is None and paper.climb == 0.0
+    assert AUTO_CLIMB == 1.0 and turbulent.climb == 1.0
+    assert turbulent.make_agent().n_moves == 10
+    assert turbulent.make_agent(on_robot=True).n_moves == 8
+    rng = np.random.default_rng(0)
+    assert make_searcher(turbulent, None, rng, rng).agent.climb == 0.0  # a robot: planar poses
+    CycleSettings.from_scenario(turbulent)  # unset is not refused on a robot
+    fixed = turbulent.with_overrides(**{"agent.climb": 0.0})
+    assert fixed.climb == 0.0 and fixed.make_agent().n_moves == 8
+    ground = turbulent.with_overrides(**{"agent.model": "unicycle"})
+    assert ground.climb == 0.0
+    # dcee show: the resolved value as a comment, and the file reads back unset
+    assert "# climb = 1.0  (unset: the default for this scenario)" in to_toml(turbulent)
+    # a stored campaign compares its unset climb as the number it resolved to
+    stored = turbulent.model_dump(mode="json")
+    explicit = turbulent.with_overrides(**{"agent.climb": 1.0}).model_dump(mode="json")
+    assert scenario_identity(stored) == scenario_identity(explicit)
+    assert scenario_identity(stored) != scenario_identity(fixed.model_dump(mode="json"))
+    before = paper.model_dump(mode="json")
+    del before["agent"]["climb"]  # a paper campaign stored before the setting existed
+    assert scenario_identity(before) == scenario_identity(paper.model_dump(mode="json"))

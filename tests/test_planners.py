@@ -411,6 +411,56 @@ def test_spread_reach_scales_the_free_disk_with_the_belief():
         planners.get("dcee-cl:spread_reach=-1")
 
 
+def test_vertical_reach_frees_the_height_error_only_for_a_climbing_agent():
+    # The belief of the test above: σ_xy = 5 m, so R = max(2, 2 · 5) = 10 m. Two hypothesised
+    # posterior means seen from (10, 10, 4): A 13 m east at height 0 (beyond the disk by 3 m,
+    # 4 m below), B straight below at −2 m (6 m below); tr P' = 1.5 and 0.5 m².
+    from dcee.planning.predicted import SequenceStats
+
+    pts = [(7.0, 6.0), (13.0, 14.0), (7.0, 14.0), (13.0, 6.0)]
+    belief = _belief(pts)
+    mean = np.array([[[23.0, 10.0, 0.0], [10.0, 10.0, -2.0]]])
+    nan = np.full((1, 2), np.nan)
+    stats = SequenceStats(nan, np.array([[0.5, 0.5]]), nan, mean, np.array([[1.5, 0.5]]), nan, nan)
+    final = np.array([[10.0, 10.0, 4.0]])
+    planner = planners.get("dcee-cl:reach=2:info_share=0")
+    volume = SearchVolume((0.0, 0.0, 0.0), (40.0, 40.0, 5.0))
+    # fixed altitude: the height error is charged in full, 3² + 4² + 1.5 and 6² + 0.5
+    planner.bind_agent(GridAgent(volume, step=2.0))
+    np.testing.assert_allclose(planner.loss(final, stats, belief), [[26.5, 36.5]])
+    # climb 1 m per 2 m step: R_z = 10 · 1 / 2 = 5 m; A's 4 m is free, B's 6 m costs 1²
+    planner.bind_agent(GridAgent(volume, step=2.0, climb=1.0))
+    assert planner.effective_vertical_reach(belief) == 5.0
+    np.testing.assert_allclose(planner.loss(final, stats, belief), [[10.5, 1.5]])
+    # vertical_reach 0 is the cost before: the height error charged in full, climbing or not
+    before = planners.get("dcee-cl:reach=2:info_share=0:vertical_reach=0")
+    before.bind_agent(GridAgent(volume, step=2.0, climb=1.0))
+    np.testing.assert_allclose(before.loss(final, stats, belief), [[26.5, 36.5]])
+    with pytest.raises(DceeInputError, match="vertical_reach"):
+        planners.get("dcee-cl:vertical_reach=-1")
+
+
+def test_a_climbing_dcee_cl_values_a_reading_at_another_height():
+    # Two equally likely sources straight below the agent's column, at 0 m and 4 m, in a calm
+    # (no wind, weak release): only a reading near one of them tells them apart. From 2 m, with
+    # the old cost (vertical_reach 0) the height error cancels the height information and a
+    # vertical move costs more than staying level (it leaves the believed mean height); with
+    # the vertical reach the move towards one of them is the cheapest (it resolves the height,
+    # which the agent can then act on).
+    theta = theta_at([(10.0, 10.0, 0.0)] * 300 + [(10.0, 10.0, 4.0)] * 300, q=0.02, u=0.0)
+    belief = Belief(theta, np.full(600, 1 / 600), Sensor(), IsotropicPlume())
+    agent = GridAgent(SearchVolume((0.0, 0.0, 0.0), (40.0, 40.0, 5.0)), step=2.0, climb=1.0)
+    position = np.array([10.0, 10.0, 2.0])
+    new = planners.get("dcee-cl:hypotheses=12").decide(
+        belief, position, agent, np.random.default_rng(0)
+    )
+    assert abs(new.candidates[new.index][2] - 2.0) == 1.0  # up or down, not level
+    old = planners.get("dcee-cl:hypotheses=12:vertical_reach=0")
+    before = old.decide(belief, position, agent, np.random.default_rng(0))
+    assert before.candidates[before.index][2] == 2.0
+    assert np.min(new.costs) < np.min(before.costs)
+
+
 def test_info_share_charges_the_information_equivalent_location_variance():
     # Beyond every predicted mean (reach 100 m) the loss is the uncertainty term alone:
     # info_share=1 gives tr P · E_z[exp(−KL(w'(z) ‖ w))], checked here against the NumPy

@@ -10,14 +10,23 @@ within R metres (horizontally) of p_{k+1} before the distance to the believed so
 
     J(u) = E_ẑ[ dist(s̄'(ẑ), disk(p_{k+1}, R))² + tr P'(ẑ) ],
 
-with dist² = max(0, ‖s̄'_xy − p_xy‖ − R)² + (s̄'_z − p_z)². Far from the mean this is MPC; within R
-of it the distance term vanishes and what is left is the expected variance reduction, which
-points at the informative move: the dual-control term the open loop cancels. R must exceed one
-step (otherwise the reading can never change what the agent does next) and not be so large that
-the MPC pull is lost; the default was chosen by measurement (docs/dual-control.md). A fixed R
-cannot suit a belief 20 m wide and one 1 m wide: R = max(``reach``, ``spread_reach`` · σ_xy)
-(default 2 σ_xy) keeps a wide belief's every move free of the distance charge, where a fixed
-8 m made the agent pace on the disk's edge (docs/held-out.md).
+with dist² = max(0, ‖s̄'_xy − p_xy‖ − R)² + max(0, |s̄'_z − p_z| − R_z)². Far from the mean this
+is MPC; within R of it the distance term vanishes and what is left is the expected variance
+reduction, which points at the informative move: the dual-control term the open loop cancels.
+R must exceed one step (otherwise the reading can never change what the agent does next) and
+not be so large that the MPC pull is lost; the default was chosen by measurement
+(docs/dual-control.md). A fixed R cannot suit a belief 20 m wide and one 1 m wide:
+R = max(``reach``, ``spread_reach`` · σ_xy) (default 2 σ_xy) keeps a wide belief's every move
+free of the distance charge, where a fixed 8 m made the agent pace on the disk's edge
+(docs/held-out.md).
+
+The vertical reach R_z: an agent at a fixed altitude (the paper's) cannot act on what a reading
+tells about the source height, so R_z = 0 and the height error is charged in full. An agent that
+climbs (``agent.climb`` > 0) can: R_z = ``vertical_reach`` · R · climb / step, as many vertical
+moves as R allows horizontal ones (default ``vertical_reach`` 1). With R_z = 0 and a climbing
+agent, E[(s̄'_z − p_z)²] + E[P'_zz] = (s̄_z − p_z)² + P_zz whatever the reading: the height term
+cancels the height information, and the planner never paid for a reading below the believed
+source height (docs/turbulent.md: 58 % of its readings at 3 m on the held-out puff study).
 
 The uncertainty term: tr P'(ẑ) counts only what a reading tells about the source *location*.
 With the wind and dispersion unknown, readings that resolve them narrow the location later, and
@@ -56,6 +65,11 @@ none informative, and the agent paced on the reach disk's edge: on the 40 tuning
 stalled > 60 s. spread_reach 1: 40/40, one 74 s stall, median time to 1 m 97 s; 2: 40/40, no
 stall > 42 s, 111 s (infotaxis 40/40, 124 s). 2 kept: no stall (docs/dual-control.md §7)."""
 
+DEFAULT_VERTICAL_REACH = 1.0
+"""R_z = 1 · R · climb / step: the same number of moves vertically as horizontally. Chosen on the
+turbulent tuning range random:13-40 against 0 (docs/turbulent.md); no effect at a fixed
+altitude."""
+
 DEFAULT_INFO_SHARE = 0.5
 """Share of the uncertainty term measured by information about every parameter rather than by
 the location variance (:meth:`ClosedLoopDCEEPlanner.uncertainty`). 0.5 and 1 were measured on
@@ -78,6 +92,7 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
         reach: float = DEFAULT_REACH,
         spread_reach: float = DEFAULT_SPREAD_REACH,
         info_share: float = DEFAULT_INFO_SHARE,
+        vertical_reach: float = DEFAULT_VERTICAL_REACH,
         **options: Any,
     ) -> None:
         super().__init__(**options)
@@ -85,6 +100,7 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
             ("reach", reach, 1e3),
             ("spread_reach", spread_reach, 10.0),
             ("info_share", info_share, 1.0),
+            ("vertical_reach", vertical_reach, 10.0),
         ):
             if isinstance(value, bool) or not (
                 isinstance(value, int | float) and math.isfinite(value) and 0 <= value <= high
@@ -93,6 +109,9 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
         self.reach = float(reach)
         self.spread_reach = float(spread_reach)
         self.info_share = float(info_share)
+        self.vertical_reach = float(vertical_reach)
+        # climb / step of the agent the current decision is for (set by bind_agent)
+        self._climb_per_step = 0.0
         # the KL divergence costs one more accumulation in the kernel: only when it is used
         self.needs_kl = self.info_share > 0.0
 
@@ -101,6 +120,7 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
             "reach": self.reach,
             "spread_reach": self.spread_reach,
             "info_share": self.info_share,
+            "vertical_reach": self.vertical_reach,
             **super().options(),
         }
 
@@ -113,6 +133,13 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
             return self.reach
         spread = math.sqrt(belief.location_variance(2))
         return max(self.reach, self.spread_reach * spread)
+
+    def bind_agent(self, agent: GridAgent) -> None:
+        self._climb_per_step = agent.climb / agent.step
+
+    def effective_vertical_reach(self, belief: Belief) -> float:
+        """R_z = ``vertical_reach`` · R · climb / step m (0 at a fixed altitude)."""
+        return self.vertical_reach * self.effective_reach(belief) * self._climb_per_step
 
     def uncertainty(self, stats: SequenceStats, belief: Belief) -> np.ndarray:
         """(S, J) the uncertainty left after each hypothesised reading, in m²:
@@ -132,7 +159,8 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
         d = stats.mean - final_positions[:, None, :]
         horizontal = horizontal_distance(final_positions, stats.mean, belief.site)
         beyond = np.maximum(horizontal - self.effective_reach(belief), 0.0)
-        return beyond * beyond + d[..., 2] * d[..., 2] + self.uncertainty(stats, belief)
+        above = np.maximum(np.abs(d[..., 2]) - self.effective_vertical_reach(belief), 0.0)
+        return beyond * beyond + above * above + self.uncertainty(stats, belief)
 
 
 @register("dcee-cl-tree")
@@ -167,6 +195,7 @@ class ScenarioTreeDCEEPlanner(ClosedLoopDCEEPlanner):
         agent: GridAgent,
         rng: np.random.Generator,
     ) -> tuple[np.ndarray, dict[str, Any]]:
+        self.bind_agent(agent)
         ctx = PredictionContext(
             belief, self.n_hypotheses, 1, rng, self.expectation, self.noise, self.readings
         )

@@ -89,6 +89,10 @@ class HypothesisPlanner(Planner):
             "subsample": self.subsample,
         }
 
+    def bind_agent(self, agent: GridAgent) -> None:
+        """Called with the agent before each decision's costs (a cost that depends on which
+        moves the agent has, as ``dcee-cl``'s vertical reach does, reads it here)."""
+
     @abstractmethod
     def loss(self, final_positions: np.ndarray, stats: SequenceStats, belief: Belief) -> np.ndarray:
         """(S, J) loss of each hypothesis for (S, 3) final positions of S sequences."""
@@ -134,6 +138,7 @@ class HypothesisPlanner(Planner):
         agent: GridAgent,
         rng: np.random.Generator,
     ) -> tuple[np.ndarray, dict[str, Any]]:
+        self.bind_agent(agent)
         belief, ctx = self.context(belief, rng, self.horizon)
         seqs = candidates[:, None, :]
         cost = self.sequence_costs(seqs, ctx, belief)

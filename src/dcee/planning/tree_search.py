@@ -219,6 +219,7 @@ class TreeSearchPlanner(Planner):
         agent: GridAgent,
         rng: np.random.Generator,
     ) -> tuple[np.ndarray, dict[str, Any]]:
+        self.cost.bind_agent(agent)
         belief, ctx = self.cost.context(belief, rng, self.depth)
         turn = np.random.default_rng(rng.integers(2**63))  # rollouts' turns at the edges
         # the heading of each candidate given (a team's robot gets a subset of its moves)

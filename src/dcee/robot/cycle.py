@@ -62,7 +62,8 @@ class CycleSettings:
     def from_scenario(cls, scenario: Scenario, **changes: Any) -> CycleSettings:
         """The scenario's hold, averaging, budget, altitude and move bound; ``changes``
         (calibration, tolerances) override."""
-        if scenario.agent.climb > 0:  # the cycle tells the estimator a fixed altitude
+        climb = scenario.agent.climb  # unset: one altitude on a robot (resolved_climb)
+        if climb is not None and climb > 0:  # the cycle tells the estimator a fixed altitude
             raise DceeInputError(
                 "agent.climb",
                 f"must be 0 on a robot (got {scenario.agent.climb:g} m): the robot cycle reads "

@@ -27,7 +27,8 @@ def make_searcher(
     ``planner`` in a :class:`~dcee.searcher.Searcher`; the simulation, the ROS node and
     ``dcee replay`` build theirs here (with the generators of :func:`streams`). ``on_robot``:
     the scenario's stop rule as a robot applies it (:meth:`Scenario.stop_rule`: the default
-    rule unless ``search.stop_spread`` says otherwise); False, as a simulated study does."""
+    rule unless ``search.stop_spread`` says otherwise) and one altitude unless ``agent.climb`` is
+    set (:meth:`Scenario.resolved_climb`); False, as a simulated study does."""
     search = scenario.search
     models = scenario.reading_models
     # the first (preferred) model draws from filter_rng itself, as a lone filter does; the others
@@ -59,7 +60,7 @@ def make_searcher(
     return Searcher(
         estimator,
         planner,
-        scenario.make_agent(),
+        scenario.make_agent(on_robot=on_robot),
         planner_rng,
         stall_guard=search.stall_guard,
         guard_spread=search.guard_share * search.acquired_rmse,

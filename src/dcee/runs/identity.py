@@ -8,7 +8,7 @@ from __future__ import annotations
 import copy
 from typing import Any
 
-from dcee.scenarios import OLD_OUTLIER_DEFAULT, READING_WEIGHT_DEFAULT, UnicycleSpec
+from dcee.scenarios import AUTO_CLIMB, OLD_OUTLIER_DEFAULT, READING_WEIGHT_DEFAULT, UnicycleSpec
 
 
 def _unicycle_defaults() -> dict[str, Any]:
@@ -86,6 +86,12 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
         if "reading_weight" in estimator and estimator["reading_weight"] is None:
             # unset: the likelihood's default, compared as the number it stands for
             estimator["reading_weight"] = READING_WEIGHT_DEFAULT[likelihood]
+    agent = out.get("agent")
+    if isinstance(agent, dict) and "climb" in agent and agent["climb"] is None:
+        # unset: the climb it resolved to (Scenario.resolved_climb), compared as that number
+        turbulent = isinstance(estimator, dict) and estimator.get("likelihood") == "fluctuation"
+        grid = agent.get("model", "grid") == "grid"
+        agent["climb"] = AUTO_CLIMB if turbulent and grid else 0.0
     sensor, truth = out.get("sensor"), out.get("truth")
     if isinstance(sensor, dict) and "dropout" not in sensor and isinstance(truth, dict):
         # stored before sensor.dropout existed, when the instrument missed 1 − pd of the

@@ -47,7 +47,7 @@ A scenario is a TOML file (or a built-in, see :mod:`dcee.scenarios.builtin`)::
     likelihood = "paper"           # or "fluctuation" (intermittent log-normal, for real plumes)
     intermittency = 0.93           # fluctuation only
     log_sd = 1.3                   # fluctuation only
-    near_source_length = 5.0       # fluctuation only, m
+    near_source_length = 2.5       # fluctuation only, m
     calm_prior = 0.1               # fluctuation only: prior probability of a calm plume (0: off)
     meander = 0.15                 # plume broadening [default: 0 paper, 0.15 fluctuation]
     outlier = 0.01                 # outlier weight [default: 0.01 for every likelihood]
@@ -57,6 +57,7 @@ A scenario is a TOML file (or a built-in, see :mod:`dcee.scenarios.builtin`)::
     start = [2.0, 2.0, 4.0]        # m; the agent flies at the start altitude
     step = 2.0                     # m
     climb = 0.0                    # m per climb or descent move; 0: fixed altitude (the paper)
+                                   #  [default: 1 with the fluctuation likelihood, else 0]
     speed = 2.0                    # m/s
     dwell = 1.0                    # s held at each waypoint [default: 1, 5 if time-varying]
 

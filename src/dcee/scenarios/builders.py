@@ -113,8 +113,9 @@ class ScenarioBuilders:
         assert out is not None  # checked at validation
         return out
 
-    def make_agent(self: Scenario) -> GridAgent:
-        """The planner's move set (clear of the ``[world]``'s obstacles and no-go zones)."""
+    def make_agent(self: Scenario, on_robot: bool = False) -> GridAgent:
+        """The planner's move set (clear of the ``[world]``'s obstacles and no-go zones;
+        ``on_robot``: at one altitude unless ``agent.climb`` is set, :meth:`resolved_climb`)."""
         a = self.agent
         return GridAgent(
             self.search_volume(),
@@ -123,7 +124,7 @@ class ScenarioBuilders:
             self.dwell,
             a.headings,
             site=self.make_site(),
-            climb=a.climb,
+            climb=self.resolved_climb(on_robot),
         )
 
     def make_motion(self: Scenario) -> MotionModel:

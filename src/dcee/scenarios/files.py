@@ -116,6 +116,7 @@ def to_toml(scenario: Scenario) -> str:
         ("estimator", "meander"): scenario.meander,
         ("estimator", "reading_weight"): scenario.reading_weight,
         ("agent", "dwell"): scenario.dwell,
+        ("agent", "climb"): scenario.climb,
         ("world", "resolution"): scenario.site_resolution,
     }
     # unset with no single resolved value: what unset means, in words

@@ -1,6 +1,12 @@
 """The scenario schema: pydantic models, one module per group of sections."""
 
-from dcee.scenarios.schema.agent import AgentSpec, SearchSpec, UnicycleSpec, team_starts
+from dcee.scenarios.schema.agent import (
+    AUTO_CLIMB,
+    AgentSpec,
+    SearchSpec,
+    UnicycleSpec,
+    team_starts,
+)
 from dcee.scenarios.schema.common import FROZEN, Finite, Positive
 from dcee.scenarios.schema.estimator import (
     LIKELIHOODS,
@@ -28,6 +34,7 @@ from dcee.scenarios.schema.truth import (
 )
 
 __all__ = [
+    "AUTO_CLIMB",
     "FIELD_MARK",
     "FROZEN",
     "LIKELIHOODS",

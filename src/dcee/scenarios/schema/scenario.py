@@ -14,7 +14,7 @@ from dcee.errors import DceeInputError
 from dcee.models.agent import GridAgent, SearchVolume
 from dcee.models.plume import PARAMETER_NAMES
 from dcee.scenarios.builders import ScenarioBuilders
-from dcee.scenarios.schema.agent import AgentSpec, SearchSpec, team_starts
+from dcee.scenarios.schema.agent import AUTO_CLIMB, AgentSpec, SearchSpec, team_starts
 from dcee.scenarios.schema.common import FROZEN
 from dcee.scenarios.schema.estimator import (
     MEANDER_DEFAULT,
@@ -103,9 +103,9 @@ class Scenario(ScenarioBuilders, BaseModel):
             self.dwell,
             self.agent.headings,
             site=site,
-            climb=self.agent.climb,
+            climb=self.climb,
         )
-        if self.agent.climb > 0 and self.agent.model != "grid":
+        if self.agent.climb is not None and self.agent.climb > 0 and self.agent.model != "grid":
             raise ValueError(
                 f'{FIELD_MARK}agent.climb: {self.agent.climb:g} m needs agent.model = "grid" '
                 f"(the {self.agent.model} robot drives on the ground); use climb = 0"
@@ -181,6 +181,20 @@ class Scenario(ScenarioBuilders, BaseModel):
             return self.agent.dwell
         return TURBULENT_HOLD if self.time_varying_truth else 1.0
 
+    def resolved_climb(self, on_robot: bool = False) -> float:
+        """m per climb or descent move (``agent.climb``, or when unset :data:`AUTO_CLIMB` for
+        the grid UAV in a turbulent plume, the fluctuation likelihood, else 0). ``on_robot``:
+        unset means 0 (the robot cycle reads planar poses)."""
+        if self.agent.climb is not None:
+            return self.agent.climb
+        turbulent_uav = self.estimator.likelihood == "fluctuation" and self.agent.model == "grid"
+        return AUTO_CLIMB if turbulent_uav and not on_robot else 0.0
+
+    @property
+    def climb(self) -> float:
+        """m per climb or descent move in a simulated search (:meth:`resolved_climb`)."""
+        return self.resolved_climb()
+
     @property
     def average(self) -> float:
         """Seconds each reading averages (``sensor.average``, or its default for the truth)."""
@@ -225,6 +239,7 @@ class Scenario(ScenarioBuilders, BaseModel):
             "outlier": self.outlier,
             "meander": self.meander,
             "reading_weight": self.reading_weight,
+            "climb": self.climb,
         }
 
     @property
