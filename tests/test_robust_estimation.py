@@ -105,10 +105,12 @@ def test_turbulent_truth_defaults_to_a_four_second_hold_and_average():
         "lognormal",
         0.93,
         1.3,
-        5.0,
+        2.5,
         0.01,
     )
     assert fluct.make_plume().meander == 0.15
+    # a turbulent plume expected: the grid UAV may climb and descend 1 m (issue 29)
+    assert fluct.climb == 1.0 and filament.climb == 0.0
     # readings of a turbulent plume count half (issue 29); the paper's model counts them fully
     assert fluct.reading_weight == 0.5 and filament.reading_weight == 1.0
     assert fluct.with_overrides(**{"estimator.reading_weight": 0.8}).reading_weight == 0.8
