@@ -52,17 +52,27 @@ case "${1:---list}" in
   turbulent-held-out)  # both turbulent truths on held-out configurations (docs/turbulent.md)
     bash studies/study_turbulent_held_out.sh
     export SUITE=held-out-100 WORKERS=${WORKERS:-2}
-    bash studies/study_turbulent_held_out.sh
-    OUT_SUFFIX=-climb bash studies/study_turbulent_held_out.sh --set agent.climb=1.0
+    # the first three ran at commit 43cea93 (each result records it), before dcee-cl's vertical
+    # reach and today's turbulent defaults: their settings are pinned here, and today's code
+    # reproduces their infotaxis searches; their dcee-cl searches need that commit
+    bash studies/study_turbulent_held_out.sh --set agent.climb=0.0 \
+      --set estimator.near_source_length=5.0
+    OUT_SUFFIX=-climb bash studies/study_turbulent_held_out.sh --set agent.climb=1.0 \
+      --set estimator.near_source_length=5.0
     OUT_SUFFIX=-climb-nsl25 bash studies/study_turbulent_held_out.sh --set agent.climb=1.0 \
       --set estimator.near_source_length=2.5
+    # today's defaults: dcee-cl (infotaxis does not read the vertical reach: its searches at
+    # today's defaults are those of -climb-nsl25, the same settings and seeds)
+    STRATEGIES=dcee-cl OUT_SUFFIX=-defaults bash studies/study_turbulent_held_out.sh
     report turbulent-filament-held-out-24 turbulent-puffs-held-out-24
     out=docs/results/turbulent-held-out-100
     gathered=()
-    rm -f "$out/climb_vs_fixed.csv" "$out/nsl25_vs_climb.csv"  # the pairs are appended below
+    rm -f "$out/climb_vs_fixed.csv" "$out/nsl25_vs_climb.csv" "$out/defaults_vs_nsl25.csv"
     for t in puffs filament; do
-      for v in "=climb:0,near_source_length:5" "-climb=climb:1,near_source_length:5" \
-        "-climb-nsl25=climb:1,near_source_length:2.5"; do
+      for v in "=climb:0,near_source_length:5,vertical_reach:0" \
+        "-climb=climb:1,near_source_length:5,vertical_reach:0" \
+        "-climb-nsl25=climb:1,near_source_length:2.5,vertical_reach:0" \
+        "-defaults=climb:1,near_source_length:2.5,vertical_reach:1"; do
         report "turbulent-$t-held-out-100${v%%=*}"
         gathered+=("results/turbulent-$t-held-out-100${v%%=*}=truth_model:$t,${v#*=}")
       done
@@ -70,6 +80,9 @@ case "${1:---list}" in
         "results/turbulent-$t-held-out-100-climb" --csv "$out/climb_vs_fixed.csv" --tag truth_model=$t
       $P studies/pair_campaigns.py "results/turbulent-$t-held-out-100-climb" \
         "results/turbulent-$t-held-out-100-climb-nsl25" --csv "$out/nsl25_vs_climb.csv" \
+        --tag truth_model=$t
+      $P studies/pair_campaigns.py "results/turbulent-$t-held-out-100-climb-nsl25" \
+        "results/turbulent-$t-held-out-100-defaults" --csv "$out/defaults_vs_nsl25.csv" \
         --tag truth_model=$t
     done
     $P studies/collect_metrics.py --out "$out" "${gathered[@]}"
@@ -102,16 +115,30 @@ case "${1:---list}" in
       --variant "rw0.5:estimator.near_source_length=10,estimator.reading_weight=0.5" \
       --variant "nsl5rw0.5:estimator.near_source_length=5,estimator.reading_weight=0.5" \
       --csv docs/results/precision-tune.csv ;;
-  turbulent-tune)  # the second tuning round, random:13-40: guard share, climb (docs/turbulent.md)
+  turbulent-tune)  # the second and third tuning rounds, random:13-40 (docs/turbulent.md)
     out=docs/results/tuning-turbulent-13-40
-    $P studies/precision_variants.py --configs random:13-40 --truths filament puffs \
-      --variant base:search.guard_share=1.0 --variant g015:search.guard_share=0.15 \
-      --csv "$out/guard-share.csv"
-    $P studies/precision_variants.py --configs random:13-40 --truths filament puffs \
-      --variant climb1:agent.climb=1.0 --csv "$out/climb.csv"
-    $P studies/precision_variants.py --configs random:13-40 --truths filament puffs \
-      --variant c1n25:agent.climb=1.0,estimator.near_source_length=2.5 \
-      --csv "$out/climb-nsl25.csv"
+    tune() {  # CSV, then --variant/--strategy arguments
+      local csv=$1; shift
+      $P studies/precision_variants.py --configs random:13-40 --truths filament puffs "$@" \
+        --csv "$out/$csv"
+    }
+    # second round, with the defaults of its day: a fixed altitude unless climbing, the
+    # near-source length 5 m, dcee-cl without the vertical reach
+    old=estimator.near_source_length=5.0
+    tune guard-share.csv --variant "base:agent.climb=0.0,$old,search.guard_share=1.0" \
+      --variant "g015:agent.climb=0.0,$old,search.guard_share=0.15" \
+      --strategy dcee-cl:vertical_reach=0
+    tune climb.csv --variant "climb1:agent.climb=1.0,$old" --strategy dcee-cl:vertical_reach=0
+    tune climb-nsl25.csv --variant c1n25:agent.climb=1.0,estimator.near_source_length=2.5 \
+      --strategy dcee-cl:vertical_reach=0
+    # third round: dcee-cl's vertical reach (today's default 1), then the reading weight and the
+    # near-source length with it, and the near-source length 2.5 m at a fixed altitude
+    c1=agent.climb=1.0,estimator.near_source_length
+    tune climb-nsl25-vr1.csv --variant "c1n25vr1:$c1=2.5"
+    tune climb-nsl25-vr1-w03.csv --variant "c1n25vr1w03:$c1=2.5,estimator.reading_weight=0.3"
+    tune climb-nsl25-vr1-w04.csv --variant "c1n25vr1w04:$c1=2.5,estimator.reading_weight=0.4"
+    tune climb-nsl35-vr1.csv --variant "c1n35vr1:$c1=3.5"
+    tune fixed-nsl25.csv --variant n25:agent.climb=0.0,estimator.near_source_length=2.5
     for unk in source full; do
       $D bench --suite random-tune --strategies dcee-cl --repeats 1 --unknown $unk \
         --particles 10000 --set search.guard_share=1.0 --out "results/tune-guard-$unk-1"

@@ -105,3 +105,17 @@ def test_an_unset_climb_follows_the_expected_plume_and_the_platform():
     before = paper.model_dump(mode="json")
     del before["agent"]["climb"]  # a paper campaign stored before the setting existed
     assert scenario_identity(before) == scenario_identity(paper.model_dump(mode="json"))
+
+
+def test_the_command_line_says_when_an_unset_climb_resolves_to_a_climbing_uav(capsys):
+    from dcee.console import climb_notice
+
+    paper = load_scenario("random:16")
+    turbulent = paper.with_overrides(**{"estimator.likelihood": "fluctuation"})
+    climb_notice([paper, turbulent.with_overrides(**{"agent.climb": 1.0})])
+    assert capsys.readouterr().err == ""  # the paper's agent, or a climb the user set
+    climb_notice(turbulent, quiet=True)
+    assert capsys.readouterr().err == ""
+    climb_notice(turbulent)
+    err = capsys.readouterr().err
+    assert "agent.climb unset" in err and "1 m" in err and err.count("\n") == 1

@@ -59,6 +59,23 @@ def compile_notice(quiet: bool) -> None:
         )
 
 
+def climb_notice(scenarios: Any, quiet: bool = False) -> None:
+    """Say so when ``agent.climb`` was left unset and resolves to a climbing UAV (the
+    fluctuation likelihood's default, :meth:`dcee.scenarios.Scenario.resolved_climb`): the agent
+    then has two moves more than the paper's. ``scenarios``: one scenario or several."""
+    if quiet:
+        return
+    many = scenarios if isinstance(scenarios, list | tuple) else [scenarios]
+    auto = [s for s in many if s.agent.climb is None and s.climb > 0]
+    if auto:
+        click.echo(
+            f"dcee: agent.climb unset: a turbulent plume is expected (fluctuation likelihood), so "
+            f"the UAV may also climb and descend {auto[0].climb:g} m; set agent.climb = 0 for a "
+            "fixed altitude (docs/turbulent.md)",
+            err=True,
+        )
+
+
 def run_with_progress(job: Callable[[Any], Any], budget: float, quiet: bool) -> Any:
     """Call ``job(progress)`` with a progress bar over the search's ``budget`` (s) on a terminal;
     ``progress(t, record)`` is None when ``quiet`` or stderr is not a terminal."""

@@ -18,7 +18,7 @@ from dcee.cli.options import (
     overrides,
     suite_names,
 )
-from dcee.console import clock, compile_notice
+from dcee.console import climb_notice, clock, compile_notice
 from dcee.io import check_writable_dir
 
 
@@ -106,6 +106,7 @@ def bench(
     )
     check_writable_dir(out_dir, "out")
     compile_notice(False)
+    climb_notice(list(campaign.scenarios.values()))
     failures: list[str] = []
     columns = (
         TextColumn("[bold]{task.description}"),

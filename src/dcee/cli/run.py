@@ -7,7 +7,7 @@ from pathlib import Path
 import click
 
 from dcee.cli.options import LIKELIHOOD_OPTION, SET_OPTION, TRUTH_OPTION, overrides
-from dcee.console import compile_notice, print_summary, run_with_progress
+from dcee.console import climb_notice, compile_notice, print_summary, run_with_progress
 from dcee.errors import DceeInputError
 from dcee.io import (
     check_writable_dir,
@@ -122,6 +122,7 @@ def run(
         truth_model = make_truth(scenario, seed)  # a bad recording fails here, before the search
         tune_allocator()  # this process is the command line's own (see dcee.allocator)
         compile_notice(quiet)
+        climb_notice(scenario, quiet)
         dense = np.linspace(0.0, scenario.search.budget, 41) if animate else ()
         result = run_with_progress(
             lambda progress: run_episode(
