@@ -61,9 +61,11 @@ case "${1:---list}" in
       --set estimator.near_source_length=5.0
     OUT_SUFFIX=-climb-nsl25 bash studies/study_turbulent_held_out.sh --set agent.climb=1.0 \
       --set estimator.near_source_length=2.5
-    # today's defaults: dcee-cl (infotaxis does not read the vertical reach: its searches at
-    # today's defaults are those of -climb-nsl25, the same settings and seeds)
-    STRATEGIES=dcee-cl OUT_SUFFIX=-defaults bash studies/study_turbulent_held_out.sh
+    # today's defaults (the climbing UAV, near-source length 2.5 m, dcee-cl's vertical reach):
+    # the puffs on held-out-100, the filament on all 200 held-out configurations (issue 28's
+    # filament study); the filament's random:1100-1199 make its held-out-100 rows
+    OUT_SUFFIX=-defaults TRUTHS=puffs bash studies/study_turbulent_held_out.sh
+    SUITE=held-out OUT_SUFFIX=-defaults TRUTHS=filament bash studies/study_turbulent_held_out.sh
     report turbulent-filament-held-out-24 turbulent-puffs-held-out-24
     out=docs/results/turbulent-held-out-100
     gathered=()
