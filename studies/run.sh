@@ -71,12 +71,14 @@ case "${1:---list}" in
     gathered=()
     rm -f "$out/climb_vs_fixed.csv" "$out/nsl25_vs_climb.csv" "$out/defaults_vs_nsl25.csv"
     for t in puffs filament; do
-      for v in "=climb:0,near_source_length:5,vertical_reach:0" \
-        "-climb=climb:1,near_source_length:5,vertical_reach:0" \
-        "-climb-nsl25=climb:1,near_source_length:2.5,vertical_reach:0" \
-        "-defaults=climb:1,near_source_length:2.5,vertical_reach:1"; do
-        report "turbulent-$t-held-out-100${v%%=*}"
-        gathered+=("results/turbulent-$t-held-out-100${v%%=*}=truth_model:$t,${v#*=}")
+      defaults="turbulent-$t-held-out-100-defaults"
+      [ "$t" = filament ] && defaults=turbulent-filament-held-out-defaults  # all 200
+      for v in "turbulent-$t-held-out-100=climb:0,near_source_length:5,vertical_reach:0" \
+        "turbulent-$t-held-out-100-climb=climb:1,near_source_length:5,vertical_reach:0" \
+        "turbulent-$t-held-out-100-climb-nsl25=climb:1,near_source_length:2.5,vertical_reach:0" \
+        "$defaults=climb:1,near_source_length:2.5,vertical_reach:1"; do
+        report "${v%%=*}"
+        gathered+=("results/${v%%=*}=truth_model:$t,${v#*=}")
       done
       $P studies/pair_campaigns.py "results/turbulent-$t-held-out-100" \
         "results/turbulent-$t-held-out-100-climb" --csv "$out/climb_vs_fixed.csv" --tag truth_model=$t
@@ -84,11 +86,20 @@ case "${1:---list}" in
         "results/turbulent-$t-held-out-100-climb-nsl25" --csv "$out/nsl25_vs_climb.csv" \
         --tag truth_model=$t
       $P studies/pair_campaigns.py "results/turbulent-$t-held-out-100-climb-nsl25" \
-        "results/turbulent-$t-held-out-100-defaults" --csv "$out/defaults_vs_nsl25.csv" \
-        --tag truth_model=$t
+        "results/$defaults" --csv "$out/defaults_vs_nsl25.csv" --tag truth_model=$t
     done
     $P studies/collect_metrics.py --out "$out" "${gathered[@]}"
     $P studies/publish_tables.py ;;
+  turbulent-public)  # the twelve public configurations on both turbulent truths, today's defaults
+    for t in filament puffs; do  # 5 repeats and 10,000 particles: ~10 min per truth on 2 cores
+      $D bench --suite paper --strategies dcee-cl,infotaxis --repeats 5 --unknown full \
+        --likelihood fluctuation --truth $t --particles 10000 --workers "${WORKERS:-2}" \
+        --out "results/turbulent-$t-public-defaults"
+      report "turbulent-$t-public-defaults"
+    done
+    $P studies/collect_metrics.py --out docs/results/turbulent-public-defaults \
+      results/turbulent-filament-public-defaults=truth_model:filament \
+      results/turbulent-puffs-public-defaults=truth_model:puffs ;;
   held-out)  # random configurations of the reporting range (docs/held-out.md)
     bash studies/study_held_out.sh
     report held-out-wind-known held-out-full held-out-filament ;;
