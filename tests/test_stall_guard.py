@@ -105,3 +105,21 @@ def test_campaigns_stored_before_the_guard_resume_only_without_it():
     off = now.with_overrides(**{"search.stall_guard": 0.0}).model_dump(mode="json")
     assert scenario_identity(stored) == scenario_identity(off)
     assert scenario_identity(stored) != scenario_identity(now.model_dump(mode="json"))
+
+
+def test_a_cornered_climbing_robot_must_still_leave_its_spot():
+    # Anchor (47.56, 48.38), the robot 2 m away in the corner (48.97, 49.80) of a 50 m area
+    # (random:1049's stall): no move takes it further from the anchor, so before the guard
+    # left every move admissible and climbing on the spot held the stall for 75 s. Now the
+    # moves that leave its horizontal position are offered: west, south and south-west.
+    from dcee.searcher import LeavingAgent
+
+    agent = GridAgent(SearchVolume((0.0, 0.0, 0.0), (50.0, 50.0, 5.0)), step=2.0, climb=1.0)
+    here = np.array([48.970563, 49.798990, 2.0])
+    leaving = LeavingAgent(agent, np.array([47.556349, 48.384776, 1.0]), here)
+    cands, heads = leaving.candidates(here)
+    assert set(heads.tolist()) == {4, 5, 6}  # 180°, 225°, 270°: no climb (8), no descent (9)
+    assert np.all(np.hypot(*(cands[:, :2] - here[:2]).T) > 1.0)
+    # where some move does leave the anchor, only those are offered, as before
+    away, _ = LeavingAgent(agent, here, here).candidates(here)
+    assert np.all(np.hypot(*(away[:, :2] - here[:2]).T) > 1.0)

@@ -52,7 +52,9 @@ STALL_HISTORY = 64
 class LeavingAgent:
     """An agent's move set without the moves that fail to take the agent further from
     ``anchor`` (3,) m than it is: what the stall guard hands a planner. Every other attribute
-    is the wrapped agent's. Where no move leaves (a corner), every move stays admissible."""
+    is the wrapped agent's. Where no move leaves the anchor (a corner), the moves that leave
+    the agent's own horizontal position: a climbing agent could otherwise hold its stall by
+    climbing and descending on one spot (random:1049, filament, held out: 75 s in a corner)."""
 
     def __init__(self, agent: GridAgent, anchor: np.ndarray, start: np.ndarray) -> None:
         self.agent = agent
@@ -65,6 +67,8 @@ class LeavingAgent:
             return cands, headings
         now = math.hypot(*(self.start[:2] - self.anchor[:2]))
         away = np.hypot(*(cands[:, :2] - self.anchor[:2]).T) > now + 0.5 * self.agent.step
+        if not away.any():  # cornered: at least leave this spot (no climb or descent in place)
+            away = np.hypot(*(cands[:, :2] - self.start[:2]).T) > 0.5 * self.agent.step
         return (cands[away], headings[away]) if away.any() else (cands, headings)
 
     def __getattr__(self, name: str) -> Any:
