@@ -25,7 +25,7 @@ def _readings(sensor: Sensor, seed: int = 2) -> list[tuple[np.ndarray, float]]:
 
 def _grid_posterior(sensor, data, power=1.0):
     """Exact posterior on an (x, y, q) grid with NumPy reference models (prior: U × U × Γ(2,1)),
-    each reading's likelihood raised to ``power``."""
+    each reading's likelihood raised to ``power`` (one number, or one per reading)."""
     xs = np.linspace(0, 10, 161)
     ys = np.linspace(0, 10, 161)
     qs = np.linspace(0.01, 9.0, 90)
@@ -47,7 +47,7 @@ def _grid_posterior(sensor, data, power=1.0):
     pos = np.array([p for p, _ in data])
     z = np.array([r for _, r in data])
     logp += history_log_likelihood_reference(
-        theta, pos, z, np.full(len(z), power), sensor, IsotropicPlume()
+        theta, pos, z, np.broadcast_to(np.asarray(power, float), len(z)), sensor, IsotropicPlume()
     )
     w = np.exp(logp - logp.max())
     w /= w.sum()
@@ -94,6 +94,37 @@ def test_reading_weight_gives_the_exact_power_likelihood_posterior(sensor):
     np.testing.assert_allclose(np.sqrt(np.diag(pf.cov())), grid_sd, rtol=0.2)
     with pytest.raises(DceeInputError, match="reading_weight"):
         ParticleFilter(planar_prior(u=2.0), sensor, n_particles=100, reading_weight=0.0)
+
+
+def test_repeat_radius_discounts_a_run_of_readings_at_one_spot(sensor):
+    """estimator.repeat_radius: a reading within the radius of an unbroken run of m readings
+    just before it weighs reading_weight / (1 + m). Each position read three times in a row
+    (1, 1/2, 1/3 at weight 1), with a reading 0.3 m off the spot in the middle of one run:
+    the filter matches the exact grid posterior with those powers, and the multiplicities it
+    keeps are the hand-computed weights."""
+    data = _readings(sensor)
+    runs = []
+    for k, (pos, z) in enumerate(data):
+        runs += [(pos, z), (pos + np.array([0.3, 0.0, 0.0]) if k == 0 else pos, z), (pos, z)]
+    powers = np.tile([1.0, 1 / 2, 1 / 3], len(data))
+    grid_mean, grid_sd = _grid_posterior(sensor, runs, power=powers)
+    pf = ParticleFilter(planar_prior(u=2.0), sensor, n_particles=20_000, seed=5, repeat_radius=0.5)
+    weights = []
+    for pos, z in runs:
+        weights.append(pf.repeat_weight(pos))
+        pf.update(pos, z)
+    np.testing.assert_allclose(weights, powers)
+    _, _, mult = pf.history()
+    np.testing.assert_allclose(mult.sum(), powers.sum())
+    np.testing.assert_array_less(np.abs(pf.mean() - grid_mean), 0.2 * grid_sd)
+    np.testing.assert_allclose(np.sqrt(np.diag(pf.cov())), grid_sd, rtol=0.2)
+    # a reading beyond the radius ends the run; radius 0 (the default) weighs every reading alike
+    assert pf.repeat_weight(np.array([20.0, 20.0, 0.0])) == 1.0
+    plain = ParticleFilter(planar_prior(u=2.0), sensor, n_particles=100, seed=5)
+    plain.update(*runs[0])
+    assert plain.repeat_weight(runs[1][0]) == 1.0
+    with pytest.raises(DceeInputError, match="repeat_radius"):
+        ParticleFilter(planar_prior(u=2.0), sensor, n_particles=100, repeat_radius=-1.0)
 
 
 def test_collapse_is_recovered_by_tempering_and_still_matches_the_posterior(sensor):

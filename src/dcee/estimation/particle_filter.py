@@ -43,6 +43,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import Any
 
 import numpy as np
 from scipy.special import logsumexp
@@ -100,10 +101,16 @@ class ParticleFilter:
         max_sweeps: int = 8,
         reading_weight: float = 1.0,
         anemometer: Anemometer | None = None,
+        repeat_radius: float = 0.0,
     ) -> None:
         if not (isinstance(reading_weight, int | float) and 0 < reading_weight <= 1):
             raise DceeInputError(
                 "estimator.reading_weight", f"must be in (0, 1], got {reading_weight!r}"
+            )
+        if not (isinstance(repeat_radius, int | float) and 0 <= repeat_radius < math.inf):
+            raise DceeInputError(
+                "estimator.repeat_radius",
+                f"must be a finite number of m >= 0, got {repeat_radius!r}",
             )
         if int(n_particles) != n_particles or n_particles < 2:
             raise DceeInputError("particles", f"must be an integer >= 2, got {n_particles}")
@@ -134,6 +141,9 @@ class ParticleFilter:
         self.diversify = diversify
         self.max_sweeps = int(max_sweeps)
         self.reading_weight = float(reading_weight)
+        self.repeat_radius = float(repeat_radius)
+        # the weight of the reading being assimilated (reading_weight, discounted for a repeat)
+        self._weight_now = self.reading_weight
         self._unknown = np.array(prior.unknown)
         # the unknown location columns: the block the global proposal redraws from the prior
         self._loc_block = [int(i) for i in self._unknown if i < 3]
@@ -146,6 +156,8 @@ class ParticleFilter:
         self._hist_z: list[float] = []
         self._hist_mult: list[float] = []
         self._nd_index: dict[tuple[float, float, float], int] = {}
+        # every assimilated reading's position in order (repeat_weight's run)
+        self._hist_order: list[tuple[float, float, float]] = []
         self.n_readings = 0
         self.recoveries: list[dict[str, float | str]] = []
         self._origin = np.arange(self.n)
@@ -227,6 +239,12 @@ class ParticleFilter:
             np.array(self._hist_mult, dtype=np.float64),
         )
 
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        # filters checkpointed before estimator.repeat_radius: off, and no run to continue
+        state = {"repeat_radius": 0.0, "_hist_order": [], **state}
+        state.setdefault("_weight_now", state.get("reading_weight", 1.0))
+        self.__dict__.update(state)
+
     # --- update -----------------------------------------------------------------------------
 
     def log_likelihood(self, theta: np.ndarray, position: np.ndarray, reading: float) -> np.ndarray:
@@ -248,6 +266,22 @@ class ParticleFilter:
             out *= self.reading_weight
         return out
 
+    def repeat_weight(self, position: np.ndarray) -> float:
+        """The weight a reading at ``position`` (3,) m gets: ``reading_weight`` / (1 + m), m the
+        number of readings just before it, in an unbroken run, taken within ``repeat_radius`` m
+        of it (0: off, every reading ``reading_weight``). A robot holding one spot sees the same
+        puffs in successive readings, so its n readings there weigh w · (1 + 1/2 + … + 1/n),
+        growing like w · ln n, not w · n."""
+        if self.repeat_radius <= 0.0 or not self._hist_order:
+            return self.reading_weight
+        reach = self.repeat_radius * (1.0 + 1e-9) + 1e-9
+        m = 0
+        for earlier in reversed(self._hist_order):
+            if math.dist(earlier, position) > reach:
+                break
+            m += 1
+        return self.reading_weight / (1.0 + m)
+
     def update(self, position: np.ndarray, reading: float) -> UpdateInfo:
         """Assimilate one reading (g/m³; below the threshold = non-detection) taken at position."""
         try:
@@ -261,7 +295,11 @@ class ParticleFilter:
         reading = self.sensor.check_reading(reading)
         if reading < self.sensor.threshold:
             reading = 0.0
+        self._weight_now = self.repeat_weight(position)
         ll_new = self.log_likelihood(self.theta, position, reading)
+        if self._weight_now != self.reading_weight:
+            ll_new *= self._weight_now / self.reading_weight
+        self._hist_order.append(tuple(position.tolist()))
         ll_new[np.isnan(ll_new)] = -np.inf
         live = np.isfinite(self._logw)
         if not np.any(np.isfinite(ll_new[live])):
@@ -349,11 +387,11 @@ class ParticleFilter:
         if reading == 0.0 and key in self._nd_index:
             idx = self._nd_index[key]
             base = self._hist_mult[idx]
-            self._hist_mult[idx] = base + self.reading_weight
+            self._hist_mult[idx] = base + self._weight_now
             return idx, base
         self._hist_pos.append(key)
         self._hist_z.append(reading)
-        self._hist_mult.append(self.reading_weight)
+        self._hist_mult.append(self._weight_now)
         idx = len(self._hist_z) - 1
         if reading == 0.0:
             self._nd_index[key] = idx
@@ -483,7 +521,7 @@ class ParticleFilter:
             # ll_new: the new reading's log-likelihood for the current particles.
             self._set_logw(self._logw + (new_beta - beta) * ll_new)
             self._hist_loglik = hist_base + new_beta * ll_new
-            self._hist_mult[entry] = base_mult + new_beta * self.reading_weight
+            self._hist_mult[entry] = base_mult + new_beta * self._weight_now
             beta = new_beta
             ll_new, hist_base = self._resample(ll_new, hist_base)
             stage_acc, stage_sweeps, distinct = self._rejuvenate()
@@ -493,9 +531,9 @@ class ParticleFilter:
                 # After the move, recompute the new reading's likelihood for the moved particles.
                 ll_new = self.log_likelihood(
                     self.theta, np.array(self._hist_pos[entry]), self._hist_z[entry]
-                )
+                ) * (self._weight_now / self.reading_weight)
                 hist_base = self._hist_loglik - beta * ll_new
-        self._hist_mult[entry] = base_mult + self.reading_weight
+        self._hist_mult[entry] = base_mult + self._weight_now
         self.recoveries.append(
             {
                 "kind": "tempering",

@@ -48,6 +48,7 @@ def make_searcher(
             diversify=search.diversify,
             max_sweeps=search.max_sweeps,
             reading_weight=scenario.reading_weight,
+            repeat_radius=scenario.estimator.repeat_radius,
             anemometer=scenario.make_anemometer(),
         )
         for model, rng in zip(models, rngs, strict=True)

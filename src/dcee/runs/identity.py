@@ -38,6 +38,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("estimator", "log_sd_length"): 0.0,
     # every detection weighed by its magnitude before issue 29's detection-only readings
     ("estimator", "magnitude"): True,
+    # every reading weighed reading_weight before the repeat discount
+    ("estimator", "repeat_radius"): 0.0,
 }
 """Scenario settings added after campaigns were first stored, with the value a stored scenario
 without one ran with, so the two compare equal."""

@@ -214,6 +214,12 @@ class EstimatorSpec(BaseModel):
     (a turbulent plume's successive holds see the same puffs and gusts), so the posterior is not
     narrower than the evidence; the planners still predict with the plain likelihood. 1: the
     plain Bayes update. None: the likelihood's default, :data:`READING_WEIGHT_DEFAULT`"""
+    repeat_radius: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 0.0
+    """m: a reading taken within this distance of the readings just before it (an unbroken run
+    of m of them) counts as ``reading_weight`` / (1 + m): a robot holding one spot sees the same
+    puffs again, so its readings there add up like a logarithm, not a count. 0: off (every
+    reading ``reading_weight``). Tried on the turbulent tuning range, not a default
+    (docs/turbulent.md)"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the
