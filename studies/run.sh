@@ -152,6 +152,9 @@ case "${1:---list}" in
     tune climb-nsl25-vr1-w04.csv --variant "c1n25vr1w04:$c1=2.5,estimator.reading_weight=0.4"
     tune climb-nsl35-vr1.csv --variant "c1n35vr1:$c1=3.5"
     tune fixed-nsl25.csv --variant n25:agent.climb=0.0,estimator.near_source_length=2.5
+    # the repeat discount at today's defaults (both rows were stopped early: see the README)
+    tune repeat-radius-2-partial.csv --variant rr2:estimator.repeat_radius=2.0
+    tune repeat-radius-05-partial.csv --variant rr05:estimator.repeat_radius=0.5
     for unk in source full; do
       $D bench --suite random-tune --strategies dcee-cl --repeats 1 --unknown $unk \
         --particles 10000 --set search.guard_share=1.0 --out "results/tune-guard-$unk-1"
