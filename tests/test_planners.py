@@ -430,7 +430,7 @@ def test_vertical_reach_frees_the_height_error_only_for_a_climbing_agent():
     np.testing.assert_allclose(planner.loss(final, stats, belief), [[26.5, 36.5]])
     # climb 1 m per 2 m step: R_z = 10 · 1 / 2 = 5 m; A's 4 m is free, B's 6 m costs 1²
     planner.bind_agent(GridAgent(volume, step=2.0, climb=1.0))
-    assert planner.effective_vertical_reach(belief) == 5.0
+    assert planner.effective_vertical_reach(planner.effective_reach(belief)) == 5.0
     np.testing.assert_allclose(planner.loss(final, stats, belief), [[10.5, 1.5]])
     # vertical_reach 0 is the cost before: the height error charged in full, climbing or not
     before = planners.get("dcee-cl:reach=2:info_share=0:vertical_reach=0")

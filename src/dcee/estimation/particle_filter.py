@@ -156,7 +156,7 @@ class ParticleFilter:
         self._hist_z: list[float] = []
         self._hist_mult: list[float] = []
         self._nd_index: dict[tuple[float, float, float], int] = {}
-        # every assimilated reading's position in order (repeat_weight's run)
+        # every assimilated reading's position in order, with repeat_radius > 0 (its runs)
         self._hist_order: list[tuple[float, float, float]] = []
         self.n_readings = 0
         self.recoveries: list[dict[str, float | str]] = []
@@ -247,23 +247,29 @@ class ParticleFilter:
 
     # --- update -----------------------------------------------------------------------------
 
-    def log_likelihood(self, theta: np.ndarray, position: np.ndarray, reading: float) -> np.ndarray:
-        """(N,) w · log p(reading | Θ) at ``position`` for source terms ``theta`` (N, 8), w the
-        filter's ``reading_weight`` (1: the plain likelihood)."""
+    def log_likelihood(
+        self,
+        theta: np.ndarray,
+        position: np.ndarray,
+        reading: float,
+        weight: float | None = None,
+    ) -> np.ndarray:
+        """(N,) w · log p(reading | Θ) at ``position`` for source terms ``theta`` (N, 8), w =
+        ``weight`` (default the filter's ``reading_weight``; 1: the plain likelihood), applied
+        as the reading's multiplicity in the kernel."""
+        w = self.reading_weight if weight is None else weight
         out = np.empty(theta.shape[0])
         history_log_likelihood(
             theta,
             np.ones(theta.shape[0], dtype=np.bool_),
             np.asarray(position, dtype=np.float64).reshape(1, 3),
             np.array([reading], dtype=np.float64),
-            np.ones(1),
+            np.array([w], dtype=np.float64),
             self.plume.min_distance,
             self.plume.meander,
             self._sp,
             out,
         )
-        if self.reading_weight != 1.0:
-            out *= self.reading_weight
         return out
 
     def repeat_weight(self, position: np.ndarray) -> float:
@@ -296,10 +302,9 @@ class ParticleFilter:
         if reading < self.sensor.threshold:
             reading = 0.0
         self._weight_now = self.repeat_weight(position)
-        ll_new = self.log_likelihood(self.theta, position, reading)
-        if self._weight_now != self.reading_weight:
-            ll_new *= self._weight_now / self.reading_weight
-        self._hist_order.append(tuple(position.tolist()))
+        ll_new = self.log_likelihood(self.theta, position, reading, self._weight_now)
+        if self.repeat_radius > 0.0:
+            self._hist_order.append(tuple(position.tolist()))
         ll_new[np.isnan(ll_new)] = -np.inf
         live = np.isfinite(self._logw)
         if not np.any(np.isfinite(ll_new[live])):
@@ -530,8 +535,11 @@ class ParticleFilter:
             if beta < 1.0:
                 # After the move, recompute the new reading's likelihood for the moved particles.
                 ll_new = self.log_likelihood(
-                    self.theta, np.array(self._hist_pos[entry]), self._hist_z[entry]
-                ) * (self._weight_now / self.reading_weight)
+                    self.theta,
+                    np.array(self._hist_pos[entry]),
+                    self._hist_z[entry],
+                    self._weight_now,
+                )
                 hist_base = self._hist_loglik - beta * ll_new
         self._hist_mult[entry] = base_mult + self._weight_now
         self.recoveries.append(

@@ -137,9 +137,10 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
     def bind_agent(self, agent: GridAgent) -> None:
         self._climb_per_step = agent.climb / agent.step
 
-    def effective_vertical_reach(self, belief: Belief) -> float:
-        """R_z = ``vertical_reach`` · R · climb / step m (0 at a fixed altitude)."""
-        return self.vertical_reach * self.effective_reach(belief) * self._climb_per_step
+    def effective_vertical_reach(self, reach: float) -> float:
+        """R_z = ``vertical_reach`` · R · climb / step m for the horizontal reach R = ``reach``
+        (:meth:`effective_reach`; 0 at a fixed altitude)."""
+        return self.vertical_reach * reach * self._climb_per_step
 
     def uncertainty(self, stats: SequenceStats, belief: Belief) -> np.ndarray:
         """(S, J) the uncertainty left after each hypothesised reading, in m²:
@@ -158,8 +159,9 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
     def loss(self, final_positions: np.ndarray, stats: SequenceStats, belief: Belief) -> np.ndarray:
         d = stats.mean - final_positions[:, None, :]
         horizontal = horizontal_distance(final_positions, stats.mean, belief.site)
-        beyond = np.maximum(horizontal - self.effective_reach(belief), 0.0)
-        above = np.maximum(np.abs(d[..., 2]) - self.effective_vertical_reach(belief), 0.0)
+        reach = self.effective_reach(belief)
+        beyond = np.maximum(horizontal - reach, 0.0)
+        above = np.maximum(np.abs(d[..., 2]) - self.effective_vertical_reach(reach), 0.0)
         return beyond * beyond + above * above + self.uncertainty(stats, belief)
 
 

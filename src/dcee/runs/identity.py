@@ -8,7 +8,12 @@ from __future__ import annotations
 import copy
 from typing import Any
 
-from dcee.scenarios import AUTO_CLIMB, OLD_OUTLIER_DEFAULT, READING_WEIGHT_DEFAULT, UnicycleSpec
+from dcee.scenarios import (
+    OLD_OUTLIER_DEFAULT,
+    READING_WEIGHT_DEFAULT,
+    UnicycleSpec,
+    unset_climb,
+)
 
 
 def _unicycle_defaults() -> dict[str, Any]:
@@ -91,9 +96,8 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
     agent = out.get("agent")
     if isinstance(agent, dict) and "climb" in agent and agent["climb"] is None:
         # unset: the climb it resolved to (Scenario.resolved_climb), compared as that number
-        turbulent = isinstance(estimator, dict) and estimator.get("likelihood") == "fluctuation"
-        grid = agent.get("model", "grid") == "grid"
-        agent["climb"] = AUTO_CLIMB if turbulent and grid else 0.0
+        likelihood = estimator.get("likelihood", "paper") if isinstance(estimator, dict) else ""
+        agent["climb"] = unset_climb(likelihood, agent.get("model", "grid"))
     sensor, truth = out.get("sensor"), out.get("truth")
     if isinstance(sensor, dict) and "dropout" not in sensor and isinstance(truth, dict):
         # stored before sensor.dropout existed, when the instrument missed 1 − pd of the

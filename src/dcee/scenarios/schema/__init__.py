@@ -6,6 +6,7 @@ from dcee.scenarios.schema.agent import (
     SearchSpec,
     UnicycleSpec,
     team_starts,
+    unset_climb,
 )
 from dcee.scenarios.schema.common import FROZEN, Finite, Positive
 from dcee.scenarios.schema.estimator import (
@@ -63,5 +64,6 @@ __all__ = [
     "Volume",
     "default_priors",
     "team_starts",
+    "unset_climb",
     "validate_scenario",
 ]

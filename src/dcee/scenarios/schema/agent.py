@@ -34,6 +34,14 @@ the held-out fixed-altitude searches the failures were low sources (median 0.5 m
 wind. Left at 0 for the paper's likelihood, so the paper's study flies the paper's agent."""
 
 
+def unset_climb(likelihood: str, model: str, on_robot: bool = False) -> float:
+    """m, what an unset ``agent.climb`` resolves to: :data:`AUTO_CLIMB` for the grid UAV with the
+    fluctuation likelihood (a turbulent plume expected), else 0; on a robot's cycle always 0 (it
+    reads planar poses)."""
+    turbulent_uav = likelihood == "fluctuation" and model == "grid"
+    return AUTO_CLIMB if turbulent_uav and not on_robot else 0.0
+
+
 class UnicycleSpec(BaseModel):
     """The differential-drive robot of ``agent.model = "unicycle"`` (:mod:`dcee.models.motion`).
     Its top speed is ``agent.speed``. Defaults: a Turtlebot-2-class robot as Nav2 drives it

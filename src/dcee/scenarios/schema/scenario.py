@@ -14,7 +14,7 @@ from dcee.errors import DceeInputError
 from dcee.models.agent import GridAgent, SearchVolume
 from dcee.models.plume import PARAMETER_NAMES
 from dcee.scenarios.builders import ScenarioBuilders
-from dcee.scenarios.schema.agent import AUTO_CLIMB, AgentSpec, SearchSpec, team_starts
+from dcee.scenarios.schema.agent import AgentSpec, SearchSpec, team_starts, unset_climb
 from dcee.scenarios.schema.common import FROZEN
 from dcee.scenarios.schema.estimator import (
     MEANDER_DEFAULT,
@@ -187,8 +187,7 @@ class Scenario(ScenarioBuilders, BaseModel):
         unset means 0 (the robot cycle reads planar poses)."""
         if self.agent.climb is not None:
             return self.agent.climb
-        turbulent_uav = self.estimator.likelihood == "fluctuation" and self.agent.model == "grid"
-        return AUTO_CLIMB if turbulent_uav and not on_robot else 0.0
+        return unset_climb(self.estimator.likelihood, self.agent.model, on_robot)
 
     @property
     def climb(self) -> float:
