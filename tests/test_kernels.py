@@ -117,8 +117,18 @@ def test_predicted_stats_multi_step_sequences_match_reference():
         Sensor(family="lognormal", pd=0.6, outlier=0.01, near_length=5.0),
         Sensor(near_length=3.0),
         Sensor(family="lognormal", pd=0.6, log_sd_near=2.0, log_sd_length=3.0, outlier=0.01),
+        Sensor(family="lognormal", pd=0.6, outlier=0.01, near_length=5.0, conserve_mean=True),
     ],
-    ids=["ln", "ln+out", "gauss+out", "ln+out+fa", "ln+near", "gauss+near", "ln+spread"],
+    ids=[
+        "ln",
+        "ln+out",
+        "gauss+out",
+        "ln+out+fa",
+        "ln+near",
+        "gauss+near",
+        "ln+spread",
+        "ln+conserve",
+    ],
 )
 def test_predicted_stats_match_reference_for_every_family(sensor):
     """The transformed-frame kernels (vectorised log-sum-exp of the outlier component, the
@@ -153,8 +163,9 @@ def test_vectorised_log1p_matches_math_log1p():
         Sensor(family="lognormal", pd=0.6),
         Sensor(family="lognormal", pd=0.6, near_length=3.0),
         Sensor(family="lognormal", pd=0.6, log_sd_near=2.0, log_sd_length=3.0),
+        Sensor(family="lognormal", pd=0.6, near_length=3.0, conserve_mean=True),
     ],
-    ids=["gauss", "gauss-pd1", "ln", "ln+near", "ln+spread"],
+    ids=["gauss", "gauss-pd1", "ln", "ln+near", "ln+spread", "ln+conserve"],
 )
 def test_position_rows_match_the_numpy_plume_and_likelihood(sensor, meander):
     """The planners' per-position terms, written into chosen rows, against the NumPy plume and

@@ -91,14 +91,18 @@ SPREAD = Sensor(
 DETECTION_ONLY = Sensor(
     family="lognormal", pd=0.6, log_sd=1.2, outlier=0.01, near_length=5.0, magnitude=False
 )
-FAMILIES = [FLUCTUATION, ROBUST, ROBUST_PAPER, NEAR, NEAR_PAPER, SPREAD]
-FAMILY_IDS = ["ln", "ln+out", "gauss+out", "ln+near", "gauss+near", "ln+spread"]
+# mean-conserving intermittency: a detection's mean is C / Pd(r)
+CONSERVING = Sensor(
+    family="lognormal", pd=0.6, log_sd=1.2, outlier=0.01, near_length=5.0, conserve_mean=True
+)
+FAMILIES = [FLUCTUATION, ROBUST, ROBUST_PAPER, NEAR, NEAR_PAPER, SPREAD, CONSERVING]
+FAMILY_IDS = ["ln", "ln+out", "gauss+out", "ln+near", "gauss+near", "ln+spread", "ln+conserve"]
 
 
 @pytest.mark.parametrize(
     "s",
-    [FLUCTUATION, ROBUST, ROBUST_PAPER, SPREAD, DETECTION_ONLY],
-    ids=["ln", "ln+out", "gauss+out", "spread", "detection"],
+    [FLUCTUATION, ROBUST, ROBUST_PAPER, SPREAD, DETECTION_ONLY, CONSERVING],
+    ids=["ln", "ln+out", "gauss+out", "spread", "detection", "conserve"],
 )
 @pytest.mark.parametrize("conc", [0.0, 2e-4, 5e-4, 3e-3, 0.5])
 @pytest.mark.parametrize("r", [0.5, 40.0])
@@ -127,8 +131,28 @@ def test_lognormal_reading_keeps_the_mean_and_intermittency():
     assert np.log(z[z > 0]).std() == pytest.approx(0.8, rel=0.01)
 
 
+def test_mean_conserving_intermittency_keeps_the_time_mean_near_the_source():
+    """Limiting case (threshold far below C): with ``conserve_mean`` the share of detections is
+    Pd(r) and a detection's mean C / Pd(r), so the mean reading, zeros included, is C at every
+    distance; without it the mean reading is Pd(r) · C."""
+    kw = dict(family="lognormal", pd=0.9, log_sd=1.0, near_length=2.5, threshold=1e-12)
+    on, off = Sensor(**kw, conserve_mean=True), Sensor(**kw)
+    rng = np.random.default_rng(5)
+    conc = np.full(400_000, 3e-2)
+    for r in (0.3, 1.0, 6.0):
+        pd = 0.9 * (1 - math.exp(-r / 2.5))
+        noise = on.draw_noise(rng, conc.shape)
+        z_on, z_off = on.simulate_from(conc, noise, r), off.simulate_from(conc, noise, r)
+        assert (z_on > 0).mean() == pytest.approx(pd, abs=0.004)
+        assert z_on.mean() == pytest.approx(3e-2, rel=0.03)
+        assert z_off.mean() == pytest.approx(pd * 3e-2, rel=0.03)
+        assert z_on[z_on > 0].mean() == pytest.approx(3e-2 / pd, rel=0.03)
+
+
 @pytest.mark.parametrize(
-    "s", [FLUCTUATION, ROBUST, ROBUST_PAPER, SPREAD], ids=["ln", "ln+out", "gauss+out", "spread"]
+    "s",
+    [FLUCTUATION, ROBUST, ROBUST_PAPER, SPREAD, CONSERVING],
+    ids=["ln", "ln+out", "gauss+out", "spread", "conserve"],
 )
 def test_simulated_readings_follow_every_family(s):
     rng = np.random.default_rng(12)

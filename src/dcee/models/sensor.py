@@ -56,6 +56,7 @@ import numpy as np
 from scipy.special import log_ndtr, ndtri_exp
 
 from dcee.errors import DceeInputError
+from dcee.models.plume import MIN_DISTANCE
 from dcee.models.sensor_kernels import SensorParams
 
 Family = Literal["gaussian", "lognormal"]
@@ -78,6 +79,11 @@ class Sensor:
     near_length: float = 0.0
     log_sd_near: float = 0.0
     log_sd_length: float = 0.0
+    conserve_mean: bool = False
+    """log-normal family: a detection's mean is C / Pd(r) (True), so a reading's mean, zeros
+    included, is the plume's time mean C (Yee & Chan 1997: the in-plume conditional mean is the
+    mean over the intermittency factor); False: a detection's mean is C, so the reading's mean is
+    Pd(r) · C"""
     magnitude: bool = True
     """True: a detection weighs by its magnitude's density (the paper's eq. 3, the log-normal
     family); False: by its probability only, times a log-uniform density on [threshold,
@@ -127,6 +133,10 @@ class Sensor:
             s = self.log_sd + (self.log_sd_near if self.log_sd_length > 0 else 0.0)
             v_thr = math.log(self.threshold)
             c_lin = self.threshold * math.exp(0.5 * s * s - 9.0 * s) if s < 9 else -1.0
+            if self.conserve_mean:
+                # the location rises by −ln Pd(r); the kernels clamp r at the plume's minimum
+                # distance, so the smallest Pd they see is Pd(MIN_DISTANCE)
+                c_lin *= float(self.detect_prob(MIN_DISTANCE))
             lin0 = lin1 = 0.0
         else:
             v_thr = self.threshold
@@ -165,6 +175,7 @@ class Sensor:
             lin0=lin0,
             lin1=lin1,
             magnitude=1.0 if self.magnitude else 0.0,
+            conserve_mean=1.0 if self.lognormal and self.conserve_mean else 0.0,
             log_flat=self._log_flat,
         )
 
@@ -222,6 +233,8 @@ class Sensor:
         if self.lognormal:
             s = self.log_sd_at(distance)
             loc = np.log(np.maximum(c, 1e-300)) - 0.5 * s**2
+            if self.conserve_mean:
+                loc = loc - np.log(self.detect_prob(distance))
             return np.broadcast_arrays(loc, s)
         return c, self.sigma_frac * c + self.sigma_min
 
@@ -356,6 +369,8 @@ class Sensor:
         if self.lognormal:
             s = self.log_sd_at(distance)
             y = c * np.exp(s * noise[..., 1] - 0.5 * s * s)
+            if self.conserve_mean:
+                y = y / self.detect_prob(distance)
         else:
             y = c + (self.sigma_frac * c + self.sigma_min) * noise[..., 1]
         detected = (noise[..., 0] < self.detect_prob(distance)) & (y >= self.threshold)

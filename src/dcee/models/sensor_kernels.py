@@ -9,7 +9,7 @@ filter's and the planners', serves both:
 family        location ``loc(C)``          scale ``σ(C)``              reading ``v(z)``
 ============  ===========================  ==========================  =================
 gaussian      C                            σ_frac·C + σ_min            z
-lognormal     ln C − s²/2                  s                           ln z
+lognormal     ln C − s²/2 [− ln Pd(r)]     s                           ln z
 ============  ===========================  ==========================  =================
 
 A detection's density is Pd·φ((v − loc)/σ)/σ · |dv/dz| (the Jacobian is 1/z for the log-normal
@@ -19,8 +19,10 @@ non-detection has probability (1 − Pd) + Pd·Φ((v_thr − loc)/σ). Detection
 log-uniform density of its magnitude on [threshold, max_reading] that no hypothesis changes,
 so a reading's size, which a turbulent plume decouples from the mean, carries no weight. With
 near-source intermittency Pd depends on the distance r between the sensor and the hypothesised
-source, Pd(r) = Pd · (1 − exp(−r / near_length)), so every function takes r as well as C. Sensor
-parameters arrive as a :class:`SensorParams` record (named fields, all float64).
+source, Pd(r) = Pd · (1 − exp(−r / near_length)), so every function takes r as well as C. With
+``conserve_mean`` the log-normal location is raised by −ln Pd(r): a detection's mean is C / Pd(r),
+a reading's mean C. Sensor parameters arrive as a :class:`SensorParams` record (named fields,
+all float64).
 """
 
 from __future__ import annotations
@@ -62,6 +64,7 @@ class SensorParams(NamedTuple):
     lin0: float
     lin1: float
     magnitude: float  # 1.0: a detection's density in its magnitude; 0.0: detection only
+    conserve_mean: float  # 1.0 (log-normal): a detection's mean is C / Pd(r); 0.0: C
     log_flat: float  # log(z · g(z)), g the log-uniform density on [threshold, max_reading]
 
 
@@ -79,10 +82,11 @@ def transform(c: float, r: float, sp: SensorParams):
     """(loc, σ) of an expected concentration C at distance r m from the source in the
     transformed frame."""
     if sp.lognormal > 0.0:
+        shift = log_detection_probability(r, sp) if sp.conserve_mean > 0.0 else 0.0
         if sp.log_sd_length > 0.0:
             s = log_sd_at(r, sp)
-            return math.log(max(c, TINY_CONCENTRATION)) - 0.5 * s * s, s
-        return math.log(max(c, TINY_CONCENTRATION)) - sp.half_s2, sp.log_sd
+            return math.log(max(c, TINY_CONCENTRATION)) - 0.5 * s * s - shift, s
+        return math.log(max(c, TINY_CONCENTRATION)) - sp.half_s2 - shift, sp.log_sd
     return c, sp.sigma_frac * c + sp.sigma_min
 
 

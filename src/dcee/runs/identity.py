@@ -43,6 +43,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("estimator", "log_sd_length"): 0.0,
     # every detection weighed by its magnitude before issue 29's detection-only readings
     ("estimator", "magnitude"): True,
+    # a detection's mean was C (not C / Pd) before the mean-conserving intermittency
+    ("estimator", "conserve_mean"): False,
     # every reading weighed reading_weight before the repeat discount
     ("estimator", "repeat_radius"): 0.0,
 }
@@ -58,6 +60,7 @@ FLUCTUATION_ONLY = (
     "near_source_length",
     "calm_prior",
     "magnitude",
+    "conserve_mean",
 )
 """Estimator settings that only the fluctuation likelihood reads: under the paper's likelihood
 they decide nothing, so changing their defaults must not orphan a campaign."""

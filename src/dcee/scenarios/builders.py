@@ -86,6 +86,7 @@ class ScenarioBuilders:
             log_sd_length=e.log_sd_length,
             near_length=e.near_source_length,
             magnitude=e.magnitude,
+            conserve_mean=e.conserve_mean,
             outlier=self.outlier,
             max_reading=s.max_reading,
         )

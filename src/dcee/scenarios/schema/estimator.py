@@ -201,6 +201,10 @@ class EstimatorSpec(BaseModel):
     its probability, whatever its size (False: detection-only readings, as Vergassola et
     al.'s infotaxis counts hits); the calm member and the paper's likelihood always use the
     magnitude. The planners predict with the magnitude either way"""
+    conserve_mean: bool = False
+    """fluctuation: a detection's mean is C / Pd(r), so a reading's mean, the zeros included, is
+    the plume's time mean C (True; Yee & Chan 1997: the in-plume mean is the mean over the
+    intermittency factor), or it is C and the reading's mean Pd(r) · C (False)"""
     meander: Annotated[float | None, Field(ge=0, le=2)] = None
     """crosswind turbulence intensity of the plume model's time-mean meander broadening
     (:mod:`dcee.models.plume`); None: the likelihood's default, :data:`MEANDER_DEFAULT`"""
