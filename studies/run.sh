@@ -61,11 +61,17 @@ case "${1:---list}" in
       --set estimator.near_source_length=5.0
     OUT_SUFFIX=-climb-nsl25 bash studies/study_turbulent_held_out.sh --set agent.climb=1.0 \
       --set estimator.near_source_length=2.5
-    # today's defaults (the climbing UAV, near-source length 2.5 m, dcee-cl's vertical reach):
-    # the puffs on held-out-100, the filament on all 200 held-out configurations (issue 28's
-    # filament study); the filament's random:1100-1199 make its held-out-100 rows
-    OUT_SUFFIX=-defaults TRUTHS=puffs bash studies/study_turbulent_held_out.sh
-    SUITE=held-out OUT_SUFFIX=-defaults TRUTHS=filament bash studies/study_turbulent_held_out.sh
+    # the third round's defaults (the climbing UAV, near-source length 2.5 m, dcee-cl's
+    # vertical reach; a detection's mean C): the puffs on held-out-100, the filament on all 200
+    # held-out configurations (issue 28's filament study); the filament's random:1100-1199 make
+    # its held-out-100 rows
+    OUT_SUFFIX=-defaults TRUTHS=puffs bash studies/study_turbulent_held_out.sh \
+      --set estimator.conserve_mean=false
+    SUITE=held-out OUT_SUFFIX=-defaults TRUTHS=filament bash studies/study_turbulent_held_out.sh \
+      --set estimator.conserve_mean=false
+    # today's defaults (the fourth round's mean-conserving intermittency), the same searches
+    OUT_SUFFIX=-cm TRUTHS=puffs bash studies/study_turbulent_held_out.sh
+    SUITE=held-out OUT_SUFFIX=-cm TRUTHS=filament bash studies/study_turbulent_held_out.sh
     report turbulent-filament-held-out-24 turbulent-puffs-held-out-24
     out=docs/results/turbulent-held-out-100
     gathered=()
@@ -94,7 +100,7 @@ case "${1:---list}" in
     for t in filament puffs; do  # 5 repeats and 10,000 particles: ~10 min per truth on 2 cores
       $D bench --suite paper --strategies dcee-cl,infotaxis --repeats 5 --unknown full \
         --likelihood fluctuation --truth $t --particles 10000 --workers "${WORKERS:-2}" \
-        --out "results/turbulent-$t-public-defaults"
+        --set estimator.conserve_mean=false --out "results/turbulent-$t-public-defaults"
       report "turbulent-$t-public-defaults"
     done
     $P studies/collect_metrics.py --out docs/results/turbulent-public-defaults \
@@ -156,15 +162,23 @@ case "${1:---list}" in
       --strategy dcee-cl:vertical_reach=0
     # third round: dcee-cl's vertical reach (today's default 1), then the reading weight and the
     # near-source length with it, and the near-source length 2.5 m at a fixed altitude
-    c1=agent.climb=1.0,estimator.near_source_length
+    # (the detection's mean C, as before the fourth round's mean-conserving intermittency)
+    c1=estimator.conserve_mean=false,agent.climb=1.0,estimator.near_source_length
     tune climb-nsl25-vr1.csv --variant "c1n25vr1:$c1=2.5"
     tune climb-nsl25-vr1-w03.csv --variant "c1n25vr1w03:$c1=2.5,estimator.reading_weight=0.3"
     tune climb-nsl25-vr1-w04.csv --variant "c1n25vr1w04:$c1=2.5,estimator.reading_weight=0.4"
     tune climb-nsl35-vr1.csv --variant "c1n35vr1:$c1=3.5"
-    tune fixed-nsl25.csv --variant n25:agent.climb=0.0,estimator.near_source_length=2.5
-    # the repeat discount at today's defaults (both rows were stopped early: see the README)
-    tune repeat-radius-2-partial.csv --variant rr2:estimator.repeat_radius=2.0
-    tune repeat-radius-05-partial.csv --variant rr05:estimator.repeat_radius=0.5
+    tune fixed-nsl25.csv \
+      --variant n25:estimator.conserve_mean=false,agent.climb=0.0,estimator.near_source_length=2.5
+    # the repeat discount at the third round's defaults (both rows were stopped early: see the
+    # README)
+    cm0=estimator.conserve_mean=false
+    tune repeat-radius-2-partial.csv --variant "rr2:$cm0,estimator.repeat_radius=2.0"
+    tune repeat-radius-05-partial.csv --variant "rr05:$cm0,estimator.repeat_radius=0.5"
+    # fourth round: the mean-conserving intermittency, alone and with the reading weight 0.4
+    tune conserve-mean.csv --variant cm:estimator.conserve_mean=true
+    tune conserve-mean-w04.csv \
+      --variant cm-w04:estimator.conserve_mean=true,estimator.reading_weight=0.4
     for unk in source full; do
       $D bench --suite random-tune --strategies dcee-cl --repeats 1 --unknown $unk \
         --particles 10000 --set search.guard_share=1.0 --out "results/tune-guard-$unk-1"

@@ -52,7 +52,7 @@ A scenario is a TOML file (or a built-in, see :mod:`dcee.scenarios.builtin`)::
     meander = 0.15                 # plume broadening [default: 0 paper, 0.15 fluctuation]
     outlier = 0.01                 # outlier weight [default: 0.01 for every likelihood]
     magnitude = true               # fluctuation only; false: detection-only readings
-    conserve_mean = false          # fluctuation only; true: a detection's mean is C / Pd(r)
+    conserve_mean = true           # fluctuation only: a detection's mean is C / Pd(r)
     repeat_radius = 0.0            # m; > 0: a run of readings at one spot adds up like ln n
 
     [agent]
