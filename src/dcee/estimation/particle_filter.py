@@ -102,6 +102,7 @@ class ParticleFilter:
         reading_weight: float = 1.0,
         anemometer: Anemometer | None = None,
         repeat_radius: float = 0.0,
+        repeat_power: float = 1.0,
     ) -> None:
         if not (isinstance(reading_weight, int | float) and 0 < reading_weight <= 1):
             raise DceeInputError(
@@ -111,6 +112,10 @@ class ParticleFilter:
             raise DceeInputError(
                 "estimator.repeat_radius",
                 f"must be a finite number of m >= 0, got {repeat_radius!r}",
+            )
+        if not (isinstance(repeat_power, int | float) and 0 < repeat_power <= 2):
+            raise DceeInputError(
+                "estimator.repeat_power", f"must be in (0, 2], got {repeat_power!r}"
             )
         if int(n_particles) != n_particles or n_particles < 2:
             raise DceeInputError("particles", f"must be an integer >= 2, got {n_particles}")
@@ -142,6 +147,7 @@ class ParticleFilter:
         self.max_sweeps = int(max_sweeps)
         self.reading_weight = float(reading_weight)
         self.repeat_radius = float(repeat_radius)
+        self.repeat_power = float(repeat_power)
         # the weight of the reading being assimilated (reading_weight, discounted for a repeat)
         self._weight_now = self.reading_weight
         self._unknown = np.array(prior.unknown)
@@ -241,7 +247,7 @@ class ParticleFilter:
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         # filters checkpointed before estimator.repeat_radius: off, and no run to continue
-        state = {"repeat_radius": 0.0, "_hist_order": [], **state}
+        state = {"repeat_radius": 0.0, "repeat_power": 1.0, "_hist_order": [], **state}
         state.setdefault("_weight_now", state.get("reading_weight", 1.0))
         self.__dict__.update(state)
 
@@ -273,11 +279,12 @@ class ParticleFilter:
         return out
 
     def repeat_weight(self, position: np.ndarray) -> float:
-        """The weight a reading at ``position`` (3,) m gets: ``reading_weight`` / (1 + m), m the
-        number of readings just before it, in an unbroken run, taken within ``repeat_radius`` m
-        of it (0: off, every reading ``reading_weight``). A robot holding one spot sees the same
-        puffs in successive readings, so its n readings there weigh w · (1 + 1/2 + … + 1/n),
-        growing like w · ln n, not w · n."""
+        """The weight a reading at ``position`` (3,) m gets: ``reading_weight`` / (1 + m)^p, m
+        the number of readings just before it, in an unbroken run, taken within
+        ``repeat_radius`` m of it (0: off, every reading ``reading_weight``), p
+        ``repeat_power``. A robot holding one spot sees the same puffs in successive readings,
+        so with p = 1 its n readings there weigh w · (1 + 1/2 + … + 1/n), growing like
+        w · ln n, not w · n; with p = 1/2 like 2 w √n."""
         if self.repeat_radius <= 0.0 or not self._hist_order:
             return self.reading_weight
         reach = self.repeat_radius * (1.0 + 1e-9) + 1e-9
@@ -286,7 +293,9 @@ class ParticleFilter:
             if math.dist(earlier, position) > reach:
                 break
             m += 1
-        return self.reading_weight / (1.0 + m)
+        if self.repeat_power == 1.0:
+            return self.reading_weight / (1.0 + m)
+        return self.reading_weight / (1.0 + m) ** self.repeat_power
 
     def update(self, position: np.ndarray, reading: float) -> UpdateInfo:
         """Assimilate one reading (g/m³; below the threshold = non-detection) taken at position."""

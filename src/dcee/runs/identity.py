@@ -47,6 +47,7 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("estimator", "conserve_mean"): False,
     # every reading weighed reading_weight before the repeat discount
     ("estimator", "repeat_radius"): 0.0,
+    ("estimator", "repeat_power"): 1.0,
 }
 """Scenario settings added after campaigns were first stored, with the value a stored scenario
 without one ran with, so the two compare equal."""

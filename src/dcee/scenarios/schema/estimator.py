@@ -229,6 +229,10 @@ class EstimatorSpec(BaseModel):
     puffs again, so its readings there add up like a logarithm, not a count. 0: off (every
     reading ``reading_weight``). Tried on the turbulent tuning range, not a default
     (docs/turbulent.md)"""
+    repeat_power: Annotated[float, Field(gt=0, le=2, allow_inf_nan=False)] = 1.0
+    """the repeat discount's power p: a reading in a run of m counts as ``reading_weight`` /
+    (1 + m)^p (only with ``repeat_radius`` > 0); 1: n readings at one spot add up like ln n,
+    1/2: like 2 √n"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the
