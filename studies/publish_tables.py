@@ -204,6 +204,7 @@ def what_we_found() -> str:
             climb=0.0,
             near_source_length=5.0,
             vertical_reach=0.0,
+            conserve_mean=0,
         ),
         pair_row(
             "**held-out**, filament truth, the same 100 configurations and settings",
@@ -212,23 +213,40 @@ def what_we_found() -> str:
             climb=0.0,
             near_source_length=5.0,
             vertical_reach=0.0,
+            conserve_mean=0,
         ),
         pair_row(
-            "**held-out**, puff truth, **today's defaults** (the UAV climbs and descends 1 m, "
-            "near-source length 2.5 m, `dcee-cl`'s vertical reach), the same 100",
+            "**held-out**, puff truth, the third round's defaults (the UAV climbs and descends "
+            "1 m, near-source length 2.5 m, `dcee-cl`'s vertical reach), the same 100",
             "turbulent-held-out-100",
             truth_model="puffs",
             climb=1.0,
             near_source_length=2.5,
             vertical_reach=1.0,
+            conserve_mean=0,
         ),
         pair_row(
-            "**held-out**, filament truth, today's defaults, all 200 held-out configurations",
+            "**held-out**, filament truth, the third round's defaults, all 200 held-out "
+            "configurations",
             "turbulent-held-out-100",
             truth_model="filament",
             climb=1.0,
             near_source_length=2.5,
             vertical_reach=1.0,
+            conserve_mean=0,
+        ),
+        pair_row(
+            "**held-out**, puff truth, **today's defaults** (the third round's and the "
+            "mean-conserving intermittency), the same 100",
+            "turbulent-held-out-100",
+            truth_model="puffs",
+            conserve_mean=1,
+        ),
+        pair_row(
+            "**held-out**, filament truth, **today's defaults**, all 200 held-out configurations",
+            "turbulent-held-out-100",
+            truth_model="filament",
+            conserve_mean=1,
         ),
     ]
     return table(
@@ -342,16 +360,17 @@ def turbulent_table() -> str:
         for strategy in ("dcee-cl", "infotaxis"):
             r = pick(frame, strategy, truth_model=truth)
             label = (
-                f"{truth}, 12 public × 5, today's defaults, 10,000 particles: `{strategy}` "
+                f"{truth}, 12 public × 5, the third round's defaults, 10,000 particles: `{strategy}` "
                 "(`turbulent-public-defaults`)"
             )
             rows.append(full_row(label, r))
     frame = study("turbulent-held-out-100")
     settings = (
-        (0.0, 5.0, 0.0, "fixed 4 m altitude (before)"),
-        (1.0, 2.5, 1.0, "today's defaults"),
+        (0.0, 5.0, 0.0, 0, "fixed 4 m altitude (before)"),
+        (1.0, 2.5, 1.0, 0, "the third round's defaults"),
+        (1.0, 2.5, 1.0, 1, "today's defaults"),
     )
-    for climb, near, reach, how in settings:
+    for climb, near, reach, conserve, how in settings:
         for truth in ("puffs", "filament"):
             for strategy in ("dcee-cl", "infotaxis"):
                 r = pick(
@@ -361,6 +380,7 @@ def turbulent_table() -> str:
                     climb=climb,
                     near_source_length=near,
                     vertical_reach=reach,
+                    conserve_mean=conserve,
                 )
                 n = int(r["searches"])
                 label = f"{truth}, {n} held-out, {how}: `{strategy}` (`turbulent-held-out-100`)"

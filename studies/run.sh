@@ -55,34 +55,41 @@ case "${1:---list}" in
     # the first three ran at commit 43cea93 (each result records it), before dcee-cl's vertical
     # reach and today's turbulent defaults: their settings are pinned here, and today's code
     # reproduces their infotaxis searches; their dcee-cl searches need that commit
+    cm0=(--set estimator.conserve_mean=false)  # a detection's mean C before the fourth round
     bash studies/study_turbulent_held_out.sh --set agent.climb=0.0 \
-      --set estimator.near_source_length=5.0
+      --set estimator.near_source_length=5.0 "${cm0[@]}"
     OUT_SUFFIX=-climb bash studies/study_turbulent_held_out.sh --set agent.climb=1.0 \
-      --set estimator.near_source_length=5.0
+      --set estimator.near_source_length=5.0 "${cm0[@]}"
     OUT_SUFFIX=-climb-nsl25 bash studies/study_turbulent_held_out.sh --set agent.climb=1.0 \
-      --set estimator.near_source_length=2.5
+      --set estimator.near_source_length=2.5 "${cm0[@]}"
     # the third round's defaults (the climbing UAV, near-source length 2.5 m, dcee-cl's
     # vertical reach; a detection's mean C): the puffs on held-out-100, the filament on all 200
     # held-out configurations (issue 28's filament study); the filament's random:1100-1199 make
     # its held-out-100 rows
-    OUT_SUFFIX=-defaults TRUTHS=puffs bash studies/study_turbulent_held_out.sh \
-      --set estimator.conserve_mean=false
+    OUT_SUFFIX=-defaults TRUTHS=puffs bash studies/study_turbulent_held_out.sh "${cm0[@]}"
     SUITE=held-out OUT_SUFFIX=-defaults TRUTHS=filament bash studies/study_turbulent_held_out.sh \
-      --set estimator.conserve_mean=false
+      "${cm0[@]}"
     # today's defaults (the fourth round's mean-conserving intermittency), the same searches
     OUT_SUFFIX=-cm TRUTHS=puffs bash studies/study_turbulent_held_out.sh
     SUITE=held-out OUT_SUFFIX=-cm TRUTHS=filament bash studies/study_turbulent_held_out.sh
     report turbulent-filament-held-out-24 turbulent-puffs-held-out-24
     out=docs/results/turbulent-held-out-100
     gathered=()
-    rm -f "$out/climb_vs_fixed.csv" "$out/nsl25_vs_climb.csv" "$out/defaults_vs_nsl25.csv"
+    rm -f "$out/climb_vs_fixed.csv" "$out/nsl25_vs_climb.csv" "$out/defaults_vs_nsl25.csv" \
+      "$out/cm_vs_defaults.csv"
     for t in puffs filament; do
       defaults="turbulent-$t-held-out-100-defaults"
-      [ "$t" = filament ] && defaults=turbulent-filament-held-out-defaults  # all 200
-      for v in "turbulent-$t-held-out-100=climb:0,near_source_length:5,vertical_reach:0" \
-        "turbulent-$t-held-out-100-climb=climb:1,near_source_length:5,vertical_reach:0" \
-        "turbulent-$t-held-out-100-climb-nsl25=climb:1,near_source_length:2.5,vertical_reach:0" \
-        "$defaults=climb:1,near_source_length:2.5,vertical_reach:1"; do
+      cm="turbulent-$t-held-out-100-cm"
+      if [ "$t" = filament ]; then  # all 200
+        defaults=turbulent-filament-held-out-defaults
+        cm=turbulent-filament-held-out-cm
+      fi
+      for v in \
+        "turbulent-$t-held-out-100=climb:0,near_source_length:5,vertical_reach:0,conserve_mean:0" \
+        "turbulent-$t-held-out-100-climb=climb:1,near_source_length:5,vertical_reach:0,conserve_mean:0" \
+        "turbulent-$t-held-out-100-climb-nsl25=climb:1,near_source_length:2.5,vertical_reach:0,conserve_mean:0" \
+        "$defaults=climb:1,near_source_length:2.5,vertical_reach:1,conserve_mean:0" \
+        "$cm=climb:1,near_source_length:2.5,vertical_reach:1,conserve_mean:1"; do
         report "${v%%=*}"
         gathered+=("results/${v%%=*}=truth_model:$t,${v#*=}")
       done
@@ -93,7 +100,13 @@ case "${1:---list}" in
         --tag truth_model=$t
       $P studies/pair_campaigns.py "results/turbulent-$t-held-out-100-climb-nsl25" \
         "results/$defaults" --csv "$out/defaults_vs_nsl25.csv" --tag truth_model=$t
+      $P studies/pair_campaigns.py "results/$defaults" "results/$cm" \
+        --csv "$out/cm_vs_defaults.csv" --tag truth_model=$t
     done
+    $P studies/calibration_diagnosis.py "results/turbulent-puffs-held-out-100-defaults" \
+      results/turbulent-filament-held-out-defaults --csv "$out/calibration-third-round.csv"
+    $P studies/calibration_diagnosis.py "results/turbulent-puffs-held-out-100-cm" \
+      results/turbulent-filament-held-out-cm --csv "$out/calibration-today.csv"
     $P studies/collect_metrics.py --out "$out" "${gathered[@]}"
     $P studies/publish_tables.py ;;
   turbulent-public)  # the twelve public configurations on both turbulent truths, today's defaults
@@ -177,8 +190,11 @@ case "${1:---list}" in
     tune repeat-radius-05-partial.csv --variant "rr05:$cm0,estimator.repeat_radius=0.5"
     # fourth round: the mean-conserving intermittency, alone and with the reading weight 0.4
     tune conserve-mean.csv --variant cm:estimator.conserve_mean=true
-    tune conserve-mean-w04.csv \
+    tune conserve-mean-w04-partial.csv \
       --variant cm-w04:estimator.conserve_mean=true,estimator.reading_weight=0.4
+    # (stopped at 37 and 54 of 56: see the README)
+    tune repeat-2-power-05-partial.csv \
+      --variant rr2p05:estimator.repeat_radius=2.0,estimator.repeat_power=0.5
     for unk in source full; do
       $D bench --suite random-tune --strategies dcee-cl --repeats 1 --unknown $unk \
         --particles 10000 --set search.guard_share=1.0 --out "results/tune-guard-$unk-1"

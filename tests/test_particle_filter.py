@@ -127,6 +127,32 @@ def test_repeat_radius_discounts_a_run_of_readings_at_one_spot(sensor):
         ParticleFilter(planar_prior(u=2.0), sensor, n_particles=100, repeat_radius=-1.0)
 
 
+def test_repeat_power_gentles_the_discount(sensor):
+    """estimator.repeat_power p: the m-th reading of a run weighs 1 / (1 + m)^p; p = 1/2 gives
+    1, 1/√2, 1/√3 (hand values), and the filter matches the exact grid posterior with them."""
+    data = _readings(sensor)
+    runs = [(pos, z) for pos, z in data for _ in range(3)]
+    powers = np.tile([1.0, 2**-0.5, 3**-0.5], len(data))
+    grid_mean, grid_sd = _grid_posterior(sensor, runs, power=powers)
+    pf = ParticleFilter(
+        planar_prior(u=2.0),
+        sensor,
+        n_particles=20_000,
+        seed=5,
+        repeat_radius=0.5,
+        repeat_power=0.5,
+    )
+    weights = []
+    for pos, z in runs:
+        weights.append(pf.repeat_weight(pos))
+        pf.update(pos, z)
+    np.testing.assert_allclose(weights, powers)
+    np.testing.assert_array_less(np.abs(pf.mean() - grid_mean), 0.2 * grid_sd)
+    np.testing.assert_allclose(np.sqrt(np.diag(pf.cov())), grid_sd, rtol=0.2)
+    with pytest.raises(DceeInputError, match="repeat_power"):
+        ParticleFilter(planar_prior(u=2.0), sensor, n_particles=100, repeat_power=0.0)
+
+
 def test_collapse_is_recovered_by_tempering_and_still_matches_the_posterior(sensor):
     data = _readings(sensor)
     grid_mean, grid_sd = _grid_posterior(sensor, data)
