@@ -205,6 +205,7 @@ def what_we_found() -> str:
             near_source_length=5.0,
             vertical_reach=0.0,
             conserve_mean=0,
+            repeat_radius=0,
         ),
         pair_row(
             "**held-out**, filament truth, the same 100 configurations and settings",
@@ -214,6 +215,7 @@ def what_we_found() -> str:
             near_source_length=5.0,
             vertical_reach=0.0,
             conserve_mean=0,
+            repeat_radius=0,
         ),
         pair_row(
             "**held-out**, puff truth, the third round's defaults (the UAV climbs and descends "
@@ -224,6 +226,7 @@ def what_we_found() -> str:
             near_source_length=2.5,
             vertical_reach=1.0,
             conserve_mean=0,
+            repeat_radius=0,
         ),
         pair_row(
             "**held-out**, filament truth, the third round's defaults, all 200 held-out "
@@ -234,6 +237,7 @@ def what_we_found() -> str:
             near_source_length=2.5,
             vertical_reach=1.0,
             conserve_mean=0,
+            repeat_radius=0,
         ),
         pair_row(
             "**held-out**, puff truth, **today's defaults** (the third round's and the "
@@ -241,12 +245,27 @@ def what_we_found() -> str:
             "turbulent-held-out-100",
             truth_model="puffs",
             conserve_mean=1,
+            repeat_radius=0,
         ),
         pair_row(
             "**held-out**, filament truth, **today's defaults**, all 200 held-out configurations",
             "turbulent-held-out-100",
             truth_model="filament",
             conserve_mean=1,
+            repeat_radius=0,
+        ),
+        pair_row(
+            "**held-out**, puff truth, today's defaults and the gentle repeat discount "
+            "(`repeat_radius = 2`, `repeat_power = 0.25`), the same 100",
+            "turbulent-held-out-100",
+            truth_model="puffs",
+            repeat_radius=2,
+        ),
+        pair_row(
+            "**held-out**, filament truth, the same settings, `held-out-100`",
+            "turbulent-held-out-100",
+            truth_model="filament",
+            repeat_radius=2,
         ),
     ]
     return table(
@@ -360,17 +379,18 @@ def turbulent_table() -> str:
         for strategy in ("dcee-cl", "infotaxis"):
             r = pick(frame, strategy, truth_model=truth)
             label = (
-                f"{truth}, 12 public × 5, the third round's defaults, 10,000 particles: `{strategy}` "
-                "(`turbulent-public-defaults`)"
+                f"{truth}, 12 public × 5, the third round's defaults, 10,000 particles: "
+                f"`{strategy}` (`turbulent-public-defaults`)"
             )
             rows.append(full_row(label, r))
     frame = study("turbulent-held-out-100")
     settings = (
-        (0.0, 5.0, 0.0, 0, "fixed 4 m altitude (before)"),
-        (1.0, 2.5, 1.0, 0, "the third round's defaults"),
-        (1.0, 2.5, 1.0, 1, "today's defaults"),
+        (0.0, 5.0, 0.0, 0, 0, "fixed 4 m altitude (before)"),
+        (1.0, 2.5, 1.0, 0, 0, "the third round's defaults"),
+        (1.0, 2.5, 1.0, 1, 0, "today's defaults"),
+        (1.0, 2.5, 1.0, 1, 2, "today's defaults, repeat discount 2 m, power 0.25"),
     )
-    for climb, near, reach, conserve, how in settings:
+    for climb, near, reach, conserve, repeat, how in settings:
         for truth in ("puffs", "filament"):
             for strategy in ("dcee-cl", "infotaxis"):
                 r = pick(
@@ -381,6 +401,7 @@ def turbulent_table() -> str:
                     near_source_length=near,
                     vertical_reach=reach,
                     conserve_mean=conserve,
+                    repeat_radius=repeat,
                 )
                 n = int(r["searches"])
                 label = f"{truth}, {n} held-out, {how}: `{strategy}` (`turbulent-held-out-100`)"

@@ -72,11 +72,14 @@ case "${1:---list}" in
     # today's defaults (the fourth round's mean-conserving intermittency), the same searches
     OUT_SUFFIX=-cm TRUTHS=puffs bash studies/study_turbulent_held_out.sh
     SUITE=held-out OUT_SUFFIX=-cm TRUTHS=filament bash studies/study_turbulent_held_out.sh
+    # and with the gentle repeat discount (the fourth round's calibrated setting), held-out-100
+    OUT_SUFFIX=-cm-rr bash studies/study_turbulent_held_out.sh \
+      --set estimator.repeat_radius=2.0 --set estimator.repeat_power=0.25
     report turbulent-filament-held-out-24 turbulent-puffs-held-out-24
     out=docs/results/turbulent-held-out-100
     gathered=()
     rm -f "$out/climb_vs_fixed.csv" "$out/nsl25_vs_climb.csv" "$out/defaults_vs_nsl25.csv" \
-      "$out/cm_vs_defaults.csv"
+      "$out/cm_vs_defaults.csv" "$out/rr_vs_cm.csv"
     for t in puffs filament; do
       defaults="turbulent-$t-held-out-100-defaults"
       cm="turbulent-$t-held-out-100-cm"
@@ -85,11 +88,12 @@ case "${1:---list}" in
         cm=turbulent-filament-held-out-cm
       fi
       for v in \
-        "turbulent-$t-held-out-100=climb:0,near_source_length:5,vertical_reach:0,conserve_mean:0" \
-        "turbulent-$t-held-out-100-climb=climb:1,near_source_length:5,vertical_reach:0,conserve_mean:0" \
-        "turbulent-$t-held-out-100-climb-nsl25=climb:1,near_source_length:2.5,vertical_reach:0,conserve_mean:0" \
-        "$defaults=climb:1,near_source_length:2.5,vertical_reach:1,conserve_mean:0" \
-        "$cm=climb:1,near_source_length:2.5,vertical_reach:1,conserve_mean:1"; do
+        "turbulent-$t-held-out-100=climb:0,near_source_length:5,vertical_reach:0,conserve_mean:0,repeat_radius:0" \
+        "turbulent-$t-held-out-100-climb=climb:1,near_source_length:5,vertical_reach:0,conserve_mean:0,repeat_radius:0" \
+        "turbulent-$t-held-out-100-climb-nsl25=climb:1,near_source_length:2.5,vertical_reach:0,conserve_mean:0,repeat_radius:0" \
+        "$defaults=climb:1,near_source_length:2.5,vertical_reach:1,conserve_mean:0,repeat_radius:0" \
+        "$cm=climb:1,near_source_length:2.5,vertical_reach:1,conserve_mean:1,repeat_radius:0" \
+        "turbulent-$t-held-out-100-cm-rr=climb:1,near_source_length:2.5,vertical_reach:1,conserve_mean:1,repeat_radius:2"; do
         report "${v%%=*}"
         gathered+=("results/${v%%=*}=truth_model:$t,${v#*=}")
       done
@@ -102,6 +106,8 @@ case "${1:---list}" in
         "results/$defaults" --csv "$out/defaults_vs_nsl25.csv" --tag truth_model=$t
       $P studies/pair_campaigns.py "results/$defaults" "results/$cm" \
         --csv "$out/cm_vs_defaults.csv" --tag truth_model=$t
+      $P studies/pair_campaigns.py "results/$cm" "results/turbulent-$t-held-out-100-cm-rr" \
+        --csv "$out/rr_vs_cm.csv" --tag truth_model=$t
     done
     $P studies/calibration_diagnosis.py "results/turbulent-puffs-held-out-100-defaults" \
       results/turbulent-filament-held-out-defaults --csv "$out/calibration-third-round.csv"
@@ -195,6 +201,8 @@ case "${1:---list}" in
     # (stopped at 37 and 54 of 56: see the README)
     tune repeat-2-power-05-partial.csv \
       --variant rr2p05:estimator.repeat_radius=2.0,estimator.repeat_power=0.5
+    tune repeat-2-power-025.csv \
+      --variant rr2p025:estimator.repeat_radius=2.0,estimator.repeat_power=0.25
     for unk in source full; do
       $D bench --suite random-tune --strategies dcee-cl --repeats 1 --unknown $unk \
         --particles 10000 --set search.guard_share=1.0 --out "results/tune-guard-$unk-1"
