@@ -240,29 +240,29 @@ def what_we_found() -> str:
             repeat_radius=0,
         ),
         pair_row(
-            "**held-out**, puff truth, **today's defaults** (the third round's and the "
-            "mean-conserving intermittency), the same 100",
+            "**held-out**, puff truth, the third round's defaults and the mean-conserving "
+            "intermittency (fourth round), the same 100",
             "turbulent-held-out-100",
             truth_model="puffs",
             conserve_mean=1,
             repeat_radius=0,
         ),
         pair_row(
-            "**held-out**, filament truth, **today's defaults**, all 200 held-out configurations",
+            "**held-out**, filament truth, the same settings, all 200 held-out configurations",
             "turbulent-held-out-100",
             truth_model="filament",
             conserve_mean=1,
             repeat_radius=0,
         ),
         pair_row(
-            "**held-out**, puff truth, today's defaults and the gentle repeat discount "
-            "(`repeat_radius = 2`, `repeat_power = 0.25`), the same 100",
+            "**held-out**, puff truth, **today's defaults** (and the gentle repeat discount, "
+            "`repeat_radius = 2`, `repeat_power = 0.25`), the same 100",
             "turbulent-held-out-100",
             truth_model="puffs",
             repeat_radius=2,
         ),
         pair_row(
-            "**held-out**, filament truth, the same settings, `held-out-100`",
+            "**held-out**, filament truth, **today's defaults**, `held-out-100`",
             "turbulent-held-out-100",
             truth_model="filament",
             repeat_radius=2,
@@ -387,8 +387,8 @@ def turbulent_table() -> str:
     settings = (
         (0.0, 5.0, 0.0, 0, 0, "fixed 4 m altitude (before)"),
         (1.0, 2.5, 1.0, 0, 0, "the third round's defaults"),
-        (1.0, 2.5, 1.0, 1, 0, "today's defaults"),
-        (1.0, 2.5, 1.0, 1, 2, "today's defaults, repeat discount 2 m, power 0.25"),
+        (1.0, 2.5, 1.0, 1, 0, "mean-conserving intermittency"),
+        (1.0, 2.5, 1.0, 1, 2, "**today's defaults**"),
     )
     for climb, near, reach, conserve, repeat, how in settings:
         for truth in ("puffs", "filament"):

@@ -55,7 +55,9 @@ case "${1:---list}" in
     # the first three ran at commit 43cea93 (each result records it), before dcee-cl's vertical
     # reach and today's turbulent defaults: their settings are pinned here, and today's code
     # reproduces their infotaxis searches; their dcee-cl searches need that commit
-    cm0=(--set estimator.conserve_mean=false)  # a detection's mean C before the fourth round
+    # before the fourth round: a detection's mean C, no repeat discount
+    rr0=(--set estimator.repeat_radius=0.0)
+    cm0=(--set estimator.conserve_mean=false "${rr0[@]}")
     bash studies/study_turbulent_held_out.sh --set agent.climb=0.0 \
       --set estimator.near_source_length=5.0 "${cm0[@]}"
     OUT_SUFFIX=-climb bash studies/study_turbulent_held_out.sh --set agent.climb=1.0 \
@@ -69,10 +71,11 @@ case "${1:---list}" in
     OUT_SUFFIX=-defaults TRUTHS=puffs bash studies/study_turbulent_held_out.sh "${cm0[@]}"
     SUITE=held-out OUT_SUFFIX=-defaults TRUTHS=filament bash studies/study_turbulent_held_out.sh \
       "${cm0[@]}"
-    # today's defaults (the fourth round's mean-conserving intermittency), the same searches
-    OUT_SUFFIX=-cm TRUTHS=puffs bash studies/study_turbulent_held_out.sh
-    SUITE=held-out OUT_SUFFIX=-cm TRUTHS=filament bash studies/study_turbulent_held_out.sh
-    # and with the gentle repeat discount (the fourth round's calibrated setting), held-out-100
+    # the fourth round's mean-conserving intermittency alone, the same searches
+    OUT_SUFFIX=-cm TRUTHS=puffs bash studies/study_turbulent_held_out.sh "${rr0[@]}"
+    SUITE=held-out OUT_SUFFIX=-cm TRUTHS=filament bash studies/study_turbulent_held_out.sh \
+      "${rr0[@]}"
+    # today's defaults: with the gentle repeat discount (2 m, power 0.25), held-out-100
     OUT_SUFFIX=-cm-rr bash studies/study_turbulent_held_out.sh \
       --set estimator.repeat_radius=2.0 --set estimator.repeat_power=0.25
     report turbulent-filament-held-out-24 turbulent-puffs-held-out-24
@@ -119,7 +122,8 @@ case "${1:---list}" in
     for t in filament puffs; do  # 5 repeats and 10,000 particles: ~10 min per truth on 2 cores
       $D bench --suite paper --strategies dcee-cl,infotaxis --repeats 5 --unknown full \
         --likelihood fluctuation --truth $t --particles 10000 --workers "${WORKERS:-2}" \
-        --set estimator.conserve_mean=false --out "results/turbulent-$t-public-defaults"
+        --set estimator.conserve_mean=false --set estimator.repeat_radius=0.0 \
+        --out "results/turbulent-$t-public-defaults"
       report "turbulent-$t-public-defaults"
     done
     $P studies/collect_metrics.py --out docs/results/turbulent-public-defaults \
@@ -172,32 +176,36 @@ case "${1:---list}" in
     }
     # second round, with the defaults of its day: a fixed altitude unless climbing, the
     # near-source length 5 m, dcee-cl without the vertical reach
-    old=estimator.near_source_length=5.0
+    cm0=estimator.conserve_mean=false,estimator.repeat_radius=0.0  # before the fourth round
+    old=estimator.near_source_length=5.0,$cm0
     tune guard-share.csv --variant "base:agent.climb=0.0,$old,search.guard_share=1.0" \
       --variant "g015:agent.climb=0.0,$old,search.guard_share=0.15" \
       --strategy dcee-cl:vertical_reach=0
     tune climb.csv --variant "climb1:agent.climb=1.0,$old" --strategy dcee-cl:vertical_reach=0
-    tune climb-nsl25.csv --variant c1n25:agent.climb=1.0,estimator.near_source_length=2.5 \
+    tune climb-nsl25.csv \
+      --variant c1n25:agent.climb=1.0,estimator.near_source_length=2.5,$cm0 \
       --strategy dcee-cl:vertical_reach=0
     # third round: dcee-cl's vertical reach (today's default 1), then the reading weight and the
     # near-source length with it, and the near-source length 2.5 m at a fixed altitude
     # (the detection's mean C, as before the fourth round's mean-conserving intermittency)
-    c1=estimator.conserve_mean=false,agent.climb=1.0,estimator.near_source_length
+    c1=estimator.conserve_mean=false,estimator.repeat_radius=0.0,agent.climb=1.0
+    c1=$c1,estimator.near_source_length
     tune climb-nsl25-vr1.csv --variant "c1n25vr1:$c1=2.5"
     tune climb-nsl25-vr1-w03.csv --variant "c1n25vr1w03:$c1=2.5,estimator.reading_weight=0.3"
     tune climb-nsl25-vr1-w04.csv --variant "c1n25vr1w04:$c1=2.5,estimator.reading_weight=0.4"
     tune climb-nsl35-vr1.csv --variant "c1n35vr1:$c1=3.5"
     tune fixed-nsl25.csv \
-      --variant n25:estimator.conserve_mean=false,agent.climb=0.0,estimator.near_source_length=2.5
+      --variant n25:estimator.conserve_mean=false,estimator.repeat_radius=0.0,agent.climb=0.0,estimator.near_source_length=2.5
     # the repeat discount at the third round's defaults (both rows were stopped early: see the
     # README)
-    cm0=estimator.conserve_mean=false
-    tune repeat-radius-2-partial.csv --variant "rr2:$cm0,estimator.repeat_radius=2.0"
-    tune repeat-radius-05-partial.csv --variant "rr05:$cm0,estimator.repeat_radius=0.5"
+    p1=estimator.repeat_power=1.0
+    tune repeat-radius-2-partial.csv --variant "rr2:$cm0,estimator.repeat_radius=2.0,$p1"
+    tune repeat-radius-05-partial.csv --variant "rr05:$cm0,estimator.repeat_radius=0.5,$p1"
     # fourth round: the mean-conserving intermittency, alone and with the reading weight 0.4
-    tune conserve-mean.csv --variant cm:estimator.conserve_mean=true
-    tune conserve-mean-w04-partial.csv \
-      --variant cm-w04:estimator.conserve_mean=true,estimator.reading_weight=0.4
+    # (the repeat discount off unless a variant sets it, as before the fourth round's default)
+    tune conserve-mean.csv --variant cm:estimator.conserve_mean=true,estimator.repeat_radius=0.0
+    tune conserve-mean-w04-partial.csv --variant \
+      cm-w04:estimator.conserve_mean=true,estimator.reading_weight=0.4,estimator.repeat_radius=0.0
     # (stopped at 37 and 54 of 56: see the README)
     tune repeat-2-power-05-partial.csv \
       --variant rr2p05:estimator.repeat_radius=2.0,estimator.repeat_power=0.5

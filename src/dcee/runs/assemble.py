@@ -48,8 +48,8 @@ def make_searcher(
             diversify=search.diversify,
             max_sweeps=search.max_sweeps,
             reading_weight=scenario.reading_weight,
-            repeat_radius=scenario.estimator.repeat_radius,
-            repeat_power=scenario.estimator.repeat_power,
+            repeat_radius=scenario.repeat_radius,
+            repeat_power=scenario.repeat_power,
             anemometer=scenario.make_anemometer(),
         )
         for model, rng in zip(models, rngs, strict=True)

@@ -11,6 +11,7 @@ from typing import Any
 from dcee.scenarios import (
     OLD_OUTLIER_DEFAULT,
     READING_WEIGHT_DEFAULT,
+    REPEAT_DEFAULT,
     UnicycleSpec,
     unset_climb,
 )
@@ -97,6 +98,10 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
         if "reading_weight" in estimator and estimator["reading_weight"] is None:
             # unset: the likelihood's default, compared as the number it stands for
             estimator["reading_weight"] = READING_WEIGHT_DEFAULT[likelihood]
+        for k, key in enumerate(("repeat_radius", "repeat_power")):
+            if key in estimator and estimator[key] is None:
+                # unset: the likelihood's default, compared as the number it stands for
+                estimator[key] = REPEAT_DEFAULT[likelihood][k]
     agent = out.get("agent")
     if isinstance(agent, dict) and "climb" in agent and agent["climb"] is None:
         # unset: the climb it resolved to (Scenario.resolved_climb), compared as that number

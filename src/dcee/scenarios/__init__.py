@@ -53,8 +53,8 @@ A scenario is a TOML file (or a built-in, see :mod:`dcee.scenarios.builtin`)::
     outlier = 0.01                 # outlier weight [default: 0.01 for every likelihood]
     magnitude = true               # fluctuation only; false: detection-only readings
     conserve_mean = true           # fluctuation only: a detection's mean is C / Pd(r)
-    repeat_radius = 0.0            # m; > 0: a run of readings at one spot adds up like ln n
-    repeat_power = 1.0             # the run's discount 1 / (1 + m)^p; 0.5: adds up like √n
+    repeat_radius = 2.0            # m, a run at one spot discounted [default: 0 paper, 2 fluct.]
+    repeat_power = 0.25            # its discount 1 / (1 + m)^p [default: 1 paper, 0.25 fluct.]
 
     [agent]
     start = [2.0, 2.0, 4.0]        # m; the agent flies at the start altitude

@@ -115,6 +115,8 @@ def to_toml(scenario: Scenario) -> str:
         ("sensor", "average"): scenario.average,
         ("estimator", "meander"): scenario.meander,
         ("estimator", "reading_weight"): scenario.reading_weight,
+        ("estimator", "repeat_radius"): scenario.repeat_radius,
+        ("estimator", "repeat_power"): scenario.repeat_power,
         ("agent", "dwell"): scenario.dwell,
         ("agent", "climb"): scenario.climb,
         ("world", "resolution"): scenario.site_resolution,

@@ -19,6 +19,7 @@ from dcee.scenarios.schema.common import FROZEN
 from dcee.scenarios.schema.estimator import (
     MEANDER_DEFAULT,
     READING_WEIGHT_DEFAULT,
+    REPEAT_DEFAULT,
     AnemometerSpec,
     EstimatorSpec,
     PriorSpec,
@@ -227,6 +228,18 @@ class Scenario(ScenarioBuilders, BaseModel):
             else READING_WEIGHT_DEFAULT[e.likelihood]
         )
 
+    @property
+    def repeat_radius(self) -> float:
+        """m, the repeat discount's radius (``estimator.repeat_radius`` or its default)."""
+        e = self.estimator
+        return e.repeat_radius if e.repeat_radius is not None else REPEAT_DEFAULT[e.likelihood][0]
+
+    @property
+    def repeat_power(self) -> float:
+        """The repeat discount's power (``estimator.repeat_power`` or its default)."""
+        e = self.estimator
+        return e.repeat_power if e.repeat_power is not None else REPEAT_DEFAULT[e.likelihood][1]
+
     def resolved_settings(self) -> dict[str, Any]:
         """The defaults resolved for this truth (stored with every result)."""
         return {
@@ -238,6 +251,8 @@ class Scenario(ScenarioBuilders, BaseModel):
             "outlier": self.outlier,
             "meander": self.meander,
             "reading_weight": self.reading_weight,
+            "repeat_radius": self.repeat_radius,
+            "repeat_power": self.repeat_power,
             "climb": self.climb,
         }
 
