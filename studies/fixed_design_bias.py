@@ -20,10 +20,10 @@ from multiprocessing import Pool
 
 import numpy as np
 import pandas as pd
-from precision_variants import parse_variant
+from precision_variants import parse_variant, variant_scenario
 
 from dcee.runs.assemble import make_searcher
-from dcee.scenarios import expand_names, load_scenario
+from dcee.scenarios import expand_names
 from dcee.simulation import make_truth
 
 DISTANCES = (1.0, 2.0, 3.0, 5.0)  # m from the source
@@ -32,13 +32,7 @@ BEARINGS = np.deg2rad(np.arange(0, 360, 45))  # from the downwind direction
 
 def one(task: tuple) -> dict:
     label, over, name, truth_kind, seed, repeats = task
-    base = {
-        "search.particles": 10000,
-        "unknown": "full",
-        "truth.model": truth_kind,
-        "estimator.likelihood": "fluctuation",
-    }
-    sc = load_scenario(name).with_overrides(**base).with_overrides(**over)
+    sc = variant_scenario(name, truth_kind, over)
     th = sc.truth_theta()
     down = -np.array([math.cos(th[5]), math.sin(th[5])])
     normal = np.array([-down[1], down[0]])

@@ -35,9 +35,9 @@ def parse_variant(text: str) -> tuple[str, dict]:
     return label, over
 
 
-def one(task: tuple) -> dict:
-    label, over, name, truth, seed, strategy = task
-    from dcee.runs import run_episode
+def variant_scenario(name: str, truth: str, over: dict):
+    """Configuration ``name`` on ``truth``, all eight unknown, the fluctuation likelihood,
+    10,000 particles, then the variant's overrides ``over``."""
     from dcee.scenarios import load_scenario
 
     base = {
@@ -46,7 +46,14 @@ def one(task: tuple) -> dict:
         "truth.model": truth,
         "estimator.likelihood": "fluctuation",
     }
-    scenario = load_scenario(name).with_overrides(**base).with_overrides(**over)
+    return load_scenario(name).with_overrides(**base).with_overrides(**over)
+
+
+def one(task: tuple) -> dict:
+    label, over, name, truth, seed, strategy = task
+    from dcee.runs import run_episode
+
+    scenario = variant_scenario(name, truth, over)
     res = run_episode(scenario, strategy, seed)
     s, last = res.summary, res.records[-1]
     theta = scenario.truth_theta()
