@@ -546,3 +546,34 @@ def test_campaigns_stored_before_issue_29_keep_the_estimator_they_ran_with():
     assert scenario_identity(old_fluct) != scenario_identity(fluct.model_dump(mode="json"))
     full = fluct.with_overrides(**{"estimator.reading_weight": 1.0})
     assert scenario_identity(old_fluct) == scenario_identity(full.model_dump(mode="json"))
+
+
+def test_the_fourth_rounds_defaults_follow_the_likelihood_and_old_campaigns_keep_theirs():
+    """The repeat discount is on (2 m, power 0.25) and the intermittency conserves the mean
+    only with the fluctuation likelihood; the filter and the reading model receive them; a
+    campaign stored before them (no conserve_mean, repeat_radius 0, no repeat_power) compares
+    equal to today's scenario with those values set, and not to today's defaults."""
+    from dcee.runs import scenario_identity
+    from dcee.runs.assemble import make_searcher
+    from dcee.scenarios import load_scenario
+
+    paper = load_scenario("paper:1")
+    fluct = paper.with_overrides(**{"estimator.likelihood": "fluctuation", "unknown": "full"})
+    assert (paper.repeat_radius, paper.repeat_power) == (0.0, 1.0)
+    assert (fluct.repeat_radius, fluct.repeat_power) == (2.0, 0.25)
+    explicit = fluct.with_overrides(**{"estimator.repeat_radius": 0.5})
+    assert (explicit.repeat_radius, explicit.repeat_power) == (0.5, 0.25)
+    rng = np.random.default_rng
+    pf = make_searcher(fluct, None, rng(0), rng(1), on_robot=False).filter.current
+    assert (pf.repeat_radius, pf.repeat_power, pf.sensor.conserve_mean) == (2.0, 0.25, True)
+    calm = make_searcher(paper, None, rng(0), rng(1), on_robot=False).filter
+    assert (calm.repeat_radius, calm.sensor.params.conserve_mean) == (0.0, 0.0)
+
+    stored = fluct.model_dump(mode="json")
+    del stored["estimator"]["conserve_mean"], stored["estimator"]["repeat_power"]
+    stored["estimator"]["repeat_radius"] = 0.0
+    pinned = fluct.with_overrides(
+        **{"estimator.conserve_mean": False, "estimator.repeat_radius": 0.0}
+    )
+    assert scenario_identity(stored) == scenario_identity(pinned.model_dump(mode="json"))
+    assert scenario_identity(stored) != scenario_identity(fluct.model_dump(mode="json"))

@@ -293,8 +293,6 @@ class ParticleFilter:
             if math.dist(earlier, position) > reach:
                 break
             m += 1
-        if self.repeat_power == 1.0:
-            return self.reading_weight / (1.0 + m)
         return self.reading_weight / (1.0 + m) ** self.repeat_power
 
     def update(self, position: np.ndarray, reading: float) -> UpdateInfo:

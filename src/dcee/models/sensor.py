@@ -366,14 +366,15 @@ class Sensor:
         """
         c = np.asarray(conc, dtype=np.float64)
         noise = np.asarray(noise, dtype=np.float64)
+        pd = self.detect_prob(distance)
         if self.lognormal:
             s = self.log_sd_at(distance)
             y = c * np.exp(s * noise[..., 1] - 0.5 * s * s)
             if self.conserve_mean:
-                y = y / self.detect_prob(distance)
+                y = y / pd
         else:
             y = c + (self.sigma_frac * c + self.sigma_min) * noise[..., 1]
-        detected = (noise[..., 0] < self.detect_prob(distance)) & (y >= self.threshold)
+        detected = (noise[..., 0] < pd) & (y >= self.threshold)
         false_alarm = (~detected) & (noise[..., 2] < self.false_alarm)
         fa_value = self.threshold + self.false_alarm_scale * noise[..., 3]
         z = np.where(detected, y, np.where(false_alarm, fa_value, 0.0))

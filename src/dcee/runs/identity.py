@@ -102,6 +102,9 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
             if key in estimator and estimator[key] is None:
                 # unset: the likelihood's default, compared as the number it stands for
                 estimator[key] = REPEAT_DEFAULT[likelihood][k]
+        if estimator.get("repeat_radius", 0.0) == 0.0:
+            # no repeat discount: its power decides nothing
+            estimator.pop("repeat_power", None)
     agent = out.get("agent")
     if isinstance(agent, dict) and "climb" in agent and agent["climb"] is None:
         # unset: the climb it resolved to (Scenario.resolved_climb), compared as that number
