@@ -1,6 +1,9 @@
 """Gather several campaigns' `dcee report` tables into one stored study (docs/results/<study>/):
 each campaign's ``report/metrics.csv`` and ``report/pairwise.csv`` rows, tagged with the columns
-that tell the campaigns apart, into ``metrics.csv`` and ``pairwise.csv``.
+that tell the campaigns apart, into ``metrics.csv`` and ``pairwise.csv``; and one row per search
+(``searches.csv``: configuration, seed, strategy, acquired, final RMSE, truth in the 95 % region,
+time to RMSE < 1 m, longest stall), so a paired comparison with a later campaign needs no search
+folder (``studies/ablation_table.py docs/results/<study>/searches.csv=STRATEGY``).
 
     .venv/bin/python studies/collect_metrics.py --out docs/results/turbulent-held-out-100 \\
         results/turbulent-puffs-held-out-100=truth_model:puffs,climb:0 \\
@@ -16,6 +19,20 @@ import sys
 from pathlib import Path
 
 import pandas as pd
+
+from dcee.analysis.report import load_campaign
+
+# what a paired comparison reads from a search (studies/ablation_table.py)
+SEARCH_COLUMNS = [
+    "scenario",
+    "seed",
+    "strategy",
+    "source_acquired",
+    "final_rmse",
+    "truth_in_95",
+    "time_to_rmse_1m",
+    "longest_stall",
+]
 
 
 def _tagged(arg: str) -> tuple[Path, dict[str, object]]:
@@ -35,7 +52,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("campaigns", nargs="+", help="DIR=key:value,key:value")
     ap.add_argument("--out", required=True, help="the study folder to write")
     args = ap.parse_args(argv)
-    metrics, pairwise = [], []
+    metrics, pairwise, searches = [], [], []
     for arg in args.campaigns:
         folder, tags = _tagged(arg)
         for name, into in (("metrics.csv", metrics), ("pairwise.csv", pairwise)):
@@ -49,11 +66,18 @@ def main(argv: list[str] | None = None) -> int:
             for i, (key, value) in enumerate(tags.items()):
                 frame.insert(1 + i, key, value)
             into.append(frame)
+        _, runs = load_campaign(folder)
+        runs = runs.reindex(columns=SEARCH_COLUMNS)
+        for i, (key, value) in enumerate(tags.items()):
+            runs.insert(3 + i, key, value)
+        searches.append(runs)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     pd.concat(metrics).to_csv(out / "metrics.csv", index=False)
     pd.concat(pairwise).to_csv(out / "pairwise.csv", index=False)
-    print(f"wrote {out / 'metrics.csv'} and {out / 'pairwise.csv'}")
+    table = pd.concat(searches).sort_values(["strategy", "scenario", "seed"], kind="stable")
+    table.to_csv(out / "searches.csv", index=False)
+    print(f"wrote {out / 'metrics.csv'}, {out / 'pairwise.csv'} and {out / 'searches.csv'}")
     return 0
 
 

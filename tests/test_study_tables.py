@@ -1,0 +1,85 @@
+"""The paired study table (studies/ablation_table.py) against hand counts, read from a stored
+study's per-search rows (the searches.csv that studies/collect_metrics.py writes)."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _script(name: str):
+    spec = importlib.util.spec_from_file_location(name, ROOT / "studies" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    assert spec.loader is not None
+    spec.loader.exec_module(module)
+    return module
+
+
+def _stored(tmp_path: Path) -> Path:
+    """Two planners on six configurations, two truths; hand-made so the counts are known."""
+    rows = []
+    for truth in ("a", "b"):
+        for k in range(6):
+            # reference: acquires 0-3; its time to 1 m 100 s + 10 k where acquired
+            rows.append(
+                ("ref", truth, k, k < 4, 0.5 + 0.1 * k, True, 100.0 + 10 * k if k < 4 else None)
+            )
+            # variant: acquires 0-4 (one more), 20 s sooner wherever both got there
+            rows.append(
+                ("var", truth, k, k < 5, 0.4 + 0.1 * k, k != 0, 80.0 + 10 * k if k < 5 else None)
+            )
+    frame = pd.DataFrame(
+        [
+            {
+                "scenario": f"random:{1000 + k}",
+                "seed": 0,
+                "strategy": s,
+                "truth_model": t,
+                "source_acquired": acq,
+                "final_rmse": rmse,
+                "truth_in_95": cover,
+                "time_to_rmse_1m": when,
+                "longest_stall": 30.0 + k,
+            }
+            for s, t, k, acq, rmse, cover, when in rows
+        ]
+    )
+    path = tmp_path / "study" / "searches.csv"
+    path.parent.mkdir()
+    frame.to_csv(path, index=False)
+    return path
+
+
+def test_paired_table_from_a_stored_study_matches_hand_counts(tmp_path: Path) -> None:
+    table_module = _script("ablation_table")
+    path = _stored(tmp_path)
+    table = table_module.compare(f"{path}=ref:truth_model:a", [f"{path}=var:truth_model:a"])
+    ref, var = table.iloc[0], table.iloc[1]
+    assert (ref["pairs"], ref["acquired"], var["acquired"]) == (6, 4, 5)
+    assert (var["acquired_reference_only"], var["acquired_variant_only"]) == (0, 1)
+    assert var["mcnemar_p"] == pytest.approx(1.0)  # one discordant pair: p = 1 exactly
+    assert var["truth_in_95"] == 5
+    # both got there on k = 0..3, 20 s sooner each time: the median difference is -20 s
+    assert var["time_to_1m_difference"] == pytest.approx(-20.0)
+    assert var["time_wilcoxon_p"] == pytest.approx(0.125)  # exact, n = 4, every sign negative
+    # median over all six, a search that never got there later than all: (100+110)/2 for k 2, 3
+    assert var["time_to_1m"] == pytest.approx(105.0)
+    assert ref["time_to_1m"] == pytest.approx(125.0)
+    assert var["final_rmse_difference"] == pytest.approx(-0.1)
+    assert var["longest_stall"] == 35.0 and var["stalled"] == 0
+    assert math.isnan(ref["time_to_1m_difference"])
+
+
+def test_paired_table_refuses_rows_of_several_studies(tmp_path: Path) -> None:
+    table_module = _script("ablation_table")
+    path = _stored(tmp_path)
+    with pytest.raises(SystemExit, match="several studies"):
+        table_module.compare(f"{path}=ref", [])
+    with pytest.raises(SystemExit, match="no such stored study"):
+        table_module.compare(f"{tmp_path / 'none' / 'searches.csv'}=ref", [])
