@@ -62,7 +62,10 @@ def main(argv: list[str] | None = None) -> int:
                     f"collect_metrics: {path} is missing; run dcee report {folder}", file=sys.stderr
                 )
                 return 2
-            frame = pd.read_csv(path)
+            try:
+                frame = pd.read_csv(path)
+            except pd.errors.EmptyDataError:  # one strategy: no pairs to list
+                continue
             for i, (key, value) in enumerate(tags.items()):
                 frame.insert(1 + i, key, value)
             into.append(frame)
@@ -74,7 +77,8 @@ def main(argv: list[str] | None = None) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     pd.concat(metrics).to_csv(out / "metrics.csv", index=False)
-    pd.concat(pairwise).to_csv(out / "pairwise.csv", index=False)
+    if pairwise:
+        pd.concat(pairwise).to_csv(out / "pairwise.csv", index=False)
     table = pd.concat(searches).sort_values(["strategy", "scenario", "seed"], kind="stable")
     table.to_csv(out / "searches.csv", index=False)
     print(f"wrote {out / 'metrics.csv'}, {out / 'pairwise.csv'} and {out / 'searches.csv'}")

@@ -1,4 +1,4 @@
-"""Write the result tables of the README, docs/index.md and docs/results.md from the stored
+"""Write the result tables of the README and docs/ (index, results, held-out) from the stored
 study results in docs/results/ (issue 31, item 5): numbers come from results, not typing.
 
 Every generated table sits between two markers on its page::
@@ -30,7 +30,7 @@ import pandas as pd
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "docs" / "results"
-PAGES = ("README.md", "docs/index.md", "docs/results.md")
+PAGES = ("README.md", "docs/index.md", "docs/results.md", "docs/held-out.md")
 MARKER = re.compile(
     r"(<!-- generated: (?P<name>[a-z0-9-]+) \(studies/publish_tables\.py\) -->\n)"
     r"(?P<body>.*?)"
@@ -180,91 +180,44 @@ def what_we_found() -> str:
             when,
         ]
 
+    today = study("held-out-today")
+    today_pairs = paired("held-out-today")
+
+    def today_row(label: str, name: str) -> list[str]:
+        a, b, t = (pick(today, s, study=name) for s in PLANNERS)
+        p = pick(today_pairs, "dcee-cl", study=name, reference="infotaxis")
+        times = [r["time_to_1m"] for r in (a, b, t)]
+        when = " / ".join("> budget" if math.isinf(x) else f"{x:.0f}" for x in times) + " s"
+        if not math.isnan(p["time_to_1m_difference"]):
+            when += (
+                f" (`dcee-cl` − infotaxis, paired: {p['time_to_1m_difference']:+.0f} s, "
+                f"Wilcoxon p = {p['time_wilcoxon_p']:.1g})"
+            )
+        return [
+            label,
+            " / ".join(count(r) for r in (a, b, t)),
+            " / ".join(f"{r['median_final_rmse']:.2f}" for r in (a, b, t)) + " m",
+            when,
+        ]
+
     rows += [
-        pair_row(
-            "**held-out**, wind known: 200 random configurations never tuned on "
-            "(`held-out-wind-known`), `dcee-cl` / `infotaxis`",
-            "held-out-wind-known",
+        today_row(
+            "**held-out**, wind known: 200 random configurations never tuned on, today's "
+            "defaults (`held-out-today`), `dcee-cl` / `infotaxis` / tree search `dcee-mcts`",
+            "wind-known",
+        ),
+        today_row("**held-out**, all eight parameters unknown, the same 200", "full"),
+        today_row(
+            "**held-out**, filament truth, all eight unknown, fluctuation likelihood, "
+            "100 of them (`held-out-100`)",
+            "filament",
         ),
         pair_row(
-            "**held-out**, all eight parameters unknown, the same 200 (`held-out-full`)",
-            "held-out-full",
-        ),
-        pair_row(
-            "**held-out**, filament truth, all eight unknown, fluctuation likelihood (its "
-            "settings before issue 29; `held-out-filament`)",
-            "held-out-filament",
-        ),
-        pair_row(
-            "**held-out**, the independent puff truth, all eight unknown, fluctuation "
-            "likelihood, the UAV at a fixed 4 m (the defaults before the climb), 100 "
-            "configurations (`turbulent-held-out-100`)",
+            "**held-out**, the independent puff truth (Farrell et al. 2002), all eight unknown, "
+            "fluctuation likelihood, `held-out-100`, `dcee-cl` / `infotaxis` "
+            "(`turbulent-held-out-100`)",
             "turbulent-held-out-100",
             truth_model="puffs",
-            climb=0.0,
-            near_source_length=5.0,
-            vertical_reach=0.0,
-            conserve_mean=0,
-            repeat_radius=0,
-        ),
-        pair_row(
-            "**held-out**, filament truth, the same 100 configurations and settings",
-            "turbulent-held-out-100",
-            truth_model="filament",
-            climb=0.0,
-            near_source_length=5.0,
-            vertical_reach=0.0,
-            conserve_mean=0,
-            repeat_radius=0,
-        ),
-        pair_row(
-            "**held-out**, puff truth, the third round's defaults (the UAV climbs and descends "
-            "1 m, near-source length 2.5 m, `dcee-cl`'s vertical reach), the same 100",
-            "turbulent-held-out-100",
-            truth_model="puffs",
-            climb=1.0,
-            near_source_length=2.5,
-            vertical_reach=1.0,
-            conserve_mean=0,
-            repeat_radius=0,
-        ),
-        pair_row(
-            "**held-out**, filament truth, the third round's defaults, all 200 held-out "
-            "configurations",
-            "turbulent-held-out-100",
-            truth_model="filament",
-            climb=1.0,
-            near_source_length=2.5,
-            vertical_reach=1.0,
-            conserve_mean=0,
-            repeat_radius=0,
-        ),
-        pair_row(
-            "**held-out**, puff truth, the third round's defaults and the mean-conserving "
-            "intermittency (fourth round), the same 100",
-            "turbulent-held-out-100",
-            truth_model="puffs",
-            conserve_mean=1,
-            repeat_radius=0,
-        ),
-        pair_row(
-            "**held-out**, filament truth, the same settings, all 200 held-out configurations",
-            "turbulent-held-out-100",
-            truth_model="filament",
-            conserve_mean=1,
-            repeat_radius=0,
-        ),
-        pair_row(
-            "**held-out**, puff truth, **today's defaults** (and the gentle repeat discount, "
-            "`repeat_radius = 2`, `repeat_power = 0.25`), the same 100",
-            "turbulent-held-out-100",
-            truth_model="puffs",
-            repeat_radius=2,
-        ),
-        pair_row(
-            "**held-out**, filament truth, **today's defaults**, `held-out-100`",
-            "turbulent-held-out-100",
-            truth_model="filament",
             repeat_radius=2,
         ),
     ]
@@ -324,42 +277,60 @@ def public_table(name: str, current: str | None) -> Callable[[], str]:
     return make
 
 
+HELD_OUT = (
+    ("wind-known", "wind known, 200"),
+    ("full", "all eight unknown, 200"),
+    ("filament", "filament truth, all eight unknown, fluctuation likelihood, `held-out-100`"),
+)
+PLANNERS = ("dcee-cl", "infotaxis", "dcee-mcts")
+
+
 def held_out_table() -> str:
+    """Today's defaults on the three held-out studies (every planner on the same searches), and
+    the filament study as first flown (its settings before issue 29)."""
     rows = []
-    for name, what in (
-        ("held-out-wind-known", "wind known"),
-        ("held-out-full", "all eight unknown"),
-        ("held-out-filament", "filament truth, all eight unknown"),
-    ):
-        frame = study(name)
-        for strategy in ("dcee-cl", "infotaxis"):
-            rows.append(full_row(f"{what}: `{strategy}` (`{name}`)", pick(frame, strategy)))
+    frame = study("held-out-today")
+    for name, what in HELD_OUT:
+        for strategy in PLANNERS:
+            r = pick(frame, strategy, study=name)
+            rows.append(full_row(f"{what}: `{strategy}` (`held-out-today`)", r))
+    frame = study("held-out-filament")
+    for strategy in ("dcee-cl", "infotaxis"):
+        label = f"filament, all 200, settings before issue 29: `{strategy}` (`held-out-filament`)"
+        rows.append(full_row(label, pick(frame, strategy)))
     return table(FULL_HEADER, rows)
 
 
 def paired_table() -> str:
+    """`dcee-cl` against infotaxis, and both against the tree search, search by search."""
+    frame = paired("held-out-today")
     rows = []
-    for name in ("held-out-wind-known", "held-out-full", "held-out-filament"):
-        p = paired(name).iloc[0]
-        diff = p["time_to_1m_difference"]
-        rows.append(
-            [
-                f"`{name}`",
-                str(int(p["pairs"])),
-                f"{int(p['acquired_a_only'])} / {int(p['acquired_b_only'])}",
-                f"{p['mcnemar_p']:.2g}",
-                "—" if math.isnan(diff) else f"{diff:+.0f} s",
-                "—" if math.isnan(diff) else f"{p['time_wilcoxon_p']:.2g}",
-            ]
-        )
+    for name, _ in HELD_OUT:
+        for variant, reference in (
+            ("dcee-cl", "infotaxis"),
+            ("dcee-cl", "dcee-mcts"),
+            ("infotaxis", "dcee-mcts"),
+        ):
+            p = pick(frame, variant, study=name, reference=reference)
+            diff, dr = p["time_to_1m_difference"], p["final_rmse_difference"]
+            rows.append(
+                [
+                    f"{name}: `{variant}` − `{reference}`",
+                    str(int(p["pairs"])),
+                    f"{int(p['acquired_variant_only'])} / {int(p['acquired_reference_only'])}",
+                    f"{p['mcnemar_p']:.2g}",
+                    "—" if math.isnan(diff) else f"{diff:+.0f} s (p = {p['time_wilcoxon_p']:.2g})",
+                    "—" if math.isnan(dr) else f"{dr:+.2f} m (p = {p['rmse_wilcoxon_p']:.2g})",
+                ]
+            )
     return table(
         [
-            "study",
+            "study: first − second planner",
             "pairs",
-            "acquired only by `dcee-cl` / only by infotaxis",
+            "acquired only by the first / only by the second",
             "McNemar p",
-            "median paired difference in time to 1 m (`dcee-cl` − infotaxis)",
-            "Wilcoxon p",
+            "median paired difference in time to RMSE < 1 m, Wilcoxon p",
+            "median paired difference in final RMSE, Wilcoxon p",
         ],
         rows,
     )

@@ -129,16 +129,51 @@ case "${1:---list}" in
     $P studies/collect_metrics.py --out docs/results/turbulent-public-defaults \
       results/turbulent-filament-public-defaults=truth_model:filament \
       results/turbulent-puffs-public-defaults=truth_model:puffs ;;
-  held-out-mcts)  # the tree search on all 200 held-out configurations, wind known and full unknown
-    $D bench --suite held-out --repeats 1 --particles 10000 --unknown source \
-      --strategies dcee-mcts --workers "${WORKERS:-2}" --out results/held-out-wind-known-mcts
-    $D bench --suite held-out --repeats 1 --particles 10000 --unknown full \
-      --strategies dcee-mcts --workers "${WORKERS:-2}" --out results/held-out-full-mcts
-    for s in wind-known full; do
-      report "held-out-$s-mcts"
-      mkdir -p "docs/results/held-out-$s-mcts"
-      cp "results/held-out-$s-mcts/report/metrics.csv" "docs/results/held-out-$s-mcts/"
-    done ;;
+  held-out-today)  # the held-out studies at today's defaults, tree search included (docs/held-out.md)
+    # isotropic: all 200 held-out configurations, wind known and full unknown; the one-step
+    # planners at today's defaults on the same configurations and seeds (the published
+    # held-out-wind-known rows ran without the stall guard: -today is the pair for the tree)
+    HO=(--suite held-out --repeats 1 --particles 10000 --allow-code-change --workers "${WORKERS:-2}")
+    $D bench "${HO[@]}" --unknown source --strategies dcee-mcts --out results/held-out-wind-known-mcts
+    $D bench "${HO[@]}" --unknown full --strategies dcee-mcts --out results/held-out-full-mcts
+    $D bench "${HO[@]}" --unknown source --strategies dcee-cl,infotaxis \
+      --out results/held-out-wind-known-today
+    $D bench "${HO[@]}" --unknown full --strategies dcee-cl,infotaxis --out results/held-out-full
+    # filament, today's defaults, held-out-100 (random:1100-1199); the one-step planners are
+    # turbulent-held-out's -cm-rr campaign (resumed here if missing)
+    export SUITE=held-out-100 TRUTHS=filament WORKERS=${WORKERS:-2}
+    OUT_SUFFIX=-cm-rr bash studies/study_turbulent_held_out.sh --allow-code-change \
+      --set estimator.repeat_radius=2.0 --set estimator.repeat_power=0.25
+    OUT_SUFFIX=-cm-rr-mcts STRATEGIES=dcee-mcts bash studies/study_turbulent_held_out.sh \
+      --allow-code-change
+    out=docs/results/held-out-today
+    mkdir -p "$out"
+    rm -f "$out/paired.csv"
+    for pair in wind-known:held-out-wind-known-mcts:held-out-wind-known-today \
+      full:held-out-full-mcts:held-out-full \
+      filament:turbulent-filament-held-out-100-cm-rr-mcts:turbulent-filament-held-out-100-cm-rr; do
+      IFS=: read -r study tree one_step <<<"$pair"
+      report "$tree" "$one_step"
+      $P studies/ablation_table.py "results/$tree" "results/$one_step=dcee-cl" \
+        "results/$one_step=infotaxis" --csv "$out/paired.csv" --tag "study=$study" \
+        --tag reference=dcee-mcts
+      $P studies/ablation_table.py "results/$one_step=infotaxis" "results/$one_step=dcee-cl" \
+        --csv "$out/paired.csv" --tag "study=$study" --tag reference=infotaxis
+    done
+    $P studies/collect_metrics.py --out "$out" \
+      results/held-out-wind-known-mcts=study:wind-known \
+      results/held-out-wind-known-today=study:wind-known \
+      results/held-out-full-mcts=study:full results/held-out-full=study:full \
+      results/turbulent-filament-held-out-100-cm-rr-mcts=study:filament \
+      results/turbulent-filament-held-out-100-cm-rr=study:filament
+    $P studies/worst_searches.py results/held-out-wind-known-mcts=dcee-mcts \
+      results/held-out-full-mcts=dcee-mcts \
+      results/turbulent-filament-held-out-100-cm-rr-mcts=dcee-mcts \
+      --out docs/figures/held-out-worst-mcts.png
+    $P studies/worst_searches.py results/held-out-wind-known-today=dcee-cl \
+      results/held-out-wind-known-today=infotaxis results/held-out-full=dcee-cl \
+      results/held-out-full=infotaxis --out docs/figures/held-out-worst-today.png
+    $P studies/publish_tables.py ;;
   held-out)  # random configurations of the reporting range (docs/held-out.md)
     bash studies/study_held_out.sh
     report held-out-wind-known held-out-full held-out-filament ;;

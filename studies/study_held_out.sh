@@ -28,7 +28,8 @@ $D bench $HO $FIL --strategies dcee-cl,infotaxis --out results/held-out-filament
 # the public study again with the defaults kept (dcee-cl's spread_reach 2): 12 x 10, paper scale
 $D bench --suite paper --repeats 10 --strategies dcee-cl --out results/paper-source-cl3
 $D bench --suite paper --repeats 10 --unknown full --strategies dcee-cl --out results/paper-full-cl3
-$D bench $HO $FIL --strategies dcee-mcts --out results/held-out-filament-mcts
 $D bench $HO --unknown full --strategies dcee-mcts --out results/held-out-full-mcts
+# the tree search on the filament (today's turbulent defaults) and paired against the one-step
+# planners at today's defaults: `bash studies/run.sh held-out-today`
 # the rest of the DCEE family (theorem-1 DCEE and MPC stall by design: docs/dual-control.md)
 $D bench $HO --unknown source --strategies dcee,mpc,dcee-ms --out results/held-out-wind-known-others

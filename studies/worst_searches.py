@@ -57,6 +57,8 @@ def main() -> None:
                 f"stall {s['longest_stall']:.0f} s, {s['detections']} detections",
                 fontsize=9,
             )
+            if c == 0:  # which campaign the row is
+                ax.set_ylabel(f"{Path(folder).name}\ny (m)", fontsize=9)
             print(strategy, s["scenario"], round(s["final_rmse"], 2), s["longest_stall"])
     fig.tight_layout()
     fig.savefig(args.out, dpi=80, bbox_inches="tight")

@@ -1,7 +1,7 @@
 """Numbers quoted on the pages agree with the stored results they cite.
 
 docs/results/<study>/ hold the stored study results; studies/publish_tables.py writes the
-tables of the README, docs/index.md and docs/results.md from them (checked here).
+tables of the README, docs/index.md, docs/results.md and docs/held-out.md from them (checked here).
 docs/results/public-wind-known-dcee-cl holds the `dcee report` tables of the public wind-known
 `dcee-cl` study (`bash studies/run.sh public-wind-known` regenerates them); docs/turbulent.md's
 row is formatted from them here and must appear verbatim."""
