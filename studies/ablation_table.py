@@ -29,10 +29,11 @@ from dcee.analysis.statistics import wilson
 
 
 def _runs(arg: str) -> tuple[str, pd.DataFrame]:
-    folder, _, pick = arg.partition("=")
-    strategy, *tags = pick.split(":") if pick else [""]
+    folder, _, strategy = arg.partition("=")
     path = Path(folder)
-    if path.suffix == ".csv":
+    tags: list[str] = []
+    if path.suffix == ".csv":  # STRATEGY[:KEY:VALUE...]; a folder's spec keeps its colons
+        strategy, *tags = strategy.split(":")
         if not path.is_file():
             sys.exit(f"ablation_table: {path}: no such stored study (studies/collect_metrics.py)")
         runs = pd.read_csv(path)

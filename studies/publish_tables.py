@@ -336,6 +336,39 @@ def paired_table() -> str:
     )
 
 
+def others_table() -> str:
+    """The rest of the DCEE family on the held-out wind-known study, paired with infotaxis."""
+    frame, pairs = study("held-out-today"), paired("held-out-today")
+    rows = []
+    for strategy in ("dcee", "mpc", "dcee-ms"):
+        r = pick(frame, strategy, study="wind-known")
+        p = pick(pairs, strategy, study="wind-known", reference="infotaxis")
+        rows.append(
+            [
+                f"`{strategy}`",
+                str(int(r["searches"])),
+                acquired(r),
+                rmse(r),
+                f"{int(p['acquired_variant_only'])} / {int(p['acquired_reference_only'])} "
+                f"(p = {p['mcnemar_p']:.2g})",
+                time_to_1m(r),
+                stall(r),
+            ]
+        )
+    return table(
+        [
+            "planner",
+            "n",
+            "source acquired (RMSE < 3 m)",
+            "median final RMSE (m)",
+            "acquired only by it / only by infotaxis (McNemar p)",
+            "median time to RMSE < 1 m (s)",
+            "longest stall (s)",
+        ],
+        rows,
+    )
+
+
 def turbulent_table() -> str:
     rows = []
     frame = study("filament-public")

@@ -139,6 +139,9 @@ case "${1:---list}" in
     $D bench "${HO[@]}" --unknown source --strategies dcee-cl,infotaxis \
       --out results/held-out-wind-known-today
     $D bench "${HO[@]}" --unknown full --strategies dcee-cl,infotaxis --out results/held-out-full
+    # the rest of the DCEE family, wind known (theorem-1 DCEE and MPC stall by design)
+    $D bench "${HO[@]}" --unknown source --strategies dcee,mpc,dcee-ms \
+      --out results/held-out-wind-known-others
     # filament, today's defaults, held-out-100 (random:1100-1199); the one-step planners are
     # turbulent-held-out's -cm-rr campaign (resumed here if missing)
     export SUITE=held-out-100 TRUTHS=filament WORKERS=${WORKERS:-2}
@@ -160,9 +163,15 @@ case "${1:---list}" in
       $P studies/ablation_table.py "results/$one_step=infotaxis" "results/$one_step=dcee-cl" \
         --csv "$out/paired.csv" --tag "study=$study" --tag reference=infotaxis
     done
+    report held-out-wind-known-others
+    $P studies/ablation_table.py results/held-out-wind-known-today=infotaxis \
+      results/held-out-wind-known-others=dcee results/held-out-wind-known-others=mpc \
+      results/held-out-wind-known-others=dcee-ms --csv "$out/paired.csv" --tag study=wind-known \
+      --tag reference=infotaxis
     $P studies/collect_metrics.py --out "$out" \
       results/held-out-wind-known-mcts=study:wind-known \
       results/held-out-wind-known-today=study:wind-known \
+      results/held-out-wind-known-others=study:wind-known \
       results/held-out-full-mcts=study:full results/held-out-full=study:full \
       results/turbulent-filament-held-out-100-cm-rr-mcts=study:filament \
       results/turbulent-filament-held-out-100-cm-rr=study:filament
@@ -173,6 +182,12 @@ case "${1:---list}" in
     $P studies/worst_searches.py results/held-out-wind-known-today=dcee-cl \
       results/held-out-wind-known-today=infotaxis results/held-out-full=dcee-cl \
       results/held-out-full=infotaxis --out docs/figures/held-out-worst-today.png
+    # why the tree ends further away: more hypothesised readings per sequence (tuning range)
+    $D bench --suite random-tune-12 --repeats 1 --particles 10000 --unknown full \
+      --strategies 'dcee-cl,dcee-mcts,dcee-mcts:n_hypotheses=40' --workers "${WORKERS:-2}" \
+      --out results/tune-mcts-hypotheses
+    $P studies/ablation_table.py results/tune-mcts-hypotheses=dcee-mcts \
+      results/tune-mcts-hypotheses=dcee-mcts:n_hypotheses=40 results/tune-mcts-hypotheses=dcee-cl
     $P studies/publish_tables.py ;;
   held-out)  # random configurations of the reporting range (docs/held-out.md)
     bash studies/study_held_out.sh
