@@ -574,6 +574,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "full-unknown": public_table("paper-full", None),
     "held-out": held_out_table,
     "held-out-paired": paired_table,
+    "held-out-others": others_table,
     "turbulent": turbulent_table,
     "team": team_table,
     "lab": lab_table,

@@ -31,5 +31,6 @@ $D bench --suite paper --repeats 10 --unknown full --strategies dcee-cl --out re
 $D bench $HO --unknown full --strategies dcee-mcts --out results/held-out-full-mcts
 # the tree search on the filament (today's turbulent defaults) and paired against the one-step
 # planners at today's defaults: `bash studies/run.sh held-out-today`
-# the rest of the DCEE family (theorem-1 DCEE and MPC stall by design: docs/dual-control.md)
+# the rest of the DCEE family (theorem-1 DCEE and MPC head for the posterior mean and fail to find
+# where the plume points away: docs/held-out.md); today's guarded run: `bash studies/run.sh held-out-today`
 $D bench $HO --unknown source --strategies dcee,mpc,dcee-ms --out results/held-out-wind-known-others
