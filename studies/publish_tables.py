@@ -387,6 +387,15 @@ def turbulent_table() -> str:
                 f"`{strategy}` (`turbulent-public-defaults`)"
             )
             rows.append(full_row(label, r))
+    frame = study("turbulent-public-today")
+    for truth in ("filament", "puffs"):
+        for strategy in ("dcee-cl", "infotaxis"):
+            r = pick(frame, strategy, truth_model=truth)
+            label = (
+                f"{truth}, 12 public × 5, **today's defaults**, 10,000 particles: "
+                f"`{strategy}` (`turbulent-public-today`)"
+            )
+            rows.append(full_row(label, r))
     frame = study("turbulent-held-out-100")
     settings = (
         (0.0, 5.0, 0.0, 0, 0, "fixed 4 m altitude (before)"),

@@ -118,7 +118,7 @@ case "${1:---list}" in
       results/turbulent-filament-held-out-cm --csv "$out/calibration-today.csv"
     $P studies/collect_metrics.py --out "$out" "${gathered[@]}"
     $P studies/publish_tables.py ;;
-  turbulent-public)  # the twelve public configurations on both turbulent truths, today's defaults
+  turbulent-public)  # the twelve public configurations on both turbulent truths: the third round's and today's defaults
     for t in filament puffs; do  # 5 repeats and 10,000 particles: ~10 min per truth on 2 cores
       $D bench --suite paper --strategies dcee-cl,infotaxis --repeats 5 --unknown full \
         --likelihood fluctuation --truth $t --particles 10000 --workers "${WORKERS:-2}" \
@@ -128,7 +128,18 @@ case "${1:---list}" in
     done
     $P studies/collect_metrics.py --out docs/results/turbulent-public-defaults \
       results/turbulent-filament-public-defaults=truth_model:filament \
-      results/turbulent-puffs-public-defaults=truth_model:puffs ;;
+      results/turbulent-puffs-public-defaults=truth_model:puffs
+    # today's defaults (the fourth round: a detection's mean conserved, the repeat discount)
+    for t in filament puffs; do
+      $D bench --suite paper --strategies dcee-cl,infotaxis --repeats 5 --unknown full \
+        --likelihood fluctuation --truth $t --particles 10000 --workers "${WORKERS:-2}" \
+        --out "results/turbulent-$t-public-today"
+      report "turbulent-$t-public-today"
+    done
+    $P studies/collect_metrics.py --out docs/results/turbulent-public-today \
+      results/turbulent-filament-public-today=truth_model:filament \
+      results/turbulent-puffs-public-today=truth_model:puffs
+    $P studies/publish_tables.py ;;
   held-out-today)  # the held-out studies at today's defaults, tree search included (docs/held-out.md)
     # isotropic: all 200 held-out configurations, wind known and full unknown; the one-step
     # planners at today's defaults on the same configurations and seeds (the published
