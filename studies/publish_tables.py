@@ -378,24 +378,16 @@ def turbulent_table() -> str:
                 f"filament, 12 public × 10: `{strategy}` (`filament-public`)", pick(frame, strategy)
             )
         )
-    frame = study("turbulent-public-defaults")
-    for truth in ("filament", "puffs"):
-        for strategy in ("dcee-cl", "infotaxis"):
-            r = pick(frame, strategy, truth_model=truth)
-            label = (
-                f"{truth}, 12 public × 5, the third round's defaults, 10,000 particles: "
-                f"`{strategy}` (`turbulent-public-defaults`)"
-            )
-            rows.append(full_row(label, r))
-    frame = study("turbulent-public-today")
-    for truth in ("filament", "puffs"):
-        for strategy in ("dcee-cl", "infotaxis"):
-            r = pick(frame, strategy, truth_model=truth)
-            label = (
-                f"{truth}, 12 public × 5, **today's defaults**, 10,000 particles: "
-                f"`{strategy}` (`turbulent-public-today`)"
-            )
-            rows.append(full_row(label, r))
+    for name, how in (
+        ("turbulent-public-defaults", "the third round's defaults"),
+        ("turbulent-public-today", "**today's defaults**"),
+    ):
+        frame = study(name)
+        for truth in ("filament", "puffs"):
+            for strategy in ("dcee-cl", "infotaxis"):
+                r = pick(frame, strategy, truth_model=truth)
+                label = f"{truth}, 12 public × 5, {how}, 10,000 particles: `{strategy}` (`{name}`)"
+                rows.append(full_row(label, r))
     frame = study("turbulent-held-out-100")
     settings = (
         (0.0, 5.0, 0.0, 0, 0, "fixed 4 m altitude (before)"),

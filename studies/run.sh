@@ -119,26 +119,23 @@ case "${1:---list}" in
     $P studies/collect_metrics.py --out "$out" "${gathered[@]}"
     $P studies/publish_tables.py ;;
   turbulent-public)  # the twelve public configurations on both turbulent truths: the third round's and today's defaults
-    for t in filament puffs; do  # 5 repeats and 10,000 particles: ~10 min per truth on 2 cores
-      $D bench --suite paper --strategies dcee-cl,infotaxis --repeats 5 --unknown full \
-        --likelihood fluctuation --truth $t --particles 10000 --workers "${WORKERS:-2}" \
-        --set estimator.conserve_mean=false --set estimator.repeat_radius=0.0 \
-        --out "results/turbulent-$t-public-defaults"
-      report "turbulent-$t-public-defaults"
+    # 5 repeats and 10,000 particles: ~10 min per truth and setting on 2 cores. "defaults": the
+    # third round's (a detection's mean C, no repeat discount; flown at commit 69b6ea3, hence
+    # --allow-code-change: every version used is recorded); "today": the fourth round's
+    for run in "defaults:--set estimator.conserve_mean=false --set estimator.repeat_radius=0.0" \
+      "today:"; do
+      name=${run%%:*}
+      read -r -a pinned <<<"${run#*:}"
+      for t in filament puffs; do
+        $D bench --suite paper --strategies dcee-cl,infotaxis --repeats 5 --unknown full \
+          --likelihood fluctuation --truth $t --particles 10000 --workers "${WORKERS:-2}" \
+          --allow-code-change "${pinned[@]}" --out "results/turbulent-$t-public-$name"
+        report "turbulent-$t-public-$name"
+      done
+      $P studies/collect_metrics.py --out "docs/results/turbulent-public-$name" \
+        "results/turbulent-filament-public-$name=truth_model:filament" \
+        "results/turbulent-puffs-public-$name=truth_model:puffs"
     done
-    $P studies/collect_metrics.py --out docs/results/turbulent-public-defaults \
-      results/turbulent-filament-public-defaults=truth_model:filament \
-      results/turbulent-puffs-public-defaults=truth_model:puffs
-    # today's defaults (the fourth round: a detection's mean conserved, the repeat discount)
-    for t in filament puffs; do
-      $D bench --suite paper --strategies dcee-cl,infotaxis --repeats 5 --unknown full \
-        --likelihood fluctuation --truth $t --particles 10000 --workers "${WORKERS:-2}" \
-        --out "results/turbulent-$t-public-today"
-      report "turbulent-$t-public-today"
-    done
-    $P studies/collect_metrics.py --out docs/results/turbulent-public-today \
-      results/turbulent-filament-public-today=truth_model:filament \
-      results/turbulent-puffs-public-today=truth_model:puffs
     $P studies/publish_tables.py ;;
   held-out-today)  # the held-out studies at today's defaults, tree search included (docs/held-out.md)
     # isotropic: all 200 held-out configurations, wind known and full unknown; the one-step

@@ -577,3 +577,28 @@ def test_the_fourth_rounds_defaults_follow_the_likelihood_and_old_campaigns_keep
     )
     assert scenario_identity(stored) == scenario_identity(pinned.model_dump(mode="json"))
     assert scenario_identity(stored) != scenario_identity(fluct.model_dump(mode="json"))
+
+
+def test_a_pinned_later_setting_resumes_a_campaign_stored_before_it_existed():
+    """`dcee bench --set estimator.conserve_mean=false` on a folder stored before the setting
+    existed (no such override recorded) resumes it: the pin is the value that campaign ran
+    with. Any other override still refuses (found by `studies/run.sh turbulent-public`)."""
+    from dcee.runs.identity import settings_identity
+
+    stored = {"suite": "paper", "overrides": {"estimator.likelihood": "fluctuation"}}
+    pinned = {
+        "suite": "paper",
+        "overrides": {
+            "estimator.conserve_mean": False,
+            "estimator.likelihood": "fluctuation",
+            "estimator.repeat_radius": 0.0,
+        },
+    }
+    assert settings_identity(stored) == settings_identity(pinned)
+    today = {**pinned, "overrides": {**pinned["overrides"], "estimator.conserve_mean": True}}
+    assert settings_identity(stored) != settings_identity(today)
+    alone = {"suite": "paper", "overrides": {"estimator.repeat_radius": 0.0}}
+    assert settings_identity({"suite": "paper"}) == settings_identity(alone)
+    assert settings_identity({"suite": "paper"}) != settings_identity(
+        {"suite": "paper", "overrides": {"estimator.repeat_radius": 2.0}}
+    )

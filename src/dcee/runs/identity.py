@@ -54,6 +54,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
 without one ran with, so the two compare equal."""
 
 
+_MISSING = object()
+
 FLUCTUATION_ONLY = (
     "intermittency",
     "log_sd",
@@ -73,6 +75,19 @@ def settings_identity(settings: dict[str, Any]) -> dict[str, Any]:
     free-text descriptions (rewording one must not orphan a campaign; it changes no result) and
     without later-added settings at their defaults (:data:`LATER_DEFAULTS`)."""
     out = dict(settings)
+    overrides = out.get("overrides")
+    if isinstance(overrides, dict):
+        # a later-added setting pinned (--set) to the value a campaign stored before it existed
+        # ran with says nothing the scenarios do not: the stored campaign still resumes
+        kept = {
+            key: value
+            for key, value in overrides.items()
+            if LATER_DEFAULTS.get(tuple(key.split(".")), _MISSING) != value
+        }
+        if kept:
+            out["overrides"] = kept
+        else:
+            out.pop("overrides")
     scenarios = out.get("scenarios")
     if isinstance(scenarios, dict):
         out["scenarios"] = {
