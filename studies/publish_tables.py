@@ -123,14 +123,6 @@ def table(header: list[str], rows: list[list[str]]) -> str:
 # --- the tables ----------------------------------------------------------------------------
 
 
-def _pair_note(name: str) -> str:
-    p = paired(name).iloc[0]
-    if math.isnan(p["time_to_1m_difference"]):
-        return ""
-    sooner = -p["time_to_1m_difference"]
-    return f" (paired: {sooner:.0f} s sooner, Wilcoxon p = {p['time_wilcoxon_p']:.1g})"
-
-
 def what_we_found() -> str:
     """The headline table (README and docs/index.md)."""
     cur = pick(study("public-wind-known-dcee-cl"), "dcee-cl")
@@ -157,48 +149,36 @@ def what_we_found() -> str:
             when += f" ({100 * r['reached_1m']:.0f} % ever get there)"
         rows.append([label, count(r), f"{r['median_final_rmse']:.2f} m", when])
 
-    def pair_row(label: str, name: str, **where: object) -> list[str]:
-        frame = study(name)
-        a, b = pick(frame, "dcee-cl", **where), pick(frame, "infotaxis", **where)
-        ta, tb = a["time_to_1m"], b["time_to_1m"]
-        if math.isnan(a["reached_1m"]) or math.isnan(b["reached_1m"]):
-            when = "—"
-        elif a["reached_1m"] == 0 and b["reached_1m"] == 0:
-            when = "never"
-        elif math.isinf(ta) or math.isinf(tb):  # the median search never got there
-            got = f"{100 * a['reached_1m']:.0f} % / {100 * b['reached_1m']:.0f} %"
-            each = ["> budget" if math.isinf(t) else f"{t:.0f} s" for t in (ta, tb)]
-            when = f"{each[0]} / {each[1]} ({got} got there)"
-        else:
-            when = f"{ta:.0f} / {tb:.0f} s"
-            if (RESULTS / name / "paired.csv").exists():
-                when += _pair_note(name)
+    def planners_row(
+        label: str,
+        frame: pd.DataFrame,
+        strategies: tuple[str, ...],
+        note: str = "",
+        **where: object,
+    ) -> list[str]:
+        """One study, several planners: "a / b / …" in each cell."""
+        rs = [pick(frame, strategy, **where) for strategy in strategies]
+        times = (
+            "> budget" if math.isinf(r["time_to_1m"]) else f"{r['time_to_1m']:.0f}" for r in rs
+        )
         return [
             label,
-            f"{count(a)} / {count(b)}",
-            f"{a['median_final_rmse']:.2f} / {b['median_final_rmse']:.2f} m",
-            when,
+            " / ".join(count(r) for r in rs),
+            " / ".join(f"{r['median_final_rmse']:.2f}" for r in rs) + " m",
+            " / ".join(times) + " s" + note,
         ]
 
-    today = study("held-out-today")
-    today_pairs = paired("held-out-today")
+    today, today_pairs = study("held-out-today"), paired("held-out-today")
 
     def today_row(label: str, name: str) -> list[str]:
-        a, b, t = (pick(today, s, study=name) for s in PLANNERS)
         p = pick(today_pairs, "dcee-cl", study=name, reference="infotaxis")
-        times = [r["time_to_1m"] for r in (a, b, t)]
-        when = " / ".join("> budget" if math.isinf(x) else f"{x:.0f}" for x in times) + " s"
+        note = ""
         if not math.isnan(p["time_to_1m_difference"]):
-            when += (
+            note = (
                 f" (`dcee-cl` − infotaxis, paired: {p['time_to_1m_difference']:+.0f} s, "
                 f"Wilcoxon p = {p['time_wilcoxon_p']:.1g})"
             )
-        return [
-            label,
-            " / ".join(count(r) for r in (a, b, t)),
-            " / ".join(f"{r['median_final_rmse']:.2f}" for r in (a, b, t)) + " m",
-            when,
-        ]
+        return planners_row(label, today, PLANNERS, note, study=name)
 
     rows += [
         today_row(
@@ -212,11 +192,12 @@ def what_we_found() -> str:
             "100 of them (`held-out-100`)",
             "filament",
         ),
-        pair_row(
+        planners_row(
             "**held-out**, the independent puff truth (Farrell et al. 2002), all eight unknown, "
             "fluctuation likelihood, `held-out-100`, `dcee-cl` / `infotaxis` "
             "(`turbulent-held-out-100`)",
-            "turbulent-held-out-100",
+            study("turbulent-held-out-100"),
+            ("dcee-cl", "infotaxis"),
             truth_model="puffs",
             repeat_radius=2,
         ),
