@@ -20,12 +20,19 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import NoReturn
 
 import pandas as pd
 from scipy.stats import binomtest, wilcoxon
 
 from dcee.analysis.report import load_campaign
 from dcee.analysis.statistics import wilson
+
+
+def _fail(message: str) -> NoReturn:
+    """One line on stderr and exit code 2, as the dcee commands do."""
+    print(f"ablation_table: {message}", file=sys.stderr)
+    raise SystemExit(2)
 
 
 def _runs(arg: str) -> tuple[str, pd.DataFrame]:
@@ -35,7 +42,7 @@ def _runs(arg: str) -> tuple[str, pd.DataFrame]:
     if path.suffix == ".csv":  # STRATEGY[:KEY:VALUE...]; a folder's spec keeps its colons
         strategy, *tags = strategy.split(":")
         if not path.is_file():
-            sys.exit(f"ablation_table: {path}: no such stored study (studies/collect_metrics.py)")
+            _fail(f"{path}: no such stored study (studies/collect_metrics.py)")
         runs = pd.read_csv(path)
         for key, value in zip(tags[::2], tags[1::2], strict=True):
             try:  # collect_metrics stores a numeric tag as a number
@@ -48,10 +55,12 @@ def _runs(arg: str) -> tuple[str, pd.DataFrame]:
         name = path.name
     if strategy:
         runs = runs[runs["strategy"] == strategy]
-    if runs.empty or runs["strategy"].nunique() != 1:
-        sys.exit(f"ablation_table: {arg}: name one strategy with DIR=STRATEGY")
+    if runs.empty:
+        _fail(f"{arg}: no search matches")
+    if runs["strategy"].nunique() != 1:
+        _fail(f"{arg}: several strategies; name one with DIR=STRATEGY")
     if runs.duplicated(["scenario", "seed"]).any():
-        sys.exit(f"ablation_table: {arg}: several studies' rows; pick one with :KEY:VALUE")
+        _fail(f"{arg}: several studies' rows; pick one with :KEY:VALUE")
     label = f"{name} ({runs['strategy'].iloc[0]})"
     return label, runs.set_index(["scenario", "seed"])
 

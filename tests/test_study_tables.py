@@ -76,10 +76,16 @@ def test_paired_table_from_a_stored_study_matches_hand_counts(tmp_path: Path) ->
     assert math.isnan(ref["time_to_1m_difference"])
 
 
-def test_paired_table_refuses_rows_of_several_studies(tmp_path: Path) -> None:
+def test_paired_table_refuses_rows_of_several_studies(tmp_path: Path, capsys) -> None:
     table_module = _script("ablation_table")
     path = _stored(tmp_path)
-    with pytest.raises(SystemExit, match="several studies"):
-        table_module.compare(f"{path}=ref", [])
-    with pytest.raises(SystemExit, match="no such stored study"):
-        table_module.compare(f"{tmp_path / 'none' / 'searches.csv'}=ref", [])
+    for arg, says in (
+        (f"{path}=ref", "several studies"),
+        (f"{tmp_path / 'none' / 'searches.csv'}=ref", "no such stored study"),
+        (f"{path}=ref:truth_model:c", "no search matches"),
+    ):
+        with pytest.raises(SystemExit) as stop:
+            table_module.compare(arg, [])
+        assert stop.value.code == 2
+        err = capsys.readouterr().err
+        assert says in err and err.count("\n") == 1
