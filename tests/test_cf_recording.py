@@ -12,9 +12,9 @@ xr = pytest.importorskip("xarray")
 pytest.importorskip("h5netcdf")
 
 from dcee.errors import DceeInputError  # noqa: E402
+from dcee.recordings.cf import concentration_factor  # noqa: E402
 from dcee.scenarios import load_scenario  # noqa: E402
 from dcee.simulation import make_truth  # noqa: E402
-from dcee.simulation.cf_recording import concentration_factor  # noqa: E402
 from dcee.simulation.playback import load_cf_recording  # noqa: E402
 from tests.helpers import run_cli  # noqa: E402
 

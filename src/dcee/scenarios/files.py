@@ -72,16 +72,17 @@ def _resolve_recording(data: dict, base: Path) -> None:
 
 
 def truth_choice(value: str) -> str | dict[str, str]:
-    """The ``truth.model`` a ``--truth`` option names: "isotropic", "filament", or the path of a
+    """The ``truth.model`` a ``--truth`` option names: "isotropic", "filament", "puffs", "lbm", or
+    the path of a
     recording (``.npy``/``.h5``), made absolute so that it means the same file wherever the
     configuration is used later."""
-    if value in ("isotropic", "filament", "puffs"):
+    if value in ("isotropic", "filament", "puffs", "lbm"):
         return value
     path = Path(value).expanduser()
     if path.suffix.lower() not in (".npy", ".h5", ".hdf5", ".nc", ".nc4", ".netcdf", ".cdf"):
         raise DceeInputError(
             "truth",
-            f"must be isotropic, filament, puffs or a .npy/.h5/.nc recording (got {value!r})",
+            f"must be isotropic, filament, puffs, lbm or a .npy/.h5/.nc recording (got {value!r})",
         )
     if not path.is_file():
         raise DceeInputError("truth", f"no such recording {value!r}")

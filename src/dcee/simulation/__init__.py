@@ -1,8 +1,9 @@
 """What the sensor sees in a simulated search: the ground-truth plumes (isotropic, filament,
-puffs, recorded playback), registered by name. The search that runs against them is
+puffs, recorded playback, the lbm solver plume), registered by name. The search that runs against them is
 :mod:`dcee.runs`."""
 
 from dcee.simulation.filament import FilamentTruth
+from dcee.simulation.lbm import SolverPlumeTruth
 from dcee.simulation.playback import PlaybackTruth, load_recording, save_recording
 from dcee.simulation.puffs import PuffTruth
 from dcee.simulation.truth import (
@@ -19,6 +20,7 @@ __all__ = [
     "IsotropicTruth",
     "PlaybackTruth",
     "PuffTruth",
+    "SolverPlumeTruth",
     "TruthModel",
     "load_recording",
     "make_truth",

@@ -8,6 +8,10 @@ strictly increasing coordinate vectors ``t`` (s), ``y``, ``x`` and optionally ``
 * ``.npy``: the array; the metadata in a JSON file beside it with the same stem
   (``plume.npy`` + ``plume.json``) holding ``t``, ``x``, ``y``, optionally ``z`` and ``source``.
 
+A planar recording (no z axis) may name the height of its plane: a number ``z`` in the JSON, an
+attribute ``z`` of the .h5 file, a scalar height coordinate in NetCDF
+(:func:`dcee.recordings.recording_layout`); the agent must then fly at that height.
+
 :func:`save_recording` writes either format. Space is interpolated trilinearly (bilinearly for a
 2-D recording, which then holds at every altitude); time by the nearest frame or linearly
 between frames. Episode time 0 is the first frame. With ``loop`` the recording repeats with
@@ -26,7 +30,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.simulation.cf_recording import SUFFIXES, read_cf_recording
+from dcee.recordings import is_cf
+from dcee.recordings.cf import read_cf_recording
 from dcee.simulation.truth import TruthModel, register_truth
 
 if TYPE_CHECKING:
@@ -226,6 +231,8 @@ def load_recording(
         raise _fail(
             f"unsupported recording {path.name!r}: use .npy (with .json), .h5 or CF NetCDF (.nc)"
         )
+    if arr.ndim == 3 and "z" in meta and np.ndim(meta["z"]) == 0:
+        meta.pop("z")  # a planar recording's height (recording_layout), not a grid axis
     missing = [k for k in ("t", "x", "y") if k not in meta]
     if arr.ndim == 4 and "z" not in meta:
         missing.append("z")
@@ -247,7 +254,7 @@ def load_cf_recording(
 ) -> tuple[PlaybackTruth, np.ndarray | None]:
     """(truth, recorded source (3,) m or None) from a CF-convention NetCDF/HDF5 recording made
     by others; ``mapping`` (variable, axes, units, molar_mass, temperature, pressure) goes to
-    :func:`dcee.simulation.cf_recording.read_cf_recording`."""
+    :func:`dcee.recordings.cf.read_cf_recording`."""
     rec = read_cf_recording(path, **mapping)
     truth = PlaybackTruth(
         rec["concentration"], rec["t"], rec["x"], rec["y"], rec["z"], time_interpolation, loop
@@ -301,8 +308,7 @@ def playback_truth(scenario: Scenario, seed: int) -> PlaybackTruth:
     spec = scenario.truth.model
     theta = scenario.truth_theta()
     low, high = np.array(scenario.volume.low), np.array(scenario.volume.high)
-    cf = Path(spec.file).suffix.lower() in SUFFIXES or spec.variable is not None or spec.axes
-    if cf:
+    if is_cf(spec.file, spec.variable, spec.axes):
         truth, source = load_cf_recording(
             spec.file,
             spec.time_interpolation,

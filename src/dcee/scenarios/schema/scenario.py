@@ -8,7 +8,7 @@ import difflib
 from typing import Any, Literal, get_args, get_origin
 
 import numpy as np
-from pydantic import BaseModel, Field, ValidationError, model_validator
+from pydantic import BaseModel, Field, PrivateAttr, ValidationError, model_validator
 
 from dcee.errors import DceeInputError
 from dcee.models.agent import GridAgent, SearchVolume
@@ -61,6 +61,7 @@ class Scenario(ScenarioBuilders, BaseModel):
     """scale, budget and success criterion, see [search]"""
     world: WorldSpec = WorldSpec()
     """obstacles, no-go zones and an occupancy-grid map, see [world]"""
+    _layout: tuple[bool, float | None] = PrivateAttr(default=(False, None))
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario:
@@ -96,6 +97,7 @@ class Scenario(ScenarioBuilders, BaseModel):
         extra = [p for p in self.prior if p not in PARAMETER_NAMES]
         if extra:
             raise ValueError(f"prior: unknown parameter name(s) {extra}; allowed {PARAMETER_NAMES}")
+        self._checked_planar(start)
         site = self._checked_site(start, src)
         agent = GridAgent(
             SearchVolume(tuple(lo), tuple(hi)),
@@ -141,6 +143,43 @@ class Scenario(ScenarioBuilders, BaseModel):
         if self.sensor.max_reading <= self.sensor.threshold:
             raise ValueError("sensor.max_reading must be above sensor.threshold")
         return self
+
+    def _checked_planar(self, start: np.ndarray) -> None:
+        """Read the truth's layout once (a recording's header) and refuse what cannot work over
+        a planar truth: a climbing agent (the readings do not change with height, the reading
+        model does) or an agent away from the plane the truth holds."""
+        try:
+            layout = self.truth.layout()
+        except DceeInputError as exc:
+            raise ValueError(f"{FIELD_MARK}{exc.field}: {exc.message}") from None
+        object.__setattr__(self, "_layout", layout)
+        planar, plane = layout
+        if not planar:
+            return
+        what = f"the truth ({self.truth.model_name}) is planar: one horizontal plane, the same "
+        if self.agent.climb is not None and self.agent.climb > 0:
+            raise ValueError(
+                f"{FIELD_MARK}agent.climb: {self.agent.climb:g} m cannot work: {what}at every "
+                "altitude, so climbing reads nothing about height while the reading model "
+                "predicts it; use climb = 0 (the default there) or a recording with a z axis"
+            )
+        if plane is not None and abs(start[2] - plane) > 1e-6:
+            raise ValueError(
+                f"{FIELD_MARK}agent.start: z = {start[2]:g} m is off the plane it holds: {what}"
+                f"at every altitude, held at z = {plane:g} m; start the agent at that height"
+            )
+
+    @property
+    def planar_truth(self) -> bool:
+        """The truth holds one horizontal plane (a 2-D recording or the solver plume): the
+        agent stays at its altitude (an unset climb is 0) and the source height is not
+        estimated (it is ``truth.z``, as with ``dimensions = 2``; errors are horizontal)."""
+        return self._layout[0]
+
+    @property
+    def search_dimensions(self) -> int:
+        """2 for a planar search (``dimensions = 2`` or a planar truth), else 3."""
+        return 2 if self.planar_truth else self.dimensions
 
     def _checked_site(self, start: np.ndarray, src: np.ndarray) -> Any:
         """The ``[world]`` map, with the start outside every blocked cell, the source outside
@@ -188,6 +227,8 @@ class Scenario(ScenarioBuilders, BaseModel):
         unset means 0 (the robot cycle reads planar poses)."""
         if self.agent.climb is not None:
             return self.agent.climb
+        if self.planar_truth:
+            return 0.0
         return unset_climb(self.estimator.likelihood, self.agent.model, on_robot)
 
     @property
@@ -274,7 +315,7 @@ class Scenario(ScenarioBuilders, BaseModel):
 
     @property
     def unknown_names(self) -> tuple[str, ...]:
-        loc = ("x", "y", "z") if self.dimensions == 3 else ("x", "y")
+        loc = ("x", "y", "z") if self.search_dimensions == 3 else ("x", "y")
         env = ("q",) if self.unknown == "source" else ("q", "u", "phi", "zeta1", "zeta2")
         return loc + env
 

@@ -9,6 +9,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, Field, field_validator, model_validator
 
+from dcee.recordings import recording_layout
 from dcee.scenarios.schema.common import FROZEN, Finite, Positive
 
 TURBULENT_HOLD = 4.0
@@ -99,6 +100,67 @@ class PuffsSpec(BaseModel):
         return "puffs"
 
 
+class LbmSpec(BaseModel):
+    """A plume computed by a fluid solver from a well-kept library, not by code written here:
+    the lattice Boltzmann method of lbmpy (cumulant collision with a Smagorinsky subgrid model)
+    solves the incompressible Navier-Stokes equations in 2-D behind a grid of bars, whose wakes
+    make the flow turbulent, and a second lattice carries a passive scalar from a continuous
+    release downstream of it (:mod:`dcee.simulation.lbm`, docs/scenarios.md). It is computed
+    once per parameter set in a canonical frame (source at the origin, wind along +x at 1 m/s),
+    cached as a CF NetCDF recording and replayed through the playback truth, moved to the
+    scenario's source, turned to its wind direction and run at its wind speed (the flow is the
+    same at any speed at the same Reynolds number; time scales as 1/u). The plume is planar: one
+    horizontal plane through the source, the same at every altitude, so the search is planar;
+    the reading model takes the source at ``truth.z``, so set it to the flight height for the
+    plane through the source (the studies do). It ignores the truth's ζ1 and ζ2.
+    Lengths are metres in the canonical frame."""
+
+    model_config = FROZEN
+    kind: Literal["lbm"] = "lbm"
+    spacing: Annotated[float, Field(gt=0.05, le=5, allow_inf_nan=False)] = 0.5
+    """lattice spacing, m"""
+    store_stride: Annotated[int, Field(ge=1, le=16)] = 2
+    """every this many lattice cells is stored (and read back bilinearly), both ways"""
+    lattice_speed: Annotated[float, Field(gt=0, le=0.15, allow_inf_nan=False)] = 0.1
+    """mean inflow in lattice units (a Mach number times √3; the method needs it small)"""
+    relaxation: Annotated[float, Field(gt=1.0, lt=2.0, allow_inf_nan=False)] = 1.99
+    """relaxation rate ω of the flow lattice: kinematic viscosity (1/ω − 1/2)/3 lattice units
+    (bar Reynolds number about 180 with the defaults, before the subgrid model)"""
+    smagorinsky: Annotated[float, Field(ge=0, le=0.5, allow_inf_nan=False)] = 0.12
+    """Smagorinsky constant of the subgrid model (0: none)"""
+    scalar_relaxation: Annotated[float, Field(gt=1.0, lt=2.0, allow_inf_nan=False)] = 1.9
+    """relaxation rate of the scalar lattice: diffusivity (1/ω − 1/2)/3 lattice units (1.9:
+    0.044 m²/s at 1 m/s; 1.6 smeared the plume to a centreline intensity of 0.13-0.44)"""
+    bar_diameter: Annotated[float, Field(gt=0, le=50, allow_inf_nan=False)] = 1.5
+    """diameter of the turbulence grid's bars, m"""
+    bar_spacing: Annotated[float, Field(gt=0, le=200, allow_inf_nan=False)] = 6.0
+    """distance between the bars' centres, m (the grid's mesh)"""
+    grid_distance: Annotated[float, Field(gt=0, le=500, allow_inf_nan=False)] = 40.0
+    """how far upstream of the source the bars stand, m"""
+    downstream: Annotated[float, Field(gt=0, le=2000, allow_inf_nan=False)] = 76.0
+    """the domain reaches this far downwind of the source, m; beyond it, and upstream of the
+    inflow or beyond half the width crosswind, the field is 0"""
+    width: Annotated[float, Field(gt=0, le=2000, allow_inf_nan=False)] = 96.0
+    """crosswind width of the domain, m (periodic)"""
+    source_radius: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.5
+    """radius of the release disc held at a fixed concentration, m"""
+    spinup: Annotated[float, Field(ge=0, le=100_000, allow_inf_nan=False)] = 300.0
+    """canonical seconds run before recording (the flow and the plume settle)"""
+    duration: Annotated[float, Field(gt=0, le=100_000, allow_inf_nan=False)] = 1200.0
+    """canonical seconds recorded; a search replays them in a loop from a seeded start"""
+    frame_interval: Annotated[float, Field(gt=0, le=100, allow_inf_nan=False)] = 1.0
+    """canonical seconds between stored frames (at 4 m/s wind: 0.25 s)"""
+    layer_depth: Annotated[float, Field(gt=0, le=1000, allow_inf_nan=False)] = 2.0
+    """m: the release spread over this depth gives the plane's concentration (g/m³) from
+    the scenario's q (g/s): the plane carries q / layer_depth per metre of height"""
+    realisation: Annotated[int, Field(ge=0, le=1_000_000)] = 0
+    """seed of the initial perturbation: another realisation of the same turbulent flow"""
+
+    @property
+    def name(self) -> str:
+        return "lbm"
+
+
 class PlaybackSpec(BaseModel):
     """A recorded or externally simulated plume played back as truth
     (:mod:`dcee.simulation.playback`)."""
@@ -146,12 +208,15 @@ TRUTH_KINDS: dict[str, TruthKind] = {
     "filament": TruthKind(FilamentSpec),
     "puffs": TruthKind(PuffsSpec),
     "playback": TruthKind(PlaybackSpec),
+    "lbm": TruthKind(LbmSpec),
 }
 """The one registry of truth kinds, by the ``kind`` of ``truth.model`` (``"isotropic"`` for the
 plain string): the scenario schema validates against the specs, :func:`dcee.simulation.make_truth`
 builds with the factories. A new truth adds its spec class here and registers its factory in its
 own module under :mod:`dcee.simulation`."""
-TruthModelSpec = Annotated[FilamentSpec | PuffsSpec | PlaybackSpec, Field(discriminator="kind")]
+TruthModelSpec = Annotated[
+    FilamentSpec | PuffsSpec | PlaybackSpec | LbmSpec, Field(discriminator="kind")
+]
 
 
 class Truth(BaseModel):
@@ -185,16 +250,29 @@ class Truth(BaseModel):
     def _model_shorthand(cls, value: Any) -> Any:
         # "filament" is short for the filament table with every default, so that the resolved
         # configuration saved beside results records every parameter; {file = ...} needs no kind.
-        if value in ("filament", "puffs"):
+        if value in ("filament", "puffs", "lbm"):
             return {"kind": value}
         if isinstance(value, dict) and "kind" not in value:
             kind = "playback" if "file" in value else "filament"
             return {"kind": kind, **value}
         if isinstance(value, str) and value != "isotropic":
             raise ValueError(
-                f'must be "isotropic", "filament", "puffs" or {{file = "..."}} (got {value!r})'
+                f'must be "isotropic", "filament", "puffs", "lbm" or {{file = "..."}} '
+                f"(got {value!r})"
             )
         return value
+
+    def layout(self) -> tuple[bool, float | None]:
+        """(planar, plane height m or None): a planar truth holds one horizontal plane, the
+        same at every altitude (a 2-D recording, whose file may say which height it holds;
+        the solver plume); nothing in it can tell altitude, so the search on it is planar and
+        the reading model takes the source at ``z`` (docs/scenarios.md)."""
+        model = self.model
+        if isinstance(model, PlaybackSpec):
+            return recording_layout(model.file, model.variable, dict(model.axes))
+        if isinstance(model, LbmSpec):
+            return True, None
+        return False, None
 
     @property
     def model_name(self) -> str:

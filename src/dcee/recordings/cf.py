@@ -174,6 +174,33 @@ def _axis_of(ds: Any, dim: str, mapping: dict[str, str]) -> str | None:
     return None
 
 
+def cf_layout(
+    path: str | Path, variable: str | None = None, axes: dict[str, str] | None = None
+) -> tuple[bool, float | None]:
+    """(planar, plane height in m or None) of a CF recording without reading its values: planar
+    when the concentration variable has no z axis; the plane's height from a scalar (0-d)
+    coordinate with axis Z or a height standard_name (CF's way of saying which level a 2-D
+    slice holds), in metres."""
+    path = Path(path)
+    if not path.is_file():
+        raise _fail(f"no such file {str(path)!r}")
+    mapping = dict(axes or {})
+    with _open(path) as ds:
+        var = _data_variable(ds, variable, path)
+        dims = [_axis_of(ds, str(dim), mapping) for dim in var.dims]
+        if "z" in dims:
+            return False, None
+        for name in var.coords:
+            coord = ds[name]
+            if coord.ndim != 0 or _axis_of(ds, str(name), {}) != "z":
+                continue
+            scale = _scale(coord.attrs.get("units"), LENGTH_METRES, "length", str(name))
+            height = float(coord.values) * scale
+            if np.isfinite(height):
+                return True, height
+        return True, None
+
+
 def read_cf_recording(
     path: str | Path,
     variable: str | None = None,
@@ -260,4 +287,4 @@ def read_cf_recording(
     }
 
 
-__all__ = ["concentration_factor", "read_cf_recording"]
+__all__ = ["cf_layout", "concentration_factor", "read_cf_recording"]
