@@ -1,6 +1,6 @@
 """What the sensor sees in a simulated search: the ground-truth plumes (isotropic, filament,
-puffs, recorded playback, the lbm solver plume), registered by name. The search that runs against them is
-:mod:`dcee.runs`."""
+puffs, recorded playback, the lbm solver plume), registered by name. The search that runs
+against them is :mod:`dcee.runs`."""
 
 from dcee.simulation.filament import FilamentTruth
 from dcee.simulation.lbm import SolverPlumeTruth

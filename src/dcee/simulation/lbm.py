@@ -100,10 +100,10 @@ class _Domain:
         dx = spec.spacing
         self.dx = dx
         self.upstream = spec.grid_distance + 4.0 * max(spec.bar_diameter, dx)
-        self.nx = int(round((self.upstream + spec.downstream) / dx)) + 1
-        self.ny = int(round(spec.width / dx))
+        self.nx = round((self.upstream + spec.downstream) / dx) + 1
+        self.ny = round(spec.width / dx)
         self.ny += self.ny % 2
-        self.source = (int(round(self.upstream / dx)), self.ny // 2)
+        self.source = (round(self.upstream / dx), self.ny // 2)
         self.x = (np.arange(self.nx) - self.source[0]) * dx
         self.y = (np.arange(self.ny) - self.source[1]) * dx
         self.step_seconds = spec.lattice_speed * dx / REFERENCE_SPEED
@@ -111,7 +111,7 @@ class _Domain:
         self.bars_x = -spec.grid_distance
         # the source straight downwind of the gap between two bars (in the mixing of two wakes,
         # not on one wake's regular vortex street), then every bar_spacing round the width
-        count = max(1, int(round(spec.width / spec.bar_spacing)))
+        count = max(1, round(spec.width / spec.bar_spacing))
         k = np.arange(count) - count // 2
         self.bars_y = spec.bar_spacing * (k + 0.5)
 
@@ -174,7 +174,7 @@ def solve(spec: LbmSpec, progress: Progress | None = None) -> dict[str, Any]:
     velocity[..., 0] = ulb
     velocity[..., 1] = 0.0
     inner = (slice(1, -1), slice(1, -1))
-    velocity[inner + (1,)] = 0.02 * ulb * rng.standard_normal((dom.nx, dom.ny))
+    velocity[(*inner, 1)] = 0.02 * ulb * rng.standard_normal((dom.nx, dom.ny))
     flow.set_pdf_fields_from_macroscopic_values()
 
     dh.add_array("scalar", values_per_cell=1)
@@ -204,9 +204,9 @@ def solve(spec: LbmSpec, progress: Progress | None = None) -> dict[str, Any]:
     dh.fill("scalar", 0.0, ghost_layers=True)
     scalar.set_pdf_fields_from_macroscopic_values()
 
-    every = max(1, int(round(spec.frame_interval / dom.step_seconds)))
-    spin = int(math.ceil(spec.spinup / dom.step_seconds / every))
-    frames = int(math.ceil(spec.duration / (every * dom.step_seconds)))
+    every = max(1, round(spec.frame_interval / dom.step_seconds))
+    spin = math.ceil(spec.spinup / dom.step_seconds / every)
+    frames = math.ceil(spec.duration / (every * dom.step_seconds))
     # stored as means over blocks of store_stride² cells (a restriction, not a pick): the scalar
     # lattice's checkerboard mode at high Péclet number (±, a few per mille of the peak round the
     # source) averages out instead of being sampled
@@ -215,7 +215,7 @@ def solve(spec: LbmSpec, progress: Progress | None = None) -> dict[str, Any]:
     keep_x = np.arange(bx_n) * stride + (stride - 1) / 2.0
     keep_y = np.arange(by_n) * stride + (stride - 1) / 2.0
     out = np.empty((frames, by_n, bx_n), dtype=np.float32)
-    flux_column = sx + int(round(FLUX_DISTANCE / dom.dx))
+    flux_column = sx + round(FLUX_DISTANCE / dom.dx)
     flux = np.zeros(frames)
     v_source = np.zeros(frames)
     u_source = np.zeros(frames)
@@ -240,8 +240,8 @@ def solve(spec: LbmSpec, progress: Progress | None = None) -> dict[str, Any]:
         block = c[: bx_n * stride, : by_n * stride].reshape(bx_n, stride, by_n, stride)
         out[f] = np.maximum(block.mean(axis=(1, 3)), 0.0).T
         flux[f] = float(np.sum(c[flux_column, :] * v[flux_column, :, 0]))
-        u_source[f] = v[sx - int(round(2.0 / dom.dx)), sy, 0]
-        v_source[f] = v[sx - int(round(2.0 / dom.dx)), sy, 1]
+        u_source[f] = v[sx - round(2.0 / dom.dx), sy, 0]
+        v_source[f] = v[sx - round(2.0 / dom.dx), sy, 1]
     if not np.all(np.isfinite(out)):
         raise DceeInputError(FIELD, "the lattice Boltzmann run produced NaN concentrations")
     # the mean flux (lattice units: scalar · lattice velocity per cell) → per metre of height
