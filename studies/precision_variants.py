@@ -26,10 +26,23 @@ import numpy as np
 from dcee.scenarios import expand_names
 
 
+def _top_level_items(body: str) -> list[str]:
+    """``a=1,b={c=[1,2]}`` → ["a=1", "b={c=[1,2]}"]: commas inside brackets stay."""
+    items, depth, start = [], 0, 0
+    for i, ch in enumerate(body):
+        depth += ch in "[{"
+        depth -= ch in "]}"
+        if ch == "," and depth == 0:
+            items.append(body[start:i])
+            start = i + 1
+    items.append(body[start:])
+    return [item for item in items if item]
+
+
 def parse_variant(text: str) -> tuple[str, dict]:
     label, _, body = text.partition(":")
     over = {}
-    for item in filter(None, body.split(",")):
+    for item in _top_level_items(body):
         key, _, value = item.partition("=")
         over[key] = tomllib.loads(f"v = {value}")["v"]
     return label, over

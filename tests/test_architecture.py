@@ -30,6 +30,7 @@ LAYERS = {
     "dcee.provenance": 0,
     "dcee.blas": 0,
     "dcee.models": 1,
+    "dcee.recordings": 1,  # plume recordings on disk: CF reader, header layout, statistics
     "dcee.estimation": 2,
     "dcee.stopping": 2,  # when the posterior is narrow enough to end a search
     "dcee.planning": 3,

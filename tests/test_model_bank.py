@@ -242,3 +242,56 @@ def test_report_tables_which_model_the_searches_ended_with():
     assert "| a | paper | 2/3 (67 [21, 94]%) | 0.950 | 2.0 |" in md
     assert "| a | fluctuation | 1/3" in md and "| b | paper | 1/1" in md
     assert model_selection_markdown(runs.drop(columns="model")) is None
+
+
+LEARNED = FLUCT.with_overrides(
+    **{"estimator.learn": {"meander": [0.15, 0.5], "log_sd": [1.3, 2.0]}, "estimator.calm_prior": 0}
+)
+
+
+@pytest.mark.parametrize("generating", ["fluctuation[meander=0.5,log_sd=2]", "fluctuation"])
+def test_learned_bank_finds_the_nuisance_values_that_made_the_readings(generating):
+    """estimator.learn: readings drawn from the fluctuation model at one (meander, log_sd) of
+    the grid on a fixed path; the bank's posterior probability of that member is the largest
+    and above the other three together (from 1/4 each: statistics of simulated data, the same
+    mean plume up to the meander)."""
+    assert LEARNED.reading_models == (
+        "fluctuation",
+        "fluctuation[meander=0.15,log_sd=2]",
+        "fluctuation[meander=0.5,log_sd=1.3]",
+        "fluctuation[meander=0.5,log_sd=2]",
+    )
+    assert LEARNED.reading_model_priors == pytest.approx((0.25,) * 4)
+    ps = _lawnmower(40)
+    ps = np.vstack([ps, ps, ps])  # 120 readings
+    zs = _readings(
+        LEARNED.make_estimator_sensor(generating), ps, 5, plume=LEARNED.make_plume(generating)
+    )
+    filters = [
+        ParticleFilter(
+            _xy_prior(),
+            LEARNED.make_estimator_sensor(m),
+            LEARNED.make_plume(m),
+            n_particles=3000,
+            seed=i,
+        )
+        for i, m in enumerate(LEARNED.reading_models)
+    ]
+    bank = ModelBank(filters, LEARNED.reading_models, LEARNED.reading_model_priors)
+    for p, z in zip(ps, zs, strict=True):
+        bank.update(p, z)
+    assert bank.selected_name == generating
+    assert bank.probabilities[bank.selected] > 0.5
+
+
+def test_learn_is_checked_before_any_work():
+    with pytest.raises(DceeInputError, match=r"estimator\.learn.*fluctuation"):
+        PAPER1.with_overrides(**{"estimator.learn": {"meander": [0.0, 0.3]}})
+    with pytest.raises(DceeInputError, match=r"estimator\.learn\.meander.*fixed value 0\.15"):
+        FLUCT.with_overrides(**{"estimator.learn": {"meander": [0.3, 0.5]}})
+    with pytest.raises(DceeInputError, match=r"estimator\.learn\.log_sd.*distinct"):
+        FLUCT.with_overrides(**{"estimator.learn": {"log_sd": [1.3, 9.0]}})
+    with pytest.raises(DceeInputError, match=r"estimator\.learn: 16 combinations"):
+        FLUCT.with_overrides(
+            **{"estimator.learn": {"log_sd": [1.3, 1, 2, 3], "meander": [0.15, 0.2, 0.3, 0.4]}}
+        )

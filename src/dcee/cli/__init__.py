@@ -13,6 +13,7 @@ import click
 from dcee.cli.bench import bench, report
 from dcee.cli.catalogue import scenarios, schema, show, strategies
 from dcee.cli.perf import perf
+from dcee.cli.plume import plume
 from dcee.cli.replay import replay
 from dcee.cli.run import run
 from dcee.console import run_command
@@ -27,7 +28,7 @@ def cli(ctx: click.Context) -> None:
         click.echo(ctx.get_help())
 
 
-for _command in (run, replay, scenarios, strategies, show, schema, perf, bench, report):
+for _command in (run, replay, scenarios, strategies, show, schema, perf, bench, report, plume):
     cli.add_command(_command)
 
 

@@ -68,7 +68,7 @@ def overrides(likelihood: str | None, settings: tuple[str, ...]) -> dict[str, An
     """The dotted scenario overrides of --likelihood and --set (checked before any work)."""
     from dcee.scenarios import parse_setting
 
-    out: dict[str, Any] = dict(parse_setting(s) for s in settings)
-    if likelihood:
-        out["estimator.likelihood"] = likelihood
+    # the likelihood first: a --set may name a setting that only it allows (estimator.learn)
+    out: dict[str, Any] = {"estimator.likelihood": likelihood} if likelihood else {}
+    out.update(parse_setting(s) for s in settings)
     return out

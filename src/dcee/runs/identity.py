@@ -49,6 +49,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     # every reading weighed reading_weight before the repeat discount
     ("estimator", "repeat_radius"): 0.0,
     ("estimator", "repeat_power"): 1.0,
+    # every nuisance setting of the reading model fixed before issue 42's learned bank
+    ("estimator", "learn"): {},
 }
 """Scenario settings added after campaigns were first stored, with the value a stored scenario
 without one ran with, so the two compare equal."""

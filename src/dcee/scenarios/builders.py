@@ -77,14 +77,15 @@ class ScenarioBuilders:
         model = self._reading_model(model)
         if model == "paper":
             return dataclasses.replace(self._paper_sensor(), outlier=self.outlier)
+        learned = dict(self.reading_model_variants)[model]
         return Sensor(
             threshold=s.threshold,
-            pd=e.intermittency,
+            pd=learned.get("intermittency", e.intermittency),
             family="lognormal",
-            log_sd=e.log_sd,
+            log_sd=learned.get("log_sd", e.log_sd),
             log_sd_near=e.log_sd_near,
             log_sd_length=e.log_sd_length,
-            near_length=e.near_source_length,
+            near_length=learned.get("near_source_length", e.near_source_length),
             magnitude=e.magnitude,
             conserve_mean=e.conserve_mean,
             outlier=self.outlier,
@@ -95,9 +96,10 @@ class ScenarioBuilders:
         """The dispersion model of the filter and the planners under reading model ``model``
         (None: the first of :attr:`reading_models`)."""
         model = self._reading_model(model)
-        if self.estimator.likelihood != model:  # the fluctuation likelihood's calm member
-            return IsotropicPlume(meander=0.0)
-        return IsotropicPlume(meander=self.meander)
+        if self.estimator.likelihood != "paper" and model == "paper":
+            return IsotropicPlume(meander=0.0)  # the fluctuation likelihood's calm member
+        learned = dict(self.reading_model_variants)[model]
+        return IsotropicPlume(meander=learned.get("meander", self.meander))
 
     def _reading_model(self: Scenario, model: str | None) -> str:
         if model is None:

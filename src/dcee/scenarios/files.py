@@ -11,6 +11,7 @@ from typing import Any
 
 from dcee.errors import DceeInputError
 from dcee.scenarios.builtin import builtin_scenarios, random_configuration, random_family_name
+from dcee.scenarios.defaults import DEFAULTS
 from dcee.scenarios.schema import Scenario, validate_scenario
 from dcee.stopping import DEFAULT_STOP_SHARE
 
@@ -103,11 +104,21 @@ def parse_setting(text: str) -> tuple[str, Any]:
     return path, value
 
 
-def to_toml(scenario: Scenario) -> str:
+def _is_default(scenario: Scenario, section: str, key: str, value: object) -> bool:
+    """Whether ``section.key`` holds its class default (a built-in scenario's own value, e.g.
+    the lab's fitted log-sd, is not the measured default and gets no provenance line)."""
+    model = type(getattr(scenario, section))
+    field = model.model_fields.get(key)
+    return field is not None and field.default == value
+
+
+def to_toml(scenario: Scenario, provenance: bool = True) -> str:
     """The scenario as a TOML file that :func:`dcee.scenarios.load_scenario` reads back to an
     equal scenario (``dcee show NAME --format toml > my.toml``): every resolved setting, so the
     file is a complete record; optional values left unset (None), whose default depends on the
-    truth or the likelihood, appear as comments with the value they resolve to."""
+    truth or the likelihood, appear as comments with the value they resolve to. With
+    ``provenance``, a comment under each measured default says what it was chosen on
+    (:data:`dcee.scenarios.defaults.DEFAULTS`)."""
     data = scenario.model_dump(mode="json", exclude_none=True)
     # settings left unset follow the truth or the likelihood: shown as comments with the value
     # this scenario resolves them to, so the file reads back with them still unset
@@ -142,9 +153,13 @@ def to_toml(scenario: Scenario) -> str:
         lines.append(f"[{key}]")
         for k, v in table.items():
             lines.append(f"{_toml_key(k)} = {_toml_value(v)}")
+            if provenance and (key, k) in DEFAULTS and _is_default(scenario, key, k, v):
+                lines.append(f"# ^ default, {DEFAULTS[key, k].line()}")
         for (section, k), v in resolved.items():
             if section == key and k not in table:
                 lines.append(f"# {k} = {_toml_value(v)}  (unset: the default for this scenario)")
+                if provenance and (key, k) in DEFAULTS:
+                    lines.append(f"# ^ {DEFAULTS[key, k].line()}")
         for (section, k), words in unset.items():
             if section == key and k not in table:
                 lines.append(f"# {k} =  ({words})")

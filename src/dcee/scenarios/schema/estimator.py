@@ -164,6 +164,19 @@ class AnemometerSpec(BaseModel):
     """°, standard deviation of a direction reading about the true direction"""
 
 
+LearnedName = Literal["meander", "log_sd", "intermittency", "near_source_length"]
+"""The reading model's nuisance parameters ``estimator.learn`` may weigh."""
+LEARN_RANGES: dict[str, tuple[float, float]] = {
+    "meander": (0.0, 2.0),
+    "log_sd": (1e-3, 5.0),
+    "intermittency": (1e-3, 1.0),
+    "near_source_length": (0.0, 1000.0),
+}
+"""Allowed values of each learned setting (as for the fixed setting)."""
+LEARN_MEMBERS_MAX = 12
+"""Most fluctuation members a learned grid may make (each costs one filter update per reading)."""
+
+
 class EstimatorSpec(BaseModel):
     """The reading model the filter and every planner use (one :class:`Sensor` for both).
 
@@ -242,6 +255,15 @@ class EstimatorSpec(BaseModel):
     (1 + m)^p (only with ``repeat_radius`` > 0); 1: n readings at one spot add up like ln n,
     1/2: like 2 √n, 1/4: like (4/3) n^(3/4). None: the likelihood's default,
     :data:`REPEAT_DEFAULT` (1 for the paper's, 0.25 for the fluctuation likelihood)"""
+    learn: dict[LearnedName, Annotated[list[float], Field(min_length=1, max_length=8)]] = Field(
+        default_factory=dict
+    )
+    """fluctuation: nuisance parameters of the reading model learned during the search instead
+    of fixed, each with the values to weigh, e.g. ``{meander = [0.15, 0.3, 0.5]}``: one filter
+    per combination (the grid's product, at most :data:`LEARN_MEMBERS_MAX`) on the same
+    readings, with equal prior probability among them, selected by their evidence like the calm
+    member (:mod:`dcee.estimation.model_bank`); the combination of the values above is the
+    preferred (first) member and must be in the grid. Empty: every value fixed"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the

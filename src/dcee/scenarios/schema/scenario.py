@@ -5,6 +5,7 @@ errors of a bad file (:func:`validate_scenario`). How a scenario becomes model o
 from __future__ import annotations
 
 import difflib
+import itertools
 from typing import Any, Literal, get_args, get_origin
 
 import numpy as np
@@ -17,6 +18,8 @@ from dcee.scenarios.builders import ScenarioBuilders
 from dcee.scenarios.schema.agent import AgentSpec, SearchSpec, team_starts, unset_climb
 from dcee.scenarios.schema.common import FROZEN
 from dcee.scenarios.schema.estimator import (
+    LEARN_MEMBERS_MAX,
+    LEARN_RANGES,
     MEANDER_DEFAULT,
     READING_WEIGHT_DEFAULT,
     REPEAT_DEFAULT,
@@ -97,6 +100,7 @@ class Scenario(ScenarioBuilders, BaseModel):
         extra = [p for p in self.prior if p not in PARAMETER_NAMES]
         if extra:
             raise ValueError(f"prior: unknown parameter name(s) {extra}; allowed {PARAMETER_NAMES}")
+        self._checked_learn()
         self._checked_planar(start)
         site = self._checked_site(start, src)
         agent = GridAgent(
@@ -143,6 +147,39 @@ class Scenario(ScenarioBuilders, BaseModel):
         if self.sensor.max_reading <= self.sensor.threshold:
             raise ValueError("sensor.max_reading must be above sensor.threshold")
         return self
+
+    def _checked_learn(self) -> None:
+        """``estimator.learn``: the fluctuation likelihood's, in range, the fixed values in the
+        grid, not too many members."""
+        e = self.estimator
+        if not e.learn:
+            return
+        if e.likelihood != "fluctuation":
+            raise ValueError(
+                f"{FIELD_MARK}estimator.learn: weighs the fluctuation model's settings; needs "
+                f'estimator.likelihood = "fluctuation" (it is "{e.likelihood}")'
+            )
+        members = 1
+        for key, values in e.learn.items():
+            low, high = LEARN_RANGES[key]
+            bad = [v for v in values if not (low <= v <= high) or not np.isfinite(v)]
+            if bad or len(set(values)) != len(values):
+                raise ValueError(
+                    f"{FIELD_MARK}estimator.learn.{key}: distinct values in [{low:g}, {high:g}] "
+                    f"(got {values})"
+                )
+            fixed = self._fluctuation_value(key)
+            if not any(abs(v - fixed) < 1e-12 for v in values):
+                raise ValueError(
+                    f"{FIELD_MARK}estimator.learn.{key}: must include the fixed value {fixed:g} "
+                    "(the preferred member)"
+                )
+            members *= len(values)
+        if members > LEARN_MEMBERS_MAX:
+            raise ValueError(
+                f"{FIELD_MARK}estimator.learn: {members} combinations; at most "
+                f"{LEARN_MEMBERS_MAX} (each is a filter updated at every reading)"
+            )
 
     def _checked_planar(self, start: np.ndarray) -> None:
         """Read the truth's layout once (a recording's header) and refuse what cannot work over
@@ -298,20 +335,52 @@ class Scenario(ScenarioBuilders, BaseModel):
         }
 
     @property
-    def reading_models(self) -> tuple[str, ...]:
-        """The reading models the filter runs, the preferred first: ``("paper",)``,
-        ``("fluctuation",)``, or with ``estimator.calm_prior`` > 0 ``("fluctuation", "paper")``."""
+    def reading_model_variants(self) -> tuple[tuple[str, dict[str, float]], ...]:
+        """(name, settings) of each reading model the filter runs, the preferred first:
+        ``paper``; or ``fluctuation`` (the fixed values), then with ``estimator.learn`` one
+        member per other combination of its grid (``fluctuation[meander=0.3]``), then with
+        ``estimator.calm_prior`` > 0 the calm ``paper`` member. ``settings`` overrides the
+        fluctuation model's values (meander, log_sd, intermittency, near_source_length)."""
         e = self.estimator
-        if e.likelihood == "fluctuation" and e.calm_prior > 0:
-            return ("fluctuation", "paper")
-        return (e.likelihood,)
+        if e.likelihood != "fluctuation":
+            return (("paper", {}),)
+        keys = list(e.learn)
+        fixed = tuple(self._fluctuation_value(k) for k in keys)
+        combos = [fixed, *(c for c in itertools.product(*e.learn.values()) if c != fixed)]
+        members: list[tuple[str, dict[str, float]]] = []
+        for combo in combos:
+            settings = dict(zip(keys, combo, strict=True))
+            label = ",".join(f"{k}={v:g}" for k, v in settings.items())
+            members.append(("fluctuation" if combo == fixed else f"fluctuation[{label}]", settings))
+        if e.calm_prior > 0:
+            members.append(("paper", {}))
+        return tuple(members)
+
+    def _fluctuation_value(self, key: str) -> float:
+        """The fixed (resolved) value of a fluctuation-model setting ``estimator.learn`` may
+        weigh."""
+        return self.meander if key == "meander" else float(getattr(self.estimator, key))
+
+    @property
+    def reading_models(self) -> tuple[str, ...]:
+        """The reading models the filter runs, the preferred first (:attr:`reading_model_variants`):
+        ``("paper",)``, ``("fluctuation",)``, or with ``estimator.calm_prior`` > 0
+        ``("fluctuation", "paper")``; with ``estimator.learn`` the other fluctuation members
+        between."""
+        return tuple(name for name, _ in self.reading_model_variants)
 
     @property
     def reading_model_priors(self) -> tuple[float, ...]:
-        """Prior probability of each of :attr:`reading_models`."""
-        if len(self.reading_models) == 1:
+        """Prior probability of each of :attr:`reading_models`: ``calm_prior`` for the calm
+        member, the rest shared equally by the fluctuation members."""
+        names = self.reading_models
+        if len(names) == 1:
             return (1.0,)
-        return (1.0 - self.estimator.calm_prior, self.estimator.calm_prior)
+        calm = self.estimator.calm_prior if names[-1] == "paper" else 0.0
+        turbulent = len(names) - (1 if calm > 0 else 0)
+        return tuple(
+            calm if (n == "paper" and calm > 0) else (1.0 - calm) / turbulent for n in names
+        )
 
     @property
     def unknown_names(self) -> tuple[str, ...]:

@@ -1,0 +1,83 @@
+"""What each measured default was chosen on: the truths and configurations, so that a reader
+knows which results are independent of it (``dcee show`` prints it beside the value; the
+README's cross-truth table and docs/scenarios.md say the same).
+
+The rule (DEVELOPERS.md): a default is chosen on a tuning set, on at most two truth families,
+and reported on the others. The truth families are ``isotropic`` (the paper's model, its own
+likelihood), ``filament`` and ``puffs`` (written here, with the fluctuation likelihood) and
+``lbm`` (a fluid solver's plume, :mod:`dcee.simulation.lbm`): no default was chosen on ``lbm``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+TRUTH_FAMILIES = ("isotropic", "filament", "puffs", "lbm")
+"""Every truth family the studies report on."""
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """What one default was chosen on."""
+
+    truths: tuple[str, ...]
+    """truth families the choice looked at (empty: not chosen by measurement, e.g. the paper's
+    value or a physical constant)"""
+    configurations: str
+    """which configurations (the tuning range) and by what"""
+
+    def line(self) -> str:
+        """One line for ``dcee show``."""
+        if not self.truths:
+            return self.configurations
+        held_out = [t for t in TRUTH_FAMILIES if t not in self.truths]
+        return (
+            f"chosen on {' + '.join(self.truths)} ({self.configurations}); "
+            f"independent on {', '.join(held_out)}"
+        )
+
+
+PAPER = Provenance((), "the paper's value (Chen, Rhodes & Liu, table 2)")
+DEFAULTS: dict[tuple[str, str], Provenance] = {
+    ("agent", "dwell"): Provenance(
+        ("filament",), "4 s hold on a time-varying truth: infotaxis, paper configurations, 12 x 3"
+    ),
+    ("agent", "climb"): Provenance(
+        ("filament", "puffs"),
+        "1 m with the fluctuation likelihood, random:13-40, dcee-cl; 0 on a planar truth, where "
+        "nothing tells altitude",
+    ),
+    ("estimator", "intermittency"): Provenance(
+        ("filament",), "maximum-likelihood fit to 4 s holds, studies/fluctuation_stats.py"
+    ),
+    ("estimator", "log_sd"): Provenance(
+        ("filament",), "maximum-likelihood fit to 4 s holds, studies/fluctuation_stats.py"
+    ),
+    ("estimator", "near_source_length"): Provenance(
+        ("filament", "puffs"), "random:13-40, dcee-cl, the climbing UAV"
+    ),
+    ("estimator", "conserve_mean"): Provenance(("filament", "puffs"), "random:13-40, dcee-cl"),
+    ("estimator", "meander"): Provenance(("filament",), "the filament truth's time mean"),
+    ("estimator", "reading_weight"): Provenance(
+        ("filament", "puffs"), "random:1-12, dcee-cl and infotaxis"
+    ),
+    ("estimator", "repeat_radius"): Provenance(("filament", "puffs"), "random:13-40, dcee-cl"),
+    ("estimator", "repeat_power"): Provenance(("filament", "puffs"), "random:13-40, dcee-cl"),
+    ("estimator", "outlier"): Provenance(
+        ("isotropic",), "random:1-6, dcee-cl, one 10^6 x reading, studies/spike_study.py"
+    ),
+    ("estimator", "calm_prior"): Provenance(
+        ("isotropic", "filament"), "which model the evidence selects, docs/scenarios.md"
+    ),
+    ("search", "stall_guard"): Provenance(("isotropic",), "held-out tuning, docs/held-out.md"),
+    ("search", "guard_share"): Provenance(("filament", "puffs"), "random:13-40, dcee-cl"),
+    ("search", "stop_hold"): Provenance(("isotropic",), "random-tune, 40 configurations"),
+    ("sensor", "threshold"): PAPER,
+    ("sensor", "pd"): PAPER,
+    ("sensor", "sigma_min"): PAPER,
+    ("sensor", "sigma_frac"): PAPER,
+}
+"""(section, setting) → what its default was chosen on."""
+
+
+__all__ = ["DEFAULTS", "TRUTH_FAMILIES", "Provenance"]

@@ -1,0 +1,130 @@
+"""The fluid solver's plume (``truth.model = "lbm"``): a small grid here, the full grid in
+``studies/lbm_statistics.py``. Checked against what any plume of a conserved scalar in turbulence
+must show and against published figures (module doc of :mod:`dcee.recordings.statistics`): the
+flux is conserved downwind, the mean spread grows inside Briggs' open-country envelope, the
+centreline intermittency rises downwind; the replay moves, turns and rescales the canonical
+field exactly; the cache computes once."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("lbmpy")
+
+from dcee.errors import DceeInputError
+from dcee.recordings.statistics import briggs_sigma_y, section_statistics
+from dcee.scenarios.schema.truth import LbmSpec
+from dcee.simulation import lbm
+from dcee.simulation.playback import PlaybackTruth
+
+SMALL = {
+    "spacing": 1.0,
+    "store_stride": 1,
+    "bar_diameter": 2.0,
+    "bar_spacing": 6.0,
+    "grid_distance": 24.0,
+    "downstream": 40.0,
+    "width": 48.0,
+    "source_radius": 1.0,
+    "spinup": 150.0,
+    "duration": 250.0,
+}
+"""A grid of 72 × 48 cells: a few seconds with the kernels' compilation."""
+
+
+@pytest.fixture(scope="module")
+def small_run() -> dict:
+    return lbm.solve(LbmSpec(**SMALL))
+
+
+def test_small_grid_is_a_conserved_turbulent_plume(small_run: dict) -> None:
+    c, x, y = small_run["concentration"], small_run["x"], small_run["y"]
+    assert c.dtype == np.float32 and np.all(np.isfinite(c)) and c.min() >= 0
+    assert c.shape == (250, len(y), len(x))
+    rows = section_statistics(c, x, y, [10, 20, 30, 38])
+    # normalised to unit flux per unit wind speed at 10 m; a conserved scalar keeps it downwind
+    # (the mean-flow part ∫C̄ dy · U; the turbulent part u'c' is the rest)
+    for r in rows:
+        assert 0.85 < r.flux < 1.1, r
+    # the spread grows, and grows inside the open-country envelope (classes D to A) downwind
+    spreads = [r.sigma_y for r in rows]
+    assert all(b > a for a, b in itertools.pairwise(spreads))
+    for r in rows[2:]:  # past the coarse grid's 2 m source disc
+        assert briggs_sigma_y(r.x, "D") < r.sigma_y < 1.3 * briggs_sigma_y(r.x, "A"), r
+    # a turbulent plume: the centreline fluctuates, and is intermittent near the source more
+    # than far from it
+    assert all(r.intensity > 0.2 for r in rows)
+    assert rows[0].intermittency < 1.0
+    assert small_run["attrs"]["turbulence_intensity_v"] > 0.05
+
+
+def test_same_parameters_same_plume(small_run: dict) -> None:
+    again = lbm.solve(LbmSpec(**SMALL))
+    np.testing.assert_array_equal(again["concentration"], small_run["concentration"])
+    other = lbm.solve(LbmSpec(**{**SMALL, "realisation": 1}))
+    assert not np.array_equal(other["concentration"], small_run["concentration"])
+
+
+def _canonical() -> PlaybackTruth:
+    """A synthetic canonical field: c(x, y, t) = (1 + x) · exp(−y²/8) · (1 + t/100), x ≥ 0."""
+    t = np.arange(0.0, 101.0)
+    x = np.arange(-5.0, 41.0)
+    y = np.arange(-20.0, 21.0)
+    X, Y = np.meshgrid(x, y)
+    base = np.where(X >= 0, 1.0 + X, 0.0) * np.exp(-(Y**2) / 8.0)
+    c = base[None] * (1.0 + t[:, None, None] / 100.0)
+    return PlaybackTruth(c, t, x, y, loop=True)
+
+
+def test_replay_moves_turns_and_rescales_the_canonical_field() -> None:
+    rec = _canonical()
+    phi = math.radians(30.0)  # wind from 30°: the plume goes towards 210°
+    q, u, depth = 6.0, 4.0, 2.0
+    truth = lbm.SolverPlumeTruth(rec, np.array([10.0, 20.0, 4.0]), q, u, phi, depth, start=10.0)
+    down = -np.array([math.cos(phi), math.sin(phi)])
+    left = np.array([-down[1], down[0]])
+    scale = q / depth / u
+    for along, cross, t in ((12.0, 0.0, 0.0), (7.0, 2.0, 5.0), (30.0, -3.0, 20.0)):
+        p = np.array([10.0, 20.0, 1.0]) + np.r_[along * down + cross * left, 0.0]
+        canonical_t = 10.0 + t * u  # the flow runs u times faster than the canonical 1 m/s
+        expected = (1 + along) * math.exp(-(cross**2) / 8.0) * (1 + canonical_t / 100.0)
+        assert truth.concentration(p, t) == pytest.approx(expected * scale, rel=1e-9)
+    # upwind of the domain and beyond half its width: no gas
+    assert truth.concentration(np.array([10.0, 20.0, 4.0]) - 8.0 * np.r_[down, 0.0], 0.0) == 0
+    assert truth.concentration(np.array([10.0, 20.0, 4.0]) + 25.0 * np.r_[left, 0.0], 0.0) == 0
+    assert truth.time_step == pytest.approx(1.0 / u)
+
+
+def test_cache_computes_once_and_replays_as_a_recording(monkeypatch, tmp_path) -> None:
+    monkeypatch.setenv("DCEE_CACHE", str(tmp_path))
+    spec = LbmSpec(**{**SMALL, "spinup": 20.0, "duration": 30.0})
+    path = lbm.cached_recording(spec)
+    assert path.parent == tmp_path / "plumes" and path.suffix == ".nc"
+
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise AssertionError("solved again although cached")
+
+    monkeypatch.setattr(lbm, "solve", refuse)
+    assert lbm.cached_recording(spec) == path
+    truth = lbm.load_canonical(path)  # through the CF reader, as a user's recording would be
+    assert truth.z is None and truth.values.shape[0] == 30
+    # a changed parameter is another plume (another file); the depth only rescales
+    assert lbm.cache_path(LbmSpec(**{**SMALL, "realisation": 3})) != lbm.cache_path(spec)
+    assert lbm.cache_path(spec.model_copy(update={"layer_depth": 9.0})) == path
+
+
+def test_a_scenario_on_the_lbm_truth_is_planar(monkeypatch, tmp_path) -> None:
+    from dcee.scenarios import load_scenario
+
+    base = load_scenario("random:1")
+    scenario = base.with_overrides(**{"truth.model": "lbm", "estimator.likelihood": "fluctuation"})
+    assert scenario.planar_truth and scenario.climb == 0.0
+    assert "z" not in scenario.unknown_names
+    with pytest.raises(DceeInputError, match=r"agent\.climb"):
+        scenario.with_overrides(**{"agent.climb": 1.0})
+    with pytest.raises(DceeInputError, match=r"truth\.u"):
+        lbm.SolverPlumeTruth(_canonical(), np.zeros(3), 1.0, 0.0, 0.0, 1.0, 0.0)
