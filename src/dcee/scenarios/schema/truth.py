@@ -129,8 +129,8 @@ class LbmSpec(BaseModel):
     smagorinsky: Annotated[float, Field(ge=0, le=0.5, allow_inf_nan=False)] = 0.12
     """Smagorinsky constant of the subgrid model (0: none)"""
     scalar_relaxation: Annotated[float, Field(gt=1.0, lt=2.0, allow_inf_nan=False)] = 1.9
-    """relaxation rate of the scalar lattice: diffusivity (1/ω − 1/2)/3 lattice units (1.9:
-    0.044 m²/s at 1 m/s; 1.6 smeared the plume to a centreline intensity of 0.13-0.44)"""
+    """odd-moment relaxation rate of the scalar lattice: diffusivity (1/ω − 1/2)/3 lattice units
+    (1.9: 0.044 m²/s at 1 m/s; 1.6 smeared the plume to a centreline intensity of 0.13-0.44)"""
     bar_diameter: Annotated[float, Field(gt=0, le=50, allow_inf_nan=False)] = 1.5
     """diameter of the turbulence grid's bars, m"""
     bar_spacing: Annotated[float, Field(gt=0, le=200, allow_inf_nan=False)] = 6.0
