@@ -22,6 +22,7 @@ from tests.test_architecture import LAYERS, import_graph, owner
 
 ROLE = {
     "dcee.models": "plume, sensor, agent, motion",
+    "dcee.recordings": "plume files: CF, layout, statistics",
     "dcee.estimation": "Estimator: particle filter, model bank",
     "dcee.planning": "planners, registered by name",
     "dcee.scenarios": "schema, builders, files",

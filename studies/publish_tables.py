@@ -30,7 +30,14 @@ import pandas as pd
 
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "docs" / "results"
-PAGES = ("README.md", "docs/index.md", "docs/results.md", "docs/held-out.md")
+PAGES = (
+    "README.md",
+    "docs/index.md",
+    "docs/results.md",
+    "docs/held-out.md",
+    "docs/scenarios.md",
+    "docs/plumes.md",
+)
 MARKER = re.compile(
     r"(<!-- generated: (?P<name>[a-z0-9-]+) \(studies/publish_tables\.py\) -->\n)"
     r"(?P<body>.*?)"
@@ -550,7 +557,105 @@ def anemometer_table() -> str:
     return out
 
 
+def lbm_statistics_table() -> str:
+    """The solver plume's statistics downwind (studies/lbm_statistics.py's stored table)."""
+    frame = pd.read_csv(RESULTS / "lbm-plume" / "statistics.csv")
+    rows = [
+        [
+            f"{r['x']:.0f}",
+            f"{r['sigma_y']:.2f}",
+            f"{r['briggs_D']:.1f} … {r['briggs_A']:.1f}",
+            f"{r['flux']:.2f}",
+            f"{r['intensity']:.2f}",
+            f"{r['intermittency']:.2f}",
+        ]
+        for _, r in frame.iterrows()
+    ]
+    header = [
+        "x downwind (m)",
+        "σ_y of the mean (m)",
+        "Briggs D … A (m)",
+        "flux ∫C̄ dy · U",
+        "centreline σc/C̄",
+        "intermittency (c > C̄/10)",
+    ]
+    return table(header, rows)
+
+
+CROSS_HEADER = [
+    "truth (held-out configurations)",
+    "defaults chosen on it",
+    "planner",
+    "n",
+    "source acquired (RMSE < 3 m)",
+    "median final RMSE (m)",
+    "truth in 95 % region",
+    "median time to RMSE < 1 m (s)",
+]
+
+
+def cross_truth_table() -> str:
+    """Every truth family at today's defaults, all eight unknown: which defaults were chosen on
+    it (docs/plumes.md; dcee.scenarios.defaults.DEFAULTS)."""
+    today = study("held-out-today")
+    turbulent = study("turbulent-held-out-100")
+    lbm = study("lbm-held-out-100")
+    rows = []
+
+    def add(truth: str, chosen: str, r: pd.Series, source: str) -> None:
+        rows.append(
+            [
+                truth,
+                chosen,
+                f"`{r['strategy']}` (`{source}`)",
+                str(int(r["searches"])),
+                acquired(r),
+                rmse(r),
+                share(r, "truth_in_95"),
+                time_to_1m(r),
+            ]
+        )
+
+    for strategy in ("dcee-cl", "infotaxis", "dcee-mcts"):
+        add(
+            "isotropic, paper's likelihood",
+            "outlier weight, stall guard, stop rule",
+            pick(today, strategy, study="full"),
+            "held-out-today",
+        )
+    for strategy in ("dcee-cl", "infotaxis", "dcee-mcts"):
+        add(
+            "filament, fluctuation likelihood",
+            "**yes**: the fluctuation model's settings, climb, hold",
+            pick(today, strategy, study="filament"),
+            "held-out-today",
+        )
+    for strategy in ("dcee-cl", "infotaxis"):
+        r = pick(
+            turbulent,
+            strategy,
+            truth_model="puffs",
+            climb=1.0,
+            near_source_length=2.5,
+            vertical_reach=1.0,
+            conserve_mean=1,
+            repeat_radius=2,
+        )
+        add(
+            "puffs, fluctuation likelihood",
+            "**yes**: climb, near-source length, repeat discount",
+            r,
+            "turbulent-held-out-100",
+        )
+    for _, r in lbm.iterrows():
+        how = "" if r["learn"] == "none" else f", `estimator.learn` {r['learn']}"
+        add(f"**lbm** (fluid solver), fluctuation likelihood{how}", "none", r, "lbm-held-out-100")
+    return table(CROSS_HEADER, rows)
+
+
 TABLES: dict[str, Callable[[], str]] = {
+    "cross-truth": cross_truth_table,
+    "lbm-statistics": lbm_statistics_table,
     "what-we-found": what_we_found,
     "wind-known": public_table("paper-source", "public-wind-known-dcee-cl"),
     "full-unknown": public_table("paper-full", None),

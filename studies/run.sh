@@ -308,6 +308,28 @@ case "${1:---list}" in
       --vague results/anemometer-off-vague results/anemometer-on-vague \
       --csv docs/results/anemometer/anemometer.csv
     $P studies/publish_tables.py ;;
+  lbm-plume)  # the fluid solver's plume against published plume measurements (docs/scenarios.md)
+    $P studies/lbm_statistics.py
+    $P studies/publish_tables.py ;;
+  tune-learn)  # the learned reading model (estimator.learn) on the tuning range, filament + puffs (docs/plumes.md)
+    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+      --variant base: \
+      --variant 'both:estimator.learn={meander=[0.15,0.3,0.6],log_sd=[1.3,2.0]}' \
+      --workers "${WORKERS:-2}" --csv docs/results/tuning-learn-13-40/variants.csv ;;
+  cross-truth)  # every truth at today's defaults; the lbm plume held out (docs/plumes.md, README)
+    export SUITE=held-out-100 TRUTHS=lbm WORKERS=${WORKERS:-2}
+    bash studies/study_turbulent_held_out.sh --set truth.z=4.0
+    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts bash studies/study_turbulent_held_out.sh --set truth.z=4.0
+    report turbulent-lbm-held-out-100 turbulent-lbm-held-out-100-mcts
+    $P studies/collect_metrics.py --out docs/results/lbm-held-out-100 \
+      results/turbulent-lbm-held-out-100=learn:none \
+      results/turbulent-lbm-held-out-100-mcts=learn:none
+    $P studies/ablation_table.py results/turbulent-lbm-held-out-100=infotaxis \
+      results/turbulent-lbm-held-out-100=dcee-cl results/turbulent-lbm-held-out-100-mcts=dcee-mcts \
+      --csv docs/results/lbm-held-out-100/paired.csv --tag reference=infotaxis
+    $P studies/worst_searches.py results/turbulent-lbm-held-out-100=dcee-cl \
+      results/turbulent-lbm-held-out-100=infotaxis --out docs/figures/lbm-held-out-worst.png
+    $P studies/publish_tables.py ;;
   publish)  # the tables of README.md, docs/index.md, docs/results.md from docs/results/
     $P studies/publish_tables.py ;;
   stonesoup-mcts)  # our tree search against Stone Soup's MCTS on its own example
