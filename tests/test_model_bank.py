@@ -295,3 +295,29 @@ def test_learn_is_checked_before_any_work():
         FLUCT.with_overrides(
             **{"estimator.learn": {"log_sd": [1.3, 1, 2, 3], "meander": [0.15, 0.2, 0.3, 0.4]}}
         )
+
+
+@pytest.mark.parametrize("generating", ["fluctuation[decay=0.5]", "fluctuation"])
+def test_learned_decay_tells_a_planar_plume_from_a_point_source(generating):
+    """estimator.learn = {decay = [1, 0.5]}: readings from the plume model with the planar
+    fall (1/√r) or the point source's (1/r); the bank finds which (simulated data)."""
+    learned = FLUCT.with_overrides(
+        **{"estimator.learn": {"decay": [1.0, 0.5]}, "estimator.calm_prior": 0}
+    )
+    assert learned.reading_models == ("fluctuation", "fluctuation[decay=0.5]")
+    assert learned.make_plume("fluctuation[decay=0.5]").decay == 0.5
+    ps = np.vstack([_lawnmower(40)] * 3)
+    zs = _readings(
+        learned.make_estimator_sensor(generating), ps, 8, plume=learned.make_plume(generating)
+    )
+    filters = [
+        ParticleFilter(
+            _xy_prior(), learned.make_estimator_sensor(m), learned.make_plume(m), 3000, seed=i
+        )
+        for i, m in enumerate(learned.reading_models)
+    ]
+    bank = ModelBank(filters, learned.reading_models, learned.reading_model_priors)
+    for p, z in zip(ps, zs, strict=True):
+        bank.update(p, z)
+    assert bank.selected_name == generating
+    assert bank.probabilities[bank.selected] > 0.9

@@ -79,6 +79,7 @@ def _history_kernel(
     multiplicity: np.ndarray,
     rmin: float,
     meander: float,
+    decay: float,
     sp: SensorParams,
     threshold: np.ndarray,
     remaining_bound: np.ndarray,
@@ -116,9 +117,11 @@ def _history_kernel(
             px = positions[k, 0]
             py = positions[k, 1]
             pz = positions[k, 2]
-            if meander > 0.0:
+            if meander > 0.0 or decay != 1.0:
                 for q in range(nb):
-                    conc[q], dist[q] = plume_at(constants_at(pc, q), px, py, pz, rmin, meander)
+                    conc[q], dist[q] = plume_at(
+                        constants_at(pc, q), px, py, pz, rmin, meander, decay
+                    )
             else:
                 _plume_block(pc, nb, px, py, pz, rmin, conc, dist)
             zk = readings[k]
@@ -191,6 +194,7 @@ def history_log_likelihood(
     multiplicity: np.ndarray,
     rmin: float,
     meander: float,
+    decay: float,
     sp: SensorParams,
     out: np.ndarray,
     threshold: np.ndarray | None = None,
@@ -220,6 +224,7 @@ def history_log_likelihood(
         multiplicity,
         rmin,
         meander,
+        decay,
         sp,
         np.ascontiguousarray(threshold, dtype=np.float64),
         remaining,
@@ -236,7 +241,9 @@ def history_log_likelihood_reference(
     plume: IsotropicPlume,
 ) -> np.ndarray:
     """NumPy reference of the compiled history likelihood: (N,) Σ_k m_k log p(z_k | Θ_i)."""
-    conc = isotropic_concentration_reference(theta, positions, plume.min_distance, plume.meander)
+    conc = isotropic_concentration_reference(
+        theta, positions, plume.min_distance, plume.meander, plume.decay
+    )
     d = positions[None, :, :] - theta[:, None, :3]
     dist = np.maximum(np.sqrt(np.einsum("nki,nki->nk", d, d)), plume.min_distance)
     ll = sensor.log_likelihood(readings[None, :], conc, dist)

@@ -99,6 +99,7 @@ def _loglik(theta, pts, positions, readings, sensor, plume) -> np.ndarray:
         np.ones(len(readings)),
         plume.min_distance,
         plume.meander,
+        plume.decay,
         sensor.params,
         out,
     )

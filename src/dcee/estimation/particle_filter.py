@@ -273,6 +273,7 @@ class ParticleFilter:
             np.array([w], dtype=np.float64),
             self.plume.min_distance,
             self.plume.meander,
+            self.plume.decay,
             self._sp,
             out,
         )
@@ -487,6 +488,7 @@ class ParticleFilter:
             mult,
             self.plume.min_distance,
             self.plume.meander,
+            self.plume.decay,
             self._sp,
             ll_prop,
             np.nan_to_num(threshold, nan=-np.inf, posinf=np.inf),

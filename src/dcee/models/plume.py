@@ -30,6 +30,15 @@ is the isotropic one at the crosswind offset compressed by f = σ_d / √(σ_d²
 1/√(1 + i² d u / (2 ζ1)), times f (mass conserved across the plume). Exact for the far field's
 Gaussian profile, f → 1 at the source and upwind.
 
+Decay (``decay`` = p, 1 by default): the prefactor falls with distance as 1/r^p. p = 1 is the
+paper's point source in three dimensions; p = 1/2 is the far field of the same equation in two
+dimensions, a planar plume (the 2-D solution q'/(2π ζ1) · K0(r/λ) · exp(advection), with
+K0(s) ≈ √(π / 2s) e^(−s) for s ≫ 1, is this formula with r^(1/2) for r and a constant that the
+release rate absorbs). A planar plume's centreline mean falls as x^(−1/2…−1) downwind, a
+point source's as x^(−1) or faster; a reading model with the wrong law places the source
+upwind of a planar plume (it explains the slower fall by a more distant source). The reading
+model can weigh both (``estimator.learn = {decay = [1, 0.5]}``).
+
 The distance is clamped at :data:`MIN_DISTANCE` = 0.1 m, the scale of a sensor inlet, so the
 model stays finite when a hypothesised source sits on the sensor (the authors' MATLAB code uses
 1e-5 m, Stone Soup 0.1 m; a tiny clamp makes a particle at the sensor predict absurd
@@ -82,6 +91,7 @@ def isotropic_concentration_reference(
     positions: np.ndarray,
     min_distance: float = MIN_DISTANCE,
     meander: float = 0.0,
+    decay: float = 1.0,
 ) -> np.ndarray:
     """Plain NumPy implementation of the plume; the compiled kernel is tested against it.
 
@@ -104,7 +114,7 @@ def isotropic_concentration_reference(
     r = np.maximum(np.sqrt(dx * dx + dy * dy + dz * dz), min_distance)
     lam = np.sqrt(z1 * z2 / (1.0 + u * u * z2 / (4.0 * z1)))
     advection = (dx * u * np.cos(phi) + dy * u * np.sin(phi)) / (2.0 * z1)
-    return factor * q / (4.0 * np.pi * z1 * r) * np.exp(-r / lam - advection)
+    return factor * q / (4.0 * np.pi * z1 * r**decay) * np.exp(-r / lam - advection)
 
 
 def isotropic_concentration(
@@ -112,6 +122,7 @@ def isotropic_concentration(
     positions: np.ndarray,
     min_distance: float = MIN_DISTANCE,
     meander: float = 0.0,
+    decay: float = 1.0,
 ) -> np.ndarray:
     """Expected concentration (g/m³) of the isotropic plume, compiled.
 
@@ -120,7 +131,7 @@ def isotropic_concentration(
     """
     theta, positions = _check_shapes(theta, positions)
     out = np.empty((theta.shape[0], positions.shape[0]))
-    plume_kernels.concentration_matrix(theta, positions, min_distance, meander, out)
+    plume_kernels.concentration_matrix(theta, positions, min_distance, meander, decay, out)
     return out
 
 
@@ -131,11 +142,18 @@ class IsotropicPlume:
     min_distance: float = MIN_DISTANCE
     meander: float = 0.0
     """crosswind turbulence intensity i of the time-mean meander broadening (0: none)"""
+    decay: float = 1.0
+    """exponent p of the prefactor's fall with distance, 1/r^p: 1 a point source in 3-D (the
+    paper), 1/2 a planar plume (module doc)"""
 
     def __post_init__(self) -> None:
         if not (0.0 <= self.meander <= 2.0):
             raise DceeInputError("meander", f"must be in [0, 2], got {self.meander}")
+        if not (0.25 <= self.decay <= 2.0):
+            raise DceeInputError("decay", f"must be in [0.25, 2], got {self.decay}")
 
     def concentration(self, theta: np.ndarray, positions: np.ndarray) -> np.ndarray:
         """(N, 8) source terms × (M, 3) positions → (N, M) concentrations in g/m³."""
-        return isotropic_concentration(theta, positions, self.min_distance, self.meander)
+        return isotropic_concentration(
+            theta, positions, self.min_distance, self.meander, self.decay
+        )

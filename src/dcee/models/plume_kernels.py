@@ -47,9 +47,9 @@ def plume_terms(theta: np.ndarray, i: int):
 
 
 @njit(cache=True, inline="always")
-def plume_at(terms, px: float, py: float, pz: float, rmin: float, meander: float):
+def plume_at(terms, px: float, py: float, pz: float, rmin: float, meander: float, decay: float):
     """(concentration, clamped distance r) at (px, py, pz) from one particle's
-    :func:`plume_terms`; see :mod:`dcee.models.plume` for ``meander``."""
+    :func:`plume_terms`; see :mod:`dcee.models.plume` for ``meander`` and ``decay``."""
     sx, sy, sz, pref, inv_lam, ax, ay, c, s, k = terms
     dx = px - sx
     dy = py - sy
@@ -68,7 +68,8 @@ def plume_at(terms, px: float, py: float, pz: float, rmin: float, meander: float
         r = rmin
     if r0 < rmin:
         r0 = rmin
-    return factor * pref / r * math.exp(-r * inv_lam - dx * ax - dy * ay), r0
+    spread = r if decay == 1.0 else r**decay
+    return factor * pref / spread * math.exp(-r * inv_lam - dx * ax - dy * ay), r0
 
 
 @njit(cache=True, inline="always")
@@ -105,8 +106,8 @@ def plume_from_terms(
 ):
     """(concentration, clamped distance r) at (px, py, pz) of a particle with the first seven
     :func:`plume_terms` (x0, y0, z0, q/(4π ζ1), 1/λ, u cosφ/(2ζ1), u sinφ/(2ζ1)), without
-    meander. Branch-free (selects only) with the vectorisable exp; equals :func:`plume_at`
-    with meander 0 to rounding (0 below e^−700).
+    meander and with decay 1. Branch-free (selects only) with the vectorisable exp; equals
+    :func:`plume_at` with meander 0 and decay 1 to rounding (0 below e^−700).
 
     It takes scalars, not the (10, N) constants array and an index: an array-and-index helper,
     even inlined, could keep LLVM from vectorising the caller's loop over particles (the
@@ -123,7 +124,12 @@ def plume_from_terms(
 
 @njit(cache=True, parallel=True)
 def concentration_grid(
-    theta: np.ndarray, positions: np.ndarray, rmin: float, meander: float, out: np.ndarray
+    theta: np.ndarray,
+    positions: np.ndarray,
+    rmin: float,
+    meander: float,
+    decay: float,
+    out: np.ndarray,
 ):
     """out[m, i] = C(positions[m]; theta[i]). theta (N, 8), positions (M, 3), out (M, N)."""
     n = theta.shape[0]
@@ -132,7 +138,7 @@ def concentration_grid(
         terms = plume_terms(theta, i)
         for m in range(m_count):
             out[m, i] = plume_at(
-                terms, positions[m, 0], positions[m, 1], positions[m, 2], rmin, meander
+                terms, positions[m, 0], positions[m, 1], positions[m, 2], rmin, meander, decay
             )[0]
 
 
@@ -142,6 +148,7 @@ def concentration_distance_grid(
     positions: np.ndarray,
     rmin: float,
     meander: float,
+    decay: float,
     conc: np.ndarray,
     dist: np.ndarray,
 ):
@@ -151,15 +158,22 @@ def concentration_distance_grid(
     for i in prange(n):
         terms = plume_terms(theta, i)
         for m in range(m_count):
-            c, r = plume_at(terms, positions[m, 0], positions[m, 1], positions[m, 2], rmin, meander)
+            c, r = plume_at(
+                terms, positions[m, 0], positions[m, 1], positions[m, 2], rmin, meander, decay
+            )
             conc[m, i] = c
             dist[m, i] = r
 
 
 def concentration_matrix(
-    theta: np.ndarray, positions: np.ndarray, rmin: float, meander: float, out: np.ndarray
+    theta: np.ndarray,
+    positions: np.ndarray,
+    rmin: float,
+    meander: float,
+    decay: float,
+    out: np.ndarray,
 ):
     """out[i, m] = C(positions[m]; theta[i]); out (N, M) C-contiguous."""
     tmp = np.empty((positions.shape[0], theta.shape[0]))
-    concentration_grid(theta, positions, rmin, meander, tmp)
+    concentration_grid(theta, positions, rmin, meander, decay, tmp)
     out[...] = tmp.T

@@ -160,7 +160,9 @@ def floor_decision(
     readings = np.ascontiguousarray(readings, dtype=np.float64)
     shape = (positions.shape[0], theta.shape[0])
     conc, dist = np.empty(shape), np.empty(shape)
-    concentration_distance_grid(theta, positions, plume.min_distance, plume.meander, conc, dist)
+    concentration_distance_grid(
+        theta, positions, plume.min_distance, plume.meander, plume.decay, conc, dist
+    )
     terms = tuple(np.empty(shape) for _ in range(4))
     _floor_position_terms(conc, dist, sensor.params, *terms)
     if out is None:

@@ -51,6 +51,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("estimator", "repeat_power"): 1.0,
     # every nuisance setting of the reading model fixed before issue 42's learned bank
     ("estimator", "learn"): {},
+    # the point source's 1/r before issue 42's decay setting
+    ("estimator", "decay"): 1.0,
 }
 """Scenario settings added after campaigns were first stored, with the value a stored scenario
 without one ran with, so the two compare equal."""
@@ -67,6 +69,8 @@ FLUCTUATION_ONLY = (
     "calm_prior",
     "magnitude",
     "conserve_mean",
+    "decay",
+    "learn",
 )
 """Estimator settings that only the fluctuation likelihood reads: under the paper's likelihood
 they decide nothing, so changing their defaults must not orphan a campaign."""

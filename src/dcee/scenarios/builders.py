@@ -99,7 +99,12 @@ class ScenarioBuilders:
         if self.estimator.likelihood != "paper" and model == "paper":
             return IsotropicPlume(meander=0.0)  # the fluctuation likelihood's calm member
         learned = dict(self.reading_model_variants)[model]
-        return IsotropicPlume(meander=learned.get("meander", self.meander))
+        if self.estimator.likelihood == "paper":
+            return IsotropicPlume(meander=self.meander)
+        return IsotropicPlume(
+            meander=learned.get("meander", self.meander),
+            decay=learned.get("decay", self.estimator.decay),
+        )
 
     def _reading_model(self: Scenario, model: str | None) -> str:
         if model is None:

@@ -164,13 +164,14 @@ class AnemometerSpec(BaseModel):
     """°, standard deviation of a direction reading about the true direction"""
 
 
-LearnedName = Literal["meander", "log_sd", "intermittency", "near_source_length"]
+LearnedName = Literal["meander", "log_sd", "intermittency", "near_source_length", "decay"]
 """The reading model's nuisance parameters ``estimator.learn`` may weigh."""
 LEARN_RANGES: dict[str, tuple[float, float]] = {
     "meander": (0.0, 2.0),
     "log_sd": (1e-3, 5.0),
     "intermittency": (1e-3, 1.0),
     "near_source_length": (0.0, 1000.0),
+    "decay": (0.25, 2.0),
 }
 """Allowed values of each learned setting (as for the fixed setting)."""
 LEARN_MEMBERS_MAX = 12
@@ -231,6 +232,10 @@ class EstimatorSpec(BaseModel):
     p = 0.001), the along-wind bias halved on the puffs (−0.45 → −0.20 m) and turned downwind
     on the filament (−0.22 → +0.24 m), acquisition 56/56 either way, the truth in the 95 %
     region as often (86 % against 88 %) (docs/turbulent.md)"""
+    decay: Annotated[float, Field(ge=0.25, le=2.0, allow_inf_nan=False)] = 1.0
+    """fluctuation: the plume model's fall with distance, 1/r^decay (:mod:`dcee.models.plume`):
+    1, a point source in 3-D (the paper's model); 1/2, a planar plume's far field. The paper's
+    likelihood and the calm member always use 1"""
     meander: Annotated[float | None, Field(ge=0, le=2)] = None
     """crosswind turbulence intensity of the plume model's time-mean meander broadening
     (:mod:`dcee.models.plume`); None: the likelihood's default, :data:`MEANDER_DEFAULT`"""
