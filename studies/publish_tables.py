@@ -653,7 +653,70 @@ def cross_truth_table() -> str:
     return table(CROSS_HEADER, rows)
 
 
+def learn_tuning_table() -> str:
+    """The learned reading model against today's defaults on the tuning range (filament and
+    puffs only: the truths defaults may be chosen on), paired by search
+    (studies/precision_variants.py's rows in docs/results/tuning-learn-13-40)."""
+    from scipy.stats import binomtest, wilcoxon
+
+    frame = pd.read_csv(RESULTS / "tuning-learn-13-40" / "variants.csv")
+    names = {
+        "base": "today's defaults (fixed 1/r)",
+        "decay": "`learn = {decay = [1, 0.5]}`",
+        "both": "`learn = {meander = [0.15, 0.3, 0.6], log_sd = [1.3, 2]}`",
+    }
+    key = ["truth", "scenario", "seed"]
+    base = frame[frame["variant"] == "base"].set_index(key)
+    rows = []
+    for variant in ("base", "decay", "both"):
+        for truth in ("filament", "puffs", "both truths"):
+            part = frame[frame["variant"] == variant]
+            if truth != "both truths":
+                part = part[part["truth"] == truth]
+            elif part["truth"].nunique() < 2:
+                continue  # one truth only: its own row says it all
+            if part.empty:
+                continue
+            n = len(part)
+            paired = "—"
+            if variant != "base":
+                joined = part.set_index(key).join(base, rsuffix="_base", how="inner")
+                diff = joined["final_rmse"] - joined["final_rmse_base"]
+                p_rmse = wilcoxon(diff).pvalue if (diff != 0).any() else 1.0
+                gained = int((joined["truth_in_95"] & ~joined["truth_in_95_base"]).sum())
+                lost = int((~joined["truth_in_95"] & joined["truth_in_95_base"]).sum())
+                p_cov = binomtest(gained, gained + lost).pvalue if gained + lost else 1.0
+                paired = (
+                    f"{diff.median():+.2f} m (Wilcoxon p = {p_rmse:.2g}); 95 % region "
+                    f"+{gained} / −{lost} (p = {p_cov:.2g}), {len(joined)} pairs"
+                )
+            rows.append(
+                [
+                    names[variant],
+                    truth,
+                    str(n),
+                    f"{int(part['acquired'].sum())}/{n}",
+                    f"{part['final_rmse'].median():.2f}",
+                    f"{100 * part['truth_in_95'].mean():.0f} %",
+                    f"{part['along'].median():+.2f}",
+                    paired,
+                ]
+            )
+    header = [
+        "reading model",
+        "truth",
+        "n",
+        "acquired",
+        "median final RMSE (m)",
+        "truth in 95 %",
+        "median along-wind error (m)",
+        "paired with today's defaults: final RMSE, median difference; 95 % region gained / lost",
+    ]
+    return table(header, rows)
+
+
 TABLES: dict[str, Callable[[], str]] = {
+    "learn-tuning": learn_tuning_table,
     "cross-truth": cross_truth_table,
     "lbm-statistics": lbm_statistics_table,
     "what-we-found": what_we_found,
