@@ -666,7 +666,7 @@ def learn_tuning_table() -> str:
         "both": "`learn = {meander = [0.15, 0.3, 0.6], log_sd = [1.3, 2]}`",
     }
     key = ["truth", "scenario", "seed"]
-    base = frame[frame["variant"] == "base"].set_index(key)
+    base = frame[frame["variant"] == "base"]
     rows = []
     for variant in ("base", "decay", "both"):
         for truth in ("filament", "puffs", "both truths"):
@@ -680,7 +680,7 @@ def learn_tuning_table() -> str:
             n = len(part)
             paired = "—"
             if variant != "base":
-                joined = part.set_index(key).join(base, rsuffix="_base", how="inner")
+                joined = part.merge(base, on=key, suffixes=("", "_base"))
                 diff = joined["final_rmse"] - joined["final_rmse_base"]
                 p_rmse = wilcoxon(diff).pvalue if (diff != 0).any() else 1.0
                 gained = int((joined["truth_in_95"] & ~joined["truth_in_95_base"]).sum())
