@@ -64,27 +64,38 @@ def test_log_evidence_of_the_first_reading_by_hand():
     assert pf.log_evidence == info.log_evidence
 
 
+def _bank_on_simulated_readings(
+    scenario, generating: str, seed: int, copies: int, priors: bool = True
+) -> ModelBank:
+    """A bank of the scenario's reading models (3000 particles each, x and y unknown) after the
+    lawnmower path flown ``copies`` times with readings drawn from model ``generating``; equal
+    prior probabilities unless ``priors``."""
+    ps = np.vstack([_lawnmower(40)] * copies)
+    zs = _readings(
+        scenario.make_estimator_sensor(generating), ps, seed, plume=scenario.make_plume(generating)
+    )
+    filters = [
+        ParticleFilter(
+            _xy_prior(),
+            scenario.make_estimator_sensor(m),
+            scenario.make_plume(m),
+            n_particles=3000,
+            seed=i,
+        )
+        for i, m in enumerate(scenario.reading_models)
+    ]
+    probabilities = scenario.reading_model_priors if priors else None
+    bank = ModelBank(filters, scenario.reading_models, probabilities)
+    for p, z in zip(ps, zs, strict=True):
+        bank.update(p, z)
+    return bank
+
+
 @pytest.mark.parametrize("generating", ["paper", "fluctuation"])
 def test_bank_selects_the_model_that_made_the_readings(generating):
     """Readings drawn from one of the two reading models (the same mean plume) on a fixed
     path: the bank gives that model a posterior probability above 0.99."""
-    ps = _lawnmower(40)
-    ps = np.vstack([ps, ps])  # 80 readings
-    sensor = FLUCT.make_estimator_sensor(generating)
-    zs = _readings(sensor, ps, seed=11, plume=FLUCT.make_plume(generating))
-    filters = [
-        ParticleFilter(
-            _xy_prior(),
-            FLUCT.make_estimator_sensor(m),
-            FLUCT.make_plume(m),
-            n_particles=3000,
-            seed=i,
-        )
-        for i, m in enumerate(FLUCT.reading_models)
-    ]
-    bank = ModelBank(filters, FLUCT.reading_models)
-    for p, z in zip(ps, zs, strict=True):
-        bank.update(p, z)
+    bank = _bank_on_simulated_readings(FLUCT, generating, seed=11, copies=2, priors=False)
     assert bank.selected_name == generating
     assert bank.probabilities[bank.selected] > 0.99
     assert bank.probabilities.sum() == pytest.approx(1.0)
@@ -262,24 +273,7 @@ def test_learned_bank_finds_the_nuisance_values_that_made_the_readings(generatin
         "fluctuation[meander=0.5,log_sd=2]",
     )
     assert LEARNED.reading_model_priors == pytest.approx((0.25,) * 4)
-    ps = _lawnmower(40)
-    ps = np.vstack([ps, ps, ps])  # 120 readings
-    zs = _readings(
-        LEARNED.make_estimator_sensor(generating), ps, 5, plume=LEARNED.make_plume(generating)
-    )
-    filters = [
-        ParticleFilter(
-            _xy_prior(),
-            LEARNED.make_estimator_sensor(m),
-            LEARNED.make_plume(m),
-            n_particles=3000,
-            seed=i,
-        )
-        for i, m in enumerate(LEARNED.reading_models)
-    ]
-    bank = ModelBank(filters, LEARNED.reading_models, LEARNED.reading_model_priors)
-    for p, z in zip(ps, zs, strict=True):
-        bank.update(p, z)
+    bank = _bank_on_simulated_readings(LEARNED, generating, seed=5, copies=3)
     assert bank.selected_name == generating
     assert bank.probabilities[bank.selected] > 0.5
 
@@ -306,18 +300,6 @@ def test_learned_decay_tells_a_planar_plume_from_a_point_source(generating):
     )
     assert learned.reading_models == ("fluctuation", "fluctuation[decay=0.5]")
     assert learned.make_plume("fluctuation[decay=0.5]").decay == 0.5
-    ps = np.vstack([_lawnmower(40)] * 3)
-    zs = _readings(
-        learned.make_estimator_sensor(generating), ps, 8, plume=learned.make_plume(generating)
-    )
-    filters = [
-        ParticleFilter(
-            _xy_prior(), learned.make_estimator_sensor(m), learned.make_plume(m), 3000, seed=i
-        )
-        for i, m in enumerate(learned.reading_models)
-    ]
-    bank = ModelBank(filters, learned.reading_models, learned.reading_model_priors)
-    for p, z in zip(ps, zs, strict=True):
-        bank.update(p, z)
+    bank = _bank_on_simulated_readings(learned, generating, seed=8, copies=3)
     assert bank.selected_name == generating
     assert bank.probabilities[bank.selected] > 0.9
