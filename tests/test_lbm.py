@@ -128,3 +128,25 @@ def test_a_scenario_on_the_lbm_truth_is_planar(monkeypatch, tmp_path) -> None:
         scenario.with_overrides(**{"agent.climb": 1.0})
     with pytest.raises(DceeInputError, match=r"truth\.u"):
         lbm.SolverPlumeTruth(_canonical(), np.zeros(3), 1.0, 0.0, 0.0, 1.0, 0.0)
+
+
+def test_plume_command_computes_once_and_refuses_bad_settings(monkeypatch, tmp_path, capsys):
+    import json
+
+    from tests.helpers import run_cli
+
+    monkeypatch.setenv("DCEE_CACHE", str(tmp_path))
+    settings = [f"--set=truth.model.{k}={v}" for k, v in {**SMALL, "duration": 40.0}.items()]
+    out = tmp_path / "stats.json"
+    code, stdout, _ = run_cli(["plume", "-q", *settings, "--json", str(out)], capsys)
+    assert code == 0 and "cached recording" in stdout
+    doc = json.loads(out.read_text())
+    assert [round(s["x"]) for s in doc["sections"]] == [5, 10, 20, 30]
+    assert all(0.5 < s["flux"] < 1.2 for s in doc["sections"])
+    # a second call reads the cache back
+    monkeypatch.setattr(lbm, "solve", lambda *a, **k: pytest.fail("solved again"))
+    assert run_cli(["plume", "-q", *settings], capsys)[0] == 0
+    code, _, err = run_cli(["plume", "--set", "truth.model.bogus=1"], capsys)
+    assert code == 2 and err.startswith("dcee: error: truth.model.bogus: not a setting")
+    code, _, err = run_cli(["plume", "--set", "spacing=-1"], capsys)
+    assert code == 2 and "truth.model.spacing" in err and len(err.strip().splitlines()) == 1
