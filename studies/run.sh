@@ -341,6 +341,8 @@ case "${1:---list}" in
       --csv docs/results/lbm-held-out-100/paired.csv --tag reference=dcee-cl
     $P studies/worst_searches.py results/turbulent-lbm-held-out-100=dcee-cl \
       results/turbulent-lbm-held-out-100=infotaxis --out docs/figures/lbm-held-out-worst.png
+    $P studies/upwind_detections.py results/turbulent-lbm-held-out-100=dcee-cl \
+      results/turbulent-lbm-held-out-100=infotaxis results/turbulent-lbm-held-out-100-decay=dcee-cl
     $P studies/publish_tables.py ;;
   publish)  # the tables of README.md, docs/index.md, docs/results.md from docs/results/
     $P studies/publish_tables.py ;;
