@@ -133,3 +133,19 @@ def test_show_says_what_each_default_was_chosen_on() -> None:
     from dcee.scenarios import validate_scenario
 
     assert validate_scenario(tomllib.loads(text)) == scenario
+
+
+def test_run_says_when_the_source_is_off_a_planar_truths_plane(tmp_path: Path, capsys) -> None:
+    from tests.helpers import run_cli
+
+    path = _plume_2d(tmp_path / "flat.npy")
+    argv = ["run", "--scenario", "random:1", "--truth", str(path), "--budget", "20"]
+    argv += ["--particles", "300", "--no-figure"]
+    for setting in ("truth.x=25.0", "truth.y=25.0", "truth.phi=180.0", "prior.phi.mean=180.0"):
+        argv += ["--set", setting]
+    argv += ["--set", "truth.model.loop=true"]
+    code, _, err = run_cli([*argv, "--out", str(tmp_path / "a")], capsys)
+    z = load_scenario("random:1").truth.z
+    assert code == 0 and f"takes the source at truth.z = {z:g} m" in err
+    code, _, err = run_cli([*argv, "--set", "truth.z=4.0", "--out", str(tmp_path / "b")], capsys)
+    assert code == 0 and "planar" not in err
