@@ -650,7 +650,7 @@ def cross_truth_table() -> str:
     for _, r in lbm.iterrows():
         how = "" if r["learn"] == "none" else f", `estimator.learn` {r['learn']} (an option)"
         if int(r["searches"]) < 100:
-            how += ", `held-out-24` (small sample)"
+            how += f", {int(r['searches'])} configurations (small sample)"
         add(f"**lbm** (fluid solver), fluctuation likelihood{how}", "none", r, "lbm-held-out-100")
     return table(CROSS_HEADER, rows)
 
