@@ -63,6 +63,10 @@ def test_layout_is_read_from_the_header(tmp_path: Path) -> None:
     assert recording_layout(_plume_2d(tmp_path / "cube.npy", three_d=True)) == (False, None)
     with pytest.raises(DceeInputError, match="no such file"):
         recording_layout(tmp_path / "missing.npy")
+    (tmp_path / "plume.txt").write_text("1 2 3")
+    with pytest.raises(DceeInputError) as err:
+        recording_layout(tmp_path / "plume.txt")
+    assert str(err.value).count("truth.model.file") == 1 and "unsupported" in str(err.value)
 
 
 def test_cf_slice_declares_its_plane(tmp_path: Path) -> None:

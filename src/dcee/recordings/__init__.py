@@ -62,6 +62,8 @@ def recording_layout(
                 f"unsupported recording {path.name!r}: use .npy (with .json), .h5 or CF "
                 "NetCDF (.nc)",
             )
+    except DceeInputError:
+        raise  # already one line naming the field (a ValueError: not to be wrapped below)
     except ImportError:
         raise DceeInputError(
             FIELD, "HDF5 recordings need h5py: pip install 'dcee[hdf5]' (or use .npy)"

@@ -96,11 +96,11 @@ class ScenarioBuilders:
         """The dispersion model of the filter and the planners under reading model ``model``
         (None: the first of :attr:`reading_models`)."""
         model = self._reading_model(model)
-        if self.estimator.likelihood != "paper" and model == "paper":
-            return IsotropicPlume(meander=0.0)  # the fluctuation likelihood's calm member
-        learned = dict(self.reading_model_variants)[model]
         if self.estimator.likelihood == "paper":
             return IsotropicPlume(meander=self.meander)
+        if model == "paper":
+            return IsotropicPlume(meander=0.0)  # the fluctuation likelihood's calm member
+        learned = dict(self.reading_model_variants)[model]
         return IsotropicPlume(
             meander=learned.get("meander", self.meander),
             decay=learned.get("decay", self.estimator.decay),

@@ -5,7 +5,8 @@ their agreement with it proves little. This truth is computed by a solver nobody
 `lbmpy <https://pypi.org/project/lbmpy/>`_ (FAU Erlangen, code generation of compiled
 lattice Boltzmann kernels), chosen by measurement (docs/scenarios.md: phiflow's NumPy backend
 took 0.9 s per step of a 256 × 128 grid on this 2-core machine, lbmpy 0.7 ms per step of a
-200 × 144 grid with the scalar, about 1,000 times less per cell).
+200 × 144 grid with the scalar, about 1,000 times less per cell; one unstored scratch run of
+each, a lab note rather than a benchmark).
 
 **Flow.** The incompressible Navier-Stokes equations in 2-D (D2Q9 cumulant lattice Boltzmann,
 Smagorinsky subgrid model) in a channel ``[-grid_distance - 4, downstream] × [-width/2,
