@@ -418,3 +418,15 @@ def test_an_edited_scenario_carries_a_derived_name_and_its_edits(tmp_path, capsy
     assert edited["edits"] == {"sensor.pd": 0.6}
     config = json.loads((tmp_path / "results" / folder / "config.json").read_text())
     assert config["edits"] == {"sensor.pd": 0.6}
+
+
+def test_likelihood_applies_before_the_settings_that_need_it():
+    """--set estimator.learn needs the fluctuation likelihood: --likelihood must come first in
+    the overrides (they are validated one at a time)."""
+    from dcee.cli.options import overrides
+    from dcee.scenarios import load_scenario
+
+    over = overrides("fluctuation", ("estimator.learn={decay=[1.0,0.5]}",))
+    assert list(over) == ["estimator.likelihood", "estimator.learn"]
+    scenario = load_scenario("random:1").with_overrides(**over)
+    assert scenario.reading_models == ("fluctuation", "fluctuation[decay=0.5]", "paper")
