@@ -430,3 +430,30 @@ def test_likelihood_applies_before_the_settings_that_need_it():
     assert list(over) == ["estimator.likelihood", "estimator.learn"]
     scenario = load_scenario("random:1").with_overrides(**over)
     assert scenario.reading_models == ("fluctuation", "fluctuation[decay=0.5]", "paper")
+
+
+def test_an_interrupt_inside_a_finaliser_still_ends_the_command(capsys):
+    """Ctrl-C landing inside a ``__del__`` (numba's finalisers, say) is not printed and lost:
+    the command ends with exit 130 and one line, no traceback."""
+    import click
+
+    from dcee.console import run_command
+
+    class InterruptedWhileCollected:
+        def __del__(self):
+            raise KeyboardInterrupt
+
+    @click.command()
+    def busy():
+        obj = InterruptedWhileCollected()
+        del obj  # the interrupt is raised in the finaliser: Python would print and go on
+        for _ in range(10_000_000):  # the redelivered interrupt ends this loop at once
+            pass
+        raise AssertionError("the interrupt was lost")
+
+    previous = sys.unraisablehook
+    with pytest.raises(SystemExit) as exc:
+        run_command(busy, "dcee", [])
+    assert exc.value.code == 130 and sys.unraisablehook is previous
+    err = capsys.readouterr().err
+    assert err.strip() == "dcee: interrupted" and "Traceback" not in err

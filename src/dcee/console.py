@@ -30,9 +30,28 @@ def error_exit(program: str, message: str) -> None:
     sys.exit(USER_ERROR)
 
 
+def _redeliver_interrupts(unraisable: Any, fallback: Callable[[Any], None]) -> None:
+    """An exception inside a finaliser (``__del__``, numba's and llvmlite's among them) cannot
+    propagate: Python prints it with a traceback and goes on. A Ctrl-C that lands there would be
+    lost and printed; this raises it again in the main thread shortly after, once the finaliser has
+    returned (from a timer thread: a signal simulated here would be raised inside this hook and
+    lost again; should it land in another finaliser, this hook defers it once more)."""
+    if unraisable.exc_type is KeyboardInterrupt:
+        import _thread
+        import threading
+
+        timer = threading.Timer(0.01, _thread.interrupt_main)
+        timer.daemon = True
+        timer.start()
+    else:
+        fallback(unraisable)
+
+
 def run_command(command: click.Command, program: str, argv: list[str] | None = None) -> None:
     """Run a click ``command`` as program ``program``: a user mistake ends in one line on stderr
     and exit 2, an interruption in exit 130, success in exit 0 (never a traceback for either)."""
+    previous = sys.unraisablehook
+    sys.unraisablehook = lambda u: _redeliver_interrupts(u, previous)
     try:
         command.main(args=argv, prog_name=program, standalone_mode=False)
     except DceeInputError as exc:
@@ -42,6 +61,8 @@ def run_command(command: click.Command, program: str, argv: list[str] | None = N
     except (KeyboardInterrupt, click.exceptions.Abort):
         click.echo(f"{program}: interrupted", err=True)
         sys.exit(INTERRUPTED)
+    finally:
+        sys.unraisablehook = previous
     sys.exit(0)
 
 

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import time
 import traceback
 from collections.abc import Callable, Iterator
@@ -251,6 +252,10 @@ def _init_worker(started: Any = None, own_process: bool = False) -> None:
     _STARTED = started
     numba.set_num_threads(1)
     if own_process:
+        # Ctrl-C reaches the whole process group. The driver stops its workers itself
+        # (_local_results); a worker that took the KeyboardInterrupt could take it anywhere, even
+        # inside a finaliser (numba's, say), where Python prints a traceback and carries on.
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
         from dcee.allocator import tune_allocator
         from dcee.blas import limit_process_blas
 
@@ -320,6 +325,12 @@ def _local_results(
                     lost.append(i)
                 except Exception as exc:  # not the search (it never raises): pickling, say
                     yield {"status": "failed", "task": tasks[i], "error": repr(exc)}
+        except KeyboardInterrupt:
+            # the workers ignore SIGINT: stop them now rather than wait for their searches
+            # (a search writes its results atomically, so a killed one leaves nothing half done)
+            for process in list((getattr(pool, "_processes", None) or {}).values()):
+                process.terminate()
+            raise
         finally:
             for f in futures:
                 f.cancel()
