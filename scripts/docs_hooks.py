@@ -3,16 +3,48 @@
 * ``reference/cli.md``: the ``--help`` of every ``dcee`` command (from the click objects).
 * ``reference/scenario.md``: every scenario field with its type, default, allowed range and
   description (from the pydantic models; the descriptions are the attribute docstrings).
+* Every page, written or generated, is refused if its Markdown or its HTML holds a control
+  character (a ``\\b`` typed into a Python string as ``\b`` becomes a backspace and breaks the
+  equation around it, which only a browser would show).
 """
 
 from __future__ import annotations
 
+import re
 import types
 import typing
 from typing import Any
 
 import click
+from mkdocs.exceptions import PluginError
 from mkdocs.structure.files import File, Files
+
+CONTROL_CHARACTER = re.compile(r"[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]")
+"""Any C0 control character but tab, newline and carriage return, and DEL."""
+
+
+def control_characters(text: str) -> list[str]:
+    """Where ``text`` holds a control character: ``"line L: U+00XX"`` for each (empty: none)."""
+    return [
+        f"line {text.count(chr(10), 0, m.start()) + 1}: U+{ord(m.group()):04X}"
+        for m in CONTROL_CHARACTER.finditer(text)
+    ]
+
+
+def _refuse_control_characters(text: str, where: str) -> None:
+    found = control_characters(text)
+    if found:
+        raise PluginError(f"{where}: control character at {', '.join(found[:3])}")
+
+
+def on_page_markdown(markdown: str, page: Any, config: Any, files: Files) -> str:
+    _refuse_control_characters(markdown, page.file.src_uri)
+    return markdown
+
+
+def on_post_page(output: str, page: Any, config: Any) -> str:
+    _refuse_control_characters(output, f"{page.file.dest_uri} (built)")
+    return output
 
 
 def on_files(files: Files, config: Any) -> Files:
