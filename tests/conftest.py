@@ -9,4 +9,4 @@ from dcee.models.sensor import Sensor
 
 @pytest.fixture
 def sensor() -> Sensor:
-    return Sensor()
+    return Sensor.paper_exact()

@@ -31,7 +31,7 @@ def test_vectorised_exp_matches_math_exp():
 def test_missed_detection_likelihood_small_and_large_concentrations(pd):
     """The linearised branch (C < 1e-6 σ_min) and the erfc branch agree with scipy to 1e-15
     absolute across the switch, and to 1e-9 relative far from it."""
-    sensor = Sensor(pd=pd)
+    sensor = Sensor.paper_exact(pd=pd)
     sp = sensor.params
     c_lin = sp.c_lin
     c = np.concatenate([[0.0], c_lin * np.array([0.01, 0.5, 0.999, 1.001, 2.0]), [1e-4, 5e-4]])
@@ -60,7 +60,7 @@ def test_predicted_stats_unreachable_reading_takes_exact_path():
     one-pass sums; the kernel must redo it exactly and still match the reference."""
     source, weights, conc = _stats_case()
     conc[1] = np.random.default_rng(0).uniform(1e-6, 2e-5, conc.shape[1])
-    sensor = Sensor()
+    sensor = Sensor.paper_exact()
     task_pos = np.array([[0], [1], [1], [2]])
     task_z = np.array([[0.0], [1e-2], [3e-4], [1e-3]])
     out = _run(conc, source, weights, task_pos, task_z, sensor)
@@ -72,7 +72,7 @@ def test_predicted_stats_unreachable_reading_takes_exact_path():
 
 def test_predicted_stats_optional_outputs_are_skipped_not_wrong():
     source, weights, conc = _stats_case()
-    sensor = Sensor()
+    sensor = Sensor.paper_exact()
     task_pos = np.array([[0], [0], [2]])
     task_z = np.array([[0.0], [2e-3], [1e-3]])
     full = _run(conc, source, weights, task_pos, task_z, sensor)
@@ -97,7 +97,7 @@ def test_predicted_stats_optional_outputs_are_skipped_not_wrong():
 def test_predicted_stats_multi_step_sequences_match_reference():
     """Horizon 3 (dcee-ms): several readings per task, mixed detections and non-detections."""
     source, weights, conc = _stats_case(n=1500, seed=8)
-    sensor = Sensor()
+    sensor = Sensor.paper_exact()
     rng = np.random.default_rng(1)
     task_pos = np.repeat(np.array([[0, 1, 2], [2, 2, 0]]), 6, axis=0)
     task_z = np.where(rng.random((12, 3)) < 0.4, 0.0, rng.lognormal(-7, 1, (12, 3)))
@@ -110,12 +110,12 @@ def test_predicted_stats_multi_step_sequences_match_reference():
 @pytest.mark.parametrize(
     "sensor",
     [
-        Sensor(family="lognormal", pd=0.5),
+        Sensor.paper_exact(family="lognormal", pd=0.5),
         Sensor(family="lognormal", pd=0.5, outlier=0.01),
         Sensor(outlier=0.01),
         Sensor(family="lognormal", pd=0.6, outlier=0.01, false_alarm=0.02),
         Sensor(family="lognormal", pd=0.6, outlier=0.01, near_length=5.0),
-        Sensor(near_length=3.0),
+        Sensor.paper_exact(near_length=3.0),
         Sensor(family="lognormal", pd=0.6, log_sd_near=2.0, log_sd_length=3.0, outlier=0.01),
         Sensor(family="lognormal", pd=0.6, outlier=0.01, near_length=5.0, conserve_mean=True),
     ],
@@ -158,12 +158,12 @@ def test_vectorised_log1p_matches_math_log1p():
 @pytest.mark.parametrize(
     "sensor",
     [
-        Sensor(pd=0.7),
-        Sensor(pd=1.0),
-        Sensor(family="lognormal", pd=0.6),
-        Sensor(family="lognormal", pd=0.6, near_length=3.0),
-        Sensor(family="lognormal", pd=0.6, log_sd_near=2.0, log_sd_length=3.0),
-        Sensor(family="lognormal", pd=0.6, near_length=3.0, conserve_mean=True),
+        Sensor.paper_exact(pd=0.7),
+        Sensor.paper_exact(pd=1.0),
+        Sensor.paper_exact(family="lognormal", pd=0.6),
+        Sensor.paper_exact(family="lognormal", pd=0.6, near_length=3.0),
+        Sensor.paper_exact(family="lognormal", pd=0.6, log_sd_near=2.0, log_sd_length=3.0),
+        Sensor.paper_exact(family="lognormal", pd=0.6, near_length=3.0, conserve_mean=True),
     ],
     ids=["gauss", "gauss-pd1", "ln", "ln+near", "ln+spread", "ln+conserve"],
 )
@@ -248,7 +248,7 @@ def test_vectorised_exp_matches_math_exp_at_every_power_of_two():
 
 @pytest.mark.parametrize(
     "sensor",
-    [Sensor(), Sensor(family="lognormal", pd=0.6, outlier=0.01, near_length=5.0)],
+    [Sensor.paper_exact(), Sensor(family="lognormal", pd=0.6, outlier=0.01, near_length=5.0)],
     ids=["paper", "fluctuation"],
 )
 def test_location_kl_matches_reference_and_its_limits(sensor):

@@ -244,12 +244,16 @@ def test_nan_reading_is_rejected(sensor, bad):
 @pytest.mark.parametrize(
     "sensor",
     [
-        Sensor(),  # the paper's: vectorised non-detections
-        Sensor(pd=1.0),
+        Sensor.paper_exact(),  # the paper's: vectorised non-detections
+        Sensor.paper_exact(pd=1.0),
         Sensor(false_alarm=0.02, outlier=0.01),
         Sensor(family="lognormal", pd=0.6, log_sd=1.3, outlier=0.01),
-        Sensor(family="lognormal", pd=0.6, log_sd=1.0, log_sd_near=2.0, log_sd_length=3.0),
-        Sensor(family="lognormal", pd=0.9, log_sd=1.3, near_length=5.0, magnitude=False),
+        Sensor.paper_exact(
+            family="lognormal", pd=0.6, log_sd=1.0, log_sd_near=2.0, log_sd_length=3.0
+        ),
+        Sensor.paper_exact(
+            family="lognormal", pd=0.9, log_sd=1.3, near_length=5.0, magnitude=False
+        ),
     ],
     ids=["paper", "pd1", "fa+outlier", "lognormal", "lognormal+spread", "detection-only"],
 )
@@ -330,7 +334,7 @@ def test_both_estimators_implement_the_estimator_interface_and_resample_on_deman
 
     def filt(seed: int) -> ParticleFilter:
         return ParticleFilter(
-            planar_prior(), Sensor(), IsotropicPlume(), n_particles=4000, seed=seed
+            planar_prior(), Sensor.paper_exact(), IsotropicPlume(), n_particles=4000, seed=seed
         )
 
     lone, bank = filt(0), ModelBank([filt(1), filt(2)], ["a", "b"])

@@ -10,7 +10,7 @@ from dcee.planning.particle_terms import ParticleTerms, merge_runs
 from dcee.planning.predicted import PredictionContext
 from tests.helpers import random_theta
 
-SENSOR = Sensor()
+SENSOR = Sensor.paper_exact()
 PLUME = IsotropicPlume()
 
 

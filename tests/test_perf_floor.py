@@ -12,7 +12,9 @@ from dcee.planning.predicted_kernels import predicted_posterior_stats_reference
 from dcee.scenarios import load_scenario
 
 
-@pytest.mark.parametrize("sensor", [Sensor(), Sensor(family="lognormal", pd=0.6, outlier=0.01)])
+@pytest.mark.parametrize(
+    "sensor", [Sensor.paper_exact(), Sensor(family="lognormal", pd=0.6, outlier=0.01)]
+)
 def test_floor_decision_matches_numpy_reference(sensor):
     scenario = load_scenario("paper:1")
     pf = ParticleFilter(scenario.make_prior(), sensor, n_particles=3000, seed=4)

@@ -15,7 +15,7 @@ START = np.array([10.0, 10.0, 0.0])
 def _belief(points, weights=None, **kw) -> Belief:
     theta = theta_at([(*p, 0.0) for p in points], **kw)
     w = np.full(len(points), 1 / len(points)) if weights is None else np.asarray(weights, float)
-    return Belief(theta, w / w.sum(), Sensor(), IsotropicPlume())
+    return Belief(theta, w / w.sum(), Sensor.paper_exact(), IsotropicPlume())
 
 
 def _two_point_belief(n_each=500):
@@ -146,7 +146,7 @@ def test_location_infotaxis_values_only_what_a_reading_tells_about_the_location(
     # location is certain, so the location information is 0 for every move.
     pts = [(13.0, 10.0, 0.0)] * 400
     theta = np.vstack([theta_at(pts[:200], q=0.02, u=0.0), theta_at(pts[200:], q=2.0, u=0.0)])
-    rates = Belief(theta, np.full(400, 1 / 400), Sensor(), IsotropicPlume())
+    rates = Belief(theta, np.full(400, 1 / 400), Sensor.paper_exact(), IsotropicPlume())
     rng = np.random.default_rng
     joint = planners.get("infotaxis").decide(rates, START, AGENT, rng(0))
     location = planners.get("infotaxis:about=location").decide(rates, START, AGENT, rng(0))
@@ -165,9 +165,9 @@ def test_location_infotaxis_values_only_what_a_reading_tells_about_the_location(
 def test_a_belief_of_the_wrong_shape_is_refused():
     theta = theta_at([(1.0, 2.0, 0.0)] * 3)
     with pytest.raises(DceeInputError, match="theta"):
-        Belief(theta[:, :7], np.full(3, 1 / 3), Sensor(), IsotropicPlume())
+        Belief(theta[:, :7], np.full(3, 1 / 3), Sensor.paper_exact(), IsotropicPlume())
     with pytest.raises(DceeInputError, match="weights"):
-        Belief(theta, np.full(4, 1 / 4), Sensor(), IsotropicPlume())
+        Belief(theta, np.full(4, 1 / 4), Sensor.paper_exact(), IsotropicPlume())
 
 
 def test_multistage_plans_through_an_intermediate_point():
@@ -195,7 +195,7 @@ def test_compiled_predicted_stats_match_reference(false_alarm):
     n = 3000
     pts = np.column_stack([rng.uniform(0, 20, n), rng.uniform(0, 20, n)])
     belief = _belief(pts, weights=rng.random(n), q=2.0, u=2.0, phi=0.5)
-    sensor = Sensor(false_alarm=false_alarm)
+    sensor = Sensor.paper_exact(false_alarm=false_alarm)
     positions = np.array([[5.0, 5.0, 0.0], [8.0, 12.0, 0.0], [15.0, 3.0, 0.0]])
     conc = np.ascontiguousarray(belief.plume.concentration(belief.theta, positions).T)
     task_pos = np.array([[0, 1], [1, 2], [2, 2], [0, 0]])
@@ -448,7 +448,7 @@ def test_a_climbing_dcee_cl_values_a_reading_at_another_height():
     # the vertical reach the move towards one of them is the cheapest (it resolves the height,
     # which the agent can then act on).
     theta = theta_at([(10.0, 10.0, 0.0)] * 300 + [(10.0, 10.0, 4.0)] * 300, q=0.02, u=0.0)
-    belief = Belief(theta, np.full(600, 1 / 600), Sensor(), IsotropicPlume())
+    belief = Belief(theta, np.full(600, 1 / 600), Sensor.paper_exact(), IsotropicPlume())
     agent = GridAgent(SearchVolume((0.0, 0.0, 0.0), (40.0, 40.0, 5.0)), step=2.0, climb=1.0)
     position = np.array([10.0, 10.0, 2.0])
     new = planners.get("dcee-cl:hypotheses=12").decide(

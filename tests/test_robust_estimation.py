@@ -21,7 +21,7 @@ from dcee.runs import run_episode
 from dcee.scenarios import load_scenario
 from dcee.searcher import Searcher
 from dcee.simulation import InjectedTruth, make_truth
-from tests.helpers import random_theta, run_cli
+from tests.helpers import random_theta, run_cli, spike_ess_share
 
 PAPER1 = load_scenario("paper:1")  # source (37.5, 12.5, 1), wind from +x at 4 m/s: plume to -x
 THETA = PAPER1.truth_theta()
@@ -158,7 +158,7 @@ def _xy_prior(scenario=PAPER1) -> SourcePrior:
 
 
 def test_absurd_readings_are_refused_before_anything_changes():
-    pf = ParticleFilter(_xy_prior(), Sensor(), n_particles=2000, seed=0)
+    pf = ParticleFilter(_xy_prior(), Sensor.paper_exact(), n_particles=2000, seed=0)
     before = pf.theta.copy()
     for bad in (1e200, float("nan"), "12", None, np.array([1.0, 2.0])):
         with pytest.raises(DceeInputError, match="reading"):
@@ -167,7 +167,7 @@ def test_absurd_readings_are_refused_before_anything_changes():
 
 
 FUZZ_SENSORS = {
-    "paper": Sensor(),
+    "paper": Sensor.paper_exact(),
     "paper+outlier": Sensor(outlier=0.01),
     "fluctuation": Sensor(family="lognormal", pd=0.63, log_sd=1.3, near_length=5.4, outlier=0.01),
 }
@@ -237,6 +237,39 @@ def test_one_huge_spike_does_not_decide_a_search_with_default_settings(config):
     assert ends[0.0] == (True, False)
 
 
+SPIKE_SCENARIO = PAPER1.with_overrides(**{"search.particles": 2000})
+
+
+def test_one_outlier_safety_default_for_every_way_of_building_a_filter():
+    """Issue 43: one 10⁶ × reading through each entry point that builds a filter — the Python
+    classes with their own defaults, a scenario's searcher (the simulation, ``dcee replay`` and
+    the ROS node build theirs there; the node itself: tests/ros) and the gym environment —
+    leaves most of the particles' weight (the outlier safety, ``OUTLIER_DEFAULT``). The paper's
+    exact likelihood, asked for by name, gives all the weight to one particle: the check can
+    fail."""
+    import gymnasium
+
+    import dcee.gym  # noqa: F401  (registers the environments)
+    from dcee.models.sensor import OUTLIER_DEFAULT
+    from dcee.runs import make_searcher
+
+    assert Sensor().outlier == SPIKE_SCENARIO.outlier == OUTLIER_DEFAULT > 0
+    prior = SPIKE_SCENARIO.make_prior()
+    classes = ParticleFilter(prior, Sensor(), n_particles=2000, seed=1)
+    rngs = np.random.default_rng(1), np.random.default_rng(2)
+    scenario = make_searcher(SPIKE_SCENARIO, None, *rngs).filter
+    env = gymnasium.make("dcee/SourceSearch-v0", scenario=SPIKE_SCENARIO, particles=2000)
+    env.reset(seed=0)
+    gym = env.unwrapped._sim().searcher.filter
+    shares = {
+        name: spike_ess_share(f, SPIKE_SCENARIO)
+        for name, f in (("classes", classes), ("scenario", scenario), ("gym", gym))
+    }
+    assert all(share > 0.5 for share in shares.values()), shares
+    exact = ParticleFilter(prior, Sensor.paper_exact(), n_particles=2000, seed=1)
+    assert spike_ess_share(exact, SPIKE_SCENARIO) < 0.01
+
+
 # --- a filter that keeps every mode ---
 
 
@@ -284,7 +317,7 @@ def test_global_moves_rebalance_separated_modes():
     d = {n: Fixed(v) for n, v in vals.items()}
     d["x"], d["y"] = Uniform(0, 20), Uniform(0, 10)
     prior = SourcePrior.from_dict(d)
-    sensor = Sensor(pd=1.0)
+    sensor = Sensor.paper_exact(pd=1.0)
     shares = {}
     for share in (0.0, 0.3):
         pf = ParticleFilter(prior, sensor, n_particles=4000, seed=2, global_share=share)
@@ -306,7 +339,7 @@ def test_global_moves_rebalance_separated_modes():
 def test_credible_region_covers_the_truth_at_its_level():
     """Truths drawn from the posterior itself are inside its 95% region 95% of the time."""
     rng = np.random.default_rng(3)
-    pf = ParticleFilter(_xy_prior(), Sensor(), n_particles=4000, seed=0)
+    pf = ParticleFilter(_xy_prior(), Sensor.paper_exact(), n_particles=4000, seed=0)
     pf.theta[:, 0] = 20 + 2.0 * rng.standard_normal(pf.n)
     pf.theta[:, 1] = 20 + rng.standard_t(4, pf.n)  # heavy tails: no Gaussian shortcut
     hits = [pf.in_credible_region(np.array([*pf.theta[i, :2], 1.0])) for i in range(4000)]
@@ -352,7 +385,7 @@ def test_run_with_fluctuation_likelihood_records_the_resolved_settings(tmp_path,
     ],
 )
 def test_searcher_tell_names_the_bad_field(position, reading, time):
-    pf = ParticleFilter(_xy_prior(), Sensor(), n_particles=100, seed=0)
+    pf = ParticleFilter(_xy_prior(), Sensor.paper_exact(), n_particles=100, seed=0)
     searcher = Searcher(pf, get_planner("mpc"), PAPER1.make_agent(), np.random.default_rng(0))
     with pytest.raises(DceeInputError):
         searcher.tell(position, reading, time)

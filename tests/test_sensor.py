@@ -11,7 +11,7 @@ from dcee.models.sensor_kernels import log_likelihood
 @pytest.mark.parametrize("false_alarm", [0.0, 0.05])
 @pytest.mark.parametrize("conc", [0.0, 2e-4, 5e-4, 1e-3, 0.05])
 def test_likelihood_is_a_proper_distribution_over_readings(conc, false_alarm):
-    s = Sensor(false_alarm=false_alarm)
+    s = Sensor.paper_exact(false_alarm=false_alarm)
     p_nd = float(s.likelihood(0.0, conc))
     sigma = s.sigma_frac * conc + s.sigma_min
     upper = max(conc + 40 * sigma, s.threshold + 60 * s.false_alarm_scale)
@@ -23,7 +23,7 @@ def test_likelihood_is_a_proper_distribution_over_readings(conc, false_alarm):
 
 
 def test_non_detection_probability_limits():
-    s = Sensor(pd=0.7)
+    s = Sensor.paper_exact(pd=0.7)
     # Far from the plume every reading is a non-detection; deep inside only misses are.
     assert float(s.likelihood(0.0, 0.0)) == pytest.approx(1.0, abs=1e-6)
     # Deep inside: misses (0.3) plus noise dipping below the threshold, Φ((thr − C)/σ) ≈ Φ(−2).
@@ -35,7 +35,7 @@ def test_non_detection_probability_limits():
 
 @pytest.mark.parametrize("false_alarm", [0.0, 0.1])
 def test_simulated_readings_follow_the_likelihood(false_alarm):
-    s = Sensor(false_alarm=false_alarm)
+    s = Sensor.paper_exact(false_alarm=false_alarm)
     rng = np.random.default_rng(11)
     conc = 8e-4
     z = s.simulate(np.full(200_000, conc), rng)
@@ -53,7 +53,7 @@ def test_simulated_readings_follow_the_likelihood(false_alarm):
 
 def test_compiled_likelihood_matches_reference():
     rng = np.random.default_rng(5)
-    for s in (Sensor(), Sensor(false_alarm=0.02, pd=1.0)):
+    for s in (Sensor.paper_exact(), Sensor.paper_exact(false_alarm=0.02, pd=1.0)):
         c = np.concatenate([[0.0, 1e-9, 5e-4], rng.gamma(0.5, 2e-3, 300), [0.5, 3.0]])
         z = np.concatenate([[0.0, 4e-4], rng.gamma(0.7, 2e-3, 60), [1.0]])
         for zi in z:
@@ -63,7 +63,7 @@ def test_compiled_likelihood_matches_reference():
 
 
 def test_simulation_is_reproducible_and_common_noise_is_shared():
-    s = Sensor()
+    s = Sensor.paper_exact()
     noise = s.draw_noise(np.random.default_rng(1), 5)
     a = s.simulate_from(np.full(5, 2e-3), noise)
     b = s.simulate(np.full(5, 2e-3), np.random.default_rng(1))
@@ -78,11 +78,11 @@ def test_invalid_sensor_parameters_name_the_field(field, value):
         Sensor(**{field: value})
 
 
-FLUCTUATION = Sensor(family="lognormal", pd=0.5, log_sd=1.0)
+FLUCTUATION = Sensor.paper_exact(family="lognormal", pd=0.5, log_sd=1.0)
 ROBUST = Sensor(family="lognormal", pd=0.5, log_sd=1.0, outlier=0.01)
 ROBUST_PAPER = Sensor(outlier=0.02, false_alarm=0.03)
 NEAR = Sensor(family="lognormal", pd=0.6, log_sd=1.2, outlier=0.01, near_length=5.0)
-NEAR_PAPER = Sensor(near_length=3.0, false_alarm=0.01)
+NEAR_PAPER = Sensor.paper_exact(near_length=3.0, false_alarm=0.01)
 # the spread grows near the source: s(r) = 1.0 + 2.0 exp(−r / 3)
 SPREAD = Sensor(
     family="lognormal", pd=0.6, log_sd=1.0, log_sd_near=2.0, log_sd_length=3.0, outlier=0.01
@@ -124,7 +124,7 @@ def test_every_family_is_a_proper_distribution_over_readings(s, conc, r):
 
 def test_lognormal_reading_keeps_the_mean_and_intermittency():
     """Limiting case: a threshold far below C leaves E[z | detected] = C and P(z > 0) = Pd."""
-    s = Sensor(family="lognormal", pd=0.4, log_sd=0.8, threshold=1e-9)
+    s = Sensor.paper_exact(family="lognormal", pd=0.4, log_sd=0.8, threshold=1e-9)
     z = s.simulate(np.full(400_000, 2e-2), np.random.default_rng(4))
     assert (z > 0).mean() == pytest.approx(0.4, abs=0.004)
     assert z[z > 0].mean() == pytest.approx(2e-2, rel=0.01)
@@ -135,7 +135,7 @@ def test_mean_conserving_intermittency_keeps_the_time_mean_near_the_source():
     """Limiting case (threshold far below C): with ``conserve_mean`` the share of detections is
     Pd(r) and a detection's mean C / Pd(r), so the mean reading, zeros included, is C at every
     distance; without it the mean reading is Pd(r) · C."""
-    kw = dict(family="lognormal", pd=0.9, log_sd=1.0, near_length=2.5, threshold=1e-12)
+    kw = dict(family="lognormal", pd=0.9, log_sd=1.0, near_length=2.5, threshold=1e-12, outlier=0.0)
     on, off = Sensor(**kw, conserve_mean=True), Sensor(**kw)
     rng = np.random.default_rng(5)
     conc = np.full(400_000, 3e-2)
@@ -199,7 +199,7 @@ def test_spread_near_the_source_by_hand():
     for r in (0.0, 0.7, 3.0, 30.0):
         assert log_sd_at(r, SPREAD.params) == pytest.approx(float(SPREAD.log_sd_at(r)), rel=1e-15)
     assert float(FLUCTUATION.log_sd_at(0.0)) == 1.0  # log_sd_length 0: constant
-    low = Sensor(
+    low = Sensor.paper_exact(
         family="lognormal", pd=1.0, log_sd=0.5, log_sd_near=0.5, log_sd_length=2.0, threshold=1e-12
     )
     noise = low.draw_noise(np.random.default_rng(5), 400_000)
@@ -223,12 +223,14 @@ def test_outlier_component_bounds_the_influence_of_one_reading():
 @pytest.mark.parametrize("bad", [1e5, 1e200, float("inf"), float("nan"), "abc", None, 1j, True])
 def test_readings_outside_the_physical_range_are_refused(bad):
     with pytest.raises(DceeInputError, match="reading"):
-        Sensor().check_reading(bad)
-    assert Sensor().check_reading(np.float32(2e-3)) == pytest.approx(2e-3)
+        Sensor.paper_exact().check_reading(bad)
+    assert Sensor.paper_exact().check_reading(np.float32(2e-3)) == pytest.approx(2e-3)
 
 
 @pytest.mark.parametrize(
-    "s", [Sensor(), Sensor(false_alarm=0.05), *FAMILIES], ids=["paper", "gauss+fa", *FAMILY_IDS]
+    "s",
+    [Sensor.paper_exact(), Sensor.paper_exact(false_alarm=0.05), *FAMILIES],
+    ids=["paper", "gauss+fa", *FAMILY_IDS],
 )
 @pytest.mark.parametrize("conc", [1e-5, 2e-3])
 def test_detection_draws_follow_the_likelihood_given_a_detection(s, conc):
@@ -257,8 +259,8 @@ def test_detection_only_readings_by_hand():
     """Detection only: p(z | C, r) = Pd(r) · P(ln z ≥ ln thr) · g(z) for a detection, g the
     log-uniform density on [threshold, max_reading]; the non-detection is the magnitude model's.
     So two detections of different sizes weigh every hypothesis alike."""
-    s = Sensor(family="lognormal", pd=0.8, log_sd=1.5, near_length=4.0, magnitude=False)
-    full = Sensor(family="lognormal", pd=0.8, log_sd=1.5, near_length=4.0)
+    s = Sensor.paper_exact(family="lognormal", pd=0.8, log_sd=1.5, near_length=4.0, magnitude=False)
+    full = Sensor.paper_exact(family="lognormal", pd=0.8, log_sd=1.5, near_length=4.0)
     c, r, z = 2e-3, 3.0, 7e-3
     pd = 0.8 * (1.0 - math.exp(-3.0 / 4.0))
     x = (math.log(c) - 0.5 * 1.5**2 - math.log(5e-4)) / 1.5

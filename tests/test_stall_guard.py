@@ -35,7 +35,7 @@ def _fly(
     guard: float, prior_box=(0.0, 40.0), moves: int = 120, **options
 ) -> tuple[float, Searcher]:
     pf = ParticleFilter(
-        planar_prior(x=prior_box, y=prior_box), Sensor(), IsotropicPlume(), 500, seed=0
+        planar_prior(x=prior_box, y=prior_box), Sensor.paper_exact(), IsotropicPlume(), 500, seed=0
     )
     rng = np.random.default_rng(0)
     searcher = Searcher(pf, _Homing(), AGENT, rng, stall_guard=guard, **options)

@@ -54,7 +54,7 @@ def _spread_belief(n=400, seed=3):
     rng = np.random.default_rng(seed)
     pts = rng.uniform(2.0, 38.0, size=(n, 2))
     theta = theta_at([(*p, 0.0) for p in pts], q=2.0, u=3.0, phi=math.radians(200))
-    return Belief(theta, np.full(n, 1 / n), Sensor(), IsotropicPlume())
+    return Belief(theta, np.full(n, 1 / n), Sensor.paper_exact(), IsotropicPlume())
 
 
 @pytest.mark.parametrize("cost", ["dcee-cl", "infotaxis"])

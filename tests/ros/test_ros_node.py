@@ -433,3 +433,31 @@ def test_node_takes_wind_from_the_wind_topic() -> None:
                 assert node.cycle.wind_readings == 0 and node.callback_errors == 0
         finally:
             rclpy.try_shutdown(context=context)
+
+
+def test_the_node_filter_has_the_outlier_safety() -> None:
+    """Issue 43: the node builds its filter with the same outlier safety as every other entry
+    point (tests/test_robust_estimation.py): one 10⁶ × reading leaves most of the weight."""
+    import rclpy
+    from rclpy.parameter import Parameter
+    from tests.helpers import spike_ess_share
+
+    from dcee.models.sensor import OUTLIER_DEFAULT
+    from dcee.ros.node import SearchNode
+
+    context = rclpy.Context()
+    rclpy.init(context=context, args=[], domain_id=_domain())
+    try:
+        node = SearchNode(
+            context=context,
+            parameter_overrides=[
+                Parameter("scenario", value="paper:1"),  # the zigzag of spike_ess_share's
+                Parameter("particles", value=2000),
+            ],
+        )
+        assert node.scenario.name == "paper:1"
+        assert node.searcher.filter.sensor.outlier == OUTLIER_DEFAULT
+        assert spike_ess_share(node.searcher.filter, node.scenario) > 0.5
+        node.destroy_node()
+    finally:
+        rclpy.try_shutdown(context=context)

@@ -127,7 +127,8 @@ def _draw_map(
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title(f"t = {until:.0f} s, RMSE {last['rmse']:.2f} m")
+    ax.set_title(f"t = {until:.0f} s, RMSE {last['rmse']:.2f} m", loc="left")
+    _draw_compass(ax, scenario.truth.phi)
     plt.colorbar(
         mesh,
         ax=ax,
@@ -135,6 +136,32 @@ def _draw_map(
         pad=0.04,
         label=f"{truth.label} at z = {scenario.agent.start[2]:g} m, t = {until:.0f} s (g/m³)",
     )
+
+
+def _draw_compass(ax: plt.Axes, phi_deg: float) -> None:
+    """A north arrow and the wind as people say it, above the map's top-right corner (outside
+    the map, so they hide nothing): an arrow pointing where the wind blows (downwind), and its
+    compass bearing (where it comes from, clockwise from north; dcee's y axis is north)."""
+    from dcee.models.compass import wind_from_words
+
+    ax.annotate(
+        "N", xy=(0.985, 1.115), xytext=(0.985, 1.02), xycoords="axes fraction",
+        ha="center", va="bottom", fontsize=7, fontweight="bold", annotation_clip=False,
+        arrowprops={"arrowstyle": "-|>", "color": "k", "lw": 1.0, "shrinkA": 0, "shrinkB": 0},
+    )  # fmt: skip
+    phi = np.radians(phi_deg)
+    down = -np.array([np.cos(phi), np.sin(phi)])  # the plume goes this way
+    centre, half = np.array([0.9, 1.065]), 0.04
+    ax.annotate(
+        "", xy=tuple(centre + half * down), xytext=tuple(centre - half * down),
+        xycoords="axes fraction", annotation_clip=False,
+        arrowprops={"arrowstyle": "-|>", "color": "tab:blue", "lw": 1.4, "shrinkA": 0,
+                    "shrinkB": 0},
+    )  # fmt: skip
+    ax.text(
+        0.84, 1.065, wind_from_words(phi_deg), transform=ax.transAxes, ha="right",
+        va="center", fontsize=7, color="tab:blue",
+    )  # fmt: skip
 
 
 def _draw_rmse(ax: plt.Axes, result: EpisodeResult, scenario: Scenario, until: float) -> None:

@@ -67,7 +67,8 @@ def dcee_decisions(n_decisions: int, seed: int = 1990) -> Iterator[float]:
             "zeta2": Uniform(6, 10),
         }
     )
-    sensor = Sensor(threshold=5e-4, pd=0.7, sigma_min=1e-4, sigma_frac=0.5)
+    # the paper's exact model, as Stone Soup's side has it
+    sensor = Sensor.paper_exact(threshold=5e-4, pd=0.7, sigma_min=1e-4, sigma_frac=0.5)
     plume = IsotropicPlume()
     pf = ParticleFilter(prior, sensor, plume, n_particles=N_PARTICLES, seed=seed)
     planner = get_planner("infotaxis", n_hypotheses=N_HYPOTHESES)

@@ -136,7 +136,8 @@ def dcee_search(strategy: str, seed: int, moves: int) -> dict[str, Any]:
             "zeta2": Normal(8, 1, low=0.0),
         }
     )
-    sensor = Sensor(threshold=5e-4, pd=0.7, sigma_min=1e-4, sigma_frac=0.5)
+    # the paper's exact model, as Stone Soup's side has it
+    sensor = Sensor.paper_exact(threshold=5e-4, pd=0.7, sigma_min=1e-4, sigma_frac=0.5)
     plume = IsotropicPlume()
     pf = ParticleFilter(prior, sensor, plume, n_particles=N_PARTICLES, seed=seed)
     agent = GridAgent(SearchVolume((0.0, 0.0, 0.0), (50.0, 50.0, 0.0)), step=2.0)

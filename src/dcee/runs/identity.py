@@ -53,6 +53,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("estimator", "learn"): {},
     # the point source's 1/r before issue 42's decay setting
     ("estimator", "decay"): 1.0,
+    # input only (a compass bearing converted to phi), always unset once validated
+    ("truth", "wind_from"): None,
 }
 """Scenario settings added after campaigns were first stored, with the value a stored scenario
 without one ran with, so the two compare equal."""

@@ -63,12 +63,15 @@ class ScenarioBuilders:
 
     def make_sensor(self: Scenario) -> Sensor:
         """The instrument that produces the (simulated) real readings: the ``[sensor]``
-        parameters with its detection probability :attr:`instrument_pd`."""
+        parameters with its detection probability :attr:`instrument_pd`, never a spike of its
+        own (spikes are injected on purpose: :class:`dcee.simulation.InjectedTruth`)."""
         return dataclasses.replace(self._paper_sensor(), pd=self.instrument_pd)
 
     def _paper_sensor(self: Scenario) -> Sensor:
-        """The paper's eq. 3 with the ``[sensor]`` parameters (its Pd included)."""
-        return Sensor(**self.sensor.model_dump(exclude={"average", "response_time", "dropout"}))
+        """The paper's eq. 3 exactly with the ``[sensor]`` parameters (its Pd included)."""
+        return Sensor.paper_exact(
+            **self.sensor.model_dump(exclude={"average", "response_time", "dropout"})
+        )
 
     def make_estimator_sensor(self: Scenario, model: str | None = None) -> Sensor:
         """The reading model ``model`` (one of :attr:`reading_models`; None: the first) of the

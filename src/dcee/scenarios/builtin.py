@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from dcee.models.compass import wind_from_words
+
 # Paper study (section 5, tables 1-2). Chosen: an open 50 m × 50 m area, altitude 0-5 m.
 PAPER_VOLUME = {"low": [0.0, 0.0, 0.0], "high": [50.0, 50.0, 5.0]}
 
@@ -56,7 +58,7 @@ def _paper(k: int, scale: float = 1.0) -> dict[str, Any]:
         "name": name,
         "description": (
             f"Paper simulation study, configuration {k}{area}: source ({x}, {y}, 1) m, "
-            f"wind from {phi:g} deg at 4 m/s; UAV at 4 m from (2, 2)."
+            f"{wind_from_words(phi)} at 4 m/s; UAV at 4 m from (2, 2)."
         ),
         "dimensions": 3,
         "unknown": "source",
@@ -186,7 +188,7 @@ def random_configuration(k: int, random_start: bool = False) -> dict[str, Any]:
         name=f"{family}:{k}",
         description=(
             f"Random configuration {k} ({use} range): source ({drawn['x']}, {drawn['y']}, "
-            f"{drawn['z']}) m, q {drawn['q']} g/s, wind from {drawn['phi']:g} deg at "
+            f"{drawn['z']}) m, q {drawn['q']} g/s, {wind_from_words(drawn['phi'])} at "
             f"{drawn['u']} m/s; UAV at 4 m from ({start[0]:g}, {start[1]:g})."
         ),
         truth={**drawn},
@@ -244,8 +246,8 @@ def _site(kind: str) -> dict[str, Any]:
     base = _paper(1)
     base["name"] = f"site:{kind}"
     base["description"] = (
-        f"Site with obstacles, {spec['description']}: source ({x}, {y}, 1) m, wind from "
-        f"{phi:g} deg at 4 m/s; UAV at 4 m from (2, 2)."
+        f"Site with obstacles, {spec['description']}: source ({x}, {y}, 1) m, "
+        f"{wind_from_words(phi)} at 4 m/s; UAV at 4 m from (2, 2)."
     )
     base["truth"] = {**base["truth"], "x": x, "y": y, "phi": phi}
     base["prior"] = {**base["prior"], "phi": {**base["prior"]["phi"], "mean": phi}}

@@ -155,6 +155,8 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
             lines.append(f"{_toml_key(k)} = {_toml_value(v)}")
             if provenance and (key, k) in DEFAULTS and _is_default(scenario, key, k, v):
                 lines.append(f"# ^ default, {DEFAULTS[key, k].line()}")
+            if k == "phi" and key in ("truth", "prior"):
+                lines.append(_bearing_comment(v))
         for (section, k), v in resolved.items():
             if section == key and k not in table:
                 lines.append(f"# {k} = {_toml_value(v)}  (unset: the default for this scenario)")
@@ -164,6 +166,28 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
             if section == key and k not in table:
                 lines.append(f"# {k} =  ({words})")
     return "\n".join(lines) + "\n"
+
+
+def _bearing_comment(phi: Any) -> str:
+    """The comment under a ``phi`` (°, counter-clockwise from east): the compass bearing it
+    is, and how to write it as one (``wind_from``)."""
+    from dcee.models.compass import bearing_from_phi, wind_from_words
+
+    if isinstance(phi, dict):  # a prior: its centre or its range
+        if phi.get("mean") is not None:
+            return f"# ^ centred on {wind_from_words(phi['mean'])} (compass bearing)"
+        lo, hi = phi.get("low"), phi.get("high")
+        if lo is not None and hi is not None:
+            return (
+                f"# ^ wind from bearings {bearing_from_phi(hi):g}° to {bearing_from_phi(lo):g}° "
+                "clockwise (compass)"
+            )
+        return "# ^ phi: degrees counter-clockwise from east (x), where the wind comes from"
+    bearing = bearing_from_phi(float(phi))
+    return (
+        f"# ^ {wind_from_words(float(phi))}: phi is counter-clockwise from east (x); "
+        f"wind_from = {bearing:g} says the same as a compass bearing"
+    )
 
 
 def _toml_key(key: str) -> str:

@@ -8,6 +8,7 @@ from typing import Annotated, Literal, get_args
 
 from pydantic import BaseModel, Field, field_validator, model_validator
 
+from dcee.models.sensor import OUTLIER_DEFAULT
 from dcee.scenarios.schema.common import FROZEN, Finite, Positive
 
 PHYSICAL_TRUNCATION = {"u": 0.0, "zeta1": 0.0, "zeta2": 0.0}
@@ -105,18 +106,10 @@ Likelihood = Literal["paper", "fluctuation"]
 LIKELIHOODS: tuple[str, ...] = get_args(Likelihood)
 """The reading models of the filter and the planners, by name (`--likelihood`)."""
 
-OUTLIER_DEFAULT = 0.01
-"""Outlier weight ``estimator.outlier`` for every likelihood, the paper's included, so that one
-reading no hypothesis can explain (a spike, a stuck or saturated sensor) never captures the
-posterior. Chosen on the tuning configurations (random:1-6, dcee-cl, one 10⁶ × reading at 40,
-60 or 100 s, ``studies/spike_study.py``): weight 0 lost 14 of 18 acquired searches to the spike,
-0.001 and 0.01 none; 0.01, the larger, bounds a reading's likelihood ratio 10× tighter. Set 0
-for the paper's exact likelihood (docs/scenarios.md: the held-out check and the public study
-with this default). Before issue 29 the default was 0 for the paper's likelihood and 0.01 for
-the fluctuation likelihood (:data:`OLD_OUTLIER_DEFAULT`, for stored campaigns)."""
-
 OLD_OUTLIER_DEFAULT: dict[str, float] = {"paper": 0.0, "fluctuation": 0.01}
-"""What an unset (null) ``estimator.outlier`` meant in a scenario stored before issue 29."""
+"""What an unset (null) ``estimator.outlier`` meant in a scenario stored before issue 29 (0 for
+the paper's likelihood, 0.01 for the fluctuation likelihood; since then
+:data:`~dcee.models.sensor.OUTLIER_DEFAULT` for every likelihood)."""
 
 
 READING_WEIGHT_DEFAULT: dict[str, float] = {"paper": 1.0, "fluctuation": 0.5}

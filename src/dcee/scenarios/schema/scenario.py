@@ -16,7 +16,7 @@ from dcee.models.agent import GridAgent, SearchVolume
 from dcee.models.plume import PARAMETER_NAMES
 from dcee.scenarios.builders import ScenarioBuilders
 from dcee.scenarios.schema.agent import AgentSpec, SearchSpec, team_starts, unset_climb
-from dcee.scenarios.schema.common import FROZEN
+from dcee.scenarios.schema.common import FIELD_MARK, FROZEN, phi_prior_from_bearing
 from dcee.scenarios.schema.estimator import (
     LEARN_MEMBERS_MAX,
     LEARN_RANGES,
@@ -65,6 +65,19 @@ class Scenario(ScenarioBuilders, BaseModel):
     world: WorldSpec = WorldSpec()
     """obstacles, no-go zones and an occupancy-grid map, see [world]"""
     _layout: tuple[bool, float | None] = PrivateAttr(default=(False, None))
+
+    @model_validator(mode="before")
+    @classmethod
+    def _prior_bearing_to_phi(cls, data: Any) -> Any:
+        # prior.wind_from: the wind direction's prior as a compass bearing, stored as prior.phi
+        prior = data.get("prior") if isinstance(data, dict) else None
+        if not isinstance(prior, dict) or "wind_from" not in prior:
+            return data
+        if "phi" in prior:
+            raise ValueError(f"{FIELD_MARK}prior.wind_from: give prior.phi or prior.wind_from")
+        prior = {k: v for k, v in prior.items() if k != "wind_from"}
+        prior["phi"] = phi_prior_from_bearing(data["prior"]["wind_from"])
+        return {**data, "prior": prior}
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario:
@@ -404,13 +417,10 @@ class Scenario(ScenarioBuilders, BaseModel):
                     raise DceeInputError(path, f"no such setting ({p!r} is not a section)")
                 node = node[p]
             node[leaf] = value
+            if leaf == "wind_from" and parents in (["truth"], ["prior"]):
+                node.pop("phi", None)  # the bearing replaces the angle it was given as
             scenario = validate_scenario(data)
         return scenario
-
-
-FIELD_MARK = "@field "
-"""Prefix of a cross-field check's message that names the field at fault (``@field
-agent.step: …``): :func:`validate_scenario` reports that field instead of the model's."""
 
 
 def validate_scenario(data: dict[str, Any]) -> Scenario:

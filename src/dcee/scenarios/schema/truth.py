@@ -10,7 +10,7 @@ from typing import Annotated, Any, Literal
 from pydantic import BaseModel, Field, field_validator, model_validator
 
 from dcee.recordings import recording_layout
-from dcee.scenarios.schema.common import FROZEN, Finite, Positive
+from dcee.scenarios.schema.common import FROZEN, Finite, Positive, phi_fields
 
 TURBULENT_HOLD = 4.0
 """Default hold (s) at each waypoint for a time-varying truth, over which a reading averages.
@@ -234,8 +234,14 @@ class Truth(BaseModel):
     u: Annotated[float, Field(ge=0, allow_inf_nan=False)]
     """mean wind speed, m/s"""
     phi: Annotated[float, Field(ge=-360.0, le=360.0, allow_inf_nan=False)] = Field(
-        description="wind direction in degrees, in [-360, 360] (wind comes from it)"
+        description="wind direction in degrees, in [-360, 360], where the wind comes from, "
+        "counter-clockwise from +x (east); or give wind_from"
     )
+    wind_from: Annotated[float | None, Field(ge=0.0, le=360.0, allow_inf_nan=False)] = None
+    """the wind direction as a meteorological (compass) bearing instead of ``phi``: degrees
+    clockwise from north (+y), where the wind comes from (270 = a west wind); converted to
+    ``phi`` = 90 − wind_from (:mod:`dcee.models.compass`) and not stored, so ``dcee show`` prints
+    ``phi`` with the bearing beside it as a comment"""
     zeta1: Positive
     """diffusivity ζ1 of the isotropic plume model, m²/s"""
     zeta2: Positive
@@ -244,6 +250,13 @@ class Truth(BaseModel):
     """what the sensor really sees: "isotropic" (the estimator's own model, the paper's
     simulation), "filament" or "puffs" (or a table with that kind and parameters: two turbulent
     truths written apart), or a table ``{file = "plume.h5"}`` to play a recording back"""
+
+    @model_validator(mode="before")
+    @classmethod
+    def _bearing_to_phi(cls, data: Any) -> Any:
+        if not isinstance(data, dict) or data.get("wind_from") is None:
+            return data
+        return {**data, **phi_fields(data, "truth")}
 
     @field_validator("model", mode="before")
     @classmethod
