@@ -666,11 +666,12 @@ def learn_tuning_table() -> str:
         "base": "today's defaults (fixed 1/r)",
         "decay": "`learn = {decay = [1, 0.5]}`",
         "both": "`learn = {meander = [0.15, 0.3, 0.6], log_sd = [1.3, 2]}`",
+        "nsl": "`learn = {near_source_length = [2.5, 0]}`",
     }
     key = ["truth", "scenario", "seed"]
     base = frame[frame["variant"] == "base"]
     rows = []
-    for variant in ("base", "decay", "both"):
+    for variant in ("base", "decay", "both", "nsl"):
         for truth in ("filament", "puffs", "both truths"):
             part = frame[frame["variant"] == variant]
             if truth != "both truths":

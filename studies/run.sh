@@ -315,6 +315,7 @@ case "${1:---list}" in
     $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
       --variant base: \
       --variant 'decay:estimator.learn={decay=[1.0,0.5]}' \
+      --variant 'nsl:estimator.learn={near_source_length=[2.5,0.0]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-learn-13-40/variants.csv
     $P studies/publish_tables.py ;;
   cross-truth)  # every truth at today's defaults; the lbm plume held out (docs/plumes.md, README)
