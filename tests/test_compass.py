@@ -82,3 +82,12 @@ def test_show_and_scenarios_print_the_bearing(capsys):
     assert "# ^ wind from 270° (W)" in out and "wind_from = 270" in out
     listing = run_cli(["scenarios"], capsys)[1]
     assert "paper:1 " in listing and "wind from 090° (E)" in listing
+
+
+def test_show_prints_a_uniform_priors_bearings():
+    from dcee.scenarios import to_toml
+
+    scenario = load_scenario("paper:1").with_overrides(
+        **{"prior.wind_from": {"kind": "uniform", "low": 200.0, "high": 290.0}}
+    )
+    assert "# ^ wind from bearings 200° to 290° clockwise (compass)" in to_toml(scenario)

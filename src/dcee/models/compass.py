@@ -25,8 +25,9 @@ def bearing_from_phi(phi_deg: float) -> float:
 
 
 def phi_from_bearing(bearing_deg: float) -> float:
-    """φ (°, counter-clockwise from east, in [0, 360)) of a meteorological bearing (°)."""
-    return (90.0 - bearing_deg) % 360.0
+    """φ (°, counter-clockwise from east, in [0, 360)) of a meteorological bearing (°): the
+    same reflection as :func:`bearing_from_phi`, its own inverse."""
+    return bearing_from_phi(bearing_deg)
 
 
 def compass_point(bearing_deg: float) -> str:

@@ -7,7 +7,7 @@ from typing import Annotated, Any
 
 from pydantic import ConfigDict, Field
 
-from dcee.models.compass import phi_from_bearing
+from dcee.models.compass import bearing_from_phi, phi_from_bearing
 
 FROZEN = ConfigDict(frozen=True, extra="forbid", use_attribute_docstrings=True)
 Finite = Annotated[float, Field(allow_inf_nan=False)]
@@ -22,8 +22,9 @@ __all__ = ["FIELD_MARK", "FROZEN", "Finite", "Positive", "phi_fields", "phi_prio
 
 
 def phi_fields(data: dict[str, Any], where: str) -> dict[str, Any]:
-    """``truth`` given with ``wind_from`` (a compass bearing, °): the ``phi`` it means and
-    ``wind_from`` cleared (:mod:`dcee.models.compass`); both given: ValueError unless they agree."""
+    """A ``where`` table (``truth``) given with ``wind_from`` (a compass bearing, °): the
+    ``phi`` it means and ``wind_from`` cleared (:mod:`dcee.models.compass`); both given:
+    ValueError unless they agree."""
     bearing = data["wind_from"]
     number = isinstance(bearing, int | float) and not isinstance(bearing, bool)
     if not (number and math.isfinite(bearing) and 0.0 <= bearing <= 360.0):
@@ -36,7 +37,7 @@ def phi_fields(data: dict[str, Any], where: str) -> dict[str, Any]:
     if given is not None and abs((float(given) - phi + 180.0) % 360.0 - 180.0) > 1e-9:
         raise ValueError(
             f"{FIELD_MARK}{where}.wind_from: give {where}.phi or {where}.wind_from, not both "
-            f"(phi {given} is the bearing {(90.0 - float(given)) % 360.0:g}, not {bearing:g})"
+            f"(phi {given} is the bearing {bearing_from_phi(float(given)):g}, not {bearing:g})"
         )
     return {"phi": phi if given is None else given, "wind_from": None}
 
