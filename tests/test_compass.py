@@ -9,7 +9,13 @@ import numpy as np
 import pytest
 
 from dcee.errors import DceeInputError
-from dcee.models.compass import bearing_from_phi, compass_point, phi_from_bearing, wind_from_words
+from dcee.models.compass import (
+    bearing_from_phi,
+    compass_point,
+    estimated_bearing,
+    phi_from_bearing,
+    wind_from_words,
+)
 from dcee.scenarios import load_scenario
 from dcee.scenarios.schema import validate_scenario
 from tests.helpers import run_cli
@@ -91,3 +97,14 @@ def test_show_prints_a_uniform_priors_bearings():
         **{"prior.wind_from": {"kind": "uniform", "low": 200.0, "high": 290.0}}
     )
     assert "# ^ wind from bearings 200° to 290° clockwise (compass)" in to_toml(scenario)
+
+
+def test_a_beliefs_bearing_is_the_circular_mean():
+    """Winds from bearings 10° and 350° (φ 80° and 100°) average to a north wind, bearing 0°,
+    not to the arithmetic mean of the bearings, 180°."""
+    phi = np.radians([80.0, 100.0])
+    assert estimated_bearing(phi, np.array([0.5, 0.5])) == pytest.approx(0.0, abs=1e-9)
+    # across φ = 0: 350° and 10° average to 0° (bearing 90°), not 180°
+    phi = np.radians([350.0, 10.0])
+    assert estimated_bearing(phi, np.array([0.5, 0.5])) == pytest.approx(90.0)
+    assert estimated_bearing(phi, np.array([1.0, 0.0])) == pytest.approx(100.0)

@@ -169,6 +169,9 @@ def test_demo_runs_the_managed_node_through_its_contract_with_a_map_and_wind(tmp
     assert summary["feedback_messages"] == len(summary["records"])
     result = summary["result"]
     assert result is not None and result["success"]
+    # the believed wind as a compass bearing: lab:upwind's wind comes from the west (270°)
+    assert abs((result["wind_from"] - 270.0 + 180.0) % 360.0 - 180.0) < 20.0
+    assert result["wind_speed"] > 0
     assert result["reason"] == summary["finish_reason"]
     sc = load_scenario("lab:upwind").with_overrides(**{"world.obstacles": wall})
     xy = np.array([[r["x"], r["y"]] for r in summary["records"]])

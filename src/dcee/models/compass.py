@@ -13,6 +13,10 @@ Examples: φ = 0 (wind from the east) is bearing 90°; φ = 90° (from the north
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
+
 POINTS = ("N", "NNE", "NE", "ENE", "E", "ESE", "SE", "SSE",
           "S", "SSW", "SW", "WSW", "W", "WNW", "NW", "NNW")  # fmt: skip
 """The 16 points of the compass, clockwise from north."""
@@ -39,3 +43,11 @@ def wind_from_words(phi_deg: float) -> str:
     """How a person says the wind direction φ (°): ``"wind from 270° (W)"``."""
     bearing = round(bearing_from_phi(phi_deg)) % 360
     return f"wind from {bearing:03d}° ({compass_point(bearing)})"
+
+
+def estimated_bearing(phi_rad: np.ndarray, weights: np.ndarray) -> float:
+    """The compass bearing (°, in [0, 360)) of a belief's wind direction: the weighted circular
+    mean of φ (radians, one per particle), so that 350° and 10° average to 0°, not 180°."""
+    s = float(np.sum(weights * np.sin(phi_rad)))
+    c = float(np.sum(weights * np.cos(phi_rad)))
+    return bearing_from_phi(math.degrees(math.atan2(s, c)))

@@ -139,7 +139,7 @@ class SearchNode(LifecycleNode):
     one is over; ``dcee/cancel`` (Trigger) ends the running one; ``dcee/feedback``
     (std_msgs/String, JSON: state, readings, mean, spread, elapsed) after every reading;
     ``dcee/result`` (std_msgs/String, JSON, latched: success, reason, mean, covariance,
-    readings) when a search ends. The area and budget are the scenario's.
+    spread, readings, wind_from as a compass bearing, wind_speed) when a search ends. The area and budget are the scenario's.
 
     ``true_location`` (3,) m, when known (a simulation), gives the records an RMSE;
     ``scenario`` (a :class:`~dcee.scenarios.Scenario`) replaces the ``scenario`` and
@@ -514,9 +514,15 @@ class SearchNode(LifecycleNode):
         """The search's result (the ``dcee/result`` message): ``success`` (the source was
         localised or the budget spent with a reading; False when cancelled or failed),
         ``reason``, the estimate's ``mean`` (3,) m and location ``covariance`` (3 × 3) m²,
-        ``spread`` m, ``readings``."""
+        ``spread`` m, ``readings``, and the believed wind: ``wind_from`` (a compass bearing,
+        °, where it comes from, clockwise from north) and ``wind_speed`` m/s."""
+        from dcee.models.compass import estimated_bearing
+        from dcee.models.plume import PARAMETER_NAMES
+
         est = self.searcher.estimate()
         readings = len(self.cycle.records)
+        belief, weights = self.searcher.filter.theta, self.searcher.filter.weights
+        phi, u = (belief[:, PARAMETER_NAMES.index(k)] for k in ("phi", "u"))
         return {
             "success": self.finish_reason in ("localised", "budget") and readings > 0,
             "reason": self.finish_reason,
@@ -524,6 +530,8 @@ class SearchNode(LifecycleNode):
             "covariance": [[float(v) for v in row] for row in est.cov],
             "spread": float(est.spread),
             "readings": readings,
+            "wind_from": estimated_bearing(phi, weights),
+            "wind_speed": float(weights @ u),
         }
 
     def _publish_feedback(self, record: dict[str, Any]) -> None:
