@@ -139,7 +139,8 @@ class SearchNode(LifecycleNode):
     one is over; ``dcee/cancel`` (Trigger) ends the running one; ``dcee/feedback``
     (std_msgs/String, JSON: state, readings, mean, spread, elapsed) after every reading;
     ``dcee/result`` (std_msgs/String, JSON, latched: success, reason, mean, covariance,
-    spread, readings, wind_from as a compass bearing, wind_speed) when a search ends. The area and budget are the scenario's.
+    spread, readings, wind_from as a compass bearing, wind_speed) when a search ends. The area
+    and budget are the scenario's.
 
     ``true_location`` (3,) m, when known (a simulation), gives the records an RMSE;
     ``scenario`` (a :class:`~dcee.scenarios.Scenario`) replaces the ``scenario`` and
