@@ -122,7 +122,7 @@ def compiled_predicted_stats(conc, source, weights, task_pos, task_z, sensor, di
 def compiled_location_kl(conc, source, weights, task_pos, task_z, sensor, cell, dist=None):
     """The compiled location-cell KL divergence with the reference's arguments (see
     :func:`compiled_predicted_stats`)."""
-    from dcee.planning.predicted_kernels import location_cells, location_kl
+    from dcee.planning.location_kl import location_cells, location_kl
 
     terms = _terms_from_concentrations(conc, dist, sensor)
     tv, tfa, tout, _ = sensor.transformed_readings(np.asarray(task_z, dtype=float))

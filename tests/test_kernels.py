@@ -9,7 +9,7 @@ import pytest
 from dcee.models import Sensor
 from dcee.models.sensor_kernels import log_likelihood
 from dcee.numeric import vexp, vlog1p
-from dcee.planning.predicted_kernels import (
+from dcee.planning.predicted_reference import (
     location_kl_reference,
     predicted_posterior_stats_reference,
 )

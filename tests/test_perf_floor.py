@@ -8,7 +8,7 @@ from dcee.estimation import ParticleFilter
 from dcee.models import IsotropicPlume, Sensor
 from dcee.models.plume import isotropic_concentration
 from dcee.perf.floor import floor_decision
-from dcee.planning.predicted_kernels import predicted_posterior_stats_reference
+from dcee.planning.predicted_reference import predicted_posterior_stats_reference
 from dcee.scenarios import load_scenario
 
 

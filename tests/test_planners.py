@@ -5,7 +5,7 @@ import pytest
 
 from dcee import DceeInputError, GridAgent, IsotropicPlume, SearchVolume, Sensor, planners
 from dcee.planning import Belief, PredictionContext
-from dcee.planning.predicted_kernels import predicted_posterior_stats_reference
+from dcee.planning.predicted_reference import predicted_posterior_stats_reference
 from tests.helpers import compiled_predicted_stats, theta_at
 
 AGENT = GridAgent(SearchVolume((0.0, 0.0, 0.0), (40.0, 40.0, 0.0)), step=2.0)

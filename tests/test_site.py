@@ -11,14 +11,13 @@ import pytest
 
 from dcee.errors import DceeInputError
 from dcee.models.motion import UnicycleMotion
+from dcee.models.ros_map import load_ros_map, write_ros_map
 from dcee.models.site import (
     Circle,
     Polygon,
     Rectangle,
     SiteMap,
     compose_site,
-    load_ros_map,
-    write_ros_map,
 )
 from dcee.runs import run_episode
 from dcee.scenarios import load_scenario

@@ -140,7 +140,8 @@ def test_node_with_pose_with_covariance_input_takes_readings_and_publishes_a_goa
     from rclpy.parameter import Parameter
     from std_msgs.msg import Float32
 
-    from dcee.ros.node import LATCHED, RELIABLE, SearchNode
+    from dcee.ros.node import SearchNode
+    from dcee.ros.parameters import LATCHED, RELIABLE
     from dcee.ros.sim_node import stamp_of
 
     context = rclpy.Context()
@@ -203,7 +204,8 @@ def test_node_keeps_planning_through_hostile_message_streams() -> None:
     from std_msgs.msg import Float32
 
     from dcee.robot.cycle import REJECTION_REASONS
-    from dcee.ros.node import LATCHED, RELIABLE, SearchNode
+    from dcee.ros.node import SearchNode
+    from dcee.ros.parameters import LATCHED, RELIABLE
     from dcee.ros.sim_node import stamp_of
 
     context = rclpy.Context()
@@ -308,7 +310,8 @@ def test_node_plans_around_a_map_from_the_map_topic() -> None:
     from std_msgs.msg import Float32
 
     from dcee.models.site import Rectangle, SiteMap
-    from dcee.ros.node import LATCHED, RELIABLE, SearchNode
+    from dcee.ros.node import SearchNode
+    from dcee.ros.parameters import LATCHED, RELIABLE
     from dcee.ros.sim_node import stamp_of
 
     context = rclpy.Context()
@@ -393,7 +396,8 @@ def test_node_takes_wind_from_the_wind_topic() -> None:
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.parameter import Parameter
 
-    from dcee.ros.node import RELIABLE, SearchNode
+    from dcee.ros.node import SearchNode
+    from dcee.ros.parameters import RELIABLE
     from dcee.ros.sim_node import stamp_of
 
     for enabled in (True, False):

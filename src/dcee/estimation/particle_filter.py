@@ -6,23 +6,9 @@ Metropolis–Hastings sweeps whose acceptance uses the prior and the likelihood 
 so far, so the chain leaves the true posterior invariant. (AutoSTE and Stone Soup accept on the
 latest reading only, which does not target the posterior.)
 
-Keeping every mode: a random-walk move cannot carry mass between separated modes, so after a
-resampling that has concentrated the particles in one region a minority mode that later readings
-favour can be lost for good. Each sweep is therefore a mixture: a share ``global_share`` of the
-particles proposes a new source location from the prior (an independence proposal for the
-location block; its acceptance ratio is the likelihood ratio times the prior ratio of the other
-columns, here 1), the rest a regularised random walk. Sweeps repeat until at least
-``diversify`` of the particles have moved since the resampling (at least ``mcmc_steps``, at most
-``max_sweeps`` sweeps); the acceptance rate, the number of distinct particles and the sweeps are
-returned in :class:`UpdateInfo` for every step.
-
-Degeneracy: in log space the weights cannot all underflow, but a reading that every particle
-finds very unlikely can collapse the weight onto a handful of particles. When the ESS after a
-reading would fall below ``collapse_threshold · N`` the reading is instead assimilated by
-likelihood tempering: exponents 0 = β₀ < β₁ < … < 1 chosen by bisection so that each stage keeps
-ESS ≈ ``resample_threshold · N``, with resampling and MCMC moves targeting prior × history ×
-p(z|Θ)^β between stages (an adaptive tempered SMC step; it targets the exact posterior). Each
-such event is recorded in :attr:`ParticleFilter.recoveries`.
+The resample-move step (systematic resampling, Metropolis–Hastings rejuvenation that keeps
+every mode, likelihood tempering when a reading would collapse the weights) is
+:class:`~dcee.estimation.resample_move.ResampleMove`.
 
 Outlier safety: a reading above the sensor's ``max_reading`` (or not a finite real number) is
 refused with :class:`DceeInputError` before anything changes. A reading that *no* particle can
@@ -50,12 +36,11 @@ from scipy.special import logsumexp
 
 from dcee.errors import DceeInputError
 from dcee.estimation.base import ReadingModelChoice, UpdateInfo
-from dcee.estimation.filter_kernels import history_log_likelihood, reading_upper_bounds
+from dcee.estimation.filter_kernels import history_log_likelihood
 from dcee.estimation.priors import SourcePrior
+from dcee.estimation.resample_move import ResampleMove
 from dcee.estimation.resampling import (
     effective_sample_size,
-    normalised_weights,
-    systematic_resample,
 )
 from dcee.estimation.summaries import in_credible_ellipsoid, weighted_rmse
 from dcee.models.anemometer import PHI_COLUMN, U_COLUMN, Anemometer, WindEvidence
@@ -63,7 +48,7 @@ from dcee.models.plume import IsotropicPlume
 from dcee.models.sensor import Sensor
 
 
-class ParticleFilter:
+class ParticleFilter(ResampleMove):
     """Sequential Monte Carlo estimate of the source term.
 
     Parameters
@@ -413,150 +398,3 @@ class ParticleFilter:
     def _set_logw(self, logw: np.ndarray) -> None:
         self._logw = logw - logw.max()
         self._weights = None
-
-    def _resample(self, *per_particle: np.ndarray) -> list[np.ndarray]:
-        """Systematic resampling of the particles, their cached history log-likelihoods and any
-        other per-particle arrays given (returned re-indexed); weights become uniform."""
-        idx = systematic_resample(self.weights, self.rng, self.n)
-        self.theta = self.theta[idx]
-        self._hist_loglik = self._hist_loglik[idx]
-        self._logw = np.full(self.n, -math.log(self.n))
-        self._weights = None
-        self.n_resamples += 1
-        self._origin = idx
-        return [a[idx] for a in per_particle]
-
-    def _rejuvenate(self) -> tuple[float, int, int]:
-        """Sweeps after a resampling until ``diversify`` of the particles have moved (see the
-        module doc). Returns (mean acceptance, sweeps, distinct particles)."""
-        moved = np.zeros(self.n, dtype=bool)
-        acc: list[float] = []
-        while len(acc) < self.max_sweeps and (
-            len(acc) < self.mcmc_steps or moved.mean() < self.diversify
-        ):
-            accepted = self._mh_sweep()
-            moved |= accepted
-            acc.append(float(accepted.mean()))
-        distinct = int(moved.sum()) + len(np.unique(self._origin[~moved]))
-        return (float(np.mean(acc)) if acc else math.nan), len(acc), distinct
-
-    def _mh_sweep(self) -> np.ndarray:
-        """One Metropolis–Hastings move of every particle, full-history target: a share
-        ``global_share`` proposes its location from the prior, the rest a random walk.
-        Returns the (N,) accepted mask."""
-        d = len(self._unknown)
-        x = self.theta[:, self._unknown]
-        cov = np.atleast_2d(np.cov(x, rowvar=False))
-        # Gaussian kernel bandwidth of the regularised particle filter (Musso et al.),
-        # as in the authors' code; a floor keeps the kernel alive if the particles collapse.
-        h = (4.0 / (self.n * (d + 2))) ** (1.0 / (d + 4))
-        floor = (1e-3 * self.prior.scales) ** 2
-        cov = h * h * cov + np.diag(floor)
-        try:
-            chol = np.linalg.cholesky(cov)
-        except np.linalg.LinAlgError:
-            chol = np.diag(np.sqrt(np.maximum(np.diag(cov), floor)))
-        proposal = self.theta.copy()
-        proposal[:, self._unknown] += self.rng.standard_normal((self.n, d)) @ chol.T
-        # Independence proposals of the location block from its prior: for these particles the
-        # proposal density (the block's prior) cancels the block's prior in the target.
-        jump = self.rng.random(self.n) < self.global_share if self._loc_block else None
-        log_q_ratio = np.zeros(self.n)
-        if jump is not None and jump.any():
-            k = int(jump.sum())
-            dists = self.prior.distributions
-            proposal[jump] = self.theta[jump]
-            for col in self._loc_block:
-                proposal[jump, col] = dists[col].sample(self.rng, k)
-                log_q_ratio[jump] += dists[col].log_pdf(self.theta[jump, col]) - dists[col].log_pdf(
-                    proposal[jump, col]
-                )
-        lp_prop = self._log_prior(proposal)
-        lp_cur = self._log_prior(self.theta)
-        active = np.isfinite(lp_prop)
-        ll_prop = np.empty(self.n)
-        pos, z, mult = self.history()
-        log_u = np.log(self.rng.random(self.n))
-        # accepted iff ll_prop > threshold: lets the kernel abandon hopeless proposals early
-        with np.errstate(invalid="ignore"):
-            threshold = log_u - lp_prop + self._hist_loglik + lp_cur - log_q_ratio
-        history_log_likelihood(
-            proposal,
-            active,
-            pos,
-            z,
-            mult,
-            self.plume.min_distance,
-            self.plume.meander,
-            self.plume.decay,
-            self._sp,
-            ll_prop,
-            np.nan_to_num(threshold, nan=-np.inf, posinf=np.inf),
-            reading_upper_bounds(z, self.sensor),
-        )
-        with np.errstate(invalid="ignore"):
-            log_ratio = (ll_prop + lp_prop) - (self._hist_loglik + lp_cur) + log_q_ratio
-            accept = active & (log_u < log_ratio)
-        self.theta[accept] = proposal[accept]
-        self._hist_loglik[accept] = ll_prop[accept]
-        return accept
-
-    def _tempered_update(
-        self, ll_new: np.ndarray, entry: int, base_mult: float, ess0: float
-    ) -> UpdateInfo:
-        beta = 0.0
-        stages = 0
-        sweeps = 0
-        distinct = self.n
-        target = self.resample_threshold * self.n
-        hist_base = self._hist_loglik.copy()
-        acc: list[float] = []
-        while beta < 1.0:
-            stages += 1
-            if stages >= self.max_tempering_stages or (
-                effective_sample_size(normalised_weights(self._logw + (1.0 - beta) * ll_new))
-                >= target
-            ):
-                new_beta = 1.0
-            else:
-                lo, hi = beta, 1.0
-                for _ in range(40):
-                    mid = 0.5 * (lo + hi)
-                    if (
-                        effective_sample_size(
-                            normalised_weights(self._logw + (mid - beta) * ll_new)
-                        )
-                        >= target
-                    ):
-                        lo = mid
-                    else:
-                        hi = mid
-                new_beta = max(lo, beta + 1e-6)
-            # ll_new: the new reading's log-likelihood for the current particles.
-            self._set_logw(self._logw + (new_beta - beta) * ll_new)
-            self._hist_loglik = hist_base + new_beta * ll_new
-            self._hist_mult[entry] = base_mult + new_beta * self._weight_now
-            beta = new_beta
-            ll_new, hist_base = self._resample(ll_new, hist_base)
-            stage_acc, stage_sweeps, distinct = self._rejuvenate()
-            acc.append(stage_acc)
-            sweeps += stage_sweeps
-            if beta < 1.0:
-                # After the move, recompute the new reading's likelihood for the moved particles.
-                ll_new = self.log_likelihood(
-                    self.theta,
-                    np.array(self._hist_pos[entry]),
-                    self._hist_z[entry],
-                    self._weight_now,
-                )
-                hist_base = self._hist_loglik - beta * ll_new
-        self._hist_mult[entry] = base_mult + self._weight_now
-        self.recoveries.append(
-            {
-                "kind": "tempering",
-                "reading_index": float(self.n_readings),
-                "ess_before": ess0,
-                "stages": float(stages),
-            }
-        )
-        return UpdateInfo(ess0, True, float(np.mean(acc)), stages, sweeps, distinct)

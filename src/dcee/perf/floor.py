@@ -14,7 +14,7 @@ maximum and no vectorised ``exp``; tasks run in parallel on numba's threads like
 kernels. ``dcee perf`` states the planners' decisions as a ratio to it, in the same run, on the
 same belief and readings.
 
-Tested against :func:`dcee.planning.predicted_kernels.predicted_posterior_stats_reference`.
+Tested against :func:`dcee.planning.predicted_reference.predicted_posterior_stats_reference`.
 """
 
 from __future__ import annotations

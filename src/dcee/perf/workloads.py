@@ -26,7 +26,7 @@ from dcee.perf.timing import RATIO_TO_FLOOR_TARGETS, Timing, times_ms
 from dcee.planning import get as get_planner
 from dcee.planning.particle_terms import ParticleTerms
 from dcee.planning.predicted import PredictionContext
-from dcee.planning.predicted_kernels import predicted_posterior_stats_reference
+from dcee.planning.predicted_reference import predicted_posterior_stats_reference
 from dcee.runs import run_episode, streams
 from dcee.scenarios import load_scenario
 from dcee.searcher import Searcher
@@ -94,7 +94,7 @@ def _reference_inputs(searcher: Searcher, n_hypotheses: int = 40):
 
 def _numpy_decision(belief, candidates: np.ndarray, readings: np.ndarray) -> None:
     """The NumPy reference of the same statistics: the plume and the predicted posteriors
-    (:func:`~dcee.planning.predicted_kernels.predicted_posterior_stats_reference`)."""
+    (:func:`~dcee.planning.predicted_reference.predicted_posterior_stats_reference`)."""
     plume = belief.plume
     conc = isotropic_concentration_reference(
         belief.theta, candidates, plume.min_distance, plume.meander, plume.decay

@@ -27,12 +27,9 @@ import numpy as np
 from dcee.errors import DceeInputError
 from dcee.estimation.resampling import systematic_resample
 from dcee.planning.base import Belief
+from dcee.planning.location_kl import location_cells, location_kl
 from dcee.planning.particle_terms import ParticleTerms, PositionTerms
-from dcee.planning.predicted_kernels import (
-    location_cells,
-    location_kl,
-    predicted_posterior_stats,
-)
+from dcee.planning.predicted_kernels import predicted_posterior_stats
 
 
 @dataclass(frozen=True)
@@ -354,7 +351,7 @@ class PredictionContext:
         )
 
     def _cells(self, cell: float) -> tuple[np.ndarray, ...]:
-        """:func:`~dcee.planning.predicted_kernels.location_cells` of this context's belief,
+        """:func:`~dcee.planning.location_kl.location_cells` of this context's belief,
         computed once per cell size."""
         key = float(cell)
         if key not in self._cell_cache:

@@ -1,6 +1,8 @@
-"""Compiled (numba) predicted-posterior statistics (:func:`predicted_posterior_stats`,
-:func:`location_kl`) beside their NumPy references (:func:`predicted_posterior_stats_reference`,
-:func:`location_kl_reference`): one family of kernels, tested against its references.
+"""Compiled (numba) predicted-posterior statistics (:func:`predicted_posterior_stats`), tested
+against its NumPy reference
+(:func:`dcee.planning.predicted_reference.predicted_posterior_stats_reference`).
+The per-reading terms it shares with :mod:`dcee.planning.location_kl` are
+:mod:`dcee.planning.reading_terms`.
 
 Readings arrive in the sensor's transformed frame (:mod:`dcee.models.sensor_kernels`,
 :meth:`dcee.models.sensor.Sensor.transformed_readings`): per task and stage the transformed
@@ -17,118 +19,17 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from dcee.models.sensor import Sensor
-from dcee.models.sensor_kernels import (
-    SensorParams,
-)
-from dcee.numeric import (
-    HALF_LOG_2PI,
-    exp_scalar,
-    logaddexp,
-    vlogaddexp,
+from dcee.models.sensor_kernels import SensorParams
+from dcee.numeric import HALF_LOG_2PI, exp_scalar, vlogaddexp
+from dcee.planning.reading_terms import (
+    cached_log_likelihood,
+    live_row_max,
+    task_bounds,
+    task_log_likelihoods,
 )
 
 _BLOCK = 512  # particles per work item; fixed, so the summation order never depends on threads
 _N_ACC = 6  # accumulated sums per task: Σe, Σe·dx, Σe·dy, Σe·dz, Σe·|d|², Σe·ll
-
-
-@njit(cache=True, inline="always")
-def _loglik_cached(
-    v: float,
-    fa: float,
-    out: float,
-    loc: float,
-    lnd: float,
-    inv_s: float,
-    det_off: float,
-    sp: SensorParams,
-) -> float:
-    """log p(z | C) less the log Jacobian, from :func:`position_rows` and the transformed
-    reading terms; equals :func:`dcee.models.sensor_kernels.log_likelihood` minus the Jacobian."""
-    if v < sp.v_threshold:
-        return lnd
-    r = (v - loc) * inv_s
-    ld = det_off - 0.5 * r * r - HALF_LOG_2PI
-    if sp.false_alarm > 0.0:
-        log_missed = lnd - sp.log_not_false_alarm - sp.log_keep
-        ld = logaddexp(ld, fa + log_missed)
-    ld += sp.log_keep
-    if sp.log_outlier > -np.inf:
-        ld = logaddexp(ld, out)
-    return ld
-
-
-@njit(cache=True, inline="always")
-def _task_bound(
-    s: int,
-    task_positions: np.ndarray,
-    task_v: np.ndarray,
-    task_fa: np.ndarray,
-    task_out: np.ndarray,
-    max_log_nd: np.ndarray,
-    max_det_offset: np.ndarray,
-    sp: SensorParams,
-) -> float:
-    """An upper bound of Σ_t log p(z_st | C_i) (less the Jacobian) over all particles i.
-
-    A detection's density term is at most max(log Pd − log σ) − ½ log 2π; a
-    false-alarm term at most its density times max P(missed); the outlier term is exact.
-    """
-    b = 0.0
-    for t in range(task_positions.shape[1]):
-        p = task_positions[s, t]
-        v = task_v[s, t]
-        if v < sp.v_threshold:
-            b += max_log_nd[p]
-            continue
-        ld = max_det_offset[p] - HALF_LOG_2PI
-        if sp.false_alarm > 0.0:
-            log_missed_max = max_log_nd[p] - sp.log_not_false_alarm - sp.log_keep
-            ld = logaddexp(ld, task_fa[s, t] + log_missed_max)
-        ld += sp.log_keep
-        if sp.log_outlier > -np.inf:
-            ld = logaddexp(ld, task_out[s, t])
-        b += ld
-    return b
-
-
-@njit(cache=True)
-def _live_row_max(
-    log_nd: np.ndarray,
-    det_offset: np.ndarray,
-    rows: np.ndarray,
-    weights: np.ndarray,
-    max_log_nd: np.ndarray,
-    max_det_offset: np.ndarray,
-) -> None:
-    """For each row r in ``rows``: the largest log_nd[r, i] and det_offset[r, i] over the
-    particles with weight > 0 (the inputs of :func:`_task_bound`)."""
-    for r in rows:
-        a = -np.inf
-        b = -np.inf
-        for i in range(weights.shape[0]):
-            if weights[i] > 0.0:
-                a = max(a, log_nd[r, i])
-                b = max(b, det_offset[r, i])
-        max_log_nd[r] = a
-        max_det_offset[r] = b
-
-
-@njit(cache=True)
-def _task_bounds(
-    task_positions: np.ndarray,
-    task_v: np.ndarray,
-    task_fa: np.ndarray,
-    task_out: np.ndarray,
-    max_log_nd: np.ndarray,
-    max_det_offset: np.ndarray,
-    sp: SensorParams,
-    out: np.ndarray,
-) -> None:
-    for s in range(task_positions.shape[0]):
-        out[s] = _task_bound(
-            s, task_positions, task_v, task_fa, task_out, max_log_nd, max_det_offset, sp
-        )
 
 
 @njit(cache=True)
@@ -336,7 +237,7 @@ def _grouped_stats(
                 inv_s = inv_sigma[p, i]
                 if with_false_alarms:
                     for j in range(k):
-                        ll[j] += _loglik_cached(
+                        ll[j] += cached_log_likelihood(
                             z[t, j], fa[t, j], out[t, j], m, lnd, inv_s, det_offset[p, i], sp
                         )
                 elif with_outliers:
@@ -371,44 +272,6 @@ def _grouped_stats(
             partial[b, s0 + j, 5] = a5[j]
 
 
-@njit(cache=True, inline="always")
-def _task_log_likelihoods(
-    s: int,
-    task_positions: np.ndarray,
-    task_v: np.ndarray,
-    task_fa: np.ndarray,
-    task_out: np.ndarray,
-    loc: np.ndarray,
-    log_nd: np.ndarray,
-    inv_sigma: np.ndarray,
-    det_offset: np.ndarray,
-    weights: np.ndarray,
-    sp: SensorParams,
-    ll: np.ndarray,
-) -> float:
-    """ll[i] = Σ_t log p(z_st | C_i(p_st)) (less the Jacobian) for every particle i, sequentially;
-    returns the largest over the particles with weight (−inf if none)."""
-    mx = -np.inf
-    for i in range(weights.shape[0]):
-        v = 0.0
-        for t in range(task_positions.shape[1]):
-            p = task_positions[s, t]
-            v += _loglik_cached(
-                task_v[s, t],
-                task_fa[s, t],
-                task_out[s, t],
-                loc[p, i],
-                log_nd[p, i],
-                inv_sigma[p, i],
-                det_offset[p, i],
-                sp,
-            )
-        ll[i] = v
-        if weights[i] > 0.0 and v > mx:
-            mx = v
-    return mx
-
-
 @njit(cache=True, parallel=True)
 def _exact_task_stats(
     loc: np.ndarray,
@@ -433,7 +296,7 @@ def _exact_task_stats(
     for q in prange(tasks.shape[0]):
         s = tasks[q]
         ll = np.empty(n)
-        mx = _task_log_likelihoods(
+        mx = task_log_likelihoods(
             s,
             task_positions,
             task_v,
@@ -518,9 +381,9 @@ def predicted_posterior_stats(
     used = np.unique(task_positions)  # rows of the position terms the tasks read
     max_log_nd = np.full(log_nd.shape[0], -np.inf)
     max_det_offset = np.full(log_nd.shape[0], -np.inf)
-    _live_row_max(log_nd, det_offset, used, weights, max_log_nd, max_det_offset)
+    live_row_max(log_nd, det_offset, used, weights, max_log_nd, max_det_offset)
     bound = np.empty(s_count)
-    _task_bounds(task_positions, task_v, task_fa, task_out, max_log_nd, max_det_offset, sp, bound)
+    task_bounds(task_positions, task_v, task_fa, task_out, max_log_nd, max_det_offset, sp, bound)
     n_blocks = (source.shape[0] + _BLOCK - 1) // _BLOCK
     partial = np.empty((n_blocks, s_count, _N_ACC))
     common = (loc, log_nd, inv_sigma, det_offset, source, weights, center)
@@ -573,160 +436,3 @@ def predicted_posterior_stats(
     mean[:] = center + offset if want_moments else np.nan
     trace = np.maximum(sums[:, 4] / s0 - np.einsum("ij,ij->i", offset, offset), 0.0)
     trace_cov[:] = trace if want_moments else np.nan
-
-
-def location_cells(source: np.ndarray, weights: np.ndarray, cell: float) -> tuple[np.ndarray, ...]:
-    """The particles grouped by the cube of side ``cell`` (m) that holds their source location.
-
-    source (N, 3), weights (N,). Returns (order (N,) particle indices cell by cell,
-    cell_start (C + 1,) where each cell's run begins in ``order``, log_cell_weight (C,) log of the
-    cell's total weight, −inf for a cell without weight)."""
-    key = np.floor(source / cell).astype(np.int64)
-    _, inverse = np.unique(key, axis=0, return_inverse=True)
-    inverse = inverse.reshape(-1)
-    order = np.argsort(inverse, kind="stable").astype(np.int64)
-    counts = np.bincount(inverse)
-    cell_start = np.concatenate(([0], np.cumsum(counts))).astype(np.int64)
-    with np.errstate(divide="ignore"):
-        log_cell_weight = np.log(np.bincount(inverse, weights=weights, minlength=len(counts)))
-    return order, cell_start, log_cell_weight
-
-
-@njit(cache=True, parallel=True, error_model="numpy")
-def location_kl(
-    loc: np.ndarray,
-    log_nd: np.ndarray,
-    inv_sigma: np.ndarray,
-    det_offset: np.ndarray,
-    weights: np.ndarray,
-    order: np.ndarray,
-    cell_start: np.ndarray,
-    log_cell_weight: np.ndarray,
-    task_positions: np.ndarray,
-    task_v: np.ndarray,
-    task_fa: np.ndarray,
-    task_out: np.ndarray,
-    sp: SensorParams,
-    kl: np.ndarray,
-) -> None:
-    """kl[s] = KL(W'_s ‖ W) between the predicted and the current distribution of the source
-    *location* over cells (the marginal of the particle belief on the cells of
-    :func:`location_cells`): W_c = Σ_{i∈c} w_i, W'_c ∝ Σ_{i∈c} w_i Π_t p(z_st | C_i(p_st)).
-
-    Position terms (P, N) as for :func:`predicted_posterior_stats`; task_* (S, T). Information
-    about the other parameters (release rate, wind, diffusion) within a cell does not count: with
-    one particle per cell this is the joint KL divergence, with one cell it is 0. Two passes per
-    task (its largest log-likelihood, then the cell sums), sequential within a task, so results do
-    not depend on the thread count."""
-    n = weights.shape[0]
-    n_cells = cell_start.shape[0] - 1
-    for s in prange(task_positions.shape[0]):
-        ll = np.empty(n)
-        mx = _task_log_likelihoods(
-            s,
-            task_positions,
-            task_v,
-            task_fa,
-            task_out,
-            loc,
-            log_nd,
-            inv_sigma,
-            det_offset,
-            weights,
-            sp,
-            ll,
-        )
-        total = 0.0
-        acc = 0.0  # Σ_c A_c log(A_c / W_c), A_c the cell's unnormalised predicted weight
-        for c in range(n_cells):
-            a = 0.0
-            for k in range(cell_start[c], cell_start[c + 1]):
-                i = order[k]
-                wi = weights[i]
-                if wi > 0.0:
-                    a += wi * math.exp(ll[i] - mx)
-            if a > 0.0:
-                total += a
-                acc += a * (math.log(a) - log_cell_weight[c])
-        kl[s] = max(acc / total - math.log(total), 0.0)
-
-
-# --- NumPy references -------------------------------------------------------------------
-
-
-def _predicted_weights_reference(
-    conc: np.ndarray,
-    dist: np.ndarray,
-    weights: np.ndarray,
-    positions: np.ndarray,
-    readings: np.ndarray,
-    sensor: Sensor,
-) -> tuple[np.ndarray, float]:
-    """Unnormalised predicted weights (N,) w_i Π_t p(z_t | C_i(p_t)) / e^mx after the readings
-    (T,) at position rows (T,), and mx, the largest log-likelihood of a particle with weight."""
-    ll = np.zeros(conc.shape[1])
-    for p, z in zip(positions, readings, strict=True):
-        ll += sensor.log_likelihood(z, conc[p], dist[p])
-    mx = ll[weights > 0].max()
-    # zero-weight particles may exceed mx; clip them so that 0 · exp(·) stays 0
-    return weights * np.exp(np.minimum(ll - mx, 0.0)), float(mx)
-
-
-def predicted_posterior_stats_reference(
-    conc: np.ndarray,
-    source: np.ndarray,
-    weights: np.ndarray,
-    task_positions: np.ndarray,
-    task_readings: np.ndarray,
-    sensor: Sensor,
-    dist: np.ndarray | None = None,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """NumPy reference of :func:`dcee.planning.predicted_kernels.predicted_posterior_stats`
-    from concentrations (P, N), source distances (P, N; None: far) and raw readings (S, T).
-    Returns (log_evidence, mean, trace_cov, kl)."""
-    dist = np.full_like(conc, np.inf) if dist is None else dist
-    s_count = task_positions.shape[0]
-    log_ev = np.empty(s_count)
-    mean = np.empty((s_count, 3))
-    trace = np.empty(s_count)
-    kl = np.empty(s_count)
-    for s in range(s_count):
-        e, mx = _predicted_weights_reference(
-            conc, dist, weights, task_positions[s], task_readings[s], sensor
-        )
-        w_post = e / e.sum()
-        log_ev[s] = mx + np.log(e.sum())
-        mean[s] = w_post @ source
-        d = source - mean[s]
-        trace[s] = w_post @ np.einsum("ij,ij->i", d, d)
-        pos = w_post > 0
-        kl[s] = np.sum(w_post[pos] * (np.log(w_post[pos]) - np.log(weights[pos])))
-    return log_ev, mean, trace, kl
-
-
-def location_kl_reference(
-    conc: np.ndarray,
-    source: np.ndarray,
-    weights: np.ndarray,
-    task_positions: np.ndarray,
-    task_readings: np.ndarray,
-    sensor: Sensor,
-    cell: float,
-    dist: np.ndarray | None = None,
-) -> np.ndarray:
-    """NumPy reference of :func:`dcee.planning.predicted_kernels.location_kl`: (S,) KL
-    divergences of the source location's distribution over cubes of side ``cell`` (m), from
-    concentrations (P, N), sources (N, 3), weights (N,), positions (S, T) and readings (S, T)."""
-    dist = np.full_like(conc, np.inf) if dist is None else dist
-    _, cell_of = np.unique(np.floor(source / cell), axis=0, return_inverse=True)
-    cell_of = cell_of.reshape(-1)
-    prior = np.bincount(cell_of, weights=weights)
-    out = np.empty(task_positions.shape[0])
-    for s in range(task_positions.shape[0]):
-        e, _ = _predicted_weights_reference(
-            conc, dist, weights, task_positions[s], task_readings[s], sensor
-        )
-        post = np.bincount(cell_of, weights=e / e.sum(), minlength=len(prior))
-        pos = post > 0
-        out[s] = np.sum(post[pos] * np.log(post[pos] / prior[pos]))
-    return out

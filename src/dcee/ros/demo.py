@@ -177,7 +177,7 @@ class Mission:
         from std_msgs.msg import String
         from std_srvs.srv import Trigger
 
-        from dcee.ros.node import LATCHED, RELIABLE
+        from dcee.ros.parameters import LATCHED, RELIABLE
 
         self.node = rclpy.create_node("dcee_mission", context=context)
         self.scenario = scenario

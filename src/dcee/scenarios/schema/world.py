@@ -1,5 +1,6 @@
 """The ``[world]`` section: obstacles and no-go zones the robot may not enter or cross, as
-shapes or as an occupancy-grid map in the ROS map-server format (:mod:`dcee.models.site`)."""
+shapes or as an occupancy-grid map in the ROS map-server format (:mod:`dcee.models.site`,
+:mod:`dcee.models.ros_map`)."""
 
 from __future__ import annotations
 

@@ -1,0 +1,155 @@
+"""Compiled per-reading terms shared by the predicted-posterior kernels
+(:mod:`dcee.planning.predicted_kernels`, :mod:`dcee.planning.location_kl`): one hypothesised
+reading's log-likelihood from the cached position terms, a task's log-likelihoods over the
+particles, and the upper bounds that let a kernel skip hopeless particles.
+
+Readings arrive in the sensor's transformed frame (:mod:`dcee.models.sensor_kernels`,
+:meth:`dcee.models.sensor.Sensor.transformed_readings`): per task and stage the transformed
+reading v, the false-alarm term and the outlier term; the log Jacobian, common to every particle,
+is added to the log evidence by the caller.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from dcee.models.sensor_kernels import SensorParams
+from dcee.numeric import HALF_LOG_2PI, logaddexp
+
+
+@njit(cache=True, inline="always")
+def cached_log_likelihood(
+    v: float,
+    fa: float,
+    out: float,
+    loc: float,
+    lnd: float,
+    inv_s: float,
+    det_off: float,
+    sp: SensorParams,
+) -> float:
+    """log p(z | C) less the log Jacobian, from :func:`position_rows` and the transformed
+    reading terms; equals :func:`dcee.models.sensor_kernels.log_likelihood` minus the Jacobian."""
+    if v < sp.v_threshold:
+        return lnd
+    r = (v - loc) * inv_s
+    ld = det_off - 0.5 * r * r - HALF_LOG_2PI
+    if sp.false_alarm > 0.0:
+        log_missed = lnd - sp.log_not_false_alarm - sp.log_keep
+        ld = logaddexp(ld, fa + log_missed)
+    ld += sp.log_keep
+    if sp.log_outlier > -np.inf:
+        ld = logaddexp(ld, out)
+    return ld
+
+
+@njit(cache=True, inline="always")
+def task_bound(
+    s: int,
+    task_positions: np.ndarray,
+    task_v: np.ndarray,
+    task_fa: np.ndarray,
+    task_out: np.ndarray,
+    max_log_nd: np.ndarray,
+    max_det_offset: np.ndarray,
+    sp: SensorParams,
+) -> float:
+    """An upper bound of Σ_t log p(z_st | C_i) (less the Jacobian) over all particles i.
+
+    A detection's density term is at most max(log Pd − log σ) − ½ log 2π; a
+    false-alarm term at most its density times max P(missed); the outlier term is exact.
+    """
+    b = 0.0
+    for t in range(task_positions.shape[1]):
+        p = task_positions[s, t]
+        v = task_v[s, t]
+        if v < sp.v_threshold:
+            b += max_log_nd[p]
+            continue
+        ld = max_det_offset[p] - HALF_LOG_2PI
+        if sp.false_alarm > 0.0:
+            log_missed_max = max_log_nd[p] - sp.log_not_false_alarm - sp.log_keep
+            ld = logaddexp(ld, task_fa[s, t] + log_missed_max)
+        ld += sp.log_keep
+        if sp.log_outlier > -np.inf:
+            ld = logaddexp(ld, task_out[s, t])
+        b += ld
+    return b
+
+
+@njit(cache=True)
+def live_row_max(
+    log_nd: np.ndarray,
+    det_offset: np.ndarray,
+    rows: np.ndarray,
+    weights: np.ndarray,
+    max_log_nd: np.ndarray,
+    max_det_offset: np.ndarray,
+) -> None:
+    """For each row r in ``rows``: the largest log_nd[r, i] and det_offset[r, i] over the
+    particles with weight > 0 (the inputs of :func:`task_bound`)."""
+    for r in rows:
+        a = -np.inf
+        b = -np.inf
+        for i in range(weights.shape[0]):
+            if weights[i] > 0.0:
+                a = max(a, log_nd[r, i])
+                b = max(b, det_offset[r, i])
+        max_log_nd[r] = a
+        max_det_offset[r] = b
+
+
+@njit(cache=True)
+def task_bounds(
+    task_positions: np.ndarray,
+    task_v: np.ndarray,
+    task_fa: np.ndarray,
+    task_out: np.ndarray,
+    max_log_nd: np.ndarray,
+    max_det_offset: np.ndarray,
+    sp: SensorParams,
+    out: np.ndarray,
+) -> None:
+    for s in range(task_positions.shape[0]):
+        out[s] = task_bound(
+            s, task_positions, task_v, task_fa, task_out, max_log_nd, max_det_offset, sp
+        )
+
+
+@njit(cache=True, inline="always")
+def task_log_likelihoods(
+    s: int,
+    task_positions: np.ndarray,
+    task_v: np.ndarray,
+    task_fa: np.ndarray,
+    task_out: np.ndarray,
+    loc: np.ndarray,
+    log_nd: np.ndarray,
+    inv_sigma: np.ndarray,
+    det_offset: np.ndarray,
+    weights: np.ndarray,
+    sp: SensorParams,
+    ll: np.ndarray,
+) -> float:
+    """ll[i] = Σ_t log p(z_st | C_i(p_st)) (less the Jacobian) for every particle i, sequentially;
+    returns the largest over the particles with weight (−inf if none)."""
+    mx = -np.inf
+    for i in range(weights.shape[0]):
+        v = 0.0
+        for t in range(task_positions.shape[1]):
+            p = task_positions[s, t]
+            v += cached_log_likelihood(
+                task_v[s, t],
+                task_fa[s, t],
+                task_out[s, t],
+                loc[p, i],
+                log_nd[p, i],
+                inv_sigma[p, i],
+                det_offset[p, i],
+                sp,
+            )
+        ll[i] = v
+        if weights[i] > 0.0 and v > mx:
+            mx = v
+    return mx
