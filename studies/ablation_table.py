@@ -7,7 +7,7 @@ before the source was acquired; how many searches stalled > 60 s).
 A folder may hold several strategies: ``DIR=STRATEGY`` picks one (the strategy spec as stored,
 e.g. ``results/filament-calm=infotaxis``); a folder without ``=`` must hold just one. A stored
 study's ``searches.csv`` (written by ``studies/collect_metrics.py``) stands in for a folder
-whose searches are gone: ``docs/results/held-out-full/searches.csv=infotaxis``; ``KEY:VALUE``
+whose searches are gone: ``docs/results/held-out-today/searches.csv=infotaxis``; ``KEY:VALUE``
 after the strategy picks rows of a tagged study (``…/searches.csv=dcee-cl:truth_model:puffs``).
 
     .venv/bin/python studies/ablation_table.py results/ablation/all results/ablation/*

@@ -274,18 +274,13 @@ PLANNERS = ("dcee-cl", "infotaxis", "dcee-mcts")
 
 
 def held_out_table() -> str:
-    """Today's defaults on the three held-out studies (every planner on the same searches), and
-    the filament study as first flown (its settings before issue 29)."""
+    """Today's defaults on the three held-out studies (every planner on the same searches)."""
     rows = []
     frame = study("held-out-today")
     for name, what in HELD_OUT:
         for strategy in PLANNERS:
             r = pick(frame, strategy, study=name)
             rows.append(full_row(f"{what}: `{strategy}` (`held-out-today`)", r))
-    frame = study("held-out-filament")
-    for strategy in ("dcee-cl", "infotaxis"):
-        label = f"filament, all 200, settings before issue 29: `{strategy}` (`held-out-filament`)"
-        rows.append(full_row(label, pick(frame, strategy)))
     return table(FULL_HEADER, rows)
 
 
@@ -359,13 +354,6 @@ def others_table() -> str:
 
 def turbulent_table() -> str:
     rows = []
-    frame = study("filament-public")
-    for strategy in ("dcee-cl", "infotaxis"):
-        rows.append(
-            full_row(
-                f"filament, 12 public × 10: `{strategy}` (`filament-public`)", pick(frame, strategy)
-            )
-        )
     for name, how in (
         ("turbulent-public-defaults", "the third round's defaults"),
         ("turbulent-public-today", "**today's defaults**"),

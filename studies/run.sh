@@ -17,17 +17,23 @@ case "${1:---list}" in
       [ -f "$out/summary.json" ] || $D run --scenario "paper:$K" --strategy "$S" --seed 0 --out "$out" --no-figure -q
     done; done
     $D report results/first-look ;;
-  paper-source)  # section 5: the paper's five planners, wind known, 12 x 10
-    $D bench --suite paper --repeats 10 --out results/paper-source
-    report paper-source ;;
+  paper-source)  # section 5: the paper's planners at today's defaults, wind known, 12 x 10
+    $D bench --suite paper --repeats 10 --strategies dcee-cl,infotaxis,dcee,mpc \
+      --workers "${WORKERS:-2}" --out results/paper-source
+    report paper-source
+    $P studies/collect_metrics.py --out docs/results/paper-source results/paper-source
+    $P studies/publish_tables.py ;;
   public-wind-known)  # dcee-cl, current defaults, wind known, 12 x 10 (README, docs/turbulent.md)
     $D bench --suite paper --repeats 10 --strategies dcee-cl --out results/public-wind-known
     $D report results/public-wind-known
     cp results/public-wind-known/report/{metrics,per_configuration}.{csv,md} \
       docs/results/public-wind-known-dcee-cl/ ;;
-  paper-full)  # section 4.1.1: all eight parameters unknown, 12 x 10
-    $D bench --suite paper --repeats 10 --unknown full --out results/paper-full
-    report paper-full ;;
+  paper-full)  # section 4.1.1: all eight parameters unknown, today's defaults, 12 x 10
+    $D bench --suite paper --repeats 10 --unknown full --strategies dcee-cl,infotaxis,dcee,mpc \
+      --workers "${WORKERS:-2}" --out results/paper-full
+    report paper-full
+    $P studies/collect_metrics.py --out docs/results/paper-full results/paper-full
+    $P studies/publish_tables.py ;;
   model-mismatch)  # filament truth, the isotropic estimator
     $D bench --suite paper --strategies dcee,entrotaxis,mpc --repeats 10 --unknown full \
       --truth filament --out results/paper-filament
@@ -37,10 +43,17 @@ case "${1:---list}" in
     $P studies/dual_control_table.py --study results/paper-source-cl
     $P studies/dual_control_table.py results/dual-ablation
     report paper-source-cl2 paper-full-cl paper-full-cl2 ;;
-  team)  # several robots, one belief
-    bash studies/study_team.sh
-    $P studies/team_table.py results/team10k-a1 results/team10k-a2 results/team10k-a3
-    $P studies/team_table.py results/paper-source-cl2 results/team-a2 results/team-a3 ;;
+  team)  # several robots, one belief: 2 and 3 robots beside paper-source's one (same seeds)
+    # one robot: paper-source's campaign (resumed, or a no-op when it is complete)
+    $D bench --suite paper --repeats 10 --strategies dcee-cl,infotaxis,dcee,mpc \
+      --workers "${WORKERS:-2}" --out results/paper-source
+    for K in 2 3; do
+      $D bench --suite paper --repeats 10 --agents "$K" --strategies dcee-cl,infotaxis \
+        --workers "${WORKERS:-2}" --out "results/team-a$K"
+    done
+    $P studies/team_table.py results/paper-source results/team-a2 results/team-a3 \
+      --out docs/results/team
+    $P studies/publish_tables.py ;;
   turbulent)  # the filament truth with hold-averaged readings and the fluctuation likelihood
     bash studies/study_turbulent.sh
     report filament-fluct ;;
@@ -207,9 +220,11 @@ case "${1:---list}" in
   fuzz)  # random reading streams: no dead filter
     $P studies/fuzz_filter.py ;;
   lab)  # the paper's indoor experiment in simulation (section 6)
-    bash studies/study_lab.sh
-    $P studies/lab_table.py results/lab-robot results/lab-grid
-    report lab-robot-filament-fit lab-robot-filament ;;
+    WORKERS=${WORKERS:-2} bash studies/study_lab.sh
+    $P studies/lab_table.py results/lab-robot=robot-isotropic results/lab-grid=grid-isotropic \
+      results/lab-robot-filament-fit=robot-filament-room \
+      results/lab-robot-filament=robot-filament-50m --out docs/results/lab
+    $P studies/publish_tables.py ;;
   precision)  # where a turbulent search's final error comes from (docs/turbulent.md)
     # the table's rows, with the defaults of the session that measured it written out
     # (near_source_length 10 m, reading_weight 1), so it reproduces with today's defaults
