@@ -20,6 +20,7 @@ disagrees with its results (tests/test_published_numbers.py runs it).
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import re
 import sys
@@ -37,6 +38,7 @@ PAGES = (
     "docs/held-out.md",
     "docs/scenarios.md",
     "docs/plumes.md",
+    "docs/performance.md",
 )
 MARKER = re.compile(
     r"(<!-- generated: (?P<name>[a-z0-9-]+) \(studies/publish_tables\.py\) -->\n)"
@@ -706,6 +708,79 @@ def learn_tuning_table() -> str:
     return table(header, rows)
 
 
+def _perf(name: str) -> dict:
+    return json.loads((RESULTS / "perf" / f"{name}.json").read_text(encoding="utf-8"))
+
+
+def _timed(record: dict) -> str:
+    """When and how a stored timing was taken: date, cores, and the load beside it."""
+    load, machine = record["load"], record["machine"]
+    when = (load.get("started") or "")[:10]
+    other = load.get("other_cores")
+    if load.get("idle") is True:
+        state = "idle"
+    elif other is None:
+        state = "load unknown"
+    else:
+        state = f"**shared** (other processes {other:.1f} cores)"
+    commit = (machine.get("code", {}).get("commit") or "")[:7]
+    return f"{when}, {machine['cpus']} CPUs, {state}, `{commit}`"
+
+
+def speed_table() -> str:
+    """Speed, from the stored `dcee perf` outputs of docs/results/perf/ (bash studies/run.sh
+    perf): every ratio's two sides timed in the same run."""
+    ste, mcts, work = _perf("stonesoup-ste"), _perf("stonesoup-mcts"), _perf("workloads")
+    by_name = {w["name"]: w for w in work["workloads"]}
+    rows = [
+        [
+            "our `infotaxis` decision vs Stone Soup's KL planner on Stone Soup's own STE "
+            f"workload, {ste['stonesoup']['decisions']} decisions each, in alternation",
+            f"{ste['stonesoup']['speedup']:.1f}× faster",
+            f"{ste['stonesoup']['dcee_infotaxis_median_ms']:.2f} ms vs "
+            f"{ste['stonesoup']['stonesoup_median_ms']:.1f} ms",
+            "≥ 50×",
+            _timed(ste),
+        ],
+        [
+            f"our tree search (`{mcts['strategy']}`) vs Stone Soup's "
+            f"`MCTSRolloutSensorManager` on its MCTS STE example, seeds 0-{mcts['seeds'] - 1}",
+            f"{mcts['speedup']:.1f}× faster at the median decision; final x-y RMSE "
+            f"{mcts['dcee_median_final_rmse']:.2f} m vs {mcts['stonesoup_median_final_rmse']:.2f}"
+            f" m (lower in {mcts['dcee_lower_rmse']}/{mcts['seeds']})",
+            f"{mcts['dcee_median_ms']:.0f} ms vs {mcts['stonesoup_median_ms']:.0f} ms",
+            "≥ 50×, lower RMSE",
+            _timed(mcts),
+        ],
+    ]
+    work_rows = (
+        ("dcee-decision-20k", "floor", "a paper-scale `dcee` decision (20,000 particles, 8 moves "
+         "× 40 readings) vs the plain compiled loop of the same arithmetic", "≤ 1.5×"),
+        ("infotaxis-decision-20k", "floor", "the same for `infotaxis`", "≤ 1.5×"),
+        ("dcee-mcts-decision-20k", "dcee-cl-decision", "a `dcee-mcts` decision vs a `dcee-cl` "
+         "decision, 20,000 particles, in alternation", "≤ 3×"),
+        ("resample-mcmc-500-readings-20k", "filter-update", "resample + MCMC move over 500 "
+         "readings vs one filter update, 20,000 particles", "≤ 76×"),
+    )  # fmt: skip
+    for name, reference, label, target in work_rows:
+        w = by_name[name]
+        ratio = w["ratio_to"][reference]
+        rows.append([label, f"{ratio:.2f}×", f"{w['median']:.3g} ms", target, _timed(work)])
+    cl = by_name["dcee-cl-decision-20k"]
+    rows.append(
+        [
+            "a paper-scale `dcee-cl` decision (20,000 particles, 8 moves × 40 readings), "
+            f"{work['machine']['numba_threads']} threads",
+            "—",
+            f"{cl['median']:.3g} ms",
+            "—",
+            _timed(work),
+        ]
+    )
+    return table(["comparison (both sides in the same run)", "ratio", "absolute", "target",
+                  "timed (date, machine, load, code)"], rows)  # fmt: skip
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "learn-tuning": learn_tuning_table,
     "cross-truth": cross_truth_table,
@@ -722,6 +797,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "stop-rule": stop_rule_table,
     "anemometer": anemometer_table,
     "sites": sites_table,
+    "speed": speed_table,
 }
 
 

@@ -367,10 +367,17 @@ case "${1:---list}" in
     $P studies/publish_tables.py ;;
   publish)  # the tables of README.md, docs/index.md, docs/results.md from docs/results/
     $P studies/publish_tables.py ;;
-  stonesoup-mcts)  # our tree search against Stone Soup's MCTS on its own example
-    $P studies/stonesoup_mcts_study.py ;;
-  perf)  # docs/performance.md
-    $D perf ;;
+  stonesoup-mcts)  # our tree search against Stone Soup's MCTS on its own example, 10 seeds
+    $P studies/stonesoup_mcts_study.py results/stonesoup-mcts --seeds 10 ;;
+  perf)  # the speed tables (README, docs/performance.md) from stored runs; run it with nothing
+    # else on the machine (each output records the load beside it and is marked shared if not)
+    mkdir -p docs/results/perf
+    $D perf --json docs/results/perf/workloads.json
+    $D perf --compare-stonesoup --decisions 20 --json docs/results/perf/stonesoup-ste.json
+    rm -rf results/perf-stonesoup-mcts  # every seed timed in this run
+    $P studies/stonesoup_mcts_study.py results/perf-stonesoup-mcts --seeds "${MCTS_SEEDS:-3}" \
+      --json docs/results/perf/stonesoup-mcts.json
+    $P studies/publish_tables.py ;;
   --list)
     sed -n 's/^  \([a-z-]*\)) *# \(.*\)/\1\t\2/p' "$0" ;;
   *)

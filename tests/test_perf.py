@@ -54,6 +54,11 @@ def test_perf_quick_writes_every_standard_workload(tmp_path, capsys):
     mem = by_name["memory-dcee-decision-100k"]
     assert mem["unit"] == "MB" and 0 < mem["median"] < 200
     assert data["machine"]["cpus"] >= 1
+    # what it ran on and beside: versions, the code, the load (dcee.perf.machine)
+    assert data["machine"]["code"]["source_hash"] and "numba" in data["machine"]["versions"]
+    load = data["load"]
+    assert load["wall_seconds"] > 0 and load["idle"] in (True, False)
+    assert (load["idle"] is False) == ("marked shared" in stdout.replace("\n", " "))
 
 
 def test_compare_stonesoup_without_the_extra_is_a_clear_error(monkeypatch, capsys):

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import sys
 from pathlib import Path
 
@@ -22,40 +21,41 @@ from dcee.io import check_writable_file, write_json
 )
 @click.option("--decisions", default=10, show_default=True, help="Decisions per side to time.")
 def perf(json_path: str | None, quick: bool, compare_stonesoup: bool, decisions: int) -> None:
-    """Time the standard workloads against their targets (see docs/performance.md)."""
-    import platform
-
+    """Time the standard workloads against their targets (see docs/performance.md). The JSON
+    records the machine, the versions and the load beside the run (dcee.perf.machine): a run
+    with other processes busy is marked shared."""
     from rich.console import Console
     from rich.table import Table
 
+    from dcee.perf.machine import LoadMonitor, load_warning, machine_record
+
     if json_path:
         check_writable_file(Path(json_path), "json")  # before minutes of timing, not after
+    if decisions < 1:
+        raise DceeInputError("decisions", f"must be >= 1, got {decisions}")
     console = Console(width=None if sys.stdout.isatty() else 120)
-    machine = {
-        "cpus": os.cpu_count(),
-        "machine": platform.machine(),
-        "processor": platform.processor(),
-        "python": platform.python_version(),
-        "numba_threads": _numba_threads(),
-    }
+    machine = machine_record()
     if compare_stonesoup:
         from dcee.perf.stonesoup_compare import compare
 
-        if decisions < 1:
-            raise DceeInputError("decisions", f"must be >= 1, got {decisions}")
-        result = compare(decisions)
+        with LoadMonitor() as load:
+            result = compare(decisions)
+        warning = load_warning(load.record())
         console.print(
             f"{result['workload']}, {decisions} decisions each (medians, same process):\n"
             f"  Stone Soup {result['stonesoup_median_ms']:.2f} ms · "
             f"dcee infotaxis {result['dcee_infotaxis_median_ms']:.2f} ms · "
             f"ratio {result['speedup']:.1f}x (target >= {result['target_speedup']:.0f}x)"
         )
+        if warning:
+            console.print(f"[yellow]{warning}")
         if json_path:
-            write_json(Path(json_path), {"machine": machine, "stonesoup": result})
+            record = {"machine": machine, "load": load.record(), "stonesoup": result}
+            write_json(Path(json_path), record)
         return
     from dcee.perf import run_workloads
 
-    with console.status("timing") as status:
+    with console.status("timing") as status, LoadMonitor() as load:
         timings = run_workloads(quick, progress=lambda name: status.update(f"timing {name}"))
     table = Table(title=f"dcee perf · {machine['cpus']} CPUs · {machine['machine']}")
     for col in ("workload", "median", "min", "max", "target", "pass"):
@@ -78,14 +78,15 @@ def perf(json_path: str | None, quick: bool, compare_stonesoup: bool, decisions:
     for t in timings:
         if t.note:
             console.print(f"  {t.name}: {t.note}")
+    if warning := load_warning(load.record()):
+        console.print(f"[yellow]{warning}")
     if json_path:
         write_json(
             Path(json_path),
-            {"machine": machine, "workloads": [t.as_dict() for t in timings]},
+            {
+                "machine": machine,
+                "load": load.record(),
+                "quick": quick,
+                "workloads": [t.as_dict() for t in timings],
+            },
         )
-
-
-def _numba_threads() -> int:
-    import numba
-
-    return int(numba.get_num_threads())

@@ -1,0 +1,120 @@
+"""What a timing was taken on, and whether anything else ran beside it.
+
+Timings on a shared machine swing 3-5× from day to day, and a process running beside a timed
+comparison slows its two sides differently, so every stored timing carries the machine, the
+versions of the code and libraries it ran, and the load during the run
+(:class:`LoadMonitor`): the cores that *other* processes used on average while it ran, read
+from the kernel's CPU counters (``/proc/stat``) less this process's own CPU time. A run with
+other processes using more than :data:`IDLE_OTHER_CORES` cores on average is marked shared.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import os
+import platform
+import resource
+import time
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from dcee.provenance import code_version
+
+IDLE_OTHER_CORES = 0.25
+"""Cores other processes may use on average during a run still called idle (a desktop's or a
+CI runner's background; one busy process beside the run is a whole core)."""
+
+LIBRARIES = ("numpy", "numba", "llvmlite", "scipy", "stonesoup")
+
+
+def machine_record() -> dict[str, Any]:
+    """The machine and the software a timing ran on: CPU count, architecture, processor,
+    Python, numba's thread count, library versions (absent ones omitted) and the code version
+    (:func:`dcee.provenance.code_version`)."""
+    import numba
+
+    versions = {}
+    for name in LIBRARIES:
+        dist = "stonesoup" if name == "stonesoup" else name
+        try:
+            versions[name] = importlib.metadata.version(dist)
+        except importlib.metadata.PackageNotFoundError:
+            continue
+    return {
+        "cpus": os.cpu_count(),
+        "machine": platform.machine(),
+        "processor": platform.processor() or platform.uname().processor,
+        "python": platform.python_version(),
+        "numba_threads": int(numba.get_num_threads()),
+        "versions": versions,
+        "code": code_version(),
+    }
+
+
+def _busy_seconds() -> float | None:
+    """CPU seconds all processors have spent busy since boot (``/proc/stat``: user, nice,
+    system, irq, softirq, steal), or None where the file does not exist."""
+    path = Path("/proc/stat")
+    if not path.exists():
+        return None
+    fields = path.read_text().split("\n", 1)[0].split()[1:]
+    user, nice, system, _idle, _iowait, irq, softirq, steal = (int(v) for v in fields[:8])
+    return (user + nice + system + irq + softirq + steal) / os.sysconf("SC_CLK_TCK")
+
+
+def _own_seconds() -> float:
+    """CPU seconds this process and its finished children have used."""
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+class LoadMonitor:
+    """``with LoadMonitor() as load: ...`` then ``load.record()``: the wall time, the cores
+    this process used and the cores every other process used on average during the block,
+    and whether the machine counts as idle (other processes below :data:`IDLE_OTHER_CORES`)."""
+
+    def __enter__(self) -> LoadMonitor:
+        self.started = datetime.now(UTC)
+        self._wall = time.perf_counter()
+        self._busy = _busy_seconds()
+        self._own = _own_seconds()
+        self._load_start = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
+        self._result: dict[str, Any] | None = None
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        wall = time.perf_counter() - self._wall
+        busy = _busy_seconds()
+        own = _own_seconds() - self._own
+        other = None
+        if busy is not None and self._busy is not None and wall > 0:
+            other = max(0.0, (busy - self._busy - own) / wall)
+        self._result = {
+            "started": self.started.isoformat(timespec="seconds"),
+            "wall_seconds": wall,
+            "own_cores": own / wall if wall > 0 else None,
+            "other_cores": other,
+            "loadavg_1min_start": self._load_start,
+            "loadavg_1min_end": os.getloadavg()[0] if hasattr(os, "getloadavg") else None,
+            "idle": None if other is None else other < IDLE_OTHER_CORES,
+        }
+
+    def record(self) -> dict[str, Any]:
+        if self._result is None:
+            raise RuntimeError("LoadMonitor.record() before the block ended")
+        return self._result
+
+
+def load_warning(load: dict[str, Any]) -> str | None:
+    """One line for a run that was not idle (None when it was, or could not be told)."""
+    if load.get("idle") is not False:
+        return None
+    return (
+        f"other processes used {load['other_cores']:.1f} cores on average during this run: "
+        "its times are marked shared; rerun with nothing else running for numbers to publish"
+    )
+
+
+__all__ = ["IDLE_OTHER_CORES", "LoadMonitor", "load_warning", "machine_record"]
