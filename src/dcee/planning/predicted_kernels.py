@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit, prange
 
 from dcee.models.sensor_kernels import SensorParams
-from dcee.numeric import HALF_LOG_2PI, exp_scalar, vlogaddexp
+from dcee.numeric import HALF_LOG_2PI, exp_scalar, log_scalar, vlogaddexp
 from dcee.planning.reading_terms import (
     cached_log_likelihood,
     live_row_max,
@@ -87,10 +87,12 @@ def _single_stage_weights(
     sp: SensorParams,
     e: np.ndarray,
     ll: np.ndarray,
+    want_ll: bool,
 ) -> None:
     """e[q] = w_i exp(ll_i − bnd) and ll[q] = log p(v | C_i) (less the Jacobian) for particles
     i = i0 + q, q < n, of one position row (1-D rows of :func:`position_rows`) and one
-    single-stage reading (transformed reading v, outlier term out).
+    single-stage reading (transformed reading v, outlier term out); ll is left unwritten for a
+    detection with the outlier component unless ``want_ll``.
 
     Branch-free loops (the detection test is the same for every particle), so LLVM vectorises
     them, ``exp`` and the outlier's log-sum-exp included. A particle of weight 0 gives exactly
@@ -105,12 +107,18 @@ def _single_stage_weights(
         return
     det_add = sp.log_keep - HALF_LOG_2PI
     if sp.log_outlier > -np.inf:
+        # with the outlier component p(z | C) = e^a + e^out (a the detection term), so
+        # e^(ll − bnd) = e^(a − bnd) + e^(out − bnd): one exp per particle instead of a
+        # log-sum-exp and an exp (2.5x less work on this, the default path; equal to 1e-15),
+        # and ll itself, a log, only when the KL divergence reads it
+        out_term = exp_scalar(min(out - bnd, 0.0))
         for q in range(n):
             i = np.uint64(i0 + q)
             r = (v - loc[i]) * inv_sigma[i]
-            lq = vlogaddexp(det_offset[i] + det_add - 0.5 * r * r, out)
-            ll[np.uint64(q)] = lq
-            e[np.uint64(q)] = weights[i] * exp_scalar(min(lq - bnd, 0.0))
+            e_rel = exp_scalar(min(det_offset[i] + det_add - 0.5 * r * r - bnd, 0.0)) + out_term
+            e[np.uint64(q)] = weights[i] * e_rel
+            if want_ll:
+                ll[np.uint64(q)] = bnd + log_scalar(e_rel)
         return
     for q in range(n):
         i = np.uint64(i0 + q)
@@ -192,6 +200,7 @@ def _grouped_stats(
                     sp,
                     e,
                     ll,
+                    want_kl,
                 )
                 for a in range(1, _N_ACC):
                     partial[b, s, a] = 0.0
