@@ -20,7 +20,7 @@ import numpy as np
 from numba import njit, prange
 
 from dcee.models.sensor_kernels import SensorParams
-from dcee.numeric import HALF_LOG_2PI, exp_scalar, log_scalar, vlogaddexp
+from dcee.numeric import HALF_LOG_2PI, exp_scalar, log_scalar
 from dcee.planning.reading_terms import (
     cached_log_likelihood,
     live_row_max,
@@ -156,7 +156,8 @@ def _grouped_stats(
     several stages: group_start[g]..group_start[g+1]−1 share one position sequence (equal
     task_positions rows), so a particle's per-position terms are loaded once and the loops over
     the group's hypothesised readings are branch-free arithmetic that LLVM vectorises (the
-    outlier component's log-sum-exp included). With false alarms the exact scalar likelihood is
+    outlier component's log-sum-exp split into a max and a product of 1 + exp terms, one log per
+    hypothesis). With false alarms the exact scalar likelihood is
     used instead (slower, not vectorised). Sums a planner does not need (the location moments,
     Σ e·ll for the KL divergence) are left at zero when not wanted; ``offsets`` (4, N) from
     :func:`_centred_offsets` is only read for the moments.
@@ -221,6 +222,10 @@ def _grouped_stats(
                 out[t, j] = task_out[s0 + j, t]
         bnd = bound[s0 : s0 + k].copy()
         ll = np.empty(k)
+        # with the outlier component each detection stage's log-sum-exp log(e^a + e^out) is
+        # split into max(a, out) (summed in ll) and 1 + e^-|a - out| (multiplied in prod): one
+        # exp per stage, and the log of the product once per hypothesis, for the KL divergence
+        prod = np.ones(k)
         a0 = np.zeros(k)
         a1 = np.zeros(k)
         a2 = np.zeros(k)
@@ -239,6 +244,7 @@ def _grouped_stats(
                 dz = offsets[2, i]
                 d2 = offsets[3, i]
             ll[:] = 0.0
+            prod[:] = 1.0
             for t in range(t_count):
                 p = task_positions[s0, t]
                 m = loc[p, i]
@@ -254,8 +260,12 @@ def _grouped_stats(
                     for j in range(k):
                         zj = z[t, j]
                         r = (zj - m) * inv_s
-                        d = vlogaddexp(det_const - 0.5 * r * r, out[t, j])
-                        ll[j] += d if zj >= v_thr else lnd
+                        a = det_const - 0.5 * r * r
+                        hi = max(a, out[t, j])
+                        factor = 1.0 + exp_scalar(min(a, out[t, j]) - hi)
+                        detected = zj >= v_thr
+                        ll[j] += hi if detected else lnd
+                        prod[j] *= factor if detected else 1.0
                 else:
                     det_const = det_offset[p, i] - HALF_LOG_2PI
                     for j in range(k):
@@ -263,7 +273,7 @@ def _grouped_stats(
                         r = (zj - m) * inv_s
                         ll[j] += det_const - 0.5 * r * r if zj >= v_thr else lnd
             for j in range(k):
-                e = wi * exp_scalar(ll[j] - bnd[j])
+                e = wi * exp_scalar(ll[j] - bnd[j]) * prod[j]
                 a0[j] += e
                 if want_moments:
                     a1[j] += e * dx
@@ -271,7 +281,7 @@ def _grouped_stats(
                     a3[j] += e * dz
                     a4[j] += e * d2
                 if want_kl:
-                    a5[j] += e * ll[j]
+                    a5[j] += e * (ll[j] + log_scalar(prod[j]) if with_outliers else ll[j])
         for j in range(k):
             partial[b, s0 + j, 0] = a0[j]
             partial[b, s0 + j, 1] = a1[j]
