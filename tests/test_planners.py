@@ -498,3 +498,25 @@ def test_info_share_charges_the_information_equivalent_location_variance():
     np.testing.assert_allclose(c_half, 0.5 * (c_zero + costs), rtol=1e-9)
     with pytest.raises(DceeInputError, match="info_share"):
         planners.get("dcee-cl:info_share=1.5")
+
+
+@pytest.mark.parametrize("sensor", [Sensor(), Sensor.paper_exact(false_alarm=0.01)])
+def test_stratified_hypotheses_of_every_sequence_at_once_are_those_one_at_a_time(sensor):
+    """PredictionContext.stats draws the stratified hypotheses of all candidate sequences in one
+    pass; they are the per-sequence ones bit for bit (decisions must not change), over one to
+    five stages, with and without detections, and where no particle can be detected."""
+    rng = np.random.default_rng(11)
+    theta = theta_at([(x, y, 0.0) for x, y in rng.uniform(0, 40, (600, 2))], q=1.0, u=2.0)
+    w = rng.random(len(theta))
+    belief = Belief(theta, w / w.sum(), sensor, IsotropicPlume())
+    for horizon in (1, 3, 5):
+        ctx = PredictionContext(belief, 12, horizon, rng, expectation="stratified")
+        seqs = rng.uniform(0, 40, (9, horizon, 3))
+        seqs[..., 2] = 0.0
+        seqs[0] = [200.0, 200.0, 0.0]  # far outside: no particle can be detected there
+        pos_idx = ctx.position_index(seqs.reshape(-1, 3)).reshape(9, horizon)
+        readings, probability = ctx._stratified_batch(pos_idx)
+        assert (readings[1:] > 0).any()
+        for s in range(9):
+            one_z, one_p = ctx._stratified_readings(pos_idx[s])
+            assert np.array_equal(one_z, readings[s]) and np.array_equal(one_p, probability[s])
