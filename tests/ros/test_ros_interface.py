@@ -64,7 +64,8 @@ def test_the_parameter_file_loads_in_rclpy_and_configures_the_node():
     import rclpy
     from rclpy.parameter import parameter_dict_from_yaml_file
 
-    from dcee.ros.node import PARAMETERS, SearchNode
+    from dcee.ros.node import SearchNode
+    from dcee.ros.parameters import PARAMETERS
 
     params = parameter_dict_from_yaml_file(str(PARAMS), target_nodes=["dcee_search"])
     assert set(params) == set(PARAMETERS)  # every parameter, none unknown
