@@ -3,6 +3,7 @@ optionally with a climb and a descent (``climb``)."""
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -21,12 +22,15 @@ class SearchVolume:
     low: tuple[float, float, float]
     high: tuple[float, float, float]
 
+    @functools.cached_property
+    def _corners(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.asarray(self.low, dtype=np.float64), np.asarray(self.high, dtype=np.float64)
+
     def contains(self, points: np.ndarray, tol: float = 1e-9) -> np.ndarray:
         """(K, 3) points → (K,) bool, inside the volume (boundary included)."""
         p = np.atleast_2d(points)
-        lo = np.asarray(self.low) - tol
-        hi = np.asarray(self.high) + tol
-        return np.all((p >= lo) & (p <= hi), axis=1)
+        low, high = self._corners  # the tree search asks thousands of times per decision
+        return np.all((p >= low - tol) & (p <= high + tol), axis=1)
 
 
 @dataclass(frozen=True)
@@ -63,16 +67,18 @@ class GridAgent:
         if not self.climb >= 0:
             raise DceeInputError("agent.climb", f"must be >= 0 m, got {self.climb}")
 
-    @property
+    @functools.cached_property
     def moves(self) -> np.ndarray:
         """(n_moves, 3) displacement vectors u in m: the headings (z component 0), then, with
-        ``climb`` > 0, (0, 0, +climb) and (0, 0, −climb)."""
+        ``climb`` > 0, (0, 0, +climb) and (0, 0, −climb). Computed once per agent (read-only:
+        the tree search asks for the candidates thousands of times per decision)."""
         angles = 2 * np.pi * np.arange(self.n_headings) / self.n_headings
         out = np.zeros((self.n_moves, 3))
         out[: self.n_headings, 0] = np.round(self.step * np.cos(angles), 12)
         out[: self.n_headings, 1] = np.round(self.step * np.sin(angles), 12)
         if self.climb > 0:
             out[self.n_headings :, 2] = (self.climb, -self.climb)
+        out.flags.writeable = False
         return out
 
     @property
