@@ -134,19 +134,17 @@ def table(header: list[str], rows: list[list[str]]) -> str:
 
 def what_we_found() -> str:
     """The headline table (README and docs/index.md)."""
-    cur = pick(study("public-wind-known-dcee-cl"), "dcee-cl")
     ps = study("paper-source")
+    cur = pick(ps, "dcee-cl")
     rows = [
         [
-            "`dcee-cl` (closed-loop DCEE, this project), current defaults "
-            "(`public-wind-known-dcee-cl`)",
+            "`dcee-cl` (closed-loop DCEE, this project), current defaults (`paper-source`)",
             count(cur),
             f"{rmse(cur).split(' ')[0]} m",
             f"{time_to_1m(cur).split(' ')[0]} s",
         ]
     ]
     for strategy, label in (
-        ("dcee-cl", "`dcee-cl` with the previous fixed 8 m reach (`paper-source`)"),
         ("infotaxis", "`infotaxis` (`paper-source`)"),
         ("dcee", "`dcee` (the paper's theorem 1, as written; `paper-source`)"),
         ("mpc", "`mpc` (`paper-source`)"),
@@ -245,23 +243,15 @@ def full_row(label: str, r: pd.Series) -> list[str]:
     ]
 
 
-def public_table(name: str, current: str | None) -> Callable[[], str]:
+def public_table(name: str) -> Callable[[], str]:
+    """The four planners of a public study (12 configurations × 10 seeds)."""
+
     def make() -> str:
-        rows = []
-        if current is not None:
-            rows.append(
-                full_row(
-                    f"`dcee-cl`, current defaults (`{current}`)", pick(study(current), "dcee-cl")
-                )
-            )
         frame = study(name)
-        for strategy in ("dcee-cl", "infotaxis", "dcee", "mpc"):
-            label = (
-                f"`dcee-cl`, fixed 8 m reach (`{name}`)"
-                if strategy == "dcee-cl"
-                else f"`{strategy}` (`{name}`)"
-            )
-            rows.append(full_row(label, pick(frame, strategy)))
+        rows = [
+            full_row(f"`{strategy}` (`{name}`)", pick(frame, strategy))
+            for strategy in ("dcee-cl", "infotaxis", "dcee", "mpc")
+        ]
         return table(FULL_HEADER, rows)
 
     return make
@@ -781,13 +771,35 @@ def speed_table() -> str:
                   "timed (date, machine, load, code)"], rows)  # fmt: skip
 
 
+def kernel_speedup_table() -> str:
+    """The predicted-posterior kernel before and after issue 46's changes, in alternation in one
+    run (studies/kernel_speedup.py, docs/results/perf/kernel-speedup.json)."""
+    record = _perf("kernel-speedup")
+    rows = [
+        [
+            w["workload"],
+            f"{w['tasks']} × {w['particles']:,}",
+            f"{w['before_ms']:.1f} ms",
+            f"{w['after_ms']:.1f} ms",
+            f"**{w['speedup']:.2f}×**",
+            f"{w['max_abs_difference']:.0e}",
+        ]
+        for w in record["workloads"]
+    ]
+    rows.append(["timed", _timed(record), f"before: `{record['before']}`", "", "", ""])
+    return table(
+        ["workload", "tasks × particles", "before", "after", "speed-up", "largest difference"],
+        rows,
+    )
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "learn-tuning": learn_tuning_table,
     "cross-truth": cross_truth_table,
     "lbm-statistics": lbm_statistics_table,
     "what-we-found": what_we_found,
-    "wind-known": public_table("paper-source", "public-wind-known-dcee-cl"),
-    "full-unknown": public_table("paper-full", None),
+    "wind-known": public_table("paper-source"),
+    "full-unknown": public_table("paper-full"),
     "held-out": held_out_table,
     "held-out-paired": paired_table,
     "held-out-others": others_table,
@@ -798,6 +810,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "anemometer": anemometer_table,
     "sites": sites_table,
     "speed": speed_table,
+    "kernel-speedup": kernel_speedup_table,
 }
 
 
