@@ -7,6 +7,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -122,10 +123,25 @@ BENCH = ["bench", "--suite", "smoke", "--strategies", "mpc,dcee", "--repeats", "
 BENCH += ["--particles", "300", "--workers", "2"]
 
 
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGKILL], ids=["ctrl-c", "kill-9"])
+def _group_alive(pgid: int) -> bool:
+    """Whether any process of the process group ``pgid`` still runs (zombies do not count)."""
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[2]) == pgid and fields[0] != "Z":
+            return True
+    return False
+
+
+@pytest.mark.parametrize(
+    "sig", [signal.SIGINT, signal.SIGTERM, signal.SIGKILL], ids=["ctrl-c", "kill", "kill-9"]
+)
 def test_interrupted_bench_keeps_finished_searches_and_resumes(tmp_path, capsys, sig):
-    """A real interruption: the signal goes to the driver and its workers (as Ctrl-C in a
-    terminal does) as soon as the first search has finished; the rerun redoes only the rest."""
+    """A real interruption as soon as the first search has finished: Ctrl-C (to the driver and
+    its workers, as a terminal sends it), ``kill PID`` (SIGTERM to the driver alone: it stops
+    its workers, none is left running) or ``kill -9`` (to all); the rerun redoes only the rest."""
     out = tmp_path / "c"
     proc = subprocess.Popen(
         [sys.executable, "-m", "dcee.cli", *BENCH, "--out", str(out)],
@@ -139,11 +155,21 @@ def test_interrupted_bench_keeps_finished_searches_and_resumes(tmp_path, capsys,
         assert proc.poll() is None, proc.communicate()
         assert time.monotonic() < deadline, "no search finished in time"
         time.sleep(0.02)
-    os.killpg(proc.pid, sig)
+    if sig == signal.SIGTERM:
+        os.kill(proc.pid, sig)
+    else:
+        os.killpg(proc.pid, sig)
     _, err = proc.communicate(timeout=120)
     if sig == signal.SIGINT:
         assert proc.returncode == 130 and err.strip().endswith("dcee: interrupted")
         assert "Traceback" not in err
+    elif sig == signal.SIGTERM:
+        assert proc.returncode == 143 and err.strip().endswith("dcee: terminated")
+        assert "Traceback" not in err
+        deadline = time.monotonic() + 30  # no worker outlives the driver
+        while _group_alive(proc.pid) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not _group_alive(proc.pid), "a worker process outlived the driver"
     else:
         assert proc.returncode == -signal.SIGKILL
     tasks = Campaign(out, "smoke", ("mpc", "dcee"), 5, particles=300).tasks()

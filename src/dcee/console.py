@@ -8,7 +8,9 @@ allowed>``, printed before any work starts), 130 interrupted.
 
 from __future__ import annotations
 
+import signal
 import sys
+import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -21,6 +23,17 @@ USER_ERROR = 2
 """Exit code of a user mistake (bad option, bad scenario value, unknown name, missing file)."""
 INTERRUPTED = 130
 """Exit code of an interrupted command (Ctrl-C)."""
+TERMINATED = 143
+"""Exit code of a command stopped by SIGTERM (``kill PID``, a scheduler stopping a job)."""
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised in the main thread while a command runs: every clean-up written for
+    Ctrl-C runs for it too (a campaign stops its worker processes instead of orphaning them)."""
+
+
+def _raise_terminated(signum: int, frame: Any) -> None:
+    raise Terminated
 
 
 def error_exit(program: str, message: str) -> None:
@@ -36,7 +49,7 @@ def _redeliver_interrupts(unraisable: Any, fallback: Callable[[Any], None]) -> N
     lost and printed; this raises it again in the main thread shortly after, once the finaliser has
     returned (from a timer thread: a signal simulated here would be raised inside this hook and
     lost again; should it land in another finaliser, this hook defers it once more)."""
-    if unraisable.exc_type is KeyboardInterrupt:
+    if unraisable.exc_type is not None and issubclass(unraisable.exc_type, KeyboardInterrupt):
         import _thread
         import threading
 
@@ -49,20 +62,29 @@ def _redeliver_interrupts(unraisable: Any, fallback: Callable[[Any], None]) -> N
 
 def run_command(command: click.Command, program: str, argv: list[str] | None = None) -> None:
     """Run a click ``command`` as program ``program``: a user mistake ends in one line on stderr
-    and exit 2, an interruption in exit 130, success in exit 0 (never a traceback for either)."""
+    and exit 2, an interruption in exit 130 (Ctrl-C) or 143 (SIGTERM, after the same clean-up),
+    success in exit 0 (never a traceback for either)."""
     previous = sys.unraisablehook
     sys.unraisablehook = lambda u: _redeliver_interrupts(u, previous)
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous_term = signal.signal(signal.SIGTERM, _raise_terminated) if main_thread else None
     try:
         command.main(args=argv, prog_name=program, standalone_mode=False)
     except DceeInputError as exc:
         error_exit(program, str(exc))
     except click.ClickException as exc:
         error_exit(program, exc.format_message())
-    except (KeyboardInterrupt, click.exceptions.Abort):
+    except (KeyboardInterrupt, click.exceptions.Abort) as exc:
+        # click turns an interruption inside a command into Abort, the interruption its cause
+        if isinstance(exc, Terminated) or isinstance(exc.__cause__, Terminated):
+            click.echo(f"{program}: terminated", err=True)
+            sys.exit(TERMINATED)
         click.echo(f"{program}: interrupted", err=True)
         sys.exit(INTERRUPTED)
     finally:
         sys.unraisablehook = previous
+        if main_thread:
+            signal.signal(signal.SIGTERM, previous_term)
     sys.exit(0)
 
 

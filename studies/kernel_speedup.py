@@ -1,0 +1,138 @@
+"""The predicted-posterior kernel before and after a change, timed in alternation in one process
+(issue 46): the kernel module of an earlier commit (read with ``git show``) against today's, on
+the same synthetic position terms, for the sums each planner reads, with the largest difference
+of their outputs. Writes JSON (with the machine and the load beside the run,
+dcee.perf.machine) that docs/performance.md's table is generated from.
+
+    .venv/bin/python studies/kernel_speedup.py [--before f52a5b6] \\
+        [--json docs/results/perf/kernel-speedup.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from dcee.io import write_json
+from dcee.models.sensor import Sensor
+from dcee.perf.machine import LoadMonitor, load_warning, machine_record
+from dcee.planning.predicted_kernels import predicted_posterior_stats
+
+ROOT = Path(__file__).resolve().parent.parent
+KERNEL = "src/dcee/planning/predicted_kernels.py"
+REPEATS = 15
+
+# (name, sensor, stages, hypotheses per sequence, sequences, particles, moments, kl)
+WORKLOADS = (
+    ("one stage, dcee (moments)", "default", 1, 41, 8, 20_000, True, False),
+    ("one stage, dcee-cl (moments and KL)", "default", 1, 41, 8, 20_000, True, True),
+    ("one stage, infotaxis (KL)", "default", 1, 41, 8, 20_000, False, True),
+    ("three stages, tree search (moments and KL)", "default", 3, 11, 20, 10_000, True, True),
+    ("one stage, paper-exact model (no outlier: unchanged)", "paper", 1, 41, 8, 20_000, True, True),
+)  # fmt: skip
+
+
+def _kernel_at(commit: str):
+    """predicted_posterior_stats of ``commit``'s kernel module (imported from a copy)."""
+    source = subprocess.run(
+        ["git", "-C", str(ROOT), "show", f"{commit}:{KERNEL}"],
+        check=True,
+        capture_output=True,
+        text=True,
+    ).stdout
+    folder = Path(tempfile.mkdtemp())
+    path = folder / f"kernel_{commit}.py"
+    path.write_text(source.replace("cache=True", "cache=False"))
+    spec = importlib.util.spec_from_file_location(path.stem, path)
+    module = importlib.util.module_from_spec(spec)
+    assert spec.loader is not None
+    spec.loader.exec_module(module)
+    return module.predicted_posterior_stats
+
+
+def _terms(sensor: Sensor, conc: np.ndarray) -> list[np.ndarray]:
+    """(loc, log_nd, inv_sigma, det_offset) (P, N) from concentrations, far from the source."""
+    dist = np.full_like(conc, np.inf)
+    loc, sigma = sensor._loc_sigma(conc, dist)
+    det_offset = np.log(sensor.detect_prob(dist)) - np.log(sigma)
+    log_nd = sensor.log_likelihood(0.0, conc, dist)
+    return [np.ascontiguousarray(a) for a in (loc, log_nd, 1.0 / sigma, det_offset)]
+
+
+def _workload(sensor_kind, stages, hypotheses, sequences, particles, seed=0):
+    rng = np.random.default_rng(seed)
+    sensor = Sensor() if sensor_kind == "default" else Sensor.paper_exact()
+    positions = 12
+    conc = rng.lognormal(-6.0, 2.5, size=(positions, particles))
+    source = rng.uniform(0.0, 50.0, size=(particles, 3))
+    w = rng.random(particles)
+    w[rng.random(particles) < 0.3] = 0.0  # resampled beliefs hold dead copies
+    w /= w.sum()
+    seqs = rng.integers(0, positions, size=(sequences, stages))
+    task_pos = np.ascontiguousarray(np.repeat(seqs, hypotheses, axis=0), dtype=np.int64)
+    s = len(task_pos)
+    z = sensor.simulate_from(
+        conc[task_pos, rng.integers(0, particles, (s, 1))], sensor.draw_noise(rng, (s, stages))
+    )
+    z[rng.random((s, stages)) < 0.3] = 0.0  # non-detections among the hypotheses
+    return sensor, _terms(sensor, conc), source, w, task_pos, sensor.transformed_readings(z)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--before", default="f52a5b6", help="the commit to compare with")
+    ap.add_argument("--json", type=Path, help="write the results here")
+    args = ap.parse_args(argv)
+    before = _kernel_at(args.before)
+    rows = []
+    with LoadMonitor() as load:
+        for name, kind, stages, hyp, seqs, n, moments, kl in WORKLOADS:
+            sensor, terms, source, w, task_pos, readings = _workload(kind, stages, hyp, seqs, n)
+            s = len(task_pos)
+
+            def run(kernel, sensor=sensor, terms=terms, source=source, w=w, task_pos=task_pos,
+                    readings=readings, s=s, moments=moments, kl=kl):  # fmt: skip
+                out = [np.empty(s), np.empty((s, 3)), np.empty(s), np.empty(s)]
+                kernel(*terms, source, w, w @ source, task_pos, *readings, sensor.params, *out,
+                       want_moments=moments, want_kl=kl)  # fmt: skip
+                return out
+
+            old, new = run(before), run(predicted_posterior_stats)  # also compiles both
+            wanted = [0] + ([1, 2] if moments else []) + ([3] if kl else [])
+            diff = max(float(np.max(np.abs(old[k] - new[k]))) for k in wanted)
+            times: dict[str, list[float]] = {"before": [], "after": []}
+            for _ in range(REPEATS):  # in alternation: both see the same load
+                for tag, kernel in (("before", before), ("after", predicted_posterior_stats)):
+                    t0 = time.perf_counter()
+                    run(kernel)
+                    times[tag].append(1e3 * (time.perf_counter() - t0))
+            b, a = float(np.median(times["before"])), float(np.median(times["after"]))
+            rows.append(
+                {
+                    "workload": name,
+                    "tasks": s,
+                    "particles": n,
+                    "before_ms": b,
+                    "after_ms": a,
+                    "speedup": b / a,
+                    "max_abs_difference": diff,
+                }
+            )
+            print(f"{name}: {b:.2f} ms -> {a:.2f} ms ({b / a:.2f}x), outputs within {diff:.1e}")
+    if warning := load_warning(load.record()):
+        print(warning)
+    if args.json:
+        record = {"machine": machine_record(), "load": load.record(), "before": args.before}
+        write_json(args.json, {**record, "repeats": REPEATS, "workloads": rows})
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
