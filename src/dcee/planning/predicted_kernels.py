@@ -14,8 +14,6 @@ not depend on the thread count.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit, prange
 
@@ -23,9 +21,9 @@ from dcee.models.sensor_kernels import SensorParams
 from dcee.numeric import HALF_LOG_2PI, exp_scalar, log_scalar
 from dcee.planning.reading_terms import (
     cached_log_likelihood,
+    exact_task_stats,
     live_row_max,
     task_bounds,
-    task_log_likelihoods,
 )
 
 _BLOCK = 512  # particles per work item; fixed, so the summation order never depends on threads
@@ -291,63 +289,6 @@ def _grouped_stats(
             partial[b, s0 + j, 5] = a5[j]
 
 
-@njit(cache=True, parallel=True)
-def _exact_task_stats(
-    loc: np.ndarray,
-    log_nd: np.ndarray,
-    inv_sigma: np.ndarray,
-    det_offset: np.ndarray,
-    source: np.ndarray,
-    weights: np.ndarray,
-    center: np.ndarray,
-    tasks: np.ndarray,
-    task_positions: np.ndarray,
-    task_v: np.ndarray,
-    task_fa: np.ndarray,
-    task_out: np.ndarray,
-    sp: SensorParams,
-    sums: np.ndarray,
-    log_max: np.ndarray,
-) -> None:
-    """Two-pass fallback for tasks whose bound was far above every particle's log-likelihood
-    (the one-pass weights would underflow): sums relative to the task's true maximum."""
-    n = source.shape[0]
-    for q in prange(tasks.shape[0]):
-        s = tasks[q]
-        ll = np.empty(n)
-        mx = task_log_likelihoods(
-            s,
-            task_positions,
-            task_v,
-            task_fa,
-            task_out,
-            loc,
-            log_nd,
-            inv_sigma,
-            det_offset,
-            weights,
-            sp,
-            ll,
-        )
-        log_max[q] = mx
-        for a in range(_N_ACC):
-            sums[q, a] = 0.0
-        for i in range(n):
-            wi = weights[i]
-            if wi <= 0.0:
-                continue
-            e = wi * math.exp(ll[i] - mx)
-            dx = source[i, 0] - center[0]
-            dy = source[i, 1] - center[1]
-            dz = source[i, 2] - center[2]
-            sums[q, 0] += e
-            sums[q, 1] += e * dx
-            sums[q, 2] += e * dy
-            sums[q, 3] += e * dz
-            sums[q, 4] += e * (dx * dx + dy * dy + dz * dz)
-            sums[q, 5] += e * ll[i]
-
-
 # A task whose best particle lies more than this below its bound is redone exactly: beyond it the
 # one-pass weights of particles within e^-60 of the best would leave float64's normal range.
 _BOUND_SLACK = 600.0
@@ -434,7 +375,7 @@ def predicted_posterior_stats(
         redo = np.flatnonzero(too_small).astype(np.int64)
         redo_sums = np.empty((len(redo), _N_ACC))
         redo_max = np.empty(len(redo))
-        _exact_task_stats(
+        exact_task_stats(
             *common,
             redo,
             task_positions,

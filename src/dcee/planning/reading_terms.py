@@ -1,7 +1,8 @@
 """Compiled per-reading terms shared by the predicted-posterior kernels
 (:mod:`dcee.planning.predicted_kernels`, :mod:`dcee.planning.location_kl`): one hypothesised
 reading's log-likelihood from the cached position terms, a task's log-likelihoods over the
-particles, and the upper bounds that let a kernel skip hopeless particles.
+particles, the upper bounds that let a kernel skip hopeless particles, and the exact two-pass
+statistics of a task whose bound was too loose for the one-pass sums (:func:`exact_task_stats`).
 
 Readings arrive in the sensor's transformed frame (:mod:`dcee.models.sensor_kernels`,
 :meth:`dcee.models.sensor.Sensor.transformed_readings`): per task and stage the transformed
@@ -11,8 +12,10 @@ is added to the log evidence by the caller.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from dcee.models.sensor_kernels import SensorParams
 from dcee.numeric import HALF_LOG_2PI, logaddexp
@@ -153,3 +156,60 @@ def task_log_likelihoods(
         if weights[i] > 0.0 and v > mx:
             mx = v
     return mx
+
+
+@njit(cache=True, parallel=True)
+def exact_task_stats(
+    loc: np.ndarray,
+    log_nd: np.ndarray,
+    inv_sigma: np.ndarray,
+    det_offset: np.ndarray,
+    source: np.ndarray,
+    weights: np.ndarray,
+    center: np.ndarray,
+    tasks: np.ndarray,
+    task_positions: np.ndarray,
+    task_v: np.ndarray,
+    task_fa: np.ndarray,
+    task_out: np.ndarray,
+    sp: SensorParams,
+    sums: np.ndarray,
+    log_max: np.ndarray,
+) -> None:
+    """Two-pass fallback for tasks whose bound was far above every particle's log-likelihood
+    (the one-pass weights would underflow): sums relative to the task's true maximum."""
+    n = source.shape[0]
+    for q in prange(tasks.shape[0]):
+        s = tasks[q]
+        ll = np.empty(n)
+        mx = task_log_likelihoods(
+            s,
+            task_positions,
+            task_v,
+            task_fa,
+            task_out,
+            loc,
+            log_nd,
+            inv_sigma,
+            det_offset,
+            weights,
+            sp,
+            ll,
+        )
+        log_max[q] = mx
+        for a in range(sums.shape[1]):
+            sums[q, a] = 0.0
+        for i in range(n):
+            wi = weights[i]
+            if wi <= 0.0:
+                continue
+            e = wi * math.exp(ll[i] - mx)
+            dx = source[i, 0] - center[0]
+            dy = source[i, 1] - center[1]
+            dz = source[i, 2] - center[2]
+            sums[q, 0] += e
+            sums[q, 1] += e * dx
+            sums[q, 2] += e * dy
+            sums[q, 3] += e * dz
+            sums[q, 4] += e * (dx * dx + dy * dy + dz * dz)
+            sums[q, 5] += e * ll[i]
