@@ -25,6 +25,9 @@ from dcee.models.sensor import Sensor
 from dcee.perf.machine import LoadMonitor, load_warning, machine_record
 from dcee.planning.predicted_kernels import predicted_posterior_stats
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+from tests.helpers import _terms_from_concentrations  # the kernel tests' position terms
+
 ROOT = Path(__file__).resolve().parent.parent
 KERNEL = "src/dcee/planning/predicted_kernels.py"
 REPEATS = 15
@@ -57,15 +60,6 @@ def _kernel_at(commit: str):
     return module.predicted_posterior_stats
 
 
-def _terms(sensor: Sensor, conc: np.ndarray) -> list[np.ndarray]:
-    """(loc, log_nd, inv_sigma, det_offset) (P, N) from concentrations, far from the source."""
-    dist = np.full_like(conc, np.inf)
-    loc, sigma = sensor._loc_sigma(conc, dist)
-    det_offset = np.log(sensor.detect_prob(dist)) - np.log(sigma)
-    log_nd = sensor.log_likelihood(0.0, conc, dist)
-    return [np.ascontiguousarray(a) for a in (loc, log_nd, 1.0 / sigma, det_offset)]
-
-
 def _workload(sensor_kind, stages, hypotheses, sequences, particles, seed=0):
     rng = np.random.default_rng(seed)
     sensor = Sensor() if sensor_kind == "default" else Sensor.paper_exact()
@@ -82,7 +76,8 @@ def _workload(sensor_kind, stages, hypotheses, sequences, particles, seed=0):
         conc[task_pos, rng.integers(0, particles, (s, 1))], sensor.draw_noise(rng, (s, stages))
     )
     z[rng.random((s, stages)) < 0.3] = 0.0  # non-detections among the hypotheses
-    return sensor, _terms(sensor, conc), source, w, task_pos, sensor.transformed_readings(z)
+    terms = _terms_from_concentrations(conc, None, sensor)
+    return sensor, terms, source, w, task_pos, sensor.transformed_readings(z)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -90,7 +85,12 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--before", default="f52a5b6", help="the commit to compare with")
     ap.add_argument("--json", type=Path, help="write the results here")
     args = ap.parse_args(argv)
-    before = _kernel_at(args.before)
+    try:
+        before = _kernel_at(args.before)
+    except subprocess.CalledProcessError as exc:
+        first = (exc.stderr or "").strip().splitlines()[:1] or ["git show failed"]
+        print(f"kernel_speedup: error: --before {args.before}: {first[0]}", file=sys.stderr)
+        return 2
     rows = []
     with LoadMonitor() as load:
         for name, kind, stages, hyp, seqs, n, moments, kl in WORKLOADS:

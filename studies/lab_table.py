@@ -95,20 +95,15 @@ def pooled_rows(args: list[str]) -> list[dict[str, object]]:
             g = runs[runs.strategy == planner]
             k, n = int(g.source_acquired.sum()), len(g)
             row: dict[str, object] = {"strategy": planner, "setting": setting, "searches": n}
-            for key, values in (
-                ("source_acquired", ("_rate", "_lo", "_hi")),
-                ("median_final_rmse", ("", "_lo", "_hi")),
-                ("time_to_0_5m", ("", "_lo", "_hi")),
+            t = censored_median_time(
+                g.time_to_rmse_0_5m.to_numpy(dtype=float), g.budget.to_numpy(dtype=float)
+            )
+            for key, suffixes, found in (
+                ("source_acquired", ("_rate", "_lo", "_hi"), wilson(k, n)),
+                ("median_final_rmse", ("", "_lo", "_hi"), median_ci(g.final_rmse.to_numpy())),
+                ("time_to_0_5m", ("", "_lo", "_hi"), t),
             ):
-                if key == "source_acquired":
-                    found = wilson(k, n)
-                elif key == "median_final_rmse":
-                    found = median_ci(g.final_rmse.to_numpy())
-                else:
-                    found = censored_median_time(
-                        g.time_to_rmse_0_5m.to_numpy(dtype=float), g.budget.to_numpy(dtype=float)
-                    )
-                row |= {key + suffix: v for suffix, v in zip(values, found, strict=True)}
+                row |= {key + suffix: v for suffix, v in zip(suffixes, found, strict=True)}
             row["readings"] = int(np.median(g.readings))
             out.append(row)
     return out

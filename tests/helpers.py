@@ -170,3 +170,43 @@ def spike_ess_share(estimator, scenario, seed: int = 0) -> float:
         estimator.update(p, float(instrument.simulate(truth.concentration(p, float(k)), rng)))
     info = estimator.update(np.array([5.0, 45.0, 1.0]), 1e6 * scenario.sensor.threshold)
     return info.ess / estimator.n
+
+
+def stratified_readings_reference(ctx, pos_idx):
+    """The stratified hypotheses of one sequence of cached positions (T,), one sequence at a
+    time as PredictionContext drew them before its batched pass: ((J', T) readings, (J',)
+    probabilities), the reference its batch is tested against bit for bit."""
+    t_count = len(pos_idx)
+    j_count = ctx._n
+    weights = ctx.belief.weights
+    log_nd = ctx.terms.log_nd[pos_idx]  # (T, N)
+    log_nd_all = log_nd.sum(axis=0)
+    p_detect_i = weights * -np.expm1(log_nd_all)  # w_i P(≥ 1 detection | Θ_i)
+    p_detect = float(p_detect_i.sum())
+    z = np.zeros((j_count + 1, t_count))
+    prob = np.zeros(j_count + 1)
+    prob[0] = max(1.0 - p_detect, 0.0)
+    if not p_detect > 1e-300:
+        prob[0] = 1.0
+        return z, prob
+    prob[1:] = p_detect / j_count
+    cumulative = np.cumsum(p_detect_i) / p_detect
+    cumulative[-1] = 1.0
+    idx = np.searchsorted(cumulative, (ctx._offset + np.arange(j_count)) / j_count, "right")
+    idx = idx.clip(0, len(weights) - 1)
+    # first detecting stage t: P ∝ Π_{t'<t} P(nd_t') (1 − P(nd_t)), by inversion
+    nd = np.exp(log_nd[:, idx]).T  # (J, T)
+    before = np.cumprod(np.column_stack([np.ones(j_count), nd[:, :-1]]), axis=1)
+    first_cdf = np.cumsum(before * (1.0 - nd), axis=1)
+    target = ctx._first_u * first_cdf[:, -1]
+    first = (first_cdf <= target[:, None]).sum(axis=1).clip(0, t_count - 1)
+    conc = ctx.conc[pos_idx][:, idx].T  # (J, T)
+    dist = ctx.terms.dist[pos_idx][:, idx].T
+    rows = np.arange(j_count)
+    z[1:] = ctx.sensor.simulate_from(conc, ctx.noise[:, :t_count], dist)
+    stage = np.arange(t_count)[None, :]
+    z[1:][stage < first[:, None]] = 0.0
+    z[1:][rows, first] = ctx.sensor.simulate_detection(
+        conc[rows, first], ctx._detect_u, dist[rows, first]
+    )
+    return z, prob

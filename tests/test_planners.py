@@ -6,7 +6,7 @@ import pytest
 from dcee import DceeInputError, GridAgent, IsotropicPlume, SearchVolume, Sensor, planners
 from dcee.planning import Belief, PredictionContext
 from dcee.planning.predicted_reference import predicted_posterior_stats_reference
-from tests.helpers import compiled_predicted_stats, theta_at
+from tests.helpers import compiled_predicted_stats, stratified_readings_reference, theta_at
 
 AGENT = GridAgent(SearchVolume((0.0, 0.0, 0.0), (40.0, 40.0, 0.0)), step=2.0)
 START = np.array([10.0, 10.0, 0.0])
@@ -503,8 +503,9 @@ def test_info_share_charges_the_information_equivalent_location_variance():
 @pytest.mark.parametrize("sensor", [Sensor(), Sensor.paper_exact(false_alarm=0.01)])
 def test_stratified_hypotheses_of_every_sequence_at_once_are_those_one_at_a_time(sensor):
     """PredictionContext.stats draws the stratified hypotheses of all candidate sequences in one
-    pass; they are the per-sequence ones bit for bit (decisions must not change), over one to
-    five stages, with and without detections, and where no particle can be detected."""
+    pass; they are the per-sequence loop's (tests/helpers.py) bit for bit, over one to five
+    stages, with and without detections, and where no particle can be detected; a sequence
+    asked for alone (``readings``) gets the same numbers."""
     rng = np.random.default_rng(11)
     theta = theta_at([(x, y, 0.0) for x, y in rng.uniform(0, 40, (600, 2))], q=1.0, u=2.0)
     w = rng.random(len(theta))
@@ -518,5 +519,7 @@ def test_stratified_hypotheses_of_every_sequence_at_once_are_those_one_at_a_time
         readings, probability = ctx._stratified_batch(pos_idx)
         assert (readings[1:] > 0).any()
         for s in range(9):
-            one_z, one_p = ctx._stratified_readings(pos_idx[s])
+            one_z, one_p = stratified_readings_reference(ctx, pos_idx[s])
             assert np.array_equal(one_z, readings[s]) and np.array_equal(one_p, probability[s])
+            alone_z, alone_p = ctx.readings(pos_idx[s])
+            assert np.array_equal(alone_z, one_z) and np.array_equal(alone_p, one_p)

@@ -36,9 +36,8 @@ def machine_record() -> dict[str, Any]:
 
     versions = {}
     for name in LIBRARIES:
-        dist = "stonesoup" if name == "stonesoup" else name
         try:
-            versions[name] = importlib.metadata.version(dist)
+            versions[name] = importlib.metadata.version(name)
         except importlib.metadata.PackageNotFoundError:
             continue
     return {

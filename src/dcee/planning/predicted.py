@@ -229,7 +229,8 @@ class PredictionContext:
         if self._fresh:
             self._draw()
         if self.expectation == "stratified":
-            return self._stratified_readings(pos_idx)
+            z, prob = self._stratified_batch(np.asarray(pos_idx)[None])
+            return z[0], prob[0]
         t_count = len(pos_idx)
         c = self.conc[pos_idx][:, self.indices].T  # (J, T)
         r = self.terms.dist[pos_idx][:, self.indices].T
@@ -244,47 +245,14 @@ class PredictionContext:
         r = self.terms.dist[:, self.indices][pos_idx].transpose(0, 2, 1)
         return self.sensor.simulate_from(c, self.noise[None, :, :t_count], r)
 
-    def _stratified_readings(self, pos_idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        t_count = len(pos_idx)
-        j_count = self._n
-        weights = self.belief.weights
-        log_nd = self.terms.log_nd[pos_idx]  # (T, N)
-        log_nd_all = log_nd.sum(axis=0)
-        p_detect_i = weights * -np.expm1(log_nd_all)  # w_i P(≥ 1 detection | Θ_i)
-        p_detect = float(p_detect_i.sum())
-        z = np.zeros((j_count + 1, t_count))
-        prob = np.zeros(j_count + 1)
-        prob[0] = max(1.0 - p_detect, 0.0)
-        if not p_detect > 1e-300:
-            prob[0] = 1.0
-            return z, prob
-        prob[1:] = p_detect / j_count
-        cumulative = np.cumsum(p_detect_i) / p_detect
-        cumulative[-1] = 1.0
-        idx = np.searchsorted(cumulative, (self._offset + np.arange(j_count)) / j_count, "right")
-        idx = idx.clip(0, len(weights) - 1)
-        # first detecting stage t: P ∝ Π_{t'<t} P(nd_t') (1 − P(nd_t)), by inversion
-        nd = np.exp(log_nd[:, idx]).T  # (J, T)
-        before = np.cumprod(np.column_stack([np.ones(j_count), nd[:, :-1]]), axis=1)
-        first_cdf = np.cumsum(before * (1.0 - nd), axis=1)
-        target = self._first_u * first_cdf[:, -1]
-        first = (first_cdf <= target[:, None]).sum(axis=1).clip(0, t_count - 1)
-        conc = self.conc[pos_idx][:, idx].T  # (J, T)
-        dist = self.terms.dist[pos_idx][:, idx].T
-        rows = np.arange(j_count)
-        z[1:] = self.sensor.simulate_from(conc, self.noise[:, :t_count], dist)
-        stage = np.arange(t_count)[None, :]
-        z[1:][stage < first[:, None]] = 0.0
-        z[1:][rows, first] = self.sensor.simulate_detection(
-            conc[rows, first], self._detect_u, dist[rows, first]
-        )
-        return z, prob
-
     def _stratified_batch(self, pos_idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`_stratified_readings` of (S, T) sequences at once: ((S, J', T) readings,
-        (S, J') probabilities), the same numbers bit for bit (the same elementwise operations
-        and reductions, with a leading axis), in chunks of sequences that keep the gathered
-        terms near 16 MB."""
+        """The stratified hypotheses of (S, T) sequences of cached positions at once: ((S, J', T)
+        readings, (S, J') probabilities). Per sequence: "no detection" with its probability,
+        then J detections spread evenly over the particles' detection probability (a
+        systematic draw with the shared offset), each at its first detecting stage (inverted
+        with the shared uniforms) with the model's readings before (none) and after it. Each
+        sequence's numbers are those of a loop over the sequences bit for bit (tested against
+        one, tests/helpers.py), computed in chunks that keep the gathered terms near 16 MB."""
         s_count, t_count = pos_idx.shape
         j_count = self._n
         weights = self.belief.weights
