@@ -88,6 +88,7 @@ def logaddexp(a: float, b: float) -> float:
 _LN2_HI = 6.93145751953125e-1  # ln 2 with its low bits cleared: m · _LN2_HI is exact
 _LN2_LO = 1.42860682030941723212e-6
 _INV_LN2 = 1.0 / math.log(2.0)
+_SQRT2 = math.sqrt(2.0)
 
 
 @njit(cache=True, inline="always")
@@ -250,11 +251,28 @@ def vndtr_upper(x: float) -> float:
 @njit(cache=True, inline="always")
 def log_scalar(x: float) -> float:
     """log(x) for a normal float x > 0, vectorisable; relative error < 2e-16. x = 2^m · f
-    with f ∈ [1, 2) read from its bits, then log1p(f − 1)."""
+    with f ∈ [√2/2, √2) read from its bits (halved, m + 1, above √2), then 2 atanh(t) with
+    t = (f − 1)/(f + 1), |t| ≤ 0.172, by its odd series to t^19 (truncation < 3e-17 relative;
+    ten terms where the unreduced f ∈ [1, 2) of :func:`log1p_scalar` needs seventeen)."""
     bits = _float_as_int(x)
     m = np.float64((bits >> np.int64(52)) - np.int64(1023))
-    x = _int_as_float((bits & _MANTISSA_BITS) | _ONE_BITS)
-    return m * _LN2_HI + (m * _LN2_LO + log1p_scalar(x - 1.0))
+    f = _int_as_float((bits & _MANTISSA_BITS) | _ONE_BITS)
+    above = f > _SQRT2
+    f = 0.5 * f if above else f  # exact
+    m = m + 1.0 if above else m
+    t = (f - 1.0) / (f + 1.0)
+    t2 = t * t
+    p = 1.0 / 19.0
+    p = 1.0 / 17.0 + t2 * p
+    p = 1.0 / 15.0 + t2 * p
+    p = 1.0 / 13.0 + t2 * p
+    p = 1.0 / 11.0 + t2 * p
+    p = 1.0 / 9.0 + t2 * p
+    p = 1.0 / 7.0 + t2 * p
+    p = 1.0 / 5.0 + t2 * p
+    p = 1.0 / 3.0 + t2 * p
+    p = 1.0 + t2 * p
+    return m * _LN2_HI + (m * _LN2_LO + 2.0 * t * p)
 
 
 @njit(cache=True, inline="always")
