@@ -32,13 +32,19 @@ ROOT = Path(__file__).resolve().parent.parent
 KERNEL = "src/dcee/planning/predicted_kernels.py"
 REPEATS = 15
 
-# (name, sensor, stages, hypotheses per sequence, sequences, particles, moments, kl)
+# (name, sensor, stages, hypotheses per sequence, sequences, particles, moments, kl, precision
+# of today's side: the planners' option, "single" for the float32 weights)
 WORKLOADS = (
-    ("one stage, dcee (moments)", "default", 1, 41, 8, 20_000, True, False),
-    ("one stage, dcee-cl (moments and KL)", "default", 1, 41, 8, 20_000, True, True),
-    ("one stage, infotaxis (KL)", "default", 1, 41, 8, 20_000, False, True),
-    ("three stages, tree search (moments and KL)", "default", 3, 11, 20, 10_000, True, True),
-    ("one stage, paper-exact model (no outlier: unchanged)", "paper", 1, 41, 8, 20_000, True, True),
+    ("one stage, dcee (moments)", "default", 1, 41, 8, 20_000, True, False, "double"),
+    ("one stage, dcee-cl (moments and KL)", "default", 1, 41, 8, 20_000, True, True, "double"),
+    ("one stage, infotaxis (KL)", "default", 1, 41, 8, 20_000, False, True, "double"),
+    ("three stages, tree search (moments and KL)", "default", 3, 11, 20, 10_000, True, True,
+     "double"),
+    ("one stage, paper-exact model (no outlier: unchanged)", "paper", 1, 41, 8, 20_000, True, True,
+     "double"),
+    ("one stage, dcee-cl, `precision=single`", "default", 1, 41, 8, 20_000, True, True, "single"),
+    ("one stage, infotaxis, `precision=single`", "default", 1, 41, 8, 20_000, False, True,
+     "single"),
 )  # fmt: skip
 
 
@@ -93,15 +99,17 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     rows = []
     with LoadMonitor() as load:
-        for name, kind, stages, hyp, seqs, n, moments, kl in WORKLOADS:
+        for name, kind, stages, hyp, seqs, n, moments, kl, precision in WORKLOADS:
             sensor, terms, source, w, task_pos, readings = _workload(kind, stages, hyp, seqs, n)
             s = len(task_pos)
 
             def run(kernel, sensor=sensor, terms=terms, source=source, w=w, task_pos=task_pos,
-                    readings=readings, s=s, moments=moments, kl=kl):  # fmt: skip
+                    readings=readings, s=s, moments=moments, kl=kl,
+                    precision=precision):  # fmt: skip
                 out = [np.empty(s), np.empty((s, 3)), np.empty(s), np.empty(s)]
+                today = {} if kernel is before else {"precision": precision}  # the old had none
                 kernel(*terms, source, w, w @ source, task_pos, *readings, sensor.params, *out,
-                       want_moments=moments, want_kl=kl)  # fmt: skip
+                       want_moments=moments, want_kl=kl, **today)  # fmt: skip
                 return out
 
             old, new = run(before), run(predicted_posterior_stats)  # also compiles both
@@ -119,6 +127,7 @@ def main(argv: list[str] | None = None) -> int:
                     "workload": name,
                     "tasks": s,
                     "particles": n,
+                    "precision": precision,
                     "before_ms": b,
                     "after_ms": a,
                     "speedup": b / a,

@@ -295,3 +295,98 @@ def vlog(x: np.ndarray, out: np.ndarray) -> None:
     """out[i] = log(x[i]) for normal floats x > 0 with the vectorisable log (for tests)."""
     for i in range(x.shape[0]):
         out[i] = log_scalar(x[i])
+
+
+# --- single precision (the planners' opt-in ``precision="single"``) ------------------------
+# float32 arithmetic: twice the SIMD lanes of float64 and shorter polynomials for a relative
+# error of a few 1e-7. Every literal is a float32 and every intermediate is cast back, because
+# numba promotes float32 mixed with a Python float (or an int64) to float64.
+
+
+@intrinsic
+def _int32_as_float32(typingctx, bits):
+    """The float32 whose IEEE-754 bits are the int32 ``bits`` (a free bit cast)."""
+    if bits != types.int32:
+        return None
+
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.FloatType())
+
+    return types.float32(types.int32), codegen
+
+
+@intrinsic
+def _float32_as_int32(typingctx, x):
+    """The int32 holding the IEEE-754 bits of the float32 ``x``."""
+    if x != types.float32:
+        return None
+
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.IntType(32))
+
+    return types.int32(types.float32), codegen
+
+
+_F32 = np.float32
+EXP_F32_FLOOR = _F32(-87.0)
+"""exp_f32 treats x below this as this (e^-87 ≈ 1.6e-38, the smallest normal float32's range)."""
+LOG_F32_TINY = np.finfo(np.float32).tiny
+"""Inputs of log_f32 below this, the smallest normal float32, are read as this."""
+_LN2_HI_F32 = _F32(0.693359375)  # Cody-Waite split of ln 2 for float32 (Cephes)
+_LN2_LO_F32 = _F32(-2.12194440e-4)
+_INV_LN2_F32 = _F32(1.0 / math.log(2.0))
+_LN2_F32 = _F32(math.log(2.0))
+_SQRT2_F32 = _F32(math.sqrt(2.0))
+
+
+@njit(cache=True, inline="always", fastmath={"contract"})
+def exp_f32(x: np.float32) -> np.float32:
+    """exp(x) for a float32 x ≤ 0, vectorisable, relative error < 3e-7 (x < −87: e^-87).
+    2^−m · e^r with |r| ≤ ln 2 / 2 and Cephes' degree-7 minimax polynomial for e^r."""
+    x = max(x, EXP_F32_FLOOR)
+    m = _F32(math.floor(x * -_INV_LN2_F32 + _F32(0.5)))
+    r = _F32(_F32(x + m * _LN2_HI_F32) + m * _LN2_LO_F32)
+    p = _F32(1.9875691500e-4)
+    p = _F32(_F32(1.3981999507e-3) + r * p)
+    p = _F32(_F32(8.3334519073e-3) + r * p)
+    p = _F32(_F32(4.1665795894e-2) + r * p)
+    p = _F32(_F32(1.6666665459e-1) + r * p)
+    p = _F32(_F32(5.0000001201e-1) + r * p)
+    p = _F32(_F32(1.0) + r * _F32(_F32(1.0) + r * p))
+    scale = _int32_as_float32(np.int32((np.int32(127) - np.int32(m)) << np.int32(23)))
+    return _F32(p * scale)
+
+
+@njit(cache=True, inline="always", fastmath={"contract"})
+def log_f32(x: np.float32) -> np.float32:
+    """log(x) for a float32 x > 0, vectorisable, absolute error < 2e-7 · max(1, |log x|)
+    (x below :data:`LOG_F32_TINY` is read as it): x = 2^e · f, f ∈ [√2/2, √2), and
+    2 atanh((f − 1)/(f + 1)) by its odd series to the 9th power."""
+    bits = _float32_as_int32(max(x, LOG_F32_TINY))
+    e = np.int32((bits >> np.int32(23)) - np.int32(127))
+    f = _int32_as_float32(np.int32((bits & np.int32(0x007FFFFF)) | np.int32(0x3F800000)))
+    above = f > _SQRT2_F32
+    f = _F32(_F32(0.5) * f) if above else f
+    e = np.int32(e + np.int32(1)) if above else e
+    t = _F32(_F32(f - _F32(1.0)) / _F32(f + _F32(1.0)))
+    t2 = _F32(t * t)
+    p = _F32(1.0 / 9.0)
+    p = _F32(_F32(1.0 / 7.0) + t2 * p)
+    p = _F32(_F32(1.0 / 5.0) + t2 * p)
+    p = _F32(_F32(1.0 / 3.0) + t2 * p)
+    p = _F32(_F32(1.0) + t2 * p)
+    return _F32(_F32(e) * _LN2_F32 + _F32(_F32(2.0) * t) * p)
+
+
+@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+def vexp_f32(x: np.ndarray, out: np.ndarray) -> None:
+    """out[i] = exp_f32(x[i]) for float32 arrays (exposed for tests)."""
+    for i in range(x.shape[0]):
+        out[i] = exp_f32(x[i])
+
+
+@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+def vlog_f32(x: np.ndarray, out: np.ndarray) -> None:
+    """out[i] = log_f32(x[i]) for float32 arrays (exposed for tests)."""
+    for i in range(x.shape[0]):
+        out[i] = log_f32(x[i])

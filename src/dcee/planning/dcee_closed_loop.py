@@ -199,7 +199,14 @@ class ScenarioTreeDCEEPlanner(ClosedLoopDCEEPlanner):
     ) -> tuple[np.ndarray, dict[str, Any]]:
         self.bind_agent(agent)
         ctx = PredictionContext(
-            belief, self.n_hypotheses, 1, rng, self.expectation, self.noise, self.readings
+            belief,
+            self.n_hypotheses,
+            1,
+            rng,
+            self.expectation,
+            self.noise,
+            self.readings,
+            self.precision,
         )
         first = ctx.stats(candidates[:, None, :], moments=False, kl=False)
         seconds = [agent.candidates(p)[0] for p in candidates]

@@ -27,7 +27,12 @@ from dcee.estimation.resampling import systematic_resample
 from dcee.models.agent import GridAgent, travel_xy
 from dcee.models.site import SiteMap
 from dcee.planning.base import Belief, Planner, check_count
-from dcee.planning.predicted import PredictionContext, SequenceStats, check_hypothesis_options
+from dcee.planning.predicted import (
+    PredictionContext,
+    SequenceStats,
+    check_hypothesis_options,
+    check_precision,
+)
 
 
 class HypothesisPlanner(Planner):
@@ -37,7 +42,10 @@ class HypothesisPlanner(Planner):
     ``expectation`` sampled | stratified, ``horizon`` H moves (1–3) and ``beam_width``; for
     ablations, ``noise`` shared | fresh (:data:`~dcee.planning.predicted.NOISE_SHARING`),
     ``readings`` model | noise-free | miss-free and ``subsample`` (predict with a systematic
-    resample of that share of the particles, equally weighted; the authors' example uses 0.2).
+    resample of that share of the particles, equally weighted; the authors' example uses 0.2);
+    ``precision`` double | single, the arithmetic of the one-step weights
+    (:data:`~dcee.planning.predicted.PRECISIONS`: single is faster, its decisions measured
+    against double's in docs/performance.md).
     """
 
     uses_hypotheses = True
@@ -58,6 +66,7 @@ class HypothesisPlanner(Planner):
         noise: str = "shared",
         readings: str = "model",
         subsample: float = 1.0,
+        precision: str = "double",
     ) -> None:
         expectation = self.default_expectation if expectation is None else expectation
         horizon = self.default_horizon if horizon is None else horizon
@@ -66,6 +75,8 @@ class HypothesisPlanner(Planner):
         if horizon not in (1, 2, 3):
             raise DceeInputError("horizon", f"must be 1, 2 or 3, got {horizon}")
         check_hypothesis_options(expectation, noise, readings)
+        check_precision(precision)
+        self.precision = str(precision)
         if isinstance(subsample, bool) or not (
             isinstance(subsample, int | float) and 0 < subsample <= 1
         ):
@@ -87,6 +98,7 @@ class HypothesisPlanner(Planner):
             "noise": self.noise,
             "readings": self.readings,
             "subsample": self.subsample,
+            "precision": self.precision,
         }
 
     def bind_agent(self, agent: GridAgent) -> None:
@@ -126,7 +138,14 @@ class HypothesisPlanner(Planner):
                 site=belief.site,
             )
         ctx = PredictionContext(
-            belief, self.n_hypotheses, stages, rng, self.expectation, self.noise, self.readings
+            belief,
+            self.n_hypotheses,
+            stages,
+            rng,
+            self.expectation,
+            self.noise,
+            self.readings,
+            self.precision,
         )
         return ctx.belief, ctx
 

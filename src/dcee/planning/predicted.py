@@ -113,6 +113,20 @@ def check_hypothesis_options(expectation: str, noise: str, readings: str) -> Non
         )
 
 
+PRECISIONS = ("double", "single")
+"""Arithmetic of the hypothesised readings' weights: ``double`` (float64 throughout) or
+``single`` (float32 exp and log for one-stage tasks, float64 sums; about 1e-6 relative, see
+:mod:`dcee.planning.predicted_single`)."""
+
+
+def check_precision(precision: object) -> None:
+    """:class:`~dcee.errors.DceeInputError` unless ``precision`` is one of :data:`PRECISIONS`."""
+    if precision not in PRECISIONS:
+        raise DceeInputError(
+            "precision", f"must be one of {', '.join(PRECISIONS)}, got {precision!r}"
+        )
+
+
 class PredictionContext:
     """One decision's hypotheses and caches; planners ask it for :class:`SequenceStats`.
 
@@ -131,8 +145,11 @@ class PredictionContext:
         expectation: str = "sampled",
         noise: str = "shared",
         readings: str = "model",
+        precision: str = "double",
     ) -> None:
         check_hypothesis_options(expectation, noise, readings)
+        check_precision(precision)
+        self.precision = precision
         self._pt = belief.cache if belief.cache is not None else ParticleTerms()
         self._pt.sync(belief.theta, belief.sensor, belief.plume)
         self._pt.begin()
@@ -351,6 +368,7 @@ class PredictionContext:
             kl_div,
             moments,
             kl,
+            self.precision,
         )
         loc_kl = np.full(n_tasks, np.nan)
         if location_cell is not None:

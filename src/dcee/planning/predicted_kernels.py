@@ -19,6 +19,10 @@ from numba import njit, prange
 
 from dcee.models.sensor_kernels import SensorParams
 from dcee.numeric import HALF_LOG_2PI, exp_scalar, log_scalar
+from dcee.planning.block_sums import BLOCK as _BLOCK
+from dcee.planning.block_sums import block_sum as _block_sum
+from dcee.planning.block_sums import product_sum as _product_sum
+from dcee.planning.predicted_single import BOUND_SLACK_SINGLE, single_stage_sums
 from dcee.planning.reading_terms import (
     cached_log_likelihood,
     exact_task_stats,
@@ -26,7 +30,12 @@ from dcee.planning.reading_terms import (
     task_bounds,
 )
 
-_BLOCK = 512  # particles per work item; fixed, so the summation order never depends on threads
+_EXP_FLOOR = -680.0
+"""Weights e^x with x below this are taken as e^-680: w · e^x then stays a normal float for any
+weight w ≥ 1e-12 (arithmetic on subnormal floats is about 100× slower on x86: measured, the
+paper-exact model without an outlier term ran its one-stage sums 2.6× slower than the default
+model). A task is redone exactly when its largest weight is below e^-600 (_BOUND_SLACK), so a
+floored particle changes a kept sum by less than N · e^-80 relative."""
 _N_ACC = 6  # accumulated sums per task: Σe, Σe·dx, Σe·dy, Σe·dz, Σe·|d|², Σe·ll
 
 
@@ -45,29 +54,6 @@ def _centred_offsets(source: np.ndarray, center: np.ndarray) -> np.ndarray:
         out[2, i] = dz
         out[3, i] = dx * dx + dy * dy + dz * dz
     return out
-
-
-@njit(cache=True, fastmath={"contract"}, error_model="numpy")
-def _block_sum(buf: np.ndarray, n: int) -> float:
-    """Σ buf[:n] for buf (_BLOCK,) by pairwise halving (buf is overwritten). Every pass is an
-    element-wise add that LLVM vectorises, and the order of additions is fixed (it does not
-    depend on the vector width, as a reassociated loop's would); pairwise, so also accurate."""
-    for q in range(n, _BLOCK):
-        buf[np.uint64(q)] = 0.0
-    m = _BLOCK
-    while m > 1:
-        m //= 2
-        for q in range(m):
-            buf[np.uint64(q)] += buf[np.uint64(q + m)]
-    return buf[0]
-
-
-@njit(cache=True, fastmath={"contract"}, error_model="numpy")
-def _product_sum(a: np.ndarray, b: np.ndarray, i0: int, n: int, buf: np.ndarray) -> float:
-    """Σ_q a[q] · b[i0 + q] over q < n (see :func:`_block_sum`; buf (_BLOCK,) scratch)."""
-    for q in range(n):
-        buf[np.uint64(q)] = a[np.uint64(q)] * b[np.uint64(i0 + q)]
-    return _block_sum(buf, n)
 
 
 @njit(cache=True, fastmath={"contract"}, error_model="numpy")
@@ -101,7 +87,7 @@ def _single_stage_weights(
             i = np.uint64(i0 + q)
             lq = log_nd[i]
             ll[np.uint64(q)] = lq
-            e[np.uint64(q)] = weights[i] * exp_scalar(min(lq - bnd, 0.0))
+            e[np.uint64(q)] = weights[i] * exp_scalar(min(max(lq - bnd, _EXP_FLOOR), 0.0))
         return
     det_add = sp.log_keep - HALF_LOG_2PI
     if sp.log_outlier > -np.inf:
@@ -113,7 +99,8 @@ def _single_stage_weights(
         for q in range(n):
             i = np.uint64(i0 + q)
             r = (v - loc[i]) * inv_sigma[i]
-            e_rel = exp_scalar(min(det_offset[i] + det_add - 0.5 * r * r - bnd, 0.0)) + out_term
+            a = max(det_offset[i] + det_add - 0.5 * r * r - bnd, _EXP_FLOOR)
+            e_rel = exp_scalar(min(a, 0.0)) + out_term
             e[np.uint64(q)] = weights[i] * e_rel
             if want_ll:
                 ll[np.uint64(q)] = bnd + log_scalar(e_rel)
@@ -123,7 +110,7 @@ def _single_stage_weights(
         r = (v - loc[i]) * inv_sigma[i]
         lq = det_offset[i] + det_add - 0.5 * r * r
         ll[np.uint64(q)] = lq
-        e[np.uint64(q)] = weights[i] * exp_scalar(min(lq - bnd, 0.0))
+        e[np.uint64(q)] = weights[i] * exp_scalar(min(max(lq - bnd, _EXP_FLOOR), 0.0))
 
 
 @njit(cache=True, parallel=True, fastmath={"contract"}, error_model="numpy")
@@ -271,7 +258,7 @@ def _grouped_stats(
                         r = (zj - m) * inv_s
                         ll[j] += det_const - 0.5 * r * r if zj >= v_thr else lnd
             for j in range(k):
-                e = wi * exp_scalar(ll[j] - bnd[j]) * prod[j]
+                e = wi * exp_scalar(min(max(ll[j] - bnd[j], _EXP_FLOOR), 0.0)) * prod[j]
                 a0[j] += e
                 if want_moments:
                     a1[j] += e * dx
@@ -314,6 +301,7 @@ def predicted_posterior_stats(
     kl: np.ndarray,
     want_moments: bool = True,
     want_kl: bool = True,
+    precision: str = "double",
 ) -> None:
     """Statistics of the predicted posterior for each task (a hypothesised reading sequence).
 
@@ -329,6 +317,8 @@ def predicted_posterior_stats(
 
     Consecutive tasks with the same position row form a group that shares per-particle loads
     (callers list all hypotheses of one candidate sequence together). Memory: O(S · N / 512).
+    ``precision="single"``: one-stage tasks without false alarms get their weights in float32
+    (:mod:`dcee.planning.predicted_single`); any other task is computed in double precision.
     """
     task_positions = np.ascontiguousarray(task_positions, dtype=np.int64)
     task_v, task_fa, task_out = (
@@ -347,30 +337,48 @@ def predicted_posterior_stats(
     n_blocks = (source.shape[0] + _BLOCK - 1) // _BLOCK
     partial = np.empty((n_blocks, s_count, _N_ACC))
     common = (loc, log_nd, inv_sigma, det_offset, source, weights, center)
-    _grouped_stats(
-        loc,
-        log_nd,
-        inv_sigma,
-        det_offset,
-        _centred_offsets(source, center) if want_moments else np.zeros((4, 0)),
-        weights,
-        group_start,
-        task_positions,
-        task_v,
-        task_fa,
-        task_out,
-        bound,
-        sp,
-        want_moments,
-        want_kl,
-        partial,
-    )
+    offsets = _centred_offsets(source, center) if want_moments else np.zeros((4, 0))
+    single = precision == "single" and task_positions.shape[1] == 1 and sp.false_alarm == 0.0
+    if single:
+        single_stage_sums(
+            (loc, log_nd, inv_sigma, det_offset),
+            offsets,
+            weights,
+            group_start,
+            task_positions,
+            task_v,
+            task_out,
+            bound,
+            sp,
+            want_moments,
+            want_kl,
+            partial,
+        )
+    else:
+        _grouped_stats(
+            loc,
+            log_nd,
+            inv_sigma,
+            det_offset,
+            offsets,
+            weights,
+            group_start,
+            task_positions,
+            task_v,
+            task_fa,
+            task_out,
+            bound,
+            sp,
+            want_moments,
+            want_kl,
+            partial,
+        )
     sums = partial.sum(axis=0)  # fixed order over blocks: independent of the thread count
     log_ref = bound.copy()
     # Σ e_i ll_i was accumulated with e relative to the bound; a task is redone exactly when its
     # largest weight e^(ll_max − bound) is too small for the one-pass sums to be accurate.
     with np.errstate(divide="ignore"):
-        too_small = ~(np.log(sums[:, 0]) > -_BOUND_SLACK)
+        too_small = ~(np.log(sums[:, 0]) > -(BOUND_SLACK_SINGLE if single else _BOUND_SLACK))
     if np.any(too_small):
         redo = np.flatnonzero(too_small).astype(np.int64)
         redo_sums = np.empty((len(redo), _N_ACC))
