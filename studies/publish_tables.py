@@ -793,6 +793,40 @@ def kernel_speedup_table() -> str:
     )
 
 
+def agreement_single_table() -> str:
+    """Decisions with ``precision=single`` against today's double-precision full computation,
+    per planner (studies/decision_agreement.py, docs/results/perf/agreement-single.json)."""
+    record = _perf("agreement-single")
+    settings = record["settings"]
+    rows = []
+    for strategy in settings["strategies"]:
+        mine = [r for r in record["searches"] if r["strategy"] == strategy]
+        decisions = sum(r["decisions"] for r in mine)
+        same = sum(r["same_choice"] for r in mine)
+        worst = max(r["max_cost_diff_over_spread"] for r in mine)
+        rows.append([f"`{strategy}`", f"{same}/{decisions}", f"{worst:.0e}"])
+    rows.append(
+        [
+            "**all**",
+            f"**{record['same_choice']}/{record['decisions']}** "
+            f"({100 * record['same_choice'] / record['decisions']:.1f} %)",
+            f"{record['max_cost_diff_over_spread']:.0e}",
+        ]
+    )
+    commit = (record["machine"].get("code", {}).get("commit") or "")[:7]
+    rows.append(
+        [
+            "settings",
+            f"{', '.join(settings['configs'])}; seeds 0-{settings['seeds'] - 1}; "
+            f"{settings['steps']} decisions per search; {settings['particles']:,} particles",
+            f"`{commit}`",
+        ]
+    )
+    return table(
+        ["planner", "same choice as double precision", "largest cost difference / spread"], rows
+    )
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "learn-tuning": learn_tuning_table,
     "cross-truth": cross_truth_table,
@@ -811,6 +845,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "sites": sites_table,
     "speed": speed_table,
     "kernel-speedup": kernel_speedup_table,
+    "agreement-single": agreement_single_table,
 }
 
 

@@ -379,6 +379,10 @@ case "${1:---list}" in
     $P studies/stonesoup_mcts_study.py results/perf-stonesoup-mcts --seeds "${MCTS_SEEDS:-3}" \
       --json docs/results/perf/stonesoup-mcts.json
     $P studies/publish_tables.py ;;
+  agreement)  # decisions with precision=single against today's double precision (20,000 particles)
+    $P studies/decision_agreement.py --precision single \
+      --strategies dcee,infotaxis,entrotaxis,dcee-cl --json docs/results/perf/agreement-single.json
+    $P studies/publish_tables.py ;;
   --list)
     sed -n 's/^  \([a-z-]*\)) *# \(.*\)/\1\t\2/p' "$0" ;;
   *)

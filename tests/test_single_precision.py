@@ -153,3 +153,17 @@ def test_predicted_stats_do_not_depend_on_the_thread_count(precision):
         numba.set_num_threads(before)
     for a, b in zip(one, two, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+def test_agreement_check_compares_like_with_like_while_the_stall_guard_fires():
+    """The agreement check decides again with the agent the searcher planned with: while the
+    stall guard fires that is the guard's restricted agent (it used to compare 8 costs with 3
+    and stop). Double against double must then agree on every decision."""
+    from dcee.perf.agreement import search_agreement
+
+    a = search_agreement("paper:1", "dcee", 0, 2000, 40)
+    assert a.decisions == 40 and a.guard_fired > 0
+    assert a.same_choice == a.decisions and a.max_cost_diff_over_spread < 1e-9
+    single = search_agreement("paper:1", "dcee-cl", 0, 2000, 10, precision="single")
+    assert single.precision == "single" and single.decisions == 10
+    assert single.max_cost_diff_over_spread < 1e-4  # float32 weights, about 1e-6 of the spread

@@ -196,15 +196,22 @@ class Searcher:
         if self.planner is None:
             raise DceeInputError("planner", "this searcher has no planner to ask")
         t0 = _time.perf_counter()
-        agent = self.agent
-        anchor = self.stall_anchor()
-        if anchor is not None:
-            agent = LeavingAgent(self.agent, anchor, self.position)  # type: ignore[assignment]
+        agent = self.decision_agent()
+        if agent is not self.agent:
             self.guard_fired += 1
         with one_blas_thread():
             self.last_decision = self.planner.decide(self.belief(), self.position, agent, self.rng)
         self.last_decision_seconds = _time.perf_counter() - t0
         return self.last_decision.position.copy()
+
+    def decision_agent(self) -> GridAgent | LeavingAgent:
+        """The agent the next :meth:`ask` plans with: :attr:`agent`, or a
+        :class:`LeavingAgent` that only offers moves away from the stall while the stall guard
+        fires (:meth:`stall_anchor`)."""
+        anchor = self.stall_anchor()
+        if anchor is None:
+            return self.agent
+        return LeavingAgent(self.agent, anchor, self.position)
 
     def stall_anchor(self) -> np.ndarray | None:
         """The position (3,) m the robot has stayed within one step of for at least

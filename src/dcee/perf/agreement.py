@@ -34,17 +34,33 @@ class Agreement:
     decisions: int
     same_choice: int
     max_cost_diff_over_spread: float
+    precision: str = "double"
+    guard_fired: int = 0
+    """decisions taken while the stall guard restricted the moves"""
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
 
 
 def search_agreement(
-    scenario_name: str, strategy: str, seed: int, particles: int, steps: int
+    scenario_name: str,
+    strategy: str,
+    seed: int,
+    particles: int,
+    steps: int,
+    precision: str = "double",
 ) -> Agreement:
-    """Fly ``steps`` decisions of one search and compare fast and reference decisions."""
+    """Fly ``steps`` decisions of one search and compare fast and reference decisions. With
+    ``precision="single"`` the search flies the planner's single-precision weights and the
+    reference stays in double precision (today's full computation)."""
     scenario = load_scenario(scenario_name).with_overrides(**{"search.particles": particles})
-    planner = get_planner(strategy, **planner_defaults(strategy, scenario, None))
+    options = planner_defaults(strategy, scenario, None)
+    reference_planner = get_planner(strategy, **options)
+    planner = (
+        reference_planner
+        if precision == "double"
+        else get_planner(strategy, **{**options, "precision": precision})
+    )
     sim = SearchSimulation(scenario, seed, planner)
     searcher = sim.searcher
     same = 0
@@ -57,7 +73,9 @@ def search_agreement(
         f = searcher.filter
         reference = Belief(f.theta, f.weights, f.sensor, f.plume, ParticleTerms(merge=False))
         rng = copy.deepcopy(searcher.rng)
-        ref = planner.decide(reference, searcher.position, searcher.agent, rng)
+        # the agent the searcher plans with (the stall guard's when it fires)
+        agent = searcher.decision_agent()
+        ref = reference_planner.decide(reference, searcher.position, agent, rng)
         waypoint = searcher.ask()
         fast = searcher.last_decision
         decisions += 1
@@ -69,4 +87,6 @@ def search_agreement(
             diff = np.abs(fast.costs[finite] - ref.costs[finite]) / scale
             worst = max(worst, float(diff.max()))
         sim.move(waypoint)
-    return Agreement(scenario_name, strategy, seed, decisions, same, worst)
+    return Agreement(
+        scenario_name, strategy, seed, decisions, same, worst, precision, searcher.guard_fired
+    )
