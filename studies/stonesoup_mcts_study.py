@@ -40,7 +40,8 @@ def main(argv: list[str] | None = None) -> int:
         if not path.exists():
             with LoadMonitor() as load:
                 (row,) = compare_mcts(range(seed, seed + 1), args.strategy)
-            write_json(path, {**row, "load": load.record()})  # a finished seed only
+            # a finished seed only, with the code and machine that ran it
+            write_json(path, {**row, "load": load.record(), "machine": machine_record()})
     rows = [json.loads((args.out / f"{stem}-seed{s}.json").read_text()) for s in range(args.seeds)]
     print(
         "| seed | moves | Stone Soup final RMSE (m) | ours | Stone Soup ms/decision | ours "
@@ -59,16 +60,24 @@ def main(argv: list[str] | None = None) -> int:
     lower = sum(o < s for o, s in zip(our_final, ss_final, strict=True))
     ss_ms = float(np.median(np.concatenate([r["stonesoup"]["decision_ms"] for r in rows])))
     our_ms = float(np.median(np.concatenate([r["dcee"]["decision_ms"] for r in rows])))
+    # Stone Soup's decisions grow slower as its track grows (1.2-1.5 s at the first decisions,
+    # 3-12 s at the last, seeds 0-2 on 2026-11-26): the first ten decisions of each search
+    # compare the two where the history has not yet inflated Stone Soup's side
+    ss_first = float(np.median(np.concatenate([r["stonesoup"]["decision_ms"][:10] for r in rows])))
+    our_first = float(np.median(np.concatenate([r["dcee"]["decision_ms"][:10] for r in rows])))
     print(
         f"\n{len(rows)} seeds: median final x-y RMSE Stone Soup {np.median(ss_final):.2f} m, "
         f"{args.strategy} {np.median(our_final):.2f} m (ours lower in {lower}); "
-        f"median ms per decision {ss_ms:.0f} vs {our_ms:.1f}: {ss_ms / our_ms:.0f}x faster"
+        f"median ms per decision {ss_ms:.0f} vs {our_ms:.1f}: {ss_ms / our_ms:.0f}x faster; "
+        f"first ten decisions {ss_first:.0f} vs {our_first:.1f}: {ss_first / our_first:.0f}x"
     )
     if args.json:
         loads = [r.get("load", {}) for r in rows]
         other = [x["other_cores"] for x in loads if x.get("other_cores") is not None]
+        ran = [r["machine"] for r in rows if "machine" in r]
         summary = {
-            "machine": machine_record(),
+            # the machine and code of the seeds' runs (all the same when the study ran at once)
+            "machine": ran[0] if len(ran) == len(rows) else machine_record(),
             "load": {
                 "started": min((x["started"] for x in loads if "started" in x), default=None),
                 "other_cores": max(other) if other else None,
@@ -80,6 +89,9 @@ def main(argv: list[str] | None = None) -> int:
             "stonesoup_median_ms": ss_ms,
             "dcee_median_ms": our_ms,
             "speedup": ss_ms / our_ms,
+            "stonesoup_first10_median_ms": ss_first,
+            "dcee_first10_median_ms": our_first,
+            "first10_speedup": ss_first / our_first,
             "stonesoup_median_final_rmse": float(np.median(ss_final)),
             "dcee_median_final_rmse": float(np.median(our_final)),
             "dcee_lower_rmse": int(lower),

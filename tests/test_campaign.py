@@ -355,20 +355,33 @@ def test_snapshots_follow_the_budget(finished):
     assert EpisodeResult.load(_run(out, "paper:1", "dcee", 1)).snapshots == []
 
 
-def test_resume_with_other_code_is_refused_unless_allowed(finished, monkeypatch):
+def test_resume_with_other_code_is_refused_unless_allowed(finished, monkeypatch, tmp_path):
+    import shutil
+
     import dcee.campaign.runner as runner
 
     out, _ = finished
+
+    def code_versions(folder):
+        return json.loads((folder / "campaign.json").read_text())["code_versions"]
+
+    before = code_versions(out)
     other = {**code_version(), "source_hash": "0123456789abcdef", "commit": "f" * 40}
     monkeypatch.setattr(runner, "code_version", lambda: other)
+    # complete: resuming runs nothing, so nothing is refused and no code is recorded
+    assert run_campaign(_campaign(out), workers=1)["skipped"] == 8
+    assert code_versions(out) == before
+    # a search left to run: other code is refused unless allowed, then recorded beside
+    copy = tmp_path / "copy"
+    shutil.copytree(out, copy)
+    (_run(copy, "paper:1", "dcee", 1) / "summary.json").unlink()
     with pytest.raises(DceeInputError, match=r"other code.*--allow-code-change"):
-        run_campaign(_campaign(out), workers=1)
-    campaign = _campaign(out)
+        run_campaign(_campaign(copy), workers=1)
+    campaign = _campaign(copy)
     campaign.allow_code_change = True
-    assert run_campaign(campaign, workers=1)["skipped"] == 8
-    hashes = [
-        c["source_hash"] for c in json.loads((out / "campaign.json").read_text())["code_versions"]
-    ]
+    counts = run_campaign(campaign, workers=1)
+    assert counts["skipped"] == 7 and counts["done"] == 1
+    hashes = [c["source_hash"] for c in code_versions(copy)]
     assert hashes == [code_version()["source_hash"], "0123456789abcdef"]
 
 

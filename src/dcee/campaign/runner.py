@@ -179,7 +179,8 @@ class Campaign:
 
     def prepare(self) -> None:
         """Create the folder or check that it holds this campaign's results, made by this code
-        (else refuse), and record the code that runs now."""
+        (else refuse), and record the code that runs now. A folder whose every search of this
+        call is done is left as it is, whatever code made it: resuming it runs nothing."""
         path = self.out_dir / "campaign.json"
         settings = self.settings()
         code = code_version()
@@ -202,6 +203,8 @@ class Campaign:
                     "use a new --out folder instead of mixing results",
                 )
             codes = list(stored.get("code_versions", []))
+            if all(is_done(t) for t in self.tasks()):
+                return  # nothing will run: no code to refuse and none to record
             if not any(same_code(c, code) for c in codes) and not self.allow_code_change:
                 earlier = describe(codes[-1]) if codes else "unknown (older dcee)"
                 raise DceeInputError(
