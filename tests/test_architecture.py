@@ -29,6 +29,7 @@ LAYERS = {
     "dcee.allocator": 0,
     "dcee.provenance": 0,
     "dcee.blas": 0,
+    "dcee.kernel_cache": 0,  # where numba keeps compiled kernels (set before numba loads)
     "dcee.models": 1,
     "dcee.recordings": 1,  # plume recordings on disk: CF reader, header layout, statistics
     "dcee.estimation": 2,

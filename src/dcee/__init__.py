@@ -12,7 +12,10 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
+from dcee.kernel_cache import key_numba_cache
 from dcee.provenance import package_version
+
+key_numba_cache()  # before numba is imported: compiled kernels keyed by the source (why: there)
 
 __version__ = package_version()
 

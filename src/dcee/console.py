@@ -93,10 +93,9 @@ def compile_notice(quiet: bool) -> None:
     or changing the code: up to a minute of no visible progress otherwise)."""
     if quiet:
         return
-    import dcee.models
+    from dcee.kernel_cache import compiled_before
 
-    cache = Path(dcee.models.__file__).parent / "__pycache__"
-    if not any(cache.glob("*.nbi")):
+    if not compiled_before():
         click.echo(
             "dcee: compiling the numerical kernels (first run only; up to a minute)", err=True
         )

@@ -1,0 +1,83 @@
+"""The compiled kernels' cache is keyed by the package's source (dcee.kernel_cache): numba checks
+only the file that defines a kernel, not the helpers inlined into it."""
+
+import os
+import subprocess
+import sys
+import time
+
+from dcee import kernel_cache
+
+
+def _package(tmp_path):
+    pkg = tmp_path / "pkg"
+    (pkg / "sub").mkdir(parents=True)
+    (pkg / "kernel.py").write_text("from numba import njit\nfrom pkg.sub.helper import h\n")
+    (pkg / "sub" / "helper.py").write_text(
+        "from numba import njit\n\n@njit\ndef h(x):\n  return x\n"
+    )
+    (pkg / "cli.py").write_text("print('no kernels here')\n")
+    return pkg
+
+
+def test_the_key_changes_with_a_kernel_or_helper_module_and_only_then(tmp_path):
+    pkg = _package(tmp_path)
+    first = kernel_cache.source_stamp(pkg)
+    assert kernel_cache.source_stamp(pkg) == first  # stable
+    helper = pkg / "sub" / "helper.py"
+    helper.write_text(helper.read_text().replace("return x", "return 2*x"))  # inlined helper
+    second = kernel_cache.source_stamp(pkg)
+    assert second != first
+    (pkg / "cli.py").write_text("print('still no kernels')\n")  # no compiled code changes
+    (pkg / "notes.txt").write_text("not python")
+    assert kernel_cache.source_stamp(pkg) == second
+    later = time.time() + 5  # a checkout that only touches times
+    os.utime(helper, (later, later))
+    assert kernel_cache.source_stamp(pkg) == second
+
+
+def test_numba_cache_dir_follows_the_source_and_old_states_are_pruned(tmp_path, monkeypatch):
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    monkeypatch.delitem(sys.modules, "numba", raising=False)  # as before numba is imported
+    root = tmp_path / "cache" / "dcee" / "numba"
+    for k in range(6):  # earlier source states, oldest first
+        old = root / f"old{k}"
+        old.mkdir(parents=True)
+        os.utime(old, (1000 + k, 1000 + k))
+    folder = kernel_cache.key_numba_cache()
+    assert folder == root / kernel_cache.source_stamp()
+    assert os.environ["NUMBA_CACHE_DIR"] == str(folder)
+    kept = sorted(p.name for p in root.iterdir())
+    assert len(kept) == kernel_cache.KEEP and folder.name in kept
+    assert {"old5", "old4", "old3"} <= set(kept)  # the most recently used survive
+    # a folder the user chose wins
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "mine"))
+    assert kernel_cache.key_numba_cache() == tmp_path / "mine"
+
+
+def test_an_unusable_cache_root_leaves_numbas_default(tmp_path, monkeypatch):
+    """A cache root that cannot be created (below a plain file: refused even to root) leaves
+    NUMBA_CACHE_DIR unset, so numba keeps its own default."""
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(blocker / "cache"))
+    monkeypatch.delitem(sys.modules, "numba", raising=False)
+    assert kernel_cache.key_numba_cache() is None
+    assert "NUMBA_CACHE_DIR" not in os.environ
+
+
+def test_importing_dcee_sets_the_keyed_folder_before_numba_loads(tmp_path):
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    env["XDG_CACHE_HOME"] = str(tmp_path)
+    code = (
+        "import os, sys, dcee; from dcee.kernel_cache import source_stamp; "
+        "import numba; from numba.core import config; "
+        "print(os.environ['NUMBA_CACHE_DIR'] == config.CACHE_DIR, source_stamp())"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+    ).stdout.split()
+    assert out[0] == "True"
+    assert (tmp_path / "dcee" / "numba" / out[1]).is_dir()
