@@ -763,6 +763,18 @@ def speed_table() -> str:
         w = by_name[name]
         ratio = w["ratio_to"][reference]
         rows.append([label, f"{ratio:.2f}×", f"{w['median']:.3g} ms", target, _timed(work)])
+    if "dcee-cl-single-decision-20k" in by_name:  # runs stored before issue 46's option lack it
+        single = by_name["dcee-cl-single-decision-20k"]
+        rows.append(
+            [
+                "a paper-scale `dcee-cl` decision with `precision=single` vs the same in double "
+                "precision, in alternation",
+                f"{single['ratio_to']['dcee-cl-decision']:.2f}×",
+                f"{single['median']:.3g} ms",
+                "—",
+                _timed(work),
+            ]
+        )
     cl = by_name["dcee-cl-decision-20k"]
     rows.append(
         [

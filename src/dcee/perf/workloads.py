@@ -331,6 +331,7 @@ def run_workloads(quick: bool = False, progress: Callable[[str], None] | None = 
                     ("entrotaxis-decision-20k", "entrotaxis", None),
                     ("infotaxis-decision-20k", "infotaxis", None),
                     ("dcee-cl-decision-20k", "dcee-cl", None),
+                    ("dcee-cl-single-decision-20k", "dcee-cl:precision=single", None),
                     ("dcee-mcts-decision-20k", "dcee-mcts", None),
                 ],
                 20_000,
@@ -395,6 +396,10 @@ def run_workloads(quick: bool = False, progress: Callable[[str], None] | None = 
     # issue 13's bound: a closed-loop decision costs at most 2× an open-loop one, same run
     cl, op = by_name["dcee-cl-decision-20k"], by_name["dcee-decision-20k"]
     cl.note = f"{cl.median / op.median:.2f}× the dcee decision in this run"
+    # issue 46: the single-precision weights against the same decision in double precision
+    single, double = by_name["dcee-cl-single-decision-20k"], by_name["dcee-cl-decision-20k"]
+    single.ratio_to = {**single.ratio_to, "dcee-cl-decision": single.median / double.median}
+    single.note = f"{single.median / double.median:.2f}× the double-precision dcee-cl decision"
     cl, op = by_name["dcee-cl-decision-20k-stall"], by_name["dcee-decision-20k-stall"]
     cl.note = f"{cl.median / op.median:.2f}× the dcee decision at the stall in this run"
     # issue 28: the tree search's default budget keeps a search under 3× a dcee-cl search; its
