@@ -126,6 +126,14 @@ def test_precision_option_is_checked(bad):
         get_planner("dcee-cl", precision=bad)
 
 
+def test_the_tree_search_refuses_single_precision_it_would_not_use():
+    """Its sequences have `depth` readings (multi-stage tasks: double precision), so the option
+    would do nothing; one line says so. With depth 1 it applies."""
+    with pytest.raises(DceeInputError, match=r"precision.*depth=4"):
+        get_planner("dcee-mcts:precision=single")
+    assert get_planner("dcee-mcts:depth=1:precision=single").options()["precision"] == "single"
+
+
 def test_single_precision_is_a_planner_option_everywhere_it_is_used():
     for name in ("dcee", "dcee-cl", "dcee-cl-tree", "dcee-ms", "infotaxis", "entrotaxis"):
         planner = get_planner(name, precision="single")

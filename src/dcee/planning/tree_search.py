@@ -195,6 +195,12 @@ class TreeSearchPlanner(Planner):
         for key in cost_options:  # name the tree, whose spec the user wrote
             if key not in allowed:
                 raise unknown_option(self.name, key, allowed)
+        if cost_options.get("precision", "double") != "double" and self.depth > 1:
+            raise DceeInputError(
+                "precision",
+                f"{cost_options['precision']!r} applies to one-reading predictions; the tree "
+                f"scores sequences of depth={self.depth} readings in double precision",
+            )
         self.cost: HypothesisPlanner = get(  # type: ignore[assignment]
             cost, subsample=subsample, n_hypotheses=n_hypotheses, **cost_options
         )
