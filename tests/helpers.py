@@ -210,3 +210,11 @@ def stratified_readings_reference(ctx, pos_idx):
         conc[rows, first], ctx._detect_u, dist[rows, first]
     )
     return z, prob
+
+
+def search_that_sleeps(task):
+    """A stand-in search that takes a minute (for the driver's signal handling)."""
+    import time
+
+    time.sleep(60)
+    return {"status": "done", "task": task}

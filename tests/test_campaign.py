@@ -641,3 +641,43 @@ def test_a_pinned_later_setting_resumes_a_campaign_stored_before_it_existed():
     assert settings_identity({"suite": "paper"}) != settings_identity(
         {"suite": "paper", "overrides": {"estimator.repeat_radius": 2.0}}
     )
+
+
+_DRIVER = """
+import signal, sys, time
+from dcee.campaign.runner import SearchTask, _local_results
+from tests.helpers import search_that_sleeps
+
+def stop(signum, frame):
+    raise KeyboardInterrupt
+signal.signal(signal.SIGTERM, stop)
+tasks = [SearchTask(sys.argv[1], "paper:1", "mpc", seed, {}) for seed in range(2)]
+try:
+    for _ in _local_results(tasks, 2, search=search_that_sleeps):
+        pass
+except KeyboardInterrupt:
+    print("stopped", flush=True)
+    sys.exit(143)
+"""
+
+
+def test_driver_answers_a_signal_while_every_search_is_still_running(tmp_path):
+    """SIGTERM to the driver while both workers are inside minute-long searches: it must stop
+    within seconds, not when a search ends (the signal may land on a pool thread; the driver's
+    wait is bounded so that its handler runs)."""
+    root = Path(__file__).resolve().parent.parent
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _DRIVER, str(tmp_path / "c")],
+        cwd=root,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    time.sleep(6)  # the workers are spawned and sleeping in their searches
+    assert proc.poll() is None, proc.communicate()
+    sent = time.monotonic()
+    os.kill(proc.pid, signal.SIGTERM)
+    out, err = proc.communicate(timeout=50)
+    assert time.monotonic() - sent < 10, "the driver waited for a search to end"
+    assert proc.returncode == 143 and "stopped" in out, err

@@ -241,6 +241,7 @@ class Campaign:
 
 
 _STARTED: Any = None  # in a local worker: shared flags, set when a search starts
+_POLL_SECONDS = 0.5  # the driver wakes at least this often (signals are handled when it wakes)
 
 
 def _init_worker(started: Any = None, own_process: bool = False) -> None:
@@ -296,7 +297,7 @@ def _local_results(
     result (a worker that cannot even start) fails what is left, so this always ends.
     """
     import multiprocessing as mp
-    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
     from concurrent.futures.process import BrokenProcessPool
 
     # Not os.environ["NUMBA_NUM_THREADS"]: numba in *this* process re-reads it at its next
@@ -319,15 +320,23 @@ def _local_results(
         )
         futures = {pool.submit(_run_marked, i, tasks[i], search): i for i in batch}
         lost: list[int] = []
+        pending = set(futures)
         try:
-            for fut in as_completed(futures):
-                i = futures[fut]
-                try:
-                    yield fut.result()
-                except BrokenProcessPool:
-                    lost.append(i)
-                except Exception as exc:  # not the search (it never raises): pickling, say
-                    yield {"status": "failed", "task": tasks[i], "error": repr(exc)}
+            while pending:
+                # a bounded wait: Python runs signal handlers only when the main thread wakes,
+                # so this guarantees `kill` is answered within half a second whichever thread
+                # the signal landed on (a driver that had been stopped and continued once kept
+                # waiting after SIGTERM; not reproduced in a test; tests/test_campaign.py checks the
+                # answer time)
+                done, pending = wait(pending, timeout=_POLL_SECONDS, return_when=FIRST_COMPLETED)
+                for fut in done:
+                    i = futures[fut]
+                    try:
+                        yield fut.result()
+                    except BrokenProcessPool:
+                        lost.append(i)
+                    except Exception as exc:  # not the search (it never raises): pickling, say
+                        yield {"status": "failed", "task": tasks[i], "error": repr(exc)}
         except KeyboardInterrupt:
             # the workers ignore SIGINT: stop them now rather than wait for their searches
             # (a search writes its results atomically, so a killed one leaves nothing half done)
