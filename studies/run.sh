@@ -379,6 +379,14 @@ case "${1:---list}" in
     $P studies/stonesoup_mcts_study.py results/perf-stonesoup-mcts --seeds "${MCTS_SEEDS:-3}" \
       --json docs/results/perf/stonesoup-mcts.json
     $P studies/publish_tables.py ;;
+  precision-single)  # dcee-cl in single precision beside double: the public study's 120 searches, paired
+    $D bench --suite paper --repeats 10 --strategies dcee-cl,dcee-cl:precision=single \
+      --workers "${WORKERS:-2}" --out results/precision-single
+    report precision-single
+    $P studies/collect_metrics.py --out docs/results/precision-single results/precision-single
+    $P studies/ablation_table.py results/precision-single=dcee-cl \
+      results/precision-single=dcee-cl:precision=single > docs/results/precision-single/paired.md
+    $P studies/publish_tables.py ;;
   agreement)  # decisions with precision=single against today's double precision (20,000 particles)
     $P studies/decision_agreement.py --precision single \
       --strategies dcee,infotaxis,entrotaxis,dcee-cl --json docs/results/perf/agreement-single.json

@@ -23,29 +23,28 @@ HALF_LOG_2PI = 0.5 * math.log(2.0 * math.pi)
 _INV_SQRT2 = 1.0 / math.sqrt(2.0)
 
 
-@intrinsic
-def _int_as_float(typingctx, bits):
-    """The float64 whose IEEE-754 bits are the int64 ``bits``: a bit cast, free and
-    vectorisable (numba has no scalar frexp/ldexp that LLVM can vectorise)."""
-    if bits != types.int64:
-        return None
+def _bit_cast(source: types.Type, target: types.Type, llvm_target: ir.Type) -> object:
+    """A numba intrinsic that reinterprets a ``source`` value's IEEE-754 bits as ``target``: a
+    bit cast, free and vectorisable (numba has no scalar frexp/ldexp that LLVM can
+    vectorise)."""
 
-    def codegen(context, builder, signature, args):
-        return builder.bitcast(args[0], ir.DoubleType())
+    def cast(typingctx, x):
+        if x != source:
+            return None
 
-    return types.float64(types.int64), codegen
+        def codegen(context, builder, signature, args):
+            return builder.bitcast(args[0], llvm_target)
+
+        return target(source), codegen
+
+    cast.__name__ = f"bit_cast_{source}_{target}"
+    return intrinsic(cast)
 
 
-@intrinsic
-def _float_as_int(typingctx, x):
-    """The int64 holding the IEEE-754 bits of the float64 ``x`` (see :func:`_int_as_float`)."""
-    if x != types.float64:
-        return None
-
-    def codegen(context, builder, signature, args):
-        return builder.bitcast(args[0], ir.IntType(64))
-
-    return types.int64(types.float64), codegen
+_int_as_float = _bit_cast(types.int64, types.float64, ir.DoubleType())
+_float_as_int = _bit_cast(types.float64, types.int64, ir.IntType(64))
+_int32_as_float32 = _bit_cast(types.int32, types.float32, ir.FloatType())
+_float32_as_int32 = _bit_cast(types.float32, types.int32, ir.IntType(32))
 
 
 _MANTISSA_BITS = np.int64(0x000FFFFFFFFFFFFF)
@@ -301,30 +300,6 @@ def vlog(x: np.ndarray, out: np.ndarray) -> None:
 # float32 arithmetic: twice the SIMD lanes of float64 and shorter polynomials for a relative
 # error of a few 1e-7. Every literal is a float32 and every intermediate is cast back, because
 # numba promotes float32 mixed with a Python float (or an int64) to float64.
-
-
-@intrinsic
-def _int32_as_float32(typingctx, bits):
-    """The float32 whose IEEE-754 bits are the int32 ``bits`` (a free bit cast)."""
-    if bits != types.int32:
-        return None
-
-    def codegen(context, builder, signature, args):
-        return builder.bitcast(args[0], ir.FloatType())
-
-    return types.float32(types.int32), codegen
-
-
-@intrinsic
-def _float32_as_int32(typingctx, x):
-    """The int32 holding the IEEE-754 bits of the float32 ``x``."""
-    if x != types.float32:
-        return None
-
-    def codegen(context, builder, signature, args):
-        return builder.bitcast(args[0], ir.IntType(32))
-
-    return types.int32(types.float32), codegen
 
 
 _F32 = np.float32
