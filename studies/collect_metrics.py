@@ -2,8 +2,9 @@
 each campaign's ``report/metrics.csv`` and ``report/pairwise.csv`` rows, tagged with the columns
 that tell the campaigns apart, into ``metrics.csv`` and ``pairwise.csv``; and one row per search
 (``searches.csv``: configuration, seed, strategy, acquired, final RMSE, truth in the 95 % region,
-time to RMSE < 1 m, longest stall), so a paired comparison with a later campaign needs no search
-folder (``studies/ablation_table.py docs/results/<study>/searches.csv=STRATEGY``).
+time to RMSE < 1 m, longest stall, mean decision time), so a paired comparison with a later
+campaign needs no search folder
+(``studies/ablation_table.py docs/results/<study>/searches.csv=STRATEGY``).
 
     .venv/bin/python studies/collect_metrics.py --out docs/results/turbulent-held-out-100 \\
         results/turbulent-puffs-held-out-100=truth_model:puffs,climb:0 \\
@@ -32,6 +33,7 @@ SEARCH_COLUMNS = [
     "truth_in_95",
     "time_to_rmse_1m",
     "longest_stall",
+    "decision_seconds_mean",  # wall time per decision, s (a comparison timed in one campaign)
 ]
 
 

@@ -812,6 +812,53 @@ def kernel_speedup_table() -> str:
     )
 
 
+def precision_single_table() -> str:
+    """`dcee-cl` in single and double precision on the public study's 120 searches, paired
+    (bash studies/run.sh precision-single; docs/results/precision-single)."""
+    metrics, pairs = study("precision-single"), paired("precision-single")
+    searches = pd.read_csv(RESULTS / "precision-single" / "searches.csv")
+    double, single = "dcee-cl", "dcee-cl:precision=single"
+    ms = {k: 1e3 * g["decision_seconds_mean"] for k, g in searches.groupby("strategy")}
+    rows = []
+    for strategy in (double, single):
+        r = pick(metrics, strategy)
+        rows.append(
+            [
+                f"`{strategy}`",
+                acquired(r),
+                share(r, "truth_in_95"),
+                rmse(r),
+                time_to_1m(r),
+                f"{ms[strategy].mean():.1f}",
+            ]
+        )
+    p = pick(pairs, single)
+    both = searches.pivot_table(index=["scenario", "seed"], columns="strategy",
+                                values="decision_seconds_mean")  # fmt: skip
+    ratio = float((both[single] / both[double]).median())
+    final = searches.pivot_table(index=["scenario", "seed"], columns="strategy",
+                                 values="final_rmse")  # fmt: skip
+    same = int((abs(final[single] - final[double]) < 1e-9).sum())
+    time_diff, time_p = p["time_to_1m_difference"], p["time_wilcoxon_p"]
+    rows.append(
+        [
+            f"paired, single − double ({same}/{len(final)} searches end at the same final RMSE "
+            "to 1e-9 m)",
+            f"{int(p['acquired_variant_only'])} / {int(p['acquired_reference_only'])} acquired "
+            f"only by one (McNemar p = {p['mcnemar_p']:.2g})",
+            "",
+            f"{p['final_rmse_difference']:+.3f} m (Wilcoxon p = {p['rmse_wilcoxon_p']:.2g})",
+            "—" if math.isnan(time_diff) else f"{time_diff:+.0f} s (p = {time_p:.2g})",
+            f"{ratio:.2f}× per search (median of {len(both)} pairs)",
+        ]
+    )
+    return table(
+        ["planner", "source acquired (RMSE < 3 m)", "truth in 95 % region",
+         "median final RMSE (m)", "median time to RMSE < 1 m (s)", "mean decision (ms)"],
+        rows,
+    )  # fmt: skip
+
+
 def agreement_single_table() -> str:
     """Decisions with ``precision=single`` against today's double-precision full computation,
     per planner (studies/decision_agreement.py, docs/results/perf/agreement-single.json)."""
@@ -865,6 +912,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "speed": speed_table,
     "kernel-speedup": kernel_speedup_table,
     "agreement-single": agreement_single_table,
+    "precision-single": precision_single_table,
 }
 
 

@@ -384,8 +384,9 @@ case "${1:---list}" in
       --workers "${WORKERS:-2}" --out results/precision-single
     report precision-single
     $P studies/collect_metrics.py --out docs/results/precision-single results/precision-single
+    rm -f docs/results/precision-single/paired.csv  # ablation_table appends
     $P studies/ablation_table.py results/precision-single=dcee-cl \
-      results/precision-single=dcee-cl:precision=single > docs/results/precision-single/paired.md
+      results/precision-single=dcee-cl:precision=single --csv docs/results/precision-single/paired.csv
     $P studies/publish_tables.py ;;
   agreement)  # decisions with precision=single against today's double precision (20,000 particles)
     $P studies/decision_agreement.py --precision single \
