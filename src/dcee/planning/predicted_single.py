@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from dcee.models.sensor_kernels import SensorParams
 from dcee.numeric import EXP_F32_FLOOR, exp_f32, log_f32
 from dcee.planning.block_sums import BLOCK as _BLOCK
 from dcee.planning.block_sums import product_sum as _product_sum
@@ -162,7 +163,7 @@ def single_stage_sums(
     task_v: np.ndarray,
     task_out: np.ndarray,
     bound: np.ndarray,
-    sp,
+    sp: SensorParams,
     want_moments: bool,
     want_kl: bool,
     partial: np.ndarray,
