@@ -638,20 +638,26 @@ def cross_truth_table() -> str:
 def learn_tuning_table() -> str:
     """The learned reading model against today's defaults on the tuning range (filament and
     puffs only: the truths defaults may be chosen on), paired by search
-    (studies/precision_variants.py's rows in docs/results/tuning-learn-13-40)."""
+    (studies/precision_variants.py's rows in docs/results/tuning-learn-13-40 and
+    tuning-log-sd-13-40; today's defaults ran in both, reading for reading the same)."""
     from scipy.stats import binomtest, wilcoxon
 
-    frame = pd.read_csv(RESULTS / "tuning-learn-13-40" / "variants.csv")
+    frame = pd.concat(
+        pd.read_csv(RESULTS / folder / "variants.csv")
+        for folder in ("tuning-learn-13-40", "tuning-log-sd-13-40")
+    )
+    key = ["truth", "scenario", "seed"]
+    frame = frame.drop_duplicates(["variant", *key])
     names = {
         "base": "today's defaults (fixed 1/r)",
         "decay": "`learn = {decay = [1, 0.5]}`",
         "both": "`learn = {meander = [0.15, 0.3, 0.6], log_sd = [1.3, 2]}`",
         "nsl": "`learn = {near_source_length = [2.5, 0]}`",
+        "sd": "`learn = {log_sd = [1.3, 2, 3]}`",
     }
-    key = ["truth", "scenario", "seed"]
     base = frame[frame["variant"] == "base"]
     rows = []
-    for variant in ("base", "decay", "both", "nsl"):
+    for variant in ("base", "decay", "both", "nsl", "sd"):
         for truth in ("filament", "puffs", "both truths"):
             part = frame[frame["variant"] == variant]
             if truth != "both truths":
