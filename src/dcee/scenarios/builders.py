@@ -82,7 +82,7 @@ class ScenarioBuilders:
             pd=learned.get("intermittency", e.intermittency),
             family="lognormal",
             log_sd=learned.get("log_sd", e.log_sd),
-            log_sd_near=e.log_sd_near,
+            log_sd_near=learned.get("log_sd_near", e.log_sd_near),
             log_sd_length=e.log_sd_length,
             near_length=learned.get("near_source_length", e.near_source_length),
             magnitude=e.magnitude,

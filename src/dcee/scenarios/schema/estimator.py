@@ -157,11 +157,14 @@ class AnemometerSpec(BaseModel):
     """°, standard deviation of a direction reading about the true direction"""
 
 
-LearnedName = Literal["meander", "log_sd", "intermittency", "near_source_length", "decay"]
+LearnedName = Literal[
+    "meander", "log_sd", "log_sd_near", "intermittency", "near_source_length", "decay"
+]
 """The reading model's nuisance parameters ``estimator.learn`` may weigh."""
 LEARN_RANGES: dict[str, tuple[float, float]] = {
     "meander": (0.0, 2.0),
     "log_sd": (1e-3, 5.0),
+    "log_sd_near": (0.0, 10.0),
     "intermittency": (1e-3, 1.0),
     "near_source_length": (0.0, 1000.0),
     "decay": (0.25, 2.0),

@@ -172,6 +172,11 @@ class Scenario(ScenarioBuilders, BaseModel):
                 f"{FIELD_MARK}estimator.learn: weighs the fluctuation model's settings; needs "
                 f'estimator.likelihood = "fluctuation" (it is "{e.likelihood}")'
             )
+        if "log_sd_near" in e.learn and e.log_sd_length == 0:
+            raise ValueError(
+                f"{FIELD_MARK}estimator.learn.log_sd_near: the near-source spread needs "
+                "estimator.log_sd_length > 0 (m; with 0 the spread is the same everywhere)"
+            )
         members = 1
         for key, values in e.learn.items():
             low, high = LEARN_RANGES[key]
@@ -353,7 +358,8 @@ class Scenario(ScenarioBuilders, BaseModel):
         ``paper``; or ``fluctuation`` (the fixed values), then with ``estimator.learn`` one
         member per other combination of its grid (``fluctuation[meander=0.3]``), then with
         ``estimator.calm_prior`` > 0 the calm ``paper`` member. ``settings`` overrides the
-        fluctuation model's values (meander, log_sd, intermittency, near_source_length)."""
+        fluctuation model's values (meander, log_sd, log_sd_near, intermittency, near_source_length,
+        decay)."""
         e = self.estimator
         if e.likelihood != "fluctuation":
             return (("paper", {}),)
