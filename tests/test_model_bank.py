@@ -26,11 +26,19 @@ def _lawnmower(n: int = 40) -> np.ndarray:
     return np.array(rows[:n])
 
 
-def _readings(sensor, positions, seed: int, plume=None) -> np.ndarray:
+def _readings(sensor, positions, seed: int, plume=None, at_distance: bool = False) -> np.ndarray:
+    """Readings of ``sensor`` on ``positions``; ``at_distance``: the terms that depend on the
+    distance to the source (near-source spread and intermittency) at the true distance (else
+    far from it)."""
     from dcee.models.plume import IsotropicPlume
 
-    conc = (plume or IsotropicPlume()).concentration(PAPER1.truth_theta(), positions)[0]
-    return sensor.simulate(conc, np.random.default_rng(seed))
+    truth = PAPER1.truth_theta()
+    conc = (plume or IsotropicPlume()).concentration(truth, positions)[0]
+    rng = np.random.default_rng(seed)
+    if not at_distance:
+        return sensor.simulate(conc, rng)
+    distance = np.linalg.norm(positions - truth[:3], axis=1)
+    return sensor.simulate_from(conc, sensor.draw_noise(rng, conc.shape), distance)
 
 
 def test_log_evidence_matches_the_exact_grid_integral():
@@ -65,14 +73,23 @@ def test_log_evidence_of_the_first_reading_by_hand():
 
 
 def _bank_on_simulated_readings(
-    scenario, generating: str, seed: int, copies: int, priors: bool = True
+    scenario,
+    generating: str,
+    seed: int,
+    copies: int,
+    priors: bool = True,
+    path: np.ndarray | None = None,
 ) -> ModelBank:
     """A bank of the scenario's reading models (3000 particles each, x and y unknown) after the
-    lawnmower path flown ``copies`` times with readings drawn from model ``generating``; equal
-    prior probabilities unless ``priors``."""
-    ps = np.vstack([_lawnmower(40)] * copies)
+    lawnmower path (or ``path``, (K, 3) m) flown ``copies`` times with readings drawn from model
+    ``generating``; equal prior probabilities unless ``priors``."""
+    ps = np.vstack([_lawnmower(40) if path is None else path] * copies)
     zs = _readings(
-        scenario.make_estimator_sensor(generating), ps, seed, plume=scenario.make_plume(generating)
+        scenario.make_estimator_sensor(generating),
+        ps,
+        seed,
+        plume=scenario.make_plume(generating),
+        at_distance=path is not None,
     )
     filters = [
         ParticleFilter(
@@ -303,3 +320,35 @@ def test_learned_decay_tells_a_planar_plume_from_a_point_source(generating):
     bank = _bank_on_simulated_readings(learned, generating, seed=8, copies=3)
     assert bank.selected_name == generating
     assert bank.probabilities[bank.selected] > 0.9
+
+
+@pytest.mark.parametrize("generating", ["fluctuation[log_sd_near=4]", "fluctuation"])
+def test_learned_near_source_spread_is_found_from_the_readings(generating):
+    """estimator.learn = {log_sd_near = [0, 4]} (log_sd_length 5 m): readings drawn with the
+    spread that grows towards the source, or with the same spread everywhere; the bank finds
+    which (simulated data), and the member's sensor carries the learned value."""
+    learned = FLUCT.with_overrides(
+        **{
+            "estimator.log_sd_length": 5.0,
+            "estimator.learn": {"log_sd_near": [0.0, 4.0]},
+            "estimator.calm_prior": 0,
+        }
+    )
+    assert learned.reading_models == ("fluctuation", "fluctuation[log_sd_near=4]")
+    near = learned.make_estimator_sensor("fluctuation[log_sd_near=4]")
+    assert (near.log_sd_near, near.log_sd_length) == (4.0, 5.0)
+    assert learned.make_estimator_sensor("fluctuation").log_sd_near == 0.0
+    # rings round the source at its height, 1.5 to 6 m out, where the two spreads differ
+    x0, y0, z0 = PAPER1.truth_theta()[:3]
+    angles = np.linspace(0.0, 2.0 * np.pi, 12, endpoint=False)
+    ring = np.array(
+        [(x0 + r * np.cos(a), y0 + r * np.sin(a), z0) for r in (1.5, 3.0, 6.0) for a in angles]
+    )
+    bank = _bank_on_simulated_readings(learned, generating, seed=8, copies=3, path=ring)
+    assert bank.selected_name == generating
+    assert bank.probabilities[bank.selected] > 0.9
+
+
+def test_learned_near_source_spread_needs_a_length():
+    with pytest.raises(DceeInputError, match=r"estimator\.learn\.log_sd_near.*log_sd_length > 0"):
+        FLUCT.with_overrides(**{"estimator.learn": {"log_sd_near": [0.0, 3.0]}})
