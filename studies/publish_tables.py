@@ -638,13 +638,14 @@ def cross_truth_table() -> str:
 def learn_tuning_table() -> str:
     """The learned reading model against today's defaults on the tuning range (filament and
     puffs only: the truths defaults may be chosen on), paired by search
-    (studies/precision_variants.py's rows in docs/results/tuning-learn-13-40 and
-    tuning-log-sd-13-40; today's defaults ran in both, reading for reading the same)."""
+    (studies/precision_variants.py's rows in docs/results/tuning-learn-13-40,
+    tuning-log-sd-13-40 and tuning-near-sd-13-40; today's defaults ran in the first two, reading
+    for reading the same)."""
     from scipy.stats import binomtest, wilcoxon
 
     frame = pd.concat(
         pd.read_csv(RESULTS / folder / "variants.csv")
-        for folder in ("tuning-learn-13-40", "tuning-log-sd-13-40")
+        for folder in ("tuning-learn-13-40", "tuning-log-sd-13-40", "tuning-near-sd-13-40")
     )
     key = ["truth", "scenario", "seed"]
     frame = frame.drop_duplicates(["variant", *key])
@@ -654,10 +655,11 @@ def learn_tuning_table() -> str:
         "both": "`learn = {meander = [0.15, 0.3, 0.6], log_sd = [1.3, 2]}`",
         "nsl": "`learn = {near_source_length = [2.5, 0]}`",
         "sd": "`learn = {log_sd = [1.3, 2, 3]}`",
+        "nearsd": "`learn = {log_sd_near = [0, 3, 6]}`, `log_sd_length = 1.5`",
     }
     base = frame[frame["variant"] == "base"]
     rows = []
-    for variant in ("base", "decay", "both", "nsl", "sd"):
+    for variant in ("base", "decay", "both", "nsl", "sd", "nearsd"):
         for truth in ("filament", "puffs", "both truths"):
             part = frame[frame["variant"] == variant]
             if truth != "both truths":
