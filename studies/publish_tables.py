@@ -629,6 +629,8 @@ def cross_truth_table() -> str:
         )
     for _, r in lbm.iterrows():
         how = "" if r["learn"] == "none" else f", `estimator.learn` {r['learn']} (an option)"
+        if int(r.get("particles", 10000)) != 10000:
+            how += f", {int(r['particles']):,} particles (measured, not chosen on)"
         if int(r["searches"]) < 100:
             how += f", {int(r['searches'])} configurations (small sample)"
         add(f"**lbm** (fluid solver), fluctuation likelihood{how}", "none", r, "lbm-held-out-100")
