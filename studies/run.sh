@@ -344,6 +344,11 @@ case "${1:---list}" in
       --variant 'nearsd:estimator.log_sd_length=1.5,estimator.learn={log_sd_near=[0.0,3.0,6.0]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-near-sd-13-40/variants.csv
     $P studies/publish_tables.py ;;
+  tune-nsl05)  # a 0.5 m near-source fall on the tuning range, filament + puffs (docs/plumes.md)
+    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+      --variant 'nsl05:estimator.near_source_length=0.5' \
+      --workers "${WORKERS:-2}" --csv docs/results/tuning-nsl05-13-40/variants.csv
+    $P studies/publish_tables.py ;;
   cross-truth)  # every truth at today's defaults; the lbm plume held out (docs/plumes.md, README)
     # dcee-cl, infotaxis and the tree search at today's defaults, 100 held-out configurations;
     # dcee-cl with the learned decay (an option, not a default: measured, not chosen on)
