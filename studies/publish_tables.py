@@ -647,7 +647,12 @@ def learn_tuning_table() -> str:
 
     frame = pd.concat(
         pd.read_csv(RESULTS / folder / "variants.csv")
-        for folder in ("tuning-learn-13-40", "tuning-log-sd-13-40", "tuning-near-sd-13-40")
+        for folder in (
+            "tuning-learn-13-40",
+            "tuning-log-sd-13-40",
+            "tuning-near-sd-13-40",
+            "tuning-nsl05-13-40",
+        )
     )
     key = ["truth", "scenario", "seed"]
     frame = frame.drop_duplicates(["variant", *key])
@@ -658,10 +663,11 @@ def learn_tuning_table() -> str:
         "nsl": "`learn = {near_source_length = [2.5, 0]}`",
         "sd": "`learn = {log_sd = [1.3, 2, 3]}`",
         "nearsd": "`learn = {log_sd_near = [0, 3, 6]}`, `log_sd_length = 1.5`",
+        "nsl05": "`near_source_length = 0.5` (fixed, not learned)",
     }
     base = frame[frame["variant"] == "base"]
     rows = []
-    for variant in ("base", "decay", "both", "nsl", "sd", "nearsd"):
+    for variant in ("base", "decay", "both", "nsl", "sd", "nearsd", "nsl05"):
         for truth in ("filament", "puffs", "both truths"):
             part = frame[frame["variant"] == variant]
             if truth != "both truths":
