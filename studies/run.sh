@@ -349,6 +349,11 @@ case "${1:---list}" in
       --variant 'nsl05:estimator.near_source_length=0.5' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-nsl05-13-40/variants.csv
     $P studies/publish_tables.py ;;
+  tune-nsl05-rp05)  # the 0.5 m fall with a repeat discount of power 1/2, tuning range (docs/plumes.md)
+    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+      --variant 'nsl05rp05:estimator.near_source_length=0.5,estimator.repeat_power=0.5' \
+      --workers "${WORKERS:-2}" --csv docs/results/tuning-nsl05-rp05-13-40/variants.csv
+    $P studies/publish_tables.py ;;
   cross-truth)  # every truth at today's defaults; the lbm plume held out (docs/plumes.md, README)
     # dcee-cl, infotaxis and the tree search at today's defaults, 100 held-out configurations;
     # dcee-cl with the learned decay (an option, not a default: measured, not chosen on)
