@@ -588,7 +588,7 @@ def test_campaigns_stored_before_issue_29_keep_the_estimator_they_ran_with():
 
 
 def test_the_fourth_rounds_defaults_follow_the_likelihood_and_old_campaigns_keep_theirs():
-    """The repeat discount is on (2 m, power 0.25) and the intermittency conserves the mean
+    """The repeat discount is on (2 m, power 0.5) and the intermittency conserves the mean
     only with the fluctuation likelihood; the filter and the reading model receive them; a
     campaign stored before them (no conserve_mean, repeat_radius 0, no repeat_power) compares
     equal to today's scenario with those values set, and not to today's defaults."""
@@ -599,12 +599,12 @@ def test_the_fourth_rounds_defaults_follow_the_likelihood_and_old_campaigns_keep
     paper = load_scenario("paper:1")
     fluct = paper.with_overrides(**{"estimator.likelihood": "fluctuation", "unknown": "full"})
     assert (paper.repeat_radius, paper.repeat_power) == (0.0, 1.0)
-    assert (fluct.repeat_radius, fluct.repeat_power) == (2.0, 0.25)
+    assert (fluct.repeat_radius, fluct.repeat_power) == (2.0, 0.5)
     explicit = fluct.with_overrides(**{"estimator.repeat_radius": 0.5})
-    assert (explicit.repeat_radius, explicit.repeat_power) == (0.5, 0.25)
+    assert (explicit.repeat_radius, explicit.repeat_power) == (0.5, 0.5)
     rng = np.random.default_rng
     pf = make_searcher(fluct, None, rng(0), rng(1), on_robot=False).filter.current
-    assert (pf.repeat_radius, pf.repeat_power, pf.sensor.conserve_mean) == (2.0, 0.25, True)
+    assert (pf.repeat_radius, pf.repeat_power, pf.sensor.conserve_mean) == (2.0, 0.5, True)
     calm = make_searcher(paper, None, rng(0), rng(1), on_robot=False).filter
     assert (calm.repeat_radius, calm.sensor.params.conserve_mean) == (0.0, 0.0)
 

@@ -122,7 +122,7 @@ def test_show_says_what_each_default_was_chosen_on() -> None:
     from dcee.scenarios.defaults import DEFAULTS
 
     text = to_toml(load_scenario("random:1000"))
-    assert "near_source_length = 2.5\n# ^ default, chosen on filament + puffs" in text
+    assert "near_source_length = 0.5\n# ^ default, chosen on filament + puffs" in text
     assert "independent on isotropic, lbm" in text
     # a built-in's own value is not the measured default: no provenance under it
     lab = to_toml(load_scenario("lab:upwind"))

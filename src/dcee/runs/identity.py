@@ -123,7 +123,10 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
             estimator["reading_weight"] = READING_WEIGHT_DEFAULT[likelihood]
         for k, key in enumerate(("repeat_radius", "repeat_power")):
             if key in estimator and estimator[key] is None:
-                # unset: the likelihood's default, compared as the number it stands for
+                # unset: the likelihood's default, compared as the number it stands for today.
+                # (The fluctuation power was 1/4 until 2026-11-27, together with a 2.5 m
+                # near-source fall that every stored scenario holds as a number: a campaign
+                # stored before cannot compare equal to one flown at today's defaults.)
                 estimator[key] = REPEAT_DEFAULT[likelihood][k]
         if estimator.get("repeat_radius", 0.0) == 0.0:
             # no repeat discount: its power decides nothing

@@ -47,14 +47,14 @@ A scenario is a TOML file (or a built-in, see :mod:`dcee.scenarios.builtin`)::
     likelihood = "paper"           # or "fluctuation" (intermittent log-normal, for real plumes)
     intermittency = 0.93           # fluctuation only
     log_sd = 1.3                   # fluctuation only
-    near_source_length = 2.5       # fluctuation only, m
+    near_source_length = 0.5       # fluctuation only, m
     calm_prior = 0.1               # fluctuation only: prior probability of a calm plume (0: off)
     meander = 0.15                 # plume broadening [default: 0 paper, 0.15 fluctuation]
     outlier = 0.01                 # outlier weight [default: 0.01 for every likelihood]
     magnitude = true               # fluctuation only; false: detection-only readings
     conserve_mean = true           # fluctuation only: a detection's mean is C / Pd(r)
     repeat_radius = 2.0            # m, a run at one spot discounted [default: 0 paper, 2 fluct.]
-    repeat_power = 0.25            # its discount 1 / (1 + m)^p [default: 1 paper, 0.25 fluct.]
+    repeat_power = 0.5             # its discount 1 / (1 + m)^p [default: 1 paper, 0.5 fluct.]
 
     [agent]
     start = [2.0, 2.0, 4.0]        # m; the agent flies at the start altitude

@@ -54,7 +54,7 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
         ("filament",), "maximum-likelihood fit to 4 s holds, studies/fluctuation_stats.py"
     ),
     ("estimator", "near_source_length"): Provenance(
-        ("filament", "puffs"), "random:13-40, dcee-cl, the climbing UAV"
+        ("filament", "puffs"), "random:13-40, dcee-cl, with repeat_power 0.5 (issue 42)"
     ),
     ("estimator", "conserve_mean"): Provenance(("filament", "puffs"), "random:13-40, dcee-cl"),
     ("estimator", "meander"): Provenance(("filament",), "the filament truth's time mean"),
@@ -62,7 +62,9 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
         ("filament", "puffs"), "random:1-12, dcee-cl and infotaxis"
     ),
     ("estimator", "repeat_radius"): Provenance(("filament", "puffs"), "random:13-40, dcee-cl"),
-    ("estimator", "repeat_power"): Provenance(("filament", "puffs"), "random:13-40, dcee-cl"),
+    ("estimator", "repeat_power"): Provenance(
+        ("filament", "puffs"), "random:13-40, dcee-cl, with near_source_length 0.5 (issue 42)"
+    ),
     ("estimator", "outlier"): Provenance(
         ("isotropic",), "random:1-6, dcee-cl, one 10^6 x reading, studies/spike_study.py"
     ),

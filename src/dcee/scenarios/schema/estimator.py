@@ -121,13 +121,16 @@ checked on held-out random:1000-1023 with dcee-cl and infotaxis: the truth insid
 in 29 more searches and 10 fewer of 96 paired ones (exact McNemar p = 0.003), acquisition and
 final error no worse (docs/turbulent.md)."""
 
-REPEAT_DEFAULT: dict[str, tuple[float, float]] = {"paper": (0.0, 1.0), "fluctuation": (2.0, 0.25)}
+REPEAT_DEFAULT: dict[str, tuple[float, float]] = {"paper": (0.0, 1.0), "fluctuation": (2.0, 0.5)}
 """(``repeat_radius`` m, ``repeat_power``) per likelihood when not given: off for the paper's
 model (independent readings, the paper's update); for the fluctuation model a run of readings
-within 2 m weighs 1 / (1 + m)^0.25 each. Chosen on the tuning range random:13-40 (dcee-cl, both
-turbulent truths, 56 searches; fourth round): the truth in the 95 % region in 96 % of searches
-against 86 %, at 0.16 m more final error (median pair, p = 3e-4); power 1/2 over-covered (100 %)
-at 0.26 m more (docs/turbulent.md)."""
+within 2 m weighs 1 / (1 + m)^0.5 each (n readings at one spot add up like 2 √n). Chosen with
+``near_source_length`` 0.5 m on the tuning range random:13-40 (dcee-cl, filament + puffs, 56
+paired searches, rule written before the run; issue 42): acquisition 56/56 either way, the final
+error 0.30 m smaller at the median pair (Wilcoxon p = 5e-8), the truth in the 95 % region in
+95 % of searches against 96 % (bound: 2 points). Power 1/4 (2026-11-23 to 11-27, with the 2.5 m
+fall) was chosen on the same range; with the 0.5 m fall it left the region too narrow
+(docs/plumes.md, docs/turbulent.md)."""
 
 MEANDER_DEFAULT: dict[str, float] = {"paper": 0.0, "fluctuation": 0.15}
 """Meander broadening per likelihood when ``estimator.meander`` is not given: none for the
@@ -206,14 +209,15 @@ class EstimatorSpec(BaseModel):
     log_sd_length: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] = 0.0
     """fluctuation: m; how fast the extra spread decays with distance; 0 = s the same
     everywhere"""
-    near_source_length: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] = 2.5
+    near_source_length: Annotated[float, Field(ge=0, le=1000, allow_inf_nan=False)] = 0.5
     """fluctuation: m; the intermittency falls near the source as 1 − exp(−r / this)
-    (r: sensor to hypothesised source); 0 = the same everywhere. 2.5 m, chosen on the tuning
-    range random:13-40 with the climbing UAV (the final error 0.56 m smaller at the median pair
-    than with 5 m, p = 1e-6; at a fixed altitude no significant difference on 14 filament
-    searches). 5 m, the value before (the maximum-likelihood fit at fixed points gave 5.4 m),
-    was chosen at the fixed altitude on random:1-12; 10 m set the final estimate about 1 m upwind
-    of the source there (docs/turbulent.md)"""
+    (r: sensor to hypothesised source); 0 = the same everywhere. 0.5 m, chosen with the repeat
+    discount's power 1/2 on the tuning range random:13-40 (filament + puffs, dcee-cl; issue 42):
+    the filter alone, on a fixed pattern of readings round each source, sits 0.72 m (filament)
+    and 0.94 m (puffs) upwind with 2.5 m and +0.06 / +0.05 m with 0.5 m; the searches end 0.30 m
+    closer at the median pair (p = 5e-8), the truth in the 95 % region in 95 % against 96 %.
+    2.5 m (2026-11-23 to 11-27) and 5 m before it were chosen on the same truths
+    (docs/plumes.md, docs/turbulent.md)"""
     magnitude: bool = True
     """fluctuation: a detection weighs by its magnitude's log-normal density (True) or only by
     its probability, whatever its size (False: detection-only readings, as Vergassola et
