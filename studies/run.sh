@@ -355,42 +355,49 @@ case "${1:---list}" in
       --workers "${WORKERS:-2}" --csv docs/results/tuning-nsl05-rp05-13-40/variants.csv
     $P studies/publish_tables.py ;;
   cross-truth)  # every truth at today's defaults; the lbm plume held out (docs/plumes.md, README)
-    # dcee-cl, infotaxis and the tree search at today's defaults, 100 held-out configurations;
-    # dcee-cl with the learned decay (an option, not a default: measured, not chosen on)
+    # dcee-cl, infotaxis and the tree search at today's defaults, 100 held-out configurations
     export SUITE=held-out-100 TRUTHS=lbm WORKERS=${WORKERS:-2}
     bash studies/study_turbulent_held_out.sh --set truth.z=4.0
-    STRATEGIES=dcee-cl OUT_SUFFIX=-decay bash studies/study_turbulent_held_out.sh \
-      --set truth.z=4.0 --set 'estimator.learn={decay=[1.0,0.5]}'
-    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts bash studies/study_turbulent_held_out.sh --set truth.z=4.0
-    # the learned near-source intermittency: measured on the tuning range and not adopted
-    # (docs/plumes.md); flown here as an option, it decides nothing
-    STRATEGIES=dcee-cl OUT_SUFFIX=-nsl bash studies/study_turbulent_held_out.sh \
-      --set truth.z=4.0 --set 'estimator.learn={near_source_length=[2.5,0.0]}'
-    # dcee-cl at the default particle count (the paper's 20,000; the study's 10,000 elsewhere):
-    # is the narrow belief the particles'? (measured, it decides nothing)
-    STRATEGIES=dcee-cl OUT_SUFFIX=-20k bash studies/study_turbulent_held_out.sh \
-      --set truth.z=4.0 --particles 20000
-    report turbulent-lbm-held-out-100 turbulent-lbm-held-out-100-decay turbulent-lbm-held-out-100-mcts \
-      turbulent-lbm-held-out-100-nsl turbulent-lbm-held-out-100-20k
+    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-today bash studies/study_turbulent_held_out.sh \
+      --set truth.z=4.0
+    # the same at the defaults of 2026-11-23 to 11-27 (a 2.5 m near-source fall, repeat power 1/4),
+    # and options measured at those defaults (they decide nothing): dcee-cl with the learned
+    # decay and the learned near-source intermittency, the tree search, 20,000 particles
+    old=(--set truth.z=4.0 --set estimator.near_source_length=2.5 --set estimator.repeat_power=0.25)
+    OUT_SUFFIX=-nsl25 bash studies/study_turbulent_held_out.sh "${old[@]}"
+    STRATEGIES=dcee-cl OUT_SUFFIX=-decay bash studies/study_turbulent_held_out.sh "${old[@]}" \
+      --set 'estimator.learn={decay=[1.0,0.5]}'
+    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts bash studies/study_turbulent_held_out.sh "${old[@]}"
+    STRATEGIES=dcee-cl OUT_SUFFIX=-nsl bash studies/study_turbulent_held_out.sh "${old[@]}" \
+      --set 'estimator.learn={near_source_length=[2.5,0.0]}'
+    STRATEGIES=dcee-cl OUT_SUFFIX=-20k bash studies/study_turbulent_held_out.sh "${old[@]}" \
+      --particles 20000
+    r=results/turbulent-lbm-held-out-100
+    report turbulent-lbm-held-out-100 turbulent-lbm-held-out-100-mcts-today \
+      turbulent-lbm-held-out-100-nsl25 turbulent-lbm-held-out-100-decay \
+      turbulent-lbm-held-out-100-mcts turbulent-lbm-held-out-100-nsl turbulent-lbm-held-out-100-20k
     $P studies/collect_metrics.py --out docs/results/lbm-held-out-100 \
-      results/turbulent-lbm-held-out-100=learn:none,particles:10000 \
-      results/turbulent-lbm-held-out-100-decay=learn:decay,particles:10000 \
-      results/turbulent-lbm-held-out-100-mcts=learn:none,particles:10000 \
-      results/turbulent-lbm-held-out-100-nsl=learn:near_source_length,particles:10000 \
-      results/turbulent-lbm-held-out-100-20k=learn:none,particles:20000
-    rm -f docs/results/lbm-held-out-100/paired.csv
+      "$r=defaults:2026-11-27,learn:none,particles:10000" \
+      "$r-mcts-today=defaults:2026-11-27,learn:none,particles:10000" \
+      "$r-nsl25=defaults:2026-11-23,learn:none,particles:10000" \
+      "$r-decay=defaults:2026-11-23,learn:decay,particles:10000" \
+      "$r-mcts=defaults:2026-11-23,learn:none,particles:10000" \
+      "$r-nsl=defaults:2026-11-23,learn:near_source_length,particles:10000" \
+      "$r-20k=defaults:2026-11-23,learn:none,particles:20000"
+    rm -f docs/results/lbm-held-out-100/paired.csv docs/results/lbm-held-out-100/today_vs_before.csv
     for ref in infotaxis dcee-cl; do
-      $P studies/ablation_table.py "results/turbulent-lbm-held-out-100=$ref" \
-        results/turbulent-lbm-held-out-100=dcee-cl results/turbulent-lbm-held-out-100-decay=dcee-cl \
-        results/turbulent-lbm-held-out-100-mcts=dcee-mcts results/turbulent-lbm-held-out-100-nsl=dcee-cl \
-        results/turbulent-lbm-held-out-100-20k=dcee-cl \
-        --csv docs/results/lbm-held-out-100/paired.csv --tag "reference=$ref"
+      $P studies/ablation_table.py "$r-nsl25=$ref" "$r-nsl25=dcee-cl" "$r-decay=dcee-cl" \
+        "$r-mcts=dcee-mcts" "$r-nsl=dcee-cl" "$r-20k=dcee-cl" \
+        --csv docs/results/lbm-held-out-100/paired.csv --tag "reference=$ref" --tag defaults=2026-11-23
+      $P studies/ablation_table.py "$r=$ref" "$r=dcee-cl" "$r-mcts-today=dcee-mcts" \
+        --csv docs/results/lbm-held-out-100/paired.csv --tag "reference=$ref" --tag defaults=2026-11-27
     done
-    $P studies/worst_searches.py results/turbulent-lbm-held-out-100=dcee-cl \
-      results/turbulent-lbm-held-out-100=infotaxis --out docs/figures/lbm-held-out-worst.png
-    $P studies/upwind_detections.py results/turbulent-lbm-held-out-100=dcee-cl \
-      results/turbulent-lbm-held-out-100=infotaxis results/turbulent-lbm-held-out-100-decay=dcee-cl \
-      results/turbulent-lbm-held-out-100-mcts=dcee-mcts results/turbulent-lbm-held-out-100-nsl=dcee-cl
+    # today's defaults against those before, search by search
+    $P studies/pair_campaigns.py "$r-nsl25" "$r" --csv docs/results/lbm-held-out-100/today_vs_before.csv \
+      --tag truth_model=lbm
+    $P studies/worst_searches.py "$r=dcee-cl" "$r=infotaxis" --out docs/figures/lbm-held-out-worst.png
+    $P studies/upwind_detections.py "$r=dcee-cl" "$r=infotaxis" "$r-nsl25=dcee-cl" \
+      "$r-nsl25=infotaxis" "$r-decay=dcee-cl" "$r-mcts=dcee-mcts" "$r-nsl=dcee-cl"
     $P studies/publish_tables.py ;;
   publish)  # the tables of README.md, docs/index.md, docs/results.md from docs/results/
     $P studies/publish_tables.py ;;

@@ -681,3 +681,57 @@ def test_driver_answers_a_signal_while_every_search_is_still_running(tmp_path):
     out, err = proc.communicate(timeout=50)
     assert time.monotonic() - sent < 10, "the driver waited for a search to end"
     assert proc.returncode == 143 and "stopped" in out, err
+
+
+def test_campaigns_flown_before_the_0_5_m_fall_keep_their_repeat_power():
+    """Until 2026-11-27 the fluctuation likelihood's defaults were a 2.5 m near-source fall and
+    a repeat power of 1/4; a campaign stored then (fall as a number, power unset) compares equal
+    to today's scenario pinned to both, and not to today's defaults (0.5 m, power 1/2)."""
+    from dcee.runs import scenario_identity
+    from dcee.scenarios import load_scenario
+
+    today = load_scenario("random:13").with_overrides(
+        **{"estimator.likelihood": "fluctuation", "truth.model": "puffs"}
+    )
+    assert (today.estimator.near_source_length, today.repeat_power) == (0.5, 0.5)
+    stored = today.model_dump(mode="json")
+    stored["estimator"]["near_source_length"] = 2.5
+    assert stored["estimator"]["repeat_power"] is None
+    pinned = today.with_overrides(
+        **{"estimator.near_source_length": 2.5, "estimator.repeat_power": 0.25}
+    )
+    assert scenario_identity(stored) == scenario_identity(pinned.model_dump(mode="json"))
+    assert scenario_identity(stored) != scenario_identity(today.model_dump(mode="json"))
+    at_half = today.with_overrides(
+        **{"estimator.near_source_length": 2.5, "estimator.repeat_power": 0.5}
+    )
+    assert scenario_identity(stored) != scenario_identity(at_half.model_dump(mode="json"))
+
+
+def test_an_override_that_changes_no_stored_scenario_keeps_the_campaign():
+    """Overrides are applied to every stored scenario, which records their effect: pinning a
+    default to the value it had (``--set estimator.near_source_length=2.5`` today, for a
+    campaign flown when 2.5 m was the default) resumes it; an override that changes the
+    scenarios does not."""
+    from dcee.runs.identity import settings_identity
+    from dcee.scenarios import load_scenario
+
+    today = load_scenario("random:13").with_overrides(**{"estimator.likelihood": "fluctuation"})
+    old = today.model_dump(mode="json")
+    old["estimator"]["near_source_length"] = 2.5
+    stored = {"suite": "s", "scenarios": {"random:13": old}, "overrides": {"truth.z": 4.0}}
+    pinned = today.with_overrides(
+        **{"estimator.near_source_length": 2.5, "estimator.repeat_power": 0.25}
+    )
+    now = {
+        "suite": "s",
+        "scenarios": {"random:13": pinned.model_dump(mode="json")},
+        "overrides": {
+            "truth.z": 4.0,
+            "estimator.near_source_length": 2.5,
+            "estimator.repeat_power": 0.25,
+        },
+    }
+    assert settings_identity(stored) == settings_identity(now)
+    moved = {**now, "scenarios": {"random:13": today.model_dump(mode="json")}}
+    assert settings_identity(stored) != settings_identity(moved)

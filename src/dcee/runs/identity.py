@@ -78,13 +78,33 @@ FLUCTUATION_ONLY = (
 they decide nothing, so changing their defaults must not orphan a campaign."""
 
 
+OLD_FALL_REPEAT = (2.5, (2.0, 0.25))
+"""The fluctuation likelihood's near-source fall (m) and repeat discount (radius m, power) until
+2026-11-27, when the two defaults changed together (0.5 m, power 1/2; issue 42)."""
+
+
+def _unset_repeat(likelihood: str, estimator: dict[str, Any]) -> tuple[float, float]:
+    """What an unset repeat discount ran with. Every stored scenario holds its near-source fall
+    as a number, and the fall and the power changed together: a fluctuation scenario stored with
+    the old 2.5 m fall and no power ran with power 1/4 (pin the power to compare a 2.5 m fall at
+    today's power)."""
+    if likelihood == "fluctuation" and estimator.get("near_source_length") == OLD_FALL_REPEAT[0]:
+        return OLD_FALL_REPEAT[1]
+    return REPEAT_DEFAULT[likelihood]
+
+
 def settings_identity(settings: dict[str, Any]) -> dict[str, Any]:
     """What must match for results to belong together: the settings without the scenarios'
     free-text descriptions (rewording one must not orphan a campaign; it changes no result) and
     without later-added settings at their defaults (:data:`LATER_DEFAULTS`)."""
     out = dict(settings)
     overrides = out.get("overrides")
-    if isinstance(overrides, dict):
+    if isinstance(out.get("scenarios"), dict) and out["scenarios"]:
+        # every override is applied to every stored scenario, which records its effect: a
+        # default pinned to the value a stored campaign ran with (a later-added setting, or an
+        # old default after it changed) says nothing the scenarios do not
+        out.pop("overrides", None)
+    elif isinstance(overrides, dict):
         # a later-added setting pinned (--set) to the value a campaign stored before it existed
         # ran with says nothing the scenarios do not: the stored campaign still resumes
         kept = {
@@ -123,11 +143,8 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
             estimator["reading_weight"] = READING_WEIGHT_DEFAULT[likelihood]
         for k, key in enumerate(("repeat_radius", "repeat_power")):
             if key in estimator and estimator[key] is None:
-                # unset: the likelihood's default, compared as the number it stands for today.
-                # (The fluctuation power was 1/4 until 2026-11-27, together with a 2.5 m
-                # near-source fall that every stored scenario holds as a number: a campaign
-                # stored before cannot compare equal to one flown at today's defaults.)
-                estimator[key] = REPEAT_DEFAULT[likelihood][k]
+                # unset: the likelihood's default, compared as the number it stands for
+                estimator[key] = _unset_repeat(likelihood, estimator)[k]
         if estimator.get("repeat_radius", 0.0) == 0.0:
             # no repeat discount: its power decides nothing
             estimator.pop("repeat_power", None)
