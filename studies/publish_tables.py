@@ -574,11 +574,16 @@ CROSS_HEADER = [
 ]
 
 
+OLD_DEFAULTS = "defaults of 2026-11-23 (2.5 m fall, repeat power 1/4)"
+"""How a row flown before the 0.5 m near-source fall and repeat power 1/2 (2026-11-27) says so."""
+
+
 def cross_truth_table() -> str:
-    """Every truth family at today's defaults, all eight unknown: which defaults were chosen on
-    it (docs/plumes.md; dcee.scenarios.defaults.DEFAULTS)."""
+    """Every truth family, all eight unknown, at today's defaults, with the rows flown at the
+    defaults before marked: which defaults were chosen on it (docs/plumes.md;
+    dcee.scenarios.defaults.DEFAULTS)."""
     today = study("held-out-today")
-    turbulent = study("turbulent-held-out-100")
+    turbulent_today = study("turbulent-held-out-100-today")
     lbm = study("lbm-held-out-100")
     rows = []
 
@@ -603,34 +608,33 @@ def cross_truth_table() -> str:
             pick(today, strategy, study="full"),
             "held-out-today",
         )
-    for strategy in ("dcee-cl", "infotaxis", "dcee-mcts"):
-        add(
-            "filament, fluctuation likelihood",
-            "**yes**: the fluctuation model's settings, climb, hold",
-            pick(today, strategy, study="filament"),
-            "held-out-today",
-        )
-    for strategy in ("dcee-cl", "infotaxis"):
-        r = pick(
-            turbulent,
-            strategy,
-            truth_model="puffs",
-            climb=1.0,
-            near_source_length=2.5,
-            vertical_reach=1.0,
-            conserve_mean=1,
-            repeat_radius=2,
-        )
-        add(
-            "puffs, fluctuation likelihood",
-            "**yes**: climb, near-source length, repeat discount",
-            r,
-            "turbulent-held-out-100",
-        )
+    for truth, chosen in (
+        ("filament", "**yes**: the fluctuation model's settings, climb, hold"),
+        ("puffs", "**yes**: climb, near-source fall, repeat discount"),
+    ):
+        for strategy in ("dcee-cl", "infotaxis"):
+            add(
+                f"{truth}, fluctuation likelihood",
+                chosen,
+                pick(turbulent_today, strategy, truth_model=truth),
+                "turbulent-held-out-100-today",
+            )
+        if truth == "filament":
+            add(
+                f"filament, fluctuation likelihood, {OLD_DEFAULTS}",
+                chosen,
+                pick(today, "dcee-mcts", study="filament"),
+                "held-out-today",
+            )
+    lbm = lbm.assign(old=lbm["defaults"].astype(str) != "2026-11-27").sort_values(
+        "old", kind="stable"
+    )
     for _, r in lbm.iterrows():
         how = "" if r["learn"] == "none" else f", `estimator.learn` {r['learn']} (an option)"
         if int(r.get("particles", 10000)) != 10000:
             how += f", {int(r['particles']):,} particles (measured, not chosen on)"
+        if r["old"]:
+            how += f", {OLD_DEFAULTS}"
         if int(r["searches"]) < 100:
             how += f", {int(r['searches'])} configurations (small sample)"
         add(f"**lbm** (fluid solver), fluctuation likelihood{how}", "none", r, "lbm-held-out-100")

@@ -81,15 +81,19 @@ case "${1:---list}" in
     # vertical reach; a detection's mean C): the puffs on held-out-100, the filament on all 200
     # held-out configurations (issue 28's filament study); the filament's random:1100-1199 make
     # its held-out-100 rows
-    OUT_SUFFIX=-defaults TRUTHS=puffs bash studies/study_turbulent_held_out.sh "${cm0[@]}"
+    # (2.5 m was the near-source fall's default until 2026-11-27: pinned since)
+    nsl25=(--set estimator.near_source_length=2.5)
+    OUT_SUFFIX=-defaults TRUTHS=puffs bash studies/study_turbulent_held_out.sh "${cm0[@]}" \
+      "${nsl25[@]}"
     SUITE=held-out OUT_SUFFIX=-defaults TRUTHS=filament bash studies/study_turbulent_held_out.sh \
-      "${cm0[@]}"
+      "${cm0[@]}" "${nsl25[@]}"
     # the fourth round's mean-conserving intermittency alone, the same searches
-    OUT_SUFFIX=-cm TRUTHS=puffs bash studies/study_turbulent_held_out.sh "${rr0[@]}"
+    OUT_SUFFIX=-cm TRUTHS=puffs bash studies/study_turbulent_held_out.sh "${rr0[@]}" "${nsl25[@]}"
     SUITE=held-out OUT_SUFFIX=-cm TRUTHS=filament bash studies/study_turbulent_held_out.sh \
-      "${rr0[@]}"
-    # today's defaults: with the gentle repeat discount (2 m, power 0.25), held-out-100
-    OUT_SUFFIX=-cm-rr bash studies/study_turbulent_held_out.sh \
+      "${rr0[@]}" "${nsl25[@]}"
+    # the defaults of 2026-11-23 to 11-27: with the gentle repeat discount (2 m, power 0.25),
+    # held-out-100 (today's: turbulent-held-out-today)
+    OUT_SUFFIX=-cm-rr bash studies/study_turbulent_held_out.sh "${nsl25[@]}" \
       --set estimator.repeat_radius=2.0 --set estimator.repeat_power=0.25
     report turbulent-filament-held-out-24 turbulent-puffs-held-out-24
     out=docs/results/turbulent-held-out-100
@@ -131,6 +135,20 @@ case "${1:---list}" in
       results/turbulent-filament-held-out-cm --csv "$out/calibration-today.csv"
     $P studies/collect_metrics.py --out "$out" "${gathered[@]}"
     $P studies/publish_tables.py ;;
+  turbulent-held-out-today)  # both turbulent truths at today's defaults, held-out-100 (docs/turbulent.md)
+    # the 0.5 m near-source fall and repeat power 1/2 (pinned, so a later default keeps these);
+    # chosen on these two truths (tuning range random:13-40): a check, not an independent result
+    export SUITE=held-out-100 WORKERS=${WORKERS:-2}
+    today=(--set estimator.near_source_length=0.5 --set estimator.repeat_radius=2.0
+      --set estimator.repeat_power=0.5)
+    OUT_SUFFIX=-today bash studies/study_turbulent_held_out.sh "${today[@]}"
+    out=docs/results/turbulent-held-out-100-today
+    mkdir -p "$out"
+    report turbulent-puffs-held-out-100-today turbulent-filament-held-out-100-today
+    $P studies/collect_metrics.py --out "$out" \
+      "results/turbulent-puffs-held-out-100-today=truth_model:puffs,defaults:2026-11-27" \
+      "results/turbulent-filament-held-out-100-today=truth_model:filament,defaults:2026-11-27"
+    $P studies/publish_tables.py ;;
   turbulent-public)  # the twelve public configurations on both turbulent truths: the third round's and today's defaults
     # 5 repeats and 10,000 particles: ~10 min per truth and setting on 2 cores. "defaults": the
     # third round's (a detection's mean C, no repeat discount; flown at commit 69b6ea3, hence
@@ -166,10 +184,12 @@ case "${1:---list}" in
     # filament, today's defaults, held-out-100 (random:1100-1199); the one-step planners are
     # turbulent-held-out's -cm-rr campaign (resumed here if missing)
     export SUITE=held-out-100 TRUTHS=filament WORKERS=${WORKERS:-2}
-    OUT_SUFFIX=-cm-rr bash studies/study_turbulent_held_out.sh --allow-code-change \
-      --set estimator.repeat_radius=2.0 --set estimator.repeat_power=0.25
+    # (the defaults of 2026-11-23 to 11-27, pinned; today's: turbulent-held-out-today)
+    old=(--set estimator.near_source_length=2.5 --set estimator.repeat_radius=2.0
+      --set estimator.repeat_power=0.25)
+    OUT_SUFFIX=-cm-rr bash studies/study_turbulent_held_out.sh --allow-code-change "${old[@]}"
     OUT_SUFFIX=-cm-rr-mcts STRATEGIES=dcee-mcts bash studies/study_turbulent_held_out.sh \
-      --allow-code-change
+      --allow-code-change "${old[@]}"
     out=docs/results/held-out-today
     mkdir -p "$out"
     rm -f "$out/paired.csv"
