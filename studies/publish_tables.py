@@ -196,19 +196,30 @@ def what_we_found() -> str:
         today_row("**held-out**, all eight parameters unknown, the same 200", "full"),
         today_row(
             "**held-out**, filament truth, all eight unknown, fluctuation likelihood, "
-            "100 of them (`held-out-100`)",
+            "100 of them (`held-out-100`), defaults of 2026-11-23",
             "filament",
         ),
         planners_row(
             "**held-out**, the independent puff truth (Farrell et al. 2002), all eight unknown, "
             "fluctuation likelihood, `held-out-100`, `dcee-cl` / `infotaxis` "
-            "(`turbulent-held-out-100`)",
+            "(`turbulent-held-out-100`), defaults of 2026-11-23",
             study("turbulent-held-out-100"),
             ("dcee-cl", "infotaxis"),
             truth_model="puffs",
             repeat_radius=2,
         ),
     ]
+    for truth, what in (("filament", "filament truth"), ("puffs", "puff truth")):
+        rows.append(
+            planners_row(
+                f"**held-out**, {what}, all eight unknown, fluctuation likelihood, "
+                "`held-out-100`, today's defaults (since 2026-11-27), `dcee-cl` / `infotaxis` "
+                "(`turbulent-held-out-100-today`)",
+                study("turbulent-held-out-100-today"),
+                ("dcee-cl", "infotaxis"),
+                truth_model=truth,
+            )
+        )
     return table(
         [
             "study (stored in docs/results/…)",
@@ -260,7 +271,11 @@ def public_table(name: str) -> Callable[[], str]:
 HELD_OUT = (
     ("wind-known", "wind known, 200"),
     ("full", "all eight unknown, 200"),
-    ("filament", "filament truth, all eight unknown, fluctuation likelihood, `held-out-100`"),
+    (
+        "filament",
+        "filament truth, all eight unknown, fluctuation likelihood, `held-out-100`, defaults of "
+        "2026-11-23",
+    ),
 )
 PLANNERS = ("dcee-cl", "infotaxis", "dcee-mcts")
 

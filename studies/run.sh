@@ -148,6 +148,14 @@ case "${1:---list}" in
     $P studies/collect_metrics.py --out "$out" \
       "results/turbulent-puffs-held-out-100-today=truth_model:puffs,defaults:2026-11-27" \
       "results/turbulent-filament-held-out-100-today=truth_model:filament,defaults:2026-11-27"
+    # paired with the defaults of 2026-11-23 where their searches are stored (the filament's,
+    # held-out-today; the puffs' old campaign kept only its metrics)
+    rm -f "$out/paired.csv"
+    for s in dcee-cl infotaxis; do
+      $P studies/ablation_table.py "docs/results/held-out-today/searches.csv=$s:study:filament" \
+        "results/turbulent-filament-held-out-100-today=$s" --csv "$out/paired.csv" \
+        --tag truth_model=filament --tag reference=defaults-2026-11-23
+    done
     $P studies/publish_tables.py ;;
   turbulent-public)  # the twelve public configurations on both turbulent truths: the third round's and today's defaults
     # 5 repeats and 10,000 particles: ~10 min per truth and setting on 2 cores. "defaults": the

@@ -52,10 +52,13 @@ def main() -> None:
                 ax, result, scenario, truth, result.records[-1]["time"], result.final_theta[idx, :3]
             )
             s = result.summary
-            ax.set_title(
-                f"{strategy} · {s['scenario']}\nRMSE {s['final_rmse']:.1f} m, "
-                f"stall {s['longest_stall']:.0f} s, {s['detections']} detections",
+            ax.set_title("", loc="left")  # the map's own time and RMSE: said below instead
+            ax.set_title(  # above the north and wind arrows
+                f"{strategy} · {s['scenario']}, t = {result.records[-1]['time']:.0f} s\n"
+                f"RMSE {s['final_rmse']:.1f} m, stall {s['longest_stall']:.0f} s, "
+                f"{s['detections']} detections",
                 fontsize=9,
+                pad=26,
             )
             if c == 0:  # which campaign the row is
                 ax.set_ylabel(f"{Path(folder).name}\ny (m)", fontsize=9)
