@@ -123,6 +123,12 @@ BENCH = ["bench", "--suite", "smoke", "--strategies", "mpc,dcee", "--repeats", "
 BENCH += ["--particles", "300", "--workers", "2"]
 
 
+def _ctrl_c_as_in_a_terminal() -> None:
+    """Before exec in a child: Ctrl-C handled by default, as a terminal's foreground job has it
+    (a job started in the background from a script starts with SIGINT ignored)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _group_alive(pgid: int) -> bool:
     """Whether any process of the process group ``pgid`` still runs (zombies do not count)."""
     for stat in Path("/proc").glob("[0-9]*/stat"):
@@ -149,6 +155,7 @@ def test_interrupted_bench_keeps_finished_searches_and_resumes(tmp_path, capsys,
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,
+        preexec_fn=_ctrl_c_as_in_a_terminal,
     )
     deadline = time.monotonic() + 180
     while not list(out.glob("runs/*/*/*/summary.json")):

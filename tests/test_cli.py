@@ -1,4 +1,5 @@
 import json
+import signal
 import subprocess
 import sys
 
@@ -452,8 +453,14 @@ def test_an_interrupt_inside_a_finaliser_still_ends_the_command(capsys):
         raise AssertionError("the interrupt was lost")
 
     previous = sys.unraisablehook
-    with pytest.raises(SystemExit) as exc:
-        run_command(busy, "dcee", [])
+    # Ctrl-C handled as in a terminal: a job started in the background from a script starts
+    # with SIGINT ignored, and then Python neither raises nor redelivers it
+    previous_int = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(SystemExit) as exc:
+            run_command(busy, "dcee", [])
+    finally:
+        signal.signal(signal.SIGINT, previous_int)
     assert exc.value.code == 130 and sys.unraisablehook is previous
     err = capsys.readouterr().err
     assert err.strip() == "dcee: interrupted" and "Traceback" not in err

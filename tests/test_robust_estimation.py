@@ -108,7 +108,7 @@ def test_turbulent_truth_defaults_to_a_four_second_hold_and_average():
         "lognormal",
         0.93,
         1.3,
-        2.5,
+        0.5,
         0.01,
     )
     assert fluct.make_plume().meander == 0.15
