@@ -589,8 +589,11 @@ CROSS_HEADER = [
 ]
 
 
+TODAY_DEFAULTS = "2026-11-27"
+"""The ``defaults`` tag of rows flown at today's defaults (a 0.5 m near-source fall, repeat
+power 1/2)."""
 OLD_DEFAULTS = "defaults of 2026-11-23 (2.5 m fall, repeat power 1/4)"
-"""How a row flown before the 0.5 m near-source fall and repeat power 1/2 (2026-11-27) says so."""
+"""How a row flown before today's defaults says so."""
 
 
 def cross_truth_table() -> str:
@@ -641,7 +644,7 @@ def cross_truth_table() -> str:
                 pick(today, "dcee-mcts", study="filament"),
                 "held-out-today",
             )
-    lbm = lbm.assign(old=lbm["defaults"].astype(str) != "2026-11-27").sort_values(
+    lbm = lbm.assign(old=lbm["defaults"].astype(str) != TODAY_DEFAULTS).sort_values(
         "old", kind="stable"
     )
     for _, r in lbm.iterrows():

@@ -95,8 +95,9 @@ def _unset_repeat(likelihood: str, estimator: dict[str, Any]) -> tuple[float, fl
 
 def settings_identity(settings: dict[str, Any]) -> dict[str, Any]:
     """What must match for results to belong together: the settings without the scenarios'
-    free-text descriptions (rewording one must not orphan a campaign; it changes no result) and
-    without later-added settings at their defaults (:data:`LATER_DEFAULTS`)."""
+    free-text descriptions (rewording one must not orphan a campaign; it changes no result),
+    without later-added settings at their defaults (:data:`LATER_DEFAULTS`), and without the
+    ``--set`` overrides where the scenarios are stored (they hold every override's effect)."""
     out = dict(settings)
     overrides = out.get("overrides")
     if isinstance(out.get("scenarios"), dict) and out["scenarios"]:
