@@ -11,7 +11,7 @@ dcee.perf.machine) that docs/performance.md's table is generated from.
 from __future__ import annotations
 
 import argparse
-import importlib.util
+import importlib
 import subprocess
 import sys
 import tempfile
@@ -48,21 +48,35 @@ WORKLOADS = (
 )  # fmt: skip
 
 
+# the kernel module and the planning modules it imports from, read from the earlier commit
+# together (a module that changed beside the kernel is taken as it was then)
+KERNEL_MODULES = ("predicted_kernels", "predicted_single", "block_sums", "reading_terms")
+
+
 def _kernel_at(commit: str):
-    """predicted_posterior_stats of ``commit``'s kernel module (imported from a copy)."""
-    source = subprocess.run(
-        ["git", "-C", str(ROOT), "show", f"{commit}:{KERNEL}"],
-        check=True,
-        capture_output=True,
-        text=True,
-    ).stdout
+    """predicted_posterior_stats of ``commit``'s kernel module (imported from a copy, with the
+    planning modules it imports from taken from the same commit)."""
     folder = Path(tempfile.mkdtemp())
-    path = folder / f"kernel_{commit}.py"
-    path.write_text(source.replace("cache=True", "cache=False"))
-    spec = importlib.util.spec_from_file_location(path.stem, path)
-    module = importlib.util.module_from_spec(spec)
-    assert spec.loader is not None
-    spec.loader.exec_module(module)
+    package = f"kernels_{commit}"
+    (folder / package).mkdir()
+    (folder / package / "__init__.py").write_text("")
+    for name in KERNEL_MODULES:
+        try:
+            source = subprocess.run(
+                ["git", "-C", str(ROOT), "show", f"{commit}:src/dcee/planning/{name}.py"],
+                check=True,
+                capture_output=True,
+                text=True,
+            ).stdout
+        except subprocess.CalledProcessError:
+            if name == "predicted_kernels":
+                raise
+            continue  # not there yet at that commit: nothing imports it
+        for other in KERNEL_MODULES:
+            source = source.replace(f"dcee.planning.{other} ", f"{package}.{other} ")
+        (folder / package / f"{name}.py").write_text(source.replace("cache=True", "cache=False"))
+    sys.path.insert(0, str(folder))
+    module = importlib.import_module(f"{package}.predicted_kernels")
     return module.predicted_posterior_stats
 
 

@@ -6,8 +6,8 @@ particle and task, and the KL divergence one ``log`` more: at paper scale (20,00
 8 moves × 41 hypotheses) these dominate a decision. Here they are float32 arithmetic
 (:func:`dcee.numeric.exp_f32`, :func:`dcee.numeric.log_f32`: twice the SIMD lanes and shorter
 polynomials, relative error a few 1e-7), while the weights w_i, the location offsets and every
-sum stay float64, summed in the fixed order of :mod:`dcee.planning.block_sums` (results do not
-depend on the thread count). Each statistic then carries a relative error of about 1e-6;
+sum stay float64 (the float32 weights are widened when stored; the sums are the matrix products
+of :mod:`dcee.planning.block_sums`). Each statistic then carries a relative error of about 1e-6;
 decisions taken with it are compared with the double-precision ones by ``dcee perf``'s
 agreement check (docs/performance.md).
 
@@ -23,7 +23,7 @@ from numba import njit, prange
 from dcee.models.sensor_kernels import SensorParams
 from dcee.numeric import EXP_F32_FLOOR, exp_f32, log_f32
 from dcee.planning.block_sums import BLOCK as _BLOCK
-from dcee.planning.block_sums import product_sum as _product_sum
+from dcee.planning.block_sums import task_sums as _task_sums
 
 _F32 = np.float32
 _ZERO = _F32(0.0)
@@ -49,12 +49,14 @@ def _weights_f32(
     v_threshold: np.float32,
     det_add: np.float32,
     with_outliers: bool,
+    want_kl: bool,
     e: np.ndarray,
     el: np.ndarray,
 ) -> None:
-    """e[q] = exp(ll_i − bnd) and el[q] = e[q] · (ll_i − bnd), float32, for particles
-    i = i0 + q, q < n, of one position row (float32 rows) and one transformed reading v
-    (``out_term`` = exp(outlier term − bnd)). Branch-free loops that LLVM vectorises."""
+    """e[q] = exp(ll_i − bnd) and, with ``want_kl``, el[q] = e[q] · (ll_i − bnd), computed in
+    float32 and stored in the float64 rows e, el, for particles i = i0 + q, q < n, of one
+    position row (float32 rows) and one transformed reading v (``out_term`` =
+    exp(outlier term − bnd)). One branch-free loop per case, which LLVM vectorises."""
     if v < v_threshold:
         for q in range(n):
             i = np.uint64(i0 + q)
@@ -68,9 +70,11 @@ def _weights_f32(
             i = np.uint64(i0 + q)
             r = _F32(_F32(v - loc[i]) * inv_sigma[i])
             a = _F32(_F32(det_offset[i] + det_add) - _HALF * r * r - bnd)
-            eq = _F32(exp_f32(min(a, _ZERO)) + out_term)
-            e[np.uint64(q)] = eq
-            el[np.uint64(q)] = _F32(eq * log_f32(eq))
+            e[np.uint64(q)] = _F32(exp_f32(min(a, _ZERO)) + out_term)
+        if want_kl:
+            for q in range(n):
+                eq = _F32(e[np.uint64(q)])
+                el[np.uint64(q)] = _F32(eq * log_f32(eq))
         return
     for q in range(n):
         i = np.uint64(i0 + q)
@@ -87,6 +91,7 @@ def single_stage_stats_f32(
     log_nd: np.ndarray,
     inv_sigma: np.ndarray,
     det_offset: np.ndarray,
+    weights: np.ndarray,
     weighted: np.ndarray,
     group_start: np.ndarray,
     task_row: np.ndarray,
@@ -105,11 +110,11 @@ def single_stage_stats_f32(
     Σe·dz, Σe·|d|², Σe·ll with e_i = w_i exp(ll_i − bound_s).
 
     loc, log_nd, inv_sigma, det_offset (U, M) float32: the position terms of the U rows the
-    tasks read; weighted (5, M) float64: w, w·dx, w·dy, w·dz, w·|d|² (offsets from the
-    caller's centre); task_row (S,) into the U rows, equal within each group
+    tasks read; weights (M,) and weighted (M, 5) float64: w, w·dx, w·dy, w·dz, w·|d|²
+    (offsets from the caller's centre); task_row (S,) into the U rows, equal within each group
     group_start[g]..group_start[g+1]−1; task_v, task_out (S,): transformed reading and outlier
     term; bound (S,). Sums not wanted are left at zero."""
-    n = weighted.shape[1]
+    n = weights.shape[0]
     n_groups = group_start.shape[0] - 1
     n_blocks = (n + _BLOCK - 1) // _BLOCK
     v_thr = _F32(v_threshold)
@@ -118,13 +123,14 @@ def single_stage_stats_f32(
         g = item // n_blocks
         b = item % n_blocks
         s0 = group_start[g]
+        k = group_start[g + 1] - s0
         i_start = b * _BLOCK
         nb = min(n, i_start + _BLOCK) - i_start
         p = task_row[s0]
-        e = np.empty(_BLOCK, dtype=np.float32)
-        el = np.empty(_BLOCK, dtype=np.float32)
-        buf = np.empty(_BLOCK)
-        for s in range(s0, group_start[g + 1]):
+        e = np.empty((k, nb))
+        el = np.empty((k, nb))
+        for j in range(k):
+            s = s0 + j
             bnd = _F32(bound[s])
             out_term = exp_f32(min(_F32(task_out[s] - bound[s]), _ZERO))
             _weights_f32(
@@ -140,24 +146,23 @@ def single_stage_stats_f32(
                 v_thr,
                 add,
                 with_outliers,
-                e,
-                el,
+                want_kl,
+                e[j],
+                el[j],
             )
-            e0 = _product_sum(e, weighted[0], i_start, nb, buf)
-            partial[b, s, 0] = e0
-            for a in range(4):
-                partial[b, s, 1 + a] = (
-                    _product_sum(e, weighted[1 + a], i_start, nb, buf) if want_moments else 0.0
-                )
-            partial[b, s, 5] = (
-                bound[s] * e0 + _product_sum(el, weighted[0], i_start, nb, buf) if want_kl else 0.0
-            )
+        sums = np.empty((k, 6))
+        _task_sums(e, el, weights, weighted, i_start, want_moments, want_kl, sums)
+        for j in range(k):
+            for a in range(6):
+                partial[b, s0 + j, a] = sums[j, a]
+            if want_kl:
+                partial[b, s0 + j, 5] += bound[s0 + j] * sums[j, 0]
 
 
 def single_stage_sums(
     terms: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
-    offsets: np.ndarray,
     weights: np.ndarray,
+    weighted: np.ndarray,
     group_start: np.ndarray,
     task_positions: np.ndarray,
     task_v: np.ndarray,
@@ -169,17 +174,13 @@ def single_stage_sums(
     partial: np.ndarray,
 ) -> None:
     """:func:`single_stage_stats_f32` from the double-precision position terms (loc, log_nd,
-    inv_sigma, det_offset), each (P, N): the rows the tasks read are copied to float32 once."""
+    inv_sigma, det_offset), each (P, N): the rows the tasks read are copied to float32 once;
+    weights (N,), weighted (N, 5) as :func:`dcee.planning.block_sums.weighted_columns` gives."""
     used, task_row = np.unique(task_positions[:, 0], return_inverse=True)
     rows32 = [np.ascontiguousarray(t[used], dtype=np.float32) for t in terms]
-    weighted = np.empty((5, len(weights)))
-    weighted[0] = weights
-    if want_moments:
-        np.multiply(offsets, weights, out=weighted[1:])
-    else:
-        weighted[1:] = 0.0
     single_stage_stats_f32(
         *rows32,
+        weights,
         weighted,
         group_start,
         task_row.astype(np.int64),
