@@ -831,10 +831,11 @@ def speed_table() -> str:
                   "timed (date, machine, load, code)"], rows)  # fmt: skip
 
 
-def kernel_speedup_table() -> str:
+def kernel_speedup_table(name: str = "kernel-speedup") -> str:
     """The predicted-posterior kernel before and after issue 46's changes, in alternation in one
-    run (studies/kernel_speedup.py, docs/results/perf/kernel-speedup.json)."""
-    record = _perf("kernel-speedup")
+    run (studies/kernel_speedup.py, docs/results/perf/kernel-speedup.json; the second round,
+    the sums as matrix products: kernel-speedup-blas.json)."""
+    record = _perf(name)
     rows = [
         [
             w["workload"],
@@ -960,6 +961,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "sites": sites_table,
     "speed": speed_table,
     "kernel-speedup": kernel_speedup_table,
+    "kernel-speedup-blas": lambda: kernel_speedup_table("kernel-speedup-blas"),
     "agreement-single": agreement_single_table,
     "precision-single": precision_single_table,
 }
