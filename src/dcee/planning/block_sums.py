@@ -60,11 +60,23 @@ def task_sums(
             out[j, 5] = 0.0
 
 
-def weighted_columns(weights: np.ndarray, offsets: np.ndarray, want_moments: bool) -> np.ndarray:
-    """(N, 5) w, w·dx, w·dy, w·dz, w·|d|² from weights (N,) and offsets (4, N) (dx, dy, dz,
-    |d|²); only the first column is filled without ``want_moments``."""
-    weighted = np.zeros((len(weights), 5))
-    weighted[:, 0] = weights
-    if want_moments:
-        weighted[:, 1:] = (offsets * weights).T
-    return weighted
+@njit(cache=True)
+def weighted_columns(
+    weights: np.ndarray, source: np.ndarray, center: np.ndarray, want_moments: bool
+) -> np.ndarray:
+    """(N, 5) w, w·dx, w·dy, w·dz, w·|d|² from weights (N,) and the sources (N, 3) less
+    ``center`` (3,); only the first column is filled without ``want_moments``."""
+    n = weights.shape[0]
+    out = np.zeros((n, 5))
+    for i in range(n):
+        w = weights[i]
+        out[i, 0] = w
+        if want_moments:
+            dx = source[i, 0] - center[0]
+            dy = source[i, 1] - center[1]
+            dz = source[i, 2] - center[2]
+            out[i, 1] = w * dx
+            out[i, 2] = w * dy
+            out[i, 3] = w * dz
+            out[i, 4] = w * (dx * dx + dy * dy + dz * dz)
+    return out

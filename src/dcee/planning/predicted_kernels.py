@@ -338,10 +338,14 @@ def predicted_posterior_stats(
     n_blocks = (source.shape[0] + _BLOCK - 1) // _BLOCK
     partial = np.empty((n_blocks, s_count, _N_ACC))
     common = (loc, log_nd, inv_sigma, det_offset, source, weights, center)
-    offsets = _centred_offsets(source, center) if want_moments else np.zeros((4, 0))
     one_stage = task_positions.shape[1] == 1 and sp.false_alarm == 0.0
-    # the one-stage kernels' sums read w, w·dx, w·dy, w·dz, w·|d|² per particle
-    weighted = weighted_columns(weights, offsets, want_moments) if one_stage else np.zeros((0, 5))
+    # the one-stage kernels' sums read w, w·dx, w·dy, w·dz, w·|d|² per particle, the kernel of
+    # several stages the offsets: each only what it reads (memory at 100,000 particles)
+    weighted = (
+        weighted_columns(weights, source, center, want_moments) if one_stage else np.zeros((0, 5))
+    )
+    several = want_moments and not one_stage
+    offsets = _centred_offsets(source, center) if several else np.zeros((4, 0))
     single = precision == "single" and one_stage
     if single:
         single_stage_sums(
