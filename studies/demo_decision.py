@@ -1,0 +1,124 @@
+"""The demo's decision time on one pinned core, two code versions in alternation (issue 46).
+
+Runs the README's demo search (``dcee run --scenario paper:1 --strategy dcee-cl --seed 0``,
+20,000 particles) with one numba, OpenMP and BLAS thread, pinned to one core (``taskset``),
+once with the code of ``--before`` (a git worktree made for it) and once with this checkout's,
+``--rounds`` times in alternation so that both sides see the same machine; the kernels are
+compiled by a first run of each side that is not counted. Writes JSON with each run's mean
+decision (the search's ``decision_seconds_mean``), the final RMSE (the two sides must fly the
+same search), the machine and the load beside the run (docs/results/perf/, the table on
+docs/performance.md is generated from it).
+
+    .venv/bin/python studies/demo_decision.py --before cae7e4f \\
+        [--json docs/results/perf/demo-decision.json] [--rounds 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from dcee.io import write_json
+from dcee.perf.machine import LoadMonitor, load_warning, machine_record
+
+ROOT = Path(__file__).resolve().parent.parent
+DEMO = ["run", "--scenario", "paper:1", "--strategy", "dcee-cl", "--seed", "0"]
+ONE_CORE = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
+
+
+def _search(src: Path, out: Path) -> dict:
+    """One demo search with the package under ``src`` on one pinned core; its summary."""
+    env = {**os.environ, **ONE_CORE, "PYTHONPATH": str(src)}
+    command = ["taskset", "-c", "0", sys.executable, "-m", "dcee.cli", *DEMO, "--out", str(out)]
+    subprocess.run(command, env=env, check=True, capture_output=True, cwd=ROOT)
+    return json.loads((out / "summary.json").read_text(encoding="utf-8"))
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--before", required=True, help="the commit to compare with")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--json", type=Path)
+    args = ap.parse_args(argv)
+    if shutil.which("taskset") is None:
+        print(
+            "demo_decision: error: taskset (util-linux) is needed to pin one core", file=sys.stderr
+        )
+        return 2
+    if args.rounds < 1:
+        print(f"demo_decision: error: --rounds must be ≥ 1, got {args.rounds}", file=sys.stderr)
+        return 2
+    work = Path(tempfile.mkdtemp())
+    tree = work / "before"
+    made = subprocess.run(
+        ["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), args.before],
+        capture_output=True,
+        text=True,
+    )
+    if made.returncode != 0:
+        first = (made.stderr.strip().splitlines() or ["git worktree add failed"])[0]
+        print(f"demo_decision: error: --before {args.before}: {first}", file=sys.stderr)
+        return 2
+    sides = {"before": tree / "src", "after": ROOT / "src"}
+    runs: dict[str, list[dict]] = {"before": [], "after": []}
+    try:
+        for side, src in sides.items():  # compile each side's kernels (not counted)
+            _search(src, work / f"warm-{side}")
+        with LoadMonitor() as load:
+            for r in range(args.rounds):
+                for side, src in sides.items():
+                    summary = _search(src, work / f"{side}-{r}")
+                    runs[side].append(
+                        {
+                            "decision_ms_mean": 1e3 * summary["decision_seconds_mean"],
+                            "final_rmse": summary["final_rmse"],
+                            "steps": summary["steps"],
+                        }
+                    )
+                    print(f"{side} round {r}: {runs[side][-1]['decision_ms_mean']:.1f} ms",
+                          flush=True)  # fmt: skip
+    finally:
+        subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)],
+                       capture_output=True)  # fmt: skip
+        shutil.rmtree(work, ignore_errors=True)
+    before = float(np.median([r["decision_ms_mean"] for r in runs["before"]]))
+    after = float(np.median([r["decision_ms_mean"] for r in runs["after"]]))
+    same = all(
+        b["final_rmse"] == a["final_rmse"] and b["steps"] == a["steps"]
+        for b, a in zip(runs["before"], runs["after"], strict=True)
+    )
+    print(f"mean decision: {before:.1f} ms -> {after:.1f} ms ({before / after:.2f}x); "
+          f"same search: {same}")  # fmt: skip
+    record = load.record()
+    if warning := load_warning(record):
+        print(warning)
+    if args.json:
+        write_json(
+            args.json,
+            {
+                "machine": machine_record(),
+                "load": record,
+                "before": args.before,
+                "command": "dcee " + " ".join(DEMO),
+                "threads": ONE_CORE,
+                "runs": runs,
+                "before_ms": before,
+                "after_ms": after,
+                "speedup": before / after,
+                "same_search": same,
+                "target_ms": 15.0,
+            },
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
