@@ -816,6 +816,20 @@ def speed_table() -> str:
                 _timed(work),
             ]
         )
+    demo_path = RESULTS / "perf" / "demo-decision.json"
+    if demo_path.exists():  # studies/demo_decision.py (issue 46)
+        demo = _perf("demo-decision")
+        rows.append(
+            [
+                "the demo's search (`paper:1`, `dcee-cl`, seed 0, 20,000 particles): mean "
+                f"decision on one pinned core, against commit `{demo['before']}` in alternation"
+                + ("" if demo["same_search"] else " (**the two flew different searches**)"),
+                f"{demo['speedup']:.2f}× faster",
+                f"{demo['after_ms']:.1f} ms vs {demo['before_ms']:.1f} ms",
+                f"≤ {demo['target_ms']:.0f} ms",
+                _timed(demo),
+            ]
+        )
     cl = by_name["dcee-cl-decision-20k"]
     rows.append(
         [
