@@ -53,8 +53,8 @@ def _weights_f32(
     e: np.ndarray,
     el: np.ndarray,
 ) -> None:
-    """e[q] = exp(ll_i − bnd) and, with ``want_kl``, el[q] = e[q] · (ll_i − bnd), computed in
-    float32 and stored in the float64 rows e, el, for particles i = i0 + q, q < n, of one
+    """e[q] = exp(ll_i − bnd) and, with ``want_kl``, el[q] = e[q] · (ll_i − bnd), float32, for
+    particles i = i0 + q, q < n, of one
     position row (float32 rows) and one transformed reading v (``out_term`` =
     exp(outlier term − bnd)). One branch-free loop per case, which LLVM vectorises."""
     if v < v_threshold:
@@ -83,6 +83,13 @@ def _weights_f32(
         eq = exp_f32(min(lq, _ZERO))
         e[np.uint64(q)] = eq
         el[np.uint64(q)] = _F32(eq * lq)
+
+
+@njit(cache=True, error_model="numpy")
+def _widen(src: np.ndarray, dst: np.ndarray) -> None:
+    """dst[q] = src[q] (float32 to float64) for q < len(src)."""
+    for q in range(src.shape[0]):
+        dst[np.uint64(q)] = src[np.uint64(q)]
 
 
 @njit(cache=True, parallel=True, fastmath={"contract"}, error_model="numpy")
@@ -129,6 +136,10 @@ def single_stage_stats_f32(
         p = task_row[s0]
         e = np.empty((k, nb))
         el = np.empty((k, nb))
+        # float32 rows, widened after: a loop that stores float64 from float32 arithmetic
+        # vectorises at half the width (measured 1.7 against 0.8 ns per particle)
+        e32 = np.empty(nb, dtype=np.float32)
+        el32 = np.empty(nb, dtype=np.float32)
         for j in range(k):
             s = s0 + j
             bnd = _F32(bound[s])
@@ -147,9 +158,12 @@ def single_stage_stats_f32(
                 add,
                 with_outliers,
                 want_kl,
-                e[j],
-                el[j],
+                e32,
+                el32,
             )
+            _widen(e32, e[j])
+            if want_kl:
+                _widen(el32, el[j])
         sums = np.empty((k, 6))
         _task_sums(e, el, weights, weighted, i_start, want_moments, want_kl, sums)
         for j in range(k):
