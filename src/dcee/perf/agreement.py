@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from dcee.planning import get as get_planner
-from dcee.planning.base import Belief
+from dcee.planning.base import Belief, constructor_options, planner_class
 from dcee.planning.particle_terms import ParticleTerms
 from dcee.runs import SearchSimulation, planner_defaults
 from dcee.scenarios import load_scenario
@@ -51,11 +51,17 @@ def search_agreement(
     precision: str = "double",
 ) -> Agreement:
     """Fly ``steps`` decisions of one search and compare fast and reference decisions. With
-    ``precision="single"`` the search flies the planner's single-precision weights and the
-    reference stays in double precision (today's full computation)."""
+    ``precision="single"`` or ``"interpolated"`` the search flies the planner with that option
+    and the reference stays exact in double precision (today's full computation)."""
     scenario = load_scenario(scenario_name).with_overrides(**{"search.particles": particles})
     options = planner_defaults(strategy, scenario, None)
-    reference_planner = get_planner(strategy, **options)
+    # the reference is today's full computation: exact sums in double precision
+    exact = (
+        {"precision": "double"}
+        if "precision" in constructor_options(planner_class(strategy))
+        else {}
+    )
+    reference_planner = get_planner(strategy, **{**options, **exact})
     planner = (
         reference_planner
         if precision == "double"

@@ -43,9 +43,10 @@ class HypothesisPlanner(Planner):
     ablations, ``noise`` shared | fresh (:data:`~dcee.planning.predicted.NOISE_SHARING`),
     ``readings`` model | noise-free | miss-free and ``subsample`` (predict with a systematic
     resample of that share of the particles, equally weighted; the authors' example uses 0.2);
-    ``precision`` double | single, the arithmetic of the one-step weights
-    (:data:`~dcee.planning.predicted.PRECISIONS`: single is faster, its decisions measured
-    against double's in docs/performance.md).
+    ``precision`` interpolated | double | single, how the one-reading predictions are summed
+    (:data:`~dcee.planning.predicted.PRECISIONS`; the default is ``interpolated`` with a
+    horizon of one move and ``double`` with more; their decisions measured against double's in
+    docs/performance.md).
     """
 
     uses_hypotheses = True
@@ -66,10 +67,15 @@ class HypothesisPlanner(Planner):
         noise: str = "shared",
         readings: str = "model",
         subsample: float = 1.0,
-        precision: str = "double",
+        precision: str | None = None,
     ) -> None:
         expectation = self.default_expectation if expectation is None else expectation
         horizon = self.default_horizon if horizon is None else horizon
+        if precision is None:
+            # one-reading predictions are interpolated over the concentration where the sensor
+            # allows it (1e-8 of the exact sums, decisions measured: docs/performance.md);
+            # sequences of several readings are computed exactly
+            precision = "interpolated" if horizon == 1 else "double"
         n_hypotheses = check_count("hypotheses", n_hypotheses)
         beam_width = check_count("beam_width", beam_width)
         if horizon not in (1, 2, 3):

@@ -113,10 +113,12 @@ def check_hypothesis_options(expectation: str, noise: str, readings: str) -> Non
         )
 
 
-PRECISIONS = ("double", "single")
-"""Arithmetic of the hypothesised readings' weights: ``double`` (float64 throughout) or
+PRECISIONS = ("double", "single", "interpolated")
+"""Arithmetic of the hypothesised readings' weights: ``double`` (float64 throughout),
 ``single`` (float32 exp and log for one-stage tasks, float64 sums; about 1e-6 relative, see
-:mod:`dcee.planning.predicted_single`)."""
+:mod:`dcee.planning.predicted_single`) or ``interpolated`` (one-stage tasks of the paper's
+sensor family summed over nodes of the predicted concentration instead of over the particles;
+about 1e-6 relative, see :mod:`dcee.planning.interpolated_kernels`)."""
 
 
 def check_precision(precision: object) -> None:

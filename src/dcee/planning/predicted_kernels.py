@@ -22,6 +22,8 @@ from dcee.numeric import HALF_LOG_2PI, exp_scalar, log_scalar
 from dcee.planning.block_sums import BLOCK as _BLOCK
 from dcee.planning.block_sums import task_sums as _task_sums
 from dcee.planning.block_sums import weighted_columns
+from dcee.planning.interpolated_kernels import INTERPOLATION_STEP, interpolated_sums
+from dcee.planning.interpolated_kernels import applicable as interpolation_applies
 from dcee.planning.predicted_single import BOUND_SLACK_SINGLE, single_stage_sums
 from dcee.planning.reading_terms import (
     cached_log_likelihood,
@@ -319,7 +321,10 @@ def predicted_posterior_stats(
     Consecutive tasks with the same position row form a group that shares per-particle loads
     (callers list all hypotheses of one candidate sequence together). Memory: O(S · N / 512).
     ``precision="single"``: one-stage tasks without false alarms get their weights in float32
-    (:mod:`dcee.planning.predicted_single`); any other task is computed in double precision.
+    (:mod:`dcee.planning.predicted_single`); ``precision="interpolated"``: one-stage tasks of the
+    paper's sensor family are summed over nodes of the predicted concentration
+    (:mod:`dcee.planning.interpolated_kernels`, an approximation of about 1e-6 relative); any
+    other task is computed in double precision.
     """
     task_positions = np.ascontiguousarray(task_positions, dtype=np.int64)
     task_v, task_fa, task_out = (
@@ -347,16 +352,55 @@ def predicted_posterior_stats(
     several = want_moments and not one_stage
     offsets = _centred_offsets(source, center) if several else np.zeros((4, 0))
     single = precision == "single" and one_stage
-    if single:
+    sums = np.empty((s_count, _N_ACC))
+    log_ref = bound.copy()
+    exact_tasks = np.arange(s_count)
+    if precision == "interpolated" and one_stage and interpolation_applies(sp):
+        # every group whose particles span few enough nodes (dcee.planning.interpolated_kernels;
+        # loc is the concentration itself with this sensor), the others exactly, below
+        done = np.zeros(len(group_start) - 1, dtype=np.bool_)
+        interpolated_sums(
+            loc,
+            weights,
+            weighted,
+            group_start,
+            np.ascontiguousarray(task_positions[:, 0]),
+            np.ascontiguousarray(task_v[:, 0]),
+            np.ascontiguousarray(task_out[:, 0]),
+            bound,
+            sp,
+            INTERPOLATION_STEP,
+            max(64, len(weights) // 4),
+            want_kl,
+            sums,
+            log_ref,
+            done,
+        )
+        exact_tasks = np.flatnonzero(np.repeat(~done, np.diff(group_start)))
+        if len(exact_tasks) < s_count:
+            sub = np.flatnonzero(np.r_[True, np.diff(exact_tasks) != 1] | new_group[exact_tasks])
+            group_start_exact = np.append(sub, len(exact_tasks)).astype(np.int64)
+        else:
+            group_start_exact = group_start
+    else:
+        group_start_exact = group_start
+    exact_positions = np.ascontiguousarray(task_positions[exact_tasks])
+    exact_v, exact_fa, exact_out = (
+        np.ascontiguousarray(a[exact_tasks]) for a in (task_v, task_fa, task_out)
+    )
+    partial = np.empty((n_blocks, len(exact_tasks), _N_ACC))
+    if len(exact_tasks) == 0:
+        pass
+    elif single:
         single_stage_sums(
             (loc, log_nd, inv_sigma, det_offset),
             weights,
             weighted,
-            group_start,
-            task_positions,
-            task_v,
-            task_out,
-            bound,
+            group_start_exact,
+            exact_positions,
+            exact_v,
+            exact_out,
+            bound[exact_tasks],
             sp,
             want_moments,
             want_kl,
@@ -371,19 +415,18 @@ def predicted_posterior_stats(
             offsets,
             weights,
             weighted,
-            group_start,
-            task_positions,
-            task_v,
-            task_fa,
-            task_out,
-            bound,
+            group_start_exact,
+            exact_positions,
+            exact_v,
+            exact_fa,
+            exact_out,
+            bound[exact_tasks],
             sp,
             want_moments,
             want_kl,
             partial,
         )
-    sums = partial.sum(axis=0)  # fixed order over blocks: independent of the thread count
-    log_ref = bound.copy()
+    sums[exact_tasks] = partial.sum(axis=0)  # fixed order over blocks: thread count free
     # Σ e_i ll_i was accumulated with e relative to the bound; a task is redone exactly when its
     # largest weight e^(ll_max − bound) is too small for the one-pass sums to be accurate.
     with np.errstate(divide="ignore"):

@@ -201,6 +201,8 @@ class TreeSearchPlanner(Planner):
                 f"{cost_options['precision']!r} applies to one-reading predictions; the tree "
                 f"scores sequences of depth={self.depth} readings in double precision",
             )
+        # the tree's sequences are computed exactly unless a precision is asked for (depth 1)
+        cost_options = {"precision": "double", **cost_options}
         self.cost: HypothesisPlanner = get(  # type: ignore[assignment]
             cost, subsample=subsample, n_hypotheses=n_hypotheses, **cost_options
         )
