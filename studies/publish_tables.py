@@ -793,10 +793,11 @@ def speed_table() -> str:
     ]
     work_rows = (
         ("dcee-decision-20k", "floor", "a paper-scale `dcee` decision (20,000 particles, 8 moves "
-         "× 40 readings) vs the plain compiled loop of the same arithmetic", "≤ 1.5×"),
+         "× 40 readings) vs the plain compiled loop computing the same statistics exactly",
+         "≤ 1.5×"),
         ("infotaxis-decision-20k", "floor", "the same for `infotaxis`", "≤ 1.5×"),
         ("dcee-mcts-decision-20k", "dcee-cl-decision", "a `dcee-mcts` decision vs a `dcee-cl` "
-         "decision, 20,000 particles, in alternation", "≤ 3×"),
+         "decision computed exactly, 20,000 particles, in alternation", "≤ 3×"),
         ("resample-mcmc-500-readings-20k", "filter-update", "resample + MCMC move over 500 "
          "readings vs one filter update, 20,000 particles", "≤ 76×"),
     )  # fmt: skip
@@ -804,14 +805,20 @@ def speed_table() -> str:
         w = by_name[name]
         ratio = w["ratio_to"][reference]
         rows.append([label, f"{ratio:.2f}×", f"{w['median']:.3g} ms", target, _timed(work)])
-    if "dcee-cl-single-decision-20k" in by_name:  # runs stored before issue 46's option lack it
-        single = by_name["dcee-cl-single-decision-20k"]
+    # issue 46: the default (interpolated sums) and precision=single against the exact decision
+    for name, label in (
+        ("dcee-cl-decision-20k", "the default (`precision=interpolated`)"),
+        ("dcee-cl-single-decision-20k", "`precision=single`"),
+    ):
+        w = by_name[name]
+        if "dcee-cl-double-decision" not in w["ratio_to"]:
+            continue  # runs stored before the interpolated sums
         rows.append(
             [
-                "a paper-scale `dcee-cl` decision with `precision=single` vs the same in double "
-                "precision, in alternation",
-                f"{single['ratio_to']['dcee-cl-decision']:.2f}×",
-                f"{single['median']:.3g} ms",
+                f"a paper-scale `dcee-cl` decision with {label} vs the same computed exactly in "
+                "double precision, in alternation",
+                f"{w['ratio_to']['dcee-cl-double-decision']:.2f}×",
+                f"{w['median']:.3g} ms",
                 "—",
                 _timed(work),
             ]
@@ -868,12 +875,18 @@ def kernel_speedup_table(name: str = "kernel-speedup") -> str:
     )
 
 
-def precision_single_table() -> str:
+def precision_single_table(
+    name: str = "precision-single",
+    double: str = "dcee-cl",
+    single: str = "dcee-cl:precision=single",
+    label: str = "single",
+) -> str:
     """`dcee-cl` in single and double precision on the public study's 120 searches, paired
-    (bash studies/run.sh precision-single; docs/results/precision-single)."""
-    metrics, pairs = study("precision-single"), paired("precision-single")
-    searches = pd.read_csv(RESULTS / "precision-single" / "searches.csv")
-    double, single = "dcee-cl", "dcee-cl:precision=single"
+    (bash studies/run.sh precision-single; docs/results/precision-single); with the other
+    arguments the interpolated sums against exact double precision
+    (docs/results/precision-interpolated)."""
+    metrics, pairs = study(name), paired(name)
+    searches = pd.read_csv(RESULTS / name / "searches.csv")
     ms = {k: 1e3 * g["decision_seconds_mean"] for k, g in searches.groupby("strategy")}
     rows = []
     for strategy in (double, single):
@@ -906,7 +919,7 @@ def precision_single_table() -> str:
         time_cell = "—"
     rows.append(
         [
-            f"paired, single − double ({same}/{len(final)} searches end at the same final RMSE "
+            f"paired, {label} − double ({same}/{len(final)} searches end at the same final RMSE "
             "to 1e-9 m)",
             f"{int(p['acquired_variant_only'])} / {int(p['acquired_reference_only'])} acquired "
             f"only by one (McNemar p = {p['mcnemar_p']:.2g})",
@@ -923,10 +936,12 @@ def precision_single_table() -> str:
     )  # fmt: skip
 
 
-def agreement_single_table() -> str:
+def agreement_single_table(name: str = "agreement-single", whole: str | None = None) -> str:
     """Decisions with ``precision=single`` against today's double-precision full computation,
-    per planner (studies/decision_agreement.py, docs/results/perf/agreement-single.json)."""
-    record = _perf("agreement-single")
+    per planner (studies/decision_agreement.py, docs/results/perf/agreement-single.json); with
+    ``name="agreement-interpolated"`` the interpolated sums, and the whole searches of
+    ``whole`` (the same check over every decision of longer searches) in a last row."""
+    record = _perf(name)
     settings = record["settings"]
     rows = []
     for strategy in settings["strategies"]:
@@ -952,8 +967,21 @@ def agreement_single_table() -> str:
             f"`{commit}`",
         ]
     )
+    if whole is not None and (RESULTS / "perf" / f"{whole}.json").exists():
+        full = _perf(whole)
+        fs = full["settings"]
+        rows.append(
+            [
+                f"whole searches: `{'`, `'.join(fs['strategies'])}`, {', '.join(fs['configs'])}, "
+                f"seed 0, up to {fs['steps']} decisions each",
+                f"**{full['same_choice']}/{full['decisions']}** "
+                f"({100 * full['same_choice'] / full['decisions']:.1f} %)",
+                f"{full['max_cost_diff_over_spread']:.0e}",
+            ]
+        )
     return table(
-        ["planner", "same choice as double precision", "largest cost difference / spread"], rows
+        ["planner", "same choice as exact double precision", "largest cost difference / spread"],
+        rows,
     )
 
 
@@ -978,6 +1006,15 @@ TABLES: dict[str, Callable[[], str]] = {
     "kernel-speedup-blas": lambda: kernel_speedup_table("kernel-speedup-blas"),
     "agreement-single": agreement_single_table,
     "precision-single": precision_single_table,
+    "agreement-interpolated": lambda: agreement_single_table(
+        "agreement-interpolated", "agreement-interpolated-full"
+    ),
+    "precision-interpolated": lambda: precision_single_table(
+        "precision-interpolated",
+        "dcee-cl:precision=double",
+        "dcee-cl:precision=interpolated",
+        "interpolated",
+    ),
 }
 
 

@@ -451,9 +451,26 @@ case "${1:---list}" in
     $P studies/ablation_table.py results/precision-single=dcee-cl \
       results/precision-single=dcee-cl:precision=single --csv docs/results/precision-single/paired.csv
     $P studies/publish_tables.py ;;
-  agreement)  # decisions with precision=single against today's double precision (20,000 particles)
+  agreement)  # decisions with precision=single and interpolated against exact double (20,000 particles)
     $P studies/decision_agreement.py --precision single \
       --strategies dcee,infotaxis,entrotaxis,dcee-cl --json docs/results/perf/agreement-single.json
+    $P studies/decision_agreement.py --precision interpolated \
+      --strategies dcee,infotaxis,entrotaxis,dcee-cl \
+      --json docs/results/perf/agreement-interpolated.json
+    # every decision of the demo's whole search (and of paper:5 and paper:12), not only the first 40
+    $P studies/decision_agreement.py --precision interpolated --strategies dcee-cl --seeds 1 \
+      --steps 450 --json docs/results/perf/agreement-interpolated-full.json
+    $P studies/publish_tables.py ;;
+  precision-interpolated)  # dcee-cl with interpolated sums beside exact double: the public study's 120 searches, paired
+    $D bench --suite paper --repeats 10 \
+      --strategies dcee-cl:precision=double,dcee-cl:precision=interpolated \
+      --workers "${WORKERS:-2}" --out results/precision-interpolated
+    report precision-interpolated
+    $P studies/collect_metrics.py --out docs/results/precision-interpolated results/precision-interpolated
+    rm -f docs/results/precision-interpolated/paired.csv  # ablation_table appends
+    $P studies/ablation_table.py results/precision-interpolated=dcee-cl:precision=double \
+      results/precision-interpolated=dcee-cl:precision=interpolated \
+      --csv docs/results/precision-interpolated/paired.csv
     $P studies/publish_tables.py ;;
   --list)
     sed -n 's/^  \([a-z-]*\)) *# \(.*\)/\1\t\2/p' "$0" ;;

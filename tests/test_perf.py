@@ -39,8 +39,15 @@ def test_perf_quick_writes_every_standard_workload(tmp_path, capsys):
     cl = by_name["dcee-cl-decision-20k"]
     ratio = cl["median_ms"] / by_name["dcee-decision-20k"]["median_ms"]
     assert cl["note"] == f"{ratio:.2f}× the dcee decision in this run"
-    single = by_name["dcee-cl-single-decision-20k"]  # issue 46: precision=single, same run
-    assert single["ratio_to"]["dcee-cl-decision"] == single["median_ms"] / cl["median_ms"]
+    # issue 46: the default (interpolated sums) and precision=single against the exact
+    # double-precision decision, and the tree search against that exact decision, same run
+    double = by_name["dcee-cl-double-decision-20k"]
+    for name in ("dcee-cl-decision-20k", "dcee-cl-single-decision-20k"):
+        w = by_name[name]
+        assert w["ratio_to"]["dcee-cl-double-decision"] == w["median_ms"] / double["median_ms"]
+    tree = by_name["dcee-mcts-decision-20k"]
+    assert tree["ratio_target"] == ["dcee-cl-decision", 3.0]
+    assert tree["ratio_to"]["dcee-cl-decision"] == tree["median_ms"] / double["median_ms"]
     # issue 17: decisions as ratios to the plain compiled loop and the NumPy reference, and the
     # move as a ratio to the update, each from medians timed in the same run
     floor, numpy_ref = by_name["floor-decision-20k"], by_name["numpy-decision-20k"]

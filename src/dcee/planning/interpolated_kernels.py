@@ -82,7 +82,7 @@ def _spread_columns(
         if weights[i] <= 0.0:
             continue
         t = (u[i] - u0) / step
-        m = int(t)
+        m = min(max(int(t), 1), g.shape[0] - 3)  # in range whatever the rounding
         f = t - m
         fm1 = f - 1.0
         fm2 = f - 2.0
@@ -179,10 +179,11 @@ def interpolated_sums(
             if weights[i] > 0.0:
                 u_min = min(u_min, u[i])
                 u_max = max(u_max, u[i])
-        nodes = int((u_max - u_min) / step) + 4
-        if not nodes <= max_nodes:
+        span = (u_max - u_min) / step
+        if not span <= max_nodes - 5:  # also False for a NaN span
             done[g] = False
             continue
+        nodes = int(span) + 5  # one spare node: rounding may put the last stencil one higher
         done[g] = True
         u0 = u_min - step  # every live particle has a node below it and two above
         g_cols = np.zeros((nodes, 5))
