@@ -924,7 +924,12 @@ def precision_single_table(
             f"{int(p['acquired_variant_only'])} / {int(p['acquired_reference_only'])} acquired "
             f"only by one (McNemar p = {p['mcnemar_p']:.2g})",
             "",
-            f"{p['final_rmse_difference']:+.3f} m (Wilcoxon p = {p['rmse_wilcoxon_p']:.2g})",
+            f"{p['final_rmse_difference']:+.3f} m "
+            + (
+                "(equal in every pair)"
+                if math.isnan(p["rmse_wilcoxon_p"])  # no nonzero difference for a test to use
+                else f"(Wilcoxon p = {p['rmse_wilcoxon_p']:.2g})"
+            ),
             time_cell,
             f"{ratio:.2f}× per search (median of {len(both)} pairs)",
         ]
