@@ -25,7 +25,7 @@ def _late_case(n=4000, seed=11, spread=0.5):
     return conc, source, weights
 
 
-def _tasks(conc, rng, hypotheses=9):
+def _tasks(conc, rng, hypotheses=20):
     """Per position: one non-detection and readings drawn around the particles' predictions,
     with one reading no particle explains (the outlier component's, or a task redone)."""
     task_pos = np.repeat(np.arange(conc.shape[0])[:, None], hypotheses, axis=0)
@@ -75,8 +75,9 @@ def test_interpolated_sums_converge_as_the_fourth_power_of_the_node_spacing(monk
 
 
 def test_interpolation_is_exact_where_it_does_not_apply():
-    """Other sensor families, several stages, and a position whose particles' concentrations
-    span too many nodes (an early, wide belief) are computed exactly: bit for bit."""
+    """Other sensor families, several stages, a position with few readings (the spread onto
+    the nodes would not pay) and a position whose particles' concentrations span too many nodes
+    (an early, wide belief) are computed exactly: bit for bit."""
     conc, source, weights = _late_case()
     rng = np.random.default_rng(3)
     wide = conc.copy()
@@ -84,7 +85,8 @@ def test_interpolation_is_exact_where_it_does_not_apply():
     cases = (
         (conc, np.repeat([[0, 1, 2]], 6, axis=0), Sensor(outlier=0.01)),
         (conc, np.repeat([[0], [1]], 4, axis=0), Sensor(family="lognormal", pd=0.6, outlier=0.01)),
-        (wide, np.repeat([[1]], 5, axis=0), Sensor(outlier=0.01)),
+        (wide, np.repeat([[1]], 20, axis=0), Sensor(outlier=0.01)),
+        (conc, np.repeat([[0], [1]], 9, axis=0), Sensor(outlier=0.01)),
     )
     for c, task_pos, sensor in cases:
         task_z = np.where(

@@ -22,7 +22,11 @@ from dcee.numeric import HALF_LOG_2PI, exp_scalar, log_scalar
 from dcee.planning.block_sums import BLOCK as _BLOCK
 from dcee.planning.block_sums import task_sums as _task_sums
 from dcee.planning.block_sums import weighted_columns
-from dcee.planning.interpolated_kernels import INTERPOLATION_STEP, interpolated_sums
+from dcee.planning.interpolated_kernels import (
+    INTERPOLATION_STEP,
+    MIN_READINGS,
+    interpolated_sums,
+)
 from dcee.planning.interpolated_kernels import applicable as interpolation_applies
 from dcee.planning.predicted_single import BOUND_SLACK_SINGLE, single_stage_sums
 from dcee.planning.reading_terms import (
@@ -371,6 +375,7 @@ def predicted_posterior_stats(
             sp,
             INTERPOLATION_STEP,
             max(64, len(weights) // 4),
+            MIN_READINGS,
             want_kl,
             sums,
             log_ref,
