@@ -135,3 +135,41 @@ def test_interpolated_decisions_agree_with_the_exact_ones():
     assert a.precision == "interpolated" and a.decisions == 12
     assert a.same_choice == a.decisions
     assert a.max_cost_diff_over_spread < 1e-4
+
+
+@pytest.mark.parametrize(
+    "sensor", [Sensor.paper_exact(), Sensor(outlier=0.01)], ids=["paper", "gauss+out"]
+)
+def test_node_terms_are_the_position_rows_formulas_bit_for_bit(sensor):
+    """The interpolation evaluates the likelihood terms at its nodes with gaussian_terms; a
+    particle at a node's concentration must get the very same terms from position_rows (one
+    formula, not two that drift apart)."""
+    from dcee.estimation.priors import Gamma, SourcePrior, Uniform
+    from dcee.planning.interpolated_kernels import gaussian_terms
+    from dcee.planning.position_kernels import plume_constants, position_rows
+
+    prior = SourcePrior.from_dict(
+        {
+            "x": Uniform(0, 50),
+            "y": Uniform(0, 50),
+            "z": Uniform(0, 5),
+            "q": Gamma(2, 5),
+            "u": Uniform(0, 6),
+            "phi": Uniform(0, 2 * np.pi),
+            "zeta1": Uniform(0.2, 2),
+            "zeta2": Uniform(6, 10),
+        }
+    )
+    theta = np.ascontiguousarray(prior.sample(np.random.default_rng(2), 2000))
+    constants = np.empty((10, len(theta)))
+    plume_constants(theta, constants)
+    out = [np.empty((1, len(theta))) for _ in range(6)]
+    position_rows(constants, np.array([[20.0, 15.0, 1.0]]), np.array([0]), 1e-3, 0.0, 1.0,
+                  sensor.params, *out)  # fmt: skip
+    conc, _, loc, log_nd, inv_sigma, det_offset = (a[0] for a in out)
+    assert np.array_equal(loc, conc)  # the location is the concentration itself
+    terms = np.array([gaussian_terms(c, sensor.params) for c in conc])
+    assert (conc < sensor.params.c_lin).any() and (conc > 1e-3).any()  # both branches
+    np.testing.assert_array_equal(terms[:, 0], log_nd)
+    np.testing.assert_array_equal(terms[:, 1], inv_sigma)
+    np.testing.assert_array_equal(terms[:, 2], det_offset)

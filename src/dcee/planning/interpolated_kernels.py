@@ -57,12 +57,13 @@ against 21-22 ms (docs/performance.md)."""
 def gaussian_terms(c: float, sp: SensorParams) -> tuple[float, float, float]:
     """(log P(non-detection | c), 1/σ(c), log Pd − log σ(c)) of the paper's sensor (Gaussian
     family, constant Pd < 1) at concentration c; the transformed location is c itself. The
-    formulas of :func:`dcee.planning.position_kernels.position_rows`' vectorised path."""
+    formulas of :func:`dcee.planning.position_kernels.position_rows`' vectorised path, in the
+    same order (a test holds the two equal bit for bit)."""
     sigma = sp.sigma_frac * c + sp.sigma_min
     inv_s = 1.0 / sigma
     missed = vlog1m(sp.pd * vndtr_upper((sp.v_threshold - c) * inv_s))  # log(1 − Pd Φ(−x))
     lin = sp.lin0 + sp.lin1 * c
-    log_nd = (lin if c < sp.c_lin else missed) + sp.log_not_false_alarm + sp.log_keep
+    log_nd = (lin if c < sp.c_lin else missed) + (sp.log_not_false_alarm + sp.log_keep)
     return log_nd, inv_s, sp.log_pd - log_scalar(sigma)
 
 
