@@ -60,7 +60,7 @@ def test_interpolated_stats_match_the_reference(sensor):
 def test_interpolated_sums_converge_as_the_fourth_power_of_the_node_spacing(monkeypatch):
     """Cubic interpolation: halving the spacing divides the error by about 16 (a limiting case
     that a wrong stencil or node placement fails)."""
-    import dcee.planning.predicted_kernels as kernels
+    import dcee.planning.interpolated_kernels as kernels
 
     conc, source, weights = _late_case(spread=0.3)
     task_pos, task_z = _tasks(conc, np.random.default_rng(6))

@@ -398,8 +398,7 @@ def run_workloads(quick: bool = False, progress: Callable[[str], None] | None = 
     # issue 13's bound: a closed-loop decision costs at most 2× an open-loop one, same run
     cl, op = by_name["dcee-cl-decision-20k"], by_name["dcee-decision-20k"]
     cl.note = f"{cl.median / op.median:.2f}× the dcee decision in this run"
-    # issue 46: the default (sums interpolated over the concentration) and the single-precision
-    # weights against the same decision computed exactly in double precision
+    # issue 46: the default (interpolated sums) and float32 weights against the exact decision
     double = by_name["dcee-cl-double-decision-20k"]
     for name in ("dcee-cl-decision-20k", "dcee-cl-single-decision-20k"):
         t = by_name[name]
@@ -408,10 +407,8 @@ def run_workloads(quick: bool = False, progress: Callable[[str], None] | None = 
         t.note = f"{t.note}; {exact}" if t.note else exact
     cl, op = by_name["dcee-cl-decision-20k-stall"], by_name["dcee-decision-20k-stall"]
     cl.note = f"{cl.median / op.median:.2f}× the dcee decision at the stall in this run"
-    # issue 28: the tree search's default budget keeps a search under 3× a dcee-cl search; its
-    # decision (which dominates a search) is judged against a dcee-cl decision, same run, both
-    # computed exactly (the tree scores sequences of several readings, which are not
-    # interpolated: against the interpolated default the bound would measure the interpolation)
+    # issue 28: the tree search's decision (which dominates a search) is judged against a dcee-cl
+    # decision, same run, both exact (the tree's sequences of readings are not interpolated)
     for where in ("", "-stall"):
         tree, cl = (
             by_name[f"dcee-mcts-decision-20k{where}"],

@@ -231,3 +231,50 @@ def interpolated_sums(
             for c in range(5):
                 sums[s, c] = st[c, j]
             sums[s, 5] = kl[j] + log_ref[s] * st[0, j] if want_kl else 0.0
+
+
+def interpolate_groups(
+    conc: np.ndarray,
+    weights: np.ndarray,
+    weighted: np.ndarray,
+    group_start: np.ndarray,
+    task_positions: np.ndarray,
+    task_v: np.ndarray,
+    task_out: np.ndarray,
+    bound: np.ndarray,
+    sp: SensorParams,
+    want_kl: bool,
+    sums: np.ndarray,
+    log_ref: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`interpolated_sums` of every group of one-stage tasks it takes, into sums (S, 6)
+    and log_ref (S,); returns the tasks left for the exact kernel (indices into the S tasks)
+    and their groups' starts among them. Arguments as :func:`interpolated_sums`;
+    task_positions, task_v, task_out (S, 1)."""
+    s_count = len(task_positions)
+    done = np.zeros(len(group_start) - 1, dtype=np.bool_)
+    interpolated_sums(
+        conc,
+        weights,
+        weighted,
+        group_start,
+        np.ascontiguousarray(task_positions[:, 0]),
+        np.ascontiguousarray(task_v[:, 0]),
+        np.ascontiguousarray(task_out[:, 0]),
+        bound,
+        sp,
+        INTERPOLATION_STEP,
+        max(64, len(weights) // 4),
+        MIN_READINGS,
+        want_kl,
+        sums,
+        log_ref,
+        done,
+    )
+    exact = np.flatnonzero(np.repeat(~done, np.diff(group_start)))
+    if len(exact) == s_count:
+        return exact, group_start
+    first = np.zeros(s_count, dtype=bool)
+    first[group_start[:-1]] = True  # each group's first task
+    starts = np.flatnonzero(first[exact])  # whole groups are left: their firsts start them
+    return exact, np.append(starts, len(exact)).astype(np.int64)

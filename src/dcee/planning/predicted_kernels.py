@@ -22,12 +22,8 @@ from dcee.numeric import HALF_LOG_2PI, exp_scalar, log_scalar
 from dcee.planning.block_sums import BLOCK as _BLOCK
 from dcee.planning.block_sums import task_sums as _task_sums
 from dcee.planning.block_sums import weighted_columns
-from dcee.planning.interpolated_kernels import (
-    INTERPOLATION_STEP,
-    MIN_READINGS,
-    interpolated_sums,
-)
 from dcee.planning.interpolated_kernels import applicable as interpolation_applies
+from dcee.planning.interpolated_kernels import interpolate_groups
 from dcee.planning.predicted_single import BOUND_SLACK_SINGLE, single_stage_sums
 from dcee.planning.reading_terms import (
     cached_log_likelihood,
@@ -358,37 +354,13 @@ def predicted_posterior_stats(
     single = precision == "single" and one_stage
     sums = np.empty((s_count, _N_ACC))
     log_ref = bound.copy()
-    exact_tasks = np.arange(s_count)
+    exact_tasks, group_start_exact = np.arange(s_count), group_start
     if precision == "interpolated" and one_stage and interpolation_applies(sp):
-        # every group whose particles span few enough nodes (dcee.planning.interpolated_kernels;
-        # loc is the concentration itself with this sensor), the others exactly, below
-        done = np.zeros(len(group_start) - 1, dtype=np.bool_)
-        interpolated_sums(
-            loc,
-            weights,
-            weighted,
-            group_start,
-            np.ascontiguousarray(task_positions[:, 0]),
-            np.ascontiguousarray(task_v[:, 0]),
-            np.ascontiguousarray(task_out[:, 0]),
-            bound,
-            sp,
-            INTERPOLATION_STEP,
-            max(64, len(weights) // 4),
-            MIN_READINGS,
-            want_kl,
-            sums,
-            log_ref,
-            done,
-        )
-        exact_tasks = np.flatnonzero(np.repeat(~done, np.diff(group_start)))
-        if len(exact_tasks) < s_count:
-            sub = np.flatnonzero(np.r_[True, np.diff(exact_tasks) != 1] | new_group[exact_tasks])
-            group_start_exact = np.append(sub, len(exact_tasks)).astype(np.int64)
-        else:
-            group_start_exact = group_start
-    else:
-        group_start_exact = group_start
+        # the groups it takes are summed over nodes (loc is C itself with this sensor)
+        exact_tasks, group_start_exact = interpolate_groups(
+            loc, weights, weighted, group_start, task_positions, task_v, task_out, bound, sp,
+            want_kl, sums, log_ref,
+        )  # fmt: skip
     exact_positions = np.ascontiguousarray(task_positions[exact_tasks])
     exact_v, exact_fa, exact_out = (
         np.ascontiguousarray(a[exact_tasks]) for a in (task_v, task_fa, task_out)
