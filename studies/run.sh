@@ -438,6 +438,7 @@ case "${1:---list}" in
     $D perf --compare-stonesoup --decisions 20 --json docs/results/perf/stonesoup-ste.json
     $P studies/kernel_speedup.py --before f52a5b6 --json docs/results/perf/kernel-speedup.json
     $P studies/kernel_speedup.py --before cae7e4f --json docs/results/perf/kernel-speedup-blas.json
+    $P studies/demo_decision.py --before cae7e4f --json docs/results/perf/demo-decision.json
     rm -rf results/perf-stonesoup-mcts  # every seed timed in this run
     $P studies/stonesoup_mcts_study.py results/perf-stonesoup-mcts --seeds "${MCTS_SEEDS:-3}" \
       --json docs/results/perf/stonesoup-mcts.json
