@@ -53,6 +53,9 @@ def main(argv: list[str] | None = None) -> int:
             "demo_decision: error: taskset (util-linux) is needed to pin one core", file=sys.stderr
         )
         return 2
+    if args.json is not None and not args.json.parent.is_dir():
+        print(f"demo_decision: error: --json: no folder {args.json.parent}", file=sys.stderr)
+        return 2
     if args.rounds < 1:
         print(f"demo_decision: error: --rounds must be ≥ 1, got {args.rounds}", file=sys.stderr)
         return 2

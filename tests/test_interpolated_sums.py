@@ -8,7 +8,7 @@ import pytest
 from dcee.models import Sensor
 from dcee.planning import get as get_planner
 from dcee.planning.predicted_reference import predicted_posterior_stats_reference
-from tests.helpers import compiled_predicted_stats
+from tests.helpers import compiled_predicted_stats, random_theta
 
 
 def _late_case(n=4000, seed=11, spread=0.5):
@@ -144,23 +144,10 @@ def test_node_terms_are_the_position_rows_formulas_bit_for_bit(sensor):
     """The interpolation evaluates the likelihood terms at its nodes with gaussian_terms; a
     particle at a node's concentration must get the very same terms from position_rows (one
     formula, not two that drift apart)."""
-    from dcee.estimation.priors import Gamma, SourcePrior, Uniform
     from dcee.planning.interpolated_kernels import gaussian_terms
     from dcee.planning.position_kernels import plume_constants, position_rows
 
-    prior = SourcePrior.from_dict(
-        {
-            "x": Uniform(0, 50),
-            "y": Uniform(0, 50),
-            "z": Uniform(0, 5),
-            "q": Gamma(2, 5),
-            "u": Uniform(0, 6),
-            "phi": Uniform(0, 2 * np.pi),
-            "zeta1": Uniform(0.2, 2),
-            "zeta2": Uniform(6, 10),
-        }
-    )
-    theta = np.ascontiguousarray(prior.sample(np.random.default_rng(2), 2000))
+    theta = np.ascontiguousarray(random_theta(2000, np.random.default_rng(2)))
     constants = np.empty((10, len(theta)))
     plume_constants(theta, constants)
     out = [np.empty((1, len(theta))) for _ in range(6)]

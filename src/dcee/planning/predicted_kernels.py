@@ -323,7 +323,7 @@ def predicted_posterior_stats(
     ``precision="single"``: one-stage tasks without false alarms get their weights in float32
     (:mod:`dcee.planning.predicted_single`); ``precision="interpolated"``: one-stage tasks of the
     paper's sensor family are summed over nodes of the predicted concentration
-    (:mod:`dcee.planning.interpolated_kernels`, an approximation of about 1e-6 relative); any
+    (:mod:`dcee.planning.interpolated_kernels`, an approximation within about 1e-8); any
     other task is computed in double precision.
     """
     task_positions = np.ascontiguousarray(task_positions, dtype=np.int64)
@@ -341,7 +341,6 @@ def predicted_posterior_stats(
     bound = np.empty(s_count)
     task_bounds(task_positions, task_v, task_fa, task_out, max_log_nd, max_det_offset, sp, bound)
     n_blocks = (source.shape[0] + _BLOCK - 1) // _BLOCK
-    partial = np.empty((n_blocks, s_count, _N_ACC))
     common = (loc, log_nd, inv_sigma, det_offset, source, weights, center)
     one_stage = task_positions.shape[1] == 1 and sp.false_alarm == 0.0
     # the one-stage kernels' sums read w, w·dx, w·dy, w·dz, w·|d|² per particle, the kernel of
@@ -367,7 +366,7 @@ def predicted_posterior_stats(
     )
     partial = np.empty((n_blocks, len(exact_tasks), _N_ACC))
     if len(exact_tasks) == 0:
-        pass
+        pass  # every task interpolated
     elif single:
         single_stage_sums(
             (loc, log_nd, inv_sigma, det_offset),
