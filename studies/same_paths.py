@@ -6,6 +6,9 @@ PYTHONPATH and compare the two files (issue 46: a kernel change must not change 
     PYTHONPATH=src .venv/bin/python studies/same_paths.py after.json
     PYTHONPATH=/path/to/old/worktree/src .venv/bin/python studies/same_paths.py before.json
     cmp before.json after.json
+
+A second argument names other strategies, comma-separated (``dcee-ms,dcee-mcts``: the
+kernels of several stages; fewer decisions there, ``--decisions``-free: 100 each).
 """
 
 import hashlib
@@ -18,16 +21,22 @@ from dcee.planning import get as get_planner
 from dcee.runs import SearchSimulation, planner_defaults
 from dcee.scenarios import load_scenario
 
+ONE_STEP = ("dcee", "dcee-cl", "infotaxis", "entrotaxis")
 
-def main(path: str) -> int:
+
+def main(path: str, strategies: tuple[str, ...] = ONE_STEP) -> int:
+    if not path.endswith(".json"):
+        print("same_paths.py: the output must be a .json file, e.g. after.json", file=sys.stderr)
+        return 2
+    decisions = 200 if strategies == ONE_STEP else 100
     out = {}
     for config in ("paper:1", "paper:5", "paper:12"):
-        for strategy in ("dcee", "dcee-cl", "infotaxis", "entrotaxis"):
+        for strategy in strategies:
             sc = load_scenario(config).with_overrides(**{"search.particles": 10000})
             planner = get_planner(strategy, **planner_defaults(strategy, sc, None))
             sim = SearchSimulation(sc, 0, planner)
             positions = []
-            for _ in range(200):
+            for _ in range(decisions):
                 sim.sense()
                 if sim.finished:
                     break
@@ -44,4 +53,4 @@ def main(path: str) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1]))
+    sys.exit(main(sys.argv[1], *([tuple(sys.argv[2].split(","))] if len(sys.argv) > 2 else [])))

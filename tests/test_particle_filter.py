@@ -351,3 +351,42 @@ def test_both_estimators_implement_the_estimator_interface_and_resample_on_deman
     assert lone.reading_model() is None
     choice = bank.reading_model()
     assert choice.name in ("a", "b") and 0.0 < choice.probability <= 1.0
+
+
+def test_compiled_summaries_match_numpy_and_a_hand_calculation():
+    """weighted_moments is np.cov(aweights, ddof=0) and the weighted mean; weighted_rmse the
+    einsum form; reweighted the log evidence and ESS of the NumPy/SciPy formulas; and two
+    points with weights 1 and 3 give the hand values."""
+    from scipy.special import logsumexp
+
+    from dcee.estimation.resampling import effective_sample_size, reweighted
+    from dcee.estimation.summaries import weighted_moments, weighted_rmse
+
+    mean, cov = weighted_moments(np.array([[0.0, 0.0, 0.0], [4.0, 0.0, 2.0]]), np.array([1, 3.0]))
+    np.testing.assert_allclose(mean, [3.0, 0.0, 1.5])
+    # Var x = (1·9 + 3·1) / 4 = 3, Var z = (1·2.25 + 3·0.25) / 4 = 0.75, Cov xz = 1.5
+    np.testing.assert_allclose(cov, [[3.0, 0, 1.5], [0, 0, 0], [1.5, 0, 0.75]])
+    rng = np.random.default_rng(4)
+    points = rng.normal(size=(5000, 3)) * [1.0, 2.0, 0.3] + [10.0, -4.0, 1.0]
+    w = rng.random(5000)
+    w /= w.sum()
+    mean, cov = weighted_moments(points, w)
+    np.testing.assert_allclose(mean, w @ points, rtol=1e-13)
+    np.testing.assert_allclose(cov, np.cov(points, rowvar=False, aweights=w, ddof=0), rtol=1e-12)
+    wide = np.column_stack([points, rng.normal(size=(5000, 2))])  # the general (not 3-column) loop
+    mean5, cov5 = weighted_moments(wide, w)
+    np.testing.assert_allclose(mean5, w @ wide, rtol=1e-13)
+    np.testing.assert_allclose(cov5, np.cov(wide, rowvar=False, aweights=w, ddof=0), atol=1e-13)
+    truth = np.array([9.0, -3.0, 1.2])
+    d = points - truth
+    assert weighted_rmse(points, w, truth) == pytest.approx(
+        np.sqrt(w @ np.einsum("ij,ij->i", d, d)), rel=1e-13
+    )
+    logw = np.log(w) + 3.0
+    logw[7] = -np.inf  # a dead particle
+    ll = rng.normal(size=5000) * 4.0
+    new, log_ev, ess = reweighted(logw, ll)
+    np.testing.assert_array_equal(new, logw + ll)
+    assert log_ev == pytest.approx(logsumexp(logw + ll) - logsumexp(logw), rel=1e-12)
+    scaled = np.exp(new - new.max())
+    assert ess == pytest.approx(effective_sample_size(scaled / scaled.sum()), rel=1e-12)

@@ -17,12 +17,17 @@ from contextlib import contextmanager
 from typing import Any
 
 _controller: Any = None
+_whole_process = False  # set by limit_process_blas: nothing left to limit per block
 
 
 @contextmanager
 def one_blas_thread() -> Iterator[None]:
     """Limit BLAS libraries loaded in this process to one thread inside the block."""
     global _controller
+    if _whole_process:
+        # threadpoolctl's limit and restore cost 0.1 ms per block, twice per step of a search
+        yield
+        return
     if _controller is None:
         from threadpoolctl import ThreadpoolController
 
@@ -35,4 +40,6 @@ def limit_process_blas() -> None:
     """One BLAS thread for the rest of this process (campaign workers: one search per core)."""
     from threadpoolctl import threadpool_limits
 
+    global _whole_process
     threadpool_limits(limits=1, user_api="blas")
+    _whole_process = True

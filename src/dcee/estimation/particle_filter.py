@@ -32,7 +32,6 @@ import math
 from typing import Any
 
 import numpy as np
-from scipy.special import logsumexp
 
 from dcee.errors import DceeInputError
 from dcee.estimation.base import ReadingModelChoice, UpdateInfo
@@ -41,8 +40,9 @@ from dcee.estimation.priors import SourcePrior
 from dcee.estimation.resample_move import ResampleMove
 from dcee.estimation.resampling import (
     effective_sample_size,
+    reweighted,
 )
-from dcee.estimation.summaries import in_credible_ellipsoid, weighted_rmse
+from dcee.estimation.summaries import in_credible_ellipsoid, weighted_moments, weighted_rmse
 from dcee.models.anemometer import PHI_COLUMN, U_COLUMN, Anemometer, WindEvidence
 from dcee.models.plume import IsotropicPlume
 from dcee.models.sensor import Sensor
@@ -190,7 +190,7 @@ class ParticleFilter(ResampleMove):
 
     def cov(self) -> np.ndarray:
         """(D, D) posterior covariance of the unknown parameters."""
-        return np.atleast_2d(np.cov(self.particles, rowvar=False, aweights=self.weights, ddof=0))
+        return weighted_moments(self.particles, self.weights)[1]
 
     def source_mean(self) -> np.ndarray:
         """(3,) posterior mean source location."""
@@ -198,7 +198,7 @@ class ParticleFilter(ResampleMove):
 
     def source_cov(self) -> np.ndarray:
         """(3, 3) posterior covariance of the source location."""
-        return np.cov(self.source_locations, rowvar=False, aweights=self.weights, ddof=0)
+        return weighted_moments(self.source_locations, self.weights)[1]
 
     def rmse(self, true_location: np.ndarray) -> float:
         """√(Σ wᵢ ‖sᵢ − s‖²): RMSE of the particles' source locations about ``true_location``."""
@@ -344,12 +344,8 @@ class ParticleFilter(ResampleMove):
         """The log weights after a reading of per-particle log-likelihood ``ll`` (N,), the
         reading's log evidence log Σ wᵢ p(z|Θᵢ) (wᵢ the normalised weights before it) and the
         effective sample size after it."""
-        logw = self._logw + ll
-        top = logw.max()
-        scaled = np.exp(logw - top)
-        total = scaled.sum()
-        log_ev = float(top + math.log(total) - logsumexp(self._logw))
-        return logw, log_ev, effective_sample_size(scaled / total)
+        logw, log_ev, ess = reweighted(self._logw, np.ascontiguousarray(ll, dtype=np.float64))
+        return logw, float(log_ev), float(ess)
 
     def _resampled_if_needed(self, ess: float, log_ev: float) -> UpdateInfo:
         """Resample-move when the effective sample size fell below the threshold."""

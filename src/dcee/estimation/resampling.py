@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
 
 
 def systematic_resample(weights: np.ndarray, rng: np.random.Generator, n: int) -> np.ndarray:
@@ -22,3 +25,30 @@ def normalised_weights(logw: np.ndarray) -> np.ndarray:
     """(N,) weights summing to 1 from (N,) log-weights (shifted by their maximum first)."""
     w = np.exp(logw - logw.max())
     return w / w.sum()
+
+
+@njit(cache=True)
+def reweighted(logw: np.ndarray, ll: np.ndarray) -> tuple[np.ndarray, float, float]:
+    """After a reading of per-particle log-likelihood ``ll`` (N,), from log weights ``logw`` (N,)
+    (any offset): the new log weights logw + ll, the reading's log evidence
+    log Σ wᵢ p(z|Θᵢ) (wᵢ the normalised weights before it) and the effective sample size after
+    it. Compiled, three passes: it runs after every reading (NumPy and SciPy's logsumexp took
+    0.6 ms at 20,000 particles)."""
+    n = logw.shape[0]
+    new = np.empty(n)
+    top_old = -np.inf
+    top = -np.inf
+    for i in range(n):
+        new[i] = logw[i] + ll[i]
+        top_old = max(top_old, logw[i])
+        top = max(top, new[i])
+    total_old = 0.0
+    total = 0.0
+    total_sq = 0.0
+    for i in range(n):
+        total_old += math.exp(logw[i] - top_old)
+        e = math.exp(new[i] - top)
+        total += e
+        total_sq += e * e
+    log_ev = top + math.log(total) - (top_old + math.log(total_old))
+    return new, log_ev, total * total / total_sq

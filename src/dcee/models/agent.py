@@ -120,8 +120,9 @@ def stall_start(xy: np.ndarray, step: float) -> int:
     order). A robot that moved on has its last position alone (n − 1) or its last move."""
     xy = np.asarray(xy, dtype=np.float64)[:, :2]
     reach = step * (1.0 + 1e-9) + 1e-9
-    first = len(xy) - 1
-    for i in range(len(xy) - 2, -1, -1):
-        if np.all(np.hypot(*(xy[i:] - xy[i]).T) <= reach):
-            first = i
-    return first
+    # all pairs at once (the searcher asks before every decision, over up to 64 positions):
+    # row i holds the distances of xy[j] from xy[i]; only j ≥ i count
+    d = xy[None, :, :] - xy[:, None, :]
+    near = np.hypot(d[..., 0], d[..., 1]) <= reach
+    near |= np.tri(len(xy), k=-1, dtype=bool)
+    return int(np.flatnonzero(near.all(axis=1))[0])

@@ -24,6 +24,7 @@ from dcee.planning.block_sums import task_sums as _task_sums
 from dcee.planning.block_sums import weighted_columns
 from dcee.planning.interpolated_kernels import applicable as interpolation_applies
 from dcee.planning.interpolated_kernels import interpolate_groups
+from dcee.planning.multi_stage_kernels import multi_stage_weights
 from dcee.planning.predicted_single import BOUND_SLACK_SINGLE, single_stage_sums
 from dcee.planning.reading_terms import (
     cached_log_likelihood,
@@ -31,6 +32,8 @@ from dcee.planning.reading_terms import (
     live_row_max,
     task_bounds,
 )
+from dcee.planning.stage_products import applies as stage_products_apply
+from dcee.planning.stage_products import key_bounds, product_stats, redo_below, stage_keys
 
 _EXP_FLOOR = -680.0
 """Weights e^x with x below this are taken as e^-680: w · e^x then stays a normal float for any
@@ -140,25 +143,20 @@ def _grouped_stats(
     (one hypothesised reading each, the one-step planners) run one task at a time over the
     block's particles in branch-free loops that LLVM vectorises (:func:`_single_stage_weights`),
     and the sums of all the group's tasks are two matrix products over ``weighted`` (N, 5)
-    (:func:`dcee.planning.block_sums.task_sums`). Tasks of
-    several stages: group_start[g]..group_start[g+1]−1 share one position sequence (equal
-    task_positions rows), so a particle's per-position terms are loaded once and the loops over
-    the group's hypothesised readings are branch-free arithmetic that LLVM vectorises (the
-    outlier component's log-sum-exp split into a max and a product of 1 + exp terms, one log per
-    hypothesis). With false alarms the exact scalar likelihood is
-    used instead (slower, not vectorised). Sums a planner does not need (the location moments,
-    Σ e·ll for the KL divergence) are left at zero when not wanted; ``offsets`` (4, N) from
+    (:func:`dcee.planning.block_sums.task_sums`). Tasks of several stages (the tree search,
+    ``dcee-ms``) the same way, their weights from
+    :func:`dcee.planning.multi_stage_kernels.multi_stage_weights`. With false alarms the exact
+    scalar likelihood is used instead, one particle at a time (slower, not vectorised). Sums a
+    planner does not need (the location moments, Σ e·ll for the KL divergence) are left at zero
+    when not wanted; ``offsets`` (4, N) from
     :func:`_centred_offsets` is only read for the moments.
     """
     n = weights.shape[0]
     t_count = task_positions.shape[1]
     n_groups = group_start.shape[0] - 1
     n_blocks = (n + _BLOCK - 1) // _BLOCK
-    v_thr = sp.v_threshold
-    log_keep = sp.log_keep
-    with_false_alarms = sp.false_alarm > 0.0
-    with_outliers = sp.log_outlier > -np.inf
-    single_stage = t_count == 1 and not with_false_alarms
+    vector_path = sp.false_alarm == 0.0
+    single_stage = t_count == 1 and vector_path
     for item in prange(n_groups * n_blocks):
         g = item // n_blocks
         b = item % n_blocks
@@ -200,76 +198,60 @@ def _grouped_stats(
                 if want_kl:
                     partial[b, s0 + j, 5] += bound[s0 + j] * sums[j, 0]
             continue
-        z = np.empty((t_count, k))
-        fa = np.empty((t_count, k))
-        out = np.empty((t_count, k))
-        for t in range(t_count):
+        if vector_path:
+            # several stages: each task's weights vectorised over the block's particles
+            # (dcee.planning.multi_stage_kernels), the sums as for one stage
+            nb = i_end - i_start
+            e = np.empty((k, nb))
+            el = np.empty((k, nb))
+            ll = np.empty(nb)
+            prod = np.empty(nb)
             for j in range(k):
-                z[t, j] = task_v[s0 + j, t]
-                fa[t, j] = task_fa[s0 + j, t]
-                out[t, j] = task_out[s0 + j, t]
-        bnd = bound[s0 : s0 + k].copy()
-        ll = np.empty(k)
-        # with the outlier component each detection stage's log-sum-exp log(e^a + e^out) is
-        # split into max(a, out) (summed in ll) and 1 + e^-|a - out| (multiplied in prod): one
-        # exp per stage, and the log of the product once per hypothesis, for the KL divergence
-        prod = np.ones(k)
+                s = s0 + j
+                multi_stage_weights(
+                    loc, log_nd, inv_sigma, det_offset, task_positions[s], i_start, nb,
+                    task_v[s], task_out[s], bound[s], sp, want_kl, e[j], el[j], ll, prod,
+                )  # fmt: skip
+            sums = np.empty((k, _N_ACC))
+            _task_sums(e, el, weights, weighted, i_start, want_moments, want_kl, sums)
+            for j in range(k):
+                for a in range(_N_ACC):
+                    partial[b, s0 + j, a] = sums[j, a]
+                if want_kl:
+                    partial[b, s0 + j, 5] += bound[s0 + j] * sums[j, 0]
+            continue
+        # false alarms: the exact scalar likelihood, one particle at a time
         a0 = np.zeros(k)
         a1 = np.zeros(k)
         a2 = np.zeros(k)
         a3 = np.zeros(k)
         a4 = np.zeros(k)
         a5 = np.zeros(k)
+        ll = np.empty(k)
         for q in range(i_end - i_start):
             i = np.uint64(i_start + q)  # unsigned: no wraparound checks on the loads
             wi = weights[i]
             if wi <= 0.0:
                 continue
-            dx = dy = dz = d2 = 0.0
-            if want_moments:
-                dx = offsets[0, i]
-                dy = offsets[1, i]
-                dz = offsets[2, i]
-                d2 = offsets[3, i]
             ll[:] = 0.0
-            prod[:] = 1.0
             for t in range(t_count):
                 p = task_positions[s0, t]
-                m = loc[p, i]
-                lnd = log_nd[p, i]
-                inv_s = inv_sigma[p, i]
-                if with_false_alarms:
-                    for j in range(k):
-                        ll[j] += cached_log_likelihood(
-                            z[t, j], fa[t, j], out[t, j], m, lnd, inv_s, det_offset[p, i], sp
-                        )
-                elif with_outliers:
-                    det_const = det_offset[p, i] - HALF_LOG_2PI + log_keep
-                    for j in range(k):
-                        zj = z[t, j]
-                        r = (zj - m) * inv_s
-                        a = det_const - 0.5 * r * r
-                        hi = max(a, out[t, j])
-                        factor = 1.0 + exp_scalar(min(a, out[t, j]) - hi)
-                        detected = zj >= v_thr
-                        ll[j] += hi if detected else lnd
-                        prod[j] *= factor if detected else 1.0
-                else:
-                    det_const = det_offset[p, i] - HALF_LOG_2PI
-                    for j in range(k):
-                        zj = z[t, j]
-                        r = (zj - m) * inv_s
-                        ll[j] += det_const - 0.5 * r * r if zj >= v_thr else lnd
+                for j in range(k):
+                    s = s0 + j
+                    ll[j] += cached_log_likelihood(
+                        task_v[s, t], task_fa[s, t], task_out[s, t], loc[p, i], log_nd[p, i],
+                        inv_sigma[p, i], det_offset[p, i], sp,
+                    )  # fmt: skip
             for j in range(k):
-                e = wi * exp_scalar(min(max(ll[j] - bnd[j], _EXP_FLOOR), 0.0)) * prod[j]
+                e = wi * exp_scalar(min(max(ll[j] - bound[s0 + j], _EXP_FLOOR), 0.0))
                 a0[j] += e
                 if want_moments:
-                    a1[j] += e * dx
-                    a2[j] += e * dy
-                    a3[j] += e * dz
-                    a4[j] += e * d2
+                    a1[j] += e * offsets[0, i]
+                    a2[j] += e * offsets[1, i]
+                    a3[j] += e * offsets[2, i]
+                    a4[j] += e * offsets[3, i]
                 if want_kl:
-                    a5[j] += e * (ll[j] + log_scalar(prod[j]) if with_outliers else ll[j])
+                    a5[j] += e * ll[j]
         for j in range(k):
             partial[b, s0 + j, 0] = a0[j]
             partial[b, s0 + j, 1] = a1[j]
@@ -324,7 +306,8 @@ def predicted_posterior_stats(
     (:mod:`dcee.planning.predicted_single`); ``precision="interpolated"``: one-stage tasks of the
     paper's sensor family are summed over nodes of the predicted concentration
     (:mod:`dcee.planning.interpolated_kernels`, an approximation within about 1e-8); any
-    other task is computed in double precision.
+    other task is computed in double precision, tasks of two or three stages as products of
+    their distinct stage factors (:mod:`dcee.planning.stage_products`).
     """
     task_positions = np.ascontiguousarray(task_positions, dtype=np.int64)
     task_v, task_fa, task_out = (
@@ -343,13 +326,14 @@ def predicted_posterior_stats(
     n_blocks = (source.shape[0] + _BLOCK - 1) // _BLOCK
     common = (loc, log_nd, inv_sigma, det_offset, source, weights, center)
     one_stage = task_positions.shape[1] == 1 and sp.false_alarm == 0.0
-    # the one-stage kernels' sums read w, w·dx, w·dy, w·dz, w·|d|² per particle, the kernel of
-    # several stages the offsets: each only what it reads (memory at 100,000 particles)
+    # the vectorised kernels' sums read w, w·dx, w·dy, w·dz, w·|d|² per particle, the scalar
+    # kernel of false alarms the offsets: each only what it reads (memory at 100,000 particles)
+    vector_path = sp.false_alarm == 0.0
     weighted = (
-        weighted_columns(weights, source, center, want_moments) if one_stage else np.zeros((0, 5))
+        weighted_columns(weights, source, center, want_moments) if vector_path else np.zeros((0, 5))
     )
-    several = want_moments and not one_stage
-    offsets = _centred_offsets(source, center) if several else np.zeros((4, 0))
+    scalar_moments = want_moments and not vector_path
+    offsets = _centred_offsets(source, center) if scalar_moments else np.zeros((4, 0))
     single = precision == "single" and one_stage
     sums = np.empty((s_count, _N_ACC))
     log_ref = bound.copy()
@@ -365,8 +349,17 @@ def predicted_posterior_stats(
         np.ascontiguousarray(a[exact_tasks]) for a in (task_v, task_fa, task_out)
     )
     partial = np.empty((n_blocks, len(exact_tasks), _N_ACC))
+    products = stage_products_apply(task_positions.shape[1], sp)
     if len(exact_tasks) == 0:
         pass  # every task interpolated
+    elif products:  # two or three stages: products of the distinct stage factors
+        key_of, key_p, key_v, key_out = stage_keys(exact_positions, exact_v, exact_out, sp)
+        key_bound = key_bounds(key_p, key_v, key_out, max_log_nd, max_det_offset, sp)
+        product_stats(
+            loc, log_nd, inv_sigma, det_offset, weights, weighted, key_p, key_v, key_out,
+            key_bound, key_of, group_start_exact, bound[exact_tasks], sp, want_moments, want_kl,
+            partial,
+        )  # fmt: skip
     elif single:
         single_stage_sums(
             (loc, log_nd, inv_sigma, det_offset),
@@ -405,8 +398,11 @@ def predicted_posterior_stats(
     sums[exact_tasks] = partial.sum(axis=0)  # fixed order over blocks: thread count free
     # Σ e_i ll_i was accumulated with e relative to the bound; a task is redone exactly when its
     # largest weight e^(ll_max − bound) is too small for the one-pass sums to be accurate.
+    slack = _BOUND_SLACK
+    if single or products:
+        slack = BOUND_SLACK_SINGLE if single else -redo_below(task_positions.shape[1])
     with np.errstate(divide="ignore"):
-        too_small = ~(np.log(sums[:, 0]) > -(BOUND_SLACK_SINGLE if single else _BOUND_SLACK))
+        too_small = ~(np.log(sums[:, 0]) > -slack)
     if np.any(too_small):
         redo = np.flatnonzero(too_small).astype(np.int64)
         redo_sums = np.empty((len(redo), _N_ACC))

@@ -48,6 +48,34 @@ def cached_log_likelihood(
 
 
 @njit(cache=True, inline="always")
+def stage_bound(
+    p: int,
+    v: float,
+    fa: float,
+    out: float,
+    max_log_nd: np.ndarray,
+    max_det_offset: np.ndarray,
+    sp: SensorParams,
+) -> float:
+    """An upper bound of log p(v | C_i(p)) (less the Jacobian) over all particles i, for one
+    stage: position row p, transformed reading v, false-alarm and outlier terms fa, out.
+
+    A detection's density term is at most max(log Pd − log σ) − ½ log 2π; a
+    false-alarm term at most its density times max P(missed); the outlier term is exact.
+    """
+    if v < sp.v_threshold:
+        return max_log_nd[p]
+    ld = max_det_offset[p] - HALF_LOG_2PI
+    if sp.false_alarm > 0.0:
+        log_missed_max = max_log_nd[p] - sp.log_not_false_alarm - sp.log_keep
+        ld = logaddexp(ld, fa + log_missed_max)
+    ld += sp.log_keep
+    if sp.log_outlier > -np.inf:
+        ld = logaddexp(ld, out)
+    return ld
+
+
+@njit(cache=True, inline="always")
 def task_bound(
     s: int,
     task_positions: np.ndarray,
@@ -58,26 +86,14 @@ def task_bound(
     max_det_offset: np.ndarray,
     sp: SensorParams,
 ) -> float:
-    """An upper bound of Σ_t log p(z_st | C_i) (less the Jacobian) over all particles i.
-
-    A detection's density term is at most max(log Pd − log σ) − ½ log 2π; a
-    false-alarm term at most its density times max P(missed); the outlier term is exact.
-    """
+    """An upper bound of Σ_t log p(z_st | C_i) (less the Jacobian) over all particles i: the
+    sum of the stages' :func:`stage_bound`."""
     b = 0.0
     for t in range(task_positions.shape[1]):
-        p = task_positions[s, t]
-        v = task_v[s, t]
-        if v < sp.v_threshold:
-            b += max_log_nd[p]
-            continue
-        ld = max_det_offset[p] - HALF_LOG_2PI
-        if sp.false_alarm > 0.0:
-            log_missed_max = max_log_nd[p] - sp.log_not_false_alarm - sp.log_keep
-            ld = logaddexp(ld, task_fa[s, t] + log_missed_max)
-        ld += sp.log_keep
-        if sp.log_outlier > -np.inf:
-            ld = logaddexp(ld, task_out[s, t])
-        b += ld
+        b += stage_bound(
+            task_positions[s, t], task_v[s, t], task_fa[s, t], task_out[s, t], max_log_nd,
+            max_det_offset, sp,
+        )  # fmt: skip
     return b
 
 
