@@ -149,7 +149,9 @@ def test_predicted_stats_match_reference_for_every_family(sensor):
             np.testing.assert_allclose(fast, slow, rtol=1e-8, atol=1e-10)
 
 
-@pytest.mark.parametrize("sensor", [Sensor(outlier=0.01), Sensor.paper_exact()], ids=["out", "exact"])
+@pytest.mark.parametrize(
+    "sensor", [Sensor(outlier=0.01), Sensor.paper_exact()], ids=["out", "exact"]
+)
 @pytest.mark.parametrize("stages", [2, 3, 4])
 def test_several_stages_share_factors_and_match_reference(sensor, stages):
     """Sequences of 2-3 stages take the product kernel (dcee.planning.stage_products: factors
