@@ -30,7 +30,14 @@ from dcee.models.plume import IsotropicPlume, isotropic_concentration_reference
 from dcee.models.plume_kernels import constants_at, plume_at, plume_from_terms, plume_terms
 from dcee.models.sensor import Sensor
 from dcee.models.sensor_kernels import SensorParams, log_likelihood
-from dcee.numeric import HALF_LOG_2PI, vlog1m, vndtr_upper
+from dcee.numeric import (
+    HALF_LOG_2PI,
+    exp_scalar,
+    log1p_scalar,
+    log_scalar,
+    vlog1m,
+    vndtr_upper,
+)
 
 _BLOCK = 256  # particles per work item
 _CHECK_EVERY = 8  # readings between early-rejection checks
@@ -70,6 +77,31 @@ def _log_missed_gaussian(conc: np.ndarray, count: int, sp: SensorParams, out: np
         out[j] = vlog1m(sp.pd * vndtr_upper(x))
 
 
+@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+def _log_detected_gaussian(
+    conc: np.ndarray, count: int, z: float, sp: SensorParams, out: np.ndarray
+) -> None:
+    """out[j] = log p(z | conc[j]) of a detection z ≥ threshold for j < count, the Gaussian
+    family with a constant Pd and no false alarms (what
+    :func:`~dcee.models.sensor_kernels.log_likelihood` gives): log Pd − ½ x² − log σ − ½ log 2π
+    + log(1 − outlier), x = (z − C)/σ(C), and with the outlier component its log-sum-exp with
+    log(outlier / ln(max/thr)) − log z as max + log1p(exp(−|difference|)). Branch-free with the
+    ``exp``, ``log`` and ``log1p`` of :mod:`dcee.numeric`, so LLVM vectorises it (the scalar libm
+    form took most of an MCMC sweep: a detection is never merged with another reading)."""
+    base = sp.log_pd - HALF_LOG_2PI + sp.log_keep
+    with_outlier = sp.log_outlier > -np.inf
+    out_term = sp.log_outlier - math.log(z) if with_outlier else 0.0
+    for j in range(count):
+        c = conc[j]
+        sigma = sp.sigma_frac * c + sp.sigma_min
+        x = (z - c) / sigma
+        ld = base - 0.5 * x * x - log_scalar(sigma)
+        if with_outlier:
+            hi = max(ld, out_term)
+            ld = hi + log1p_scalar(exp_scalar(min(ld, out_term) - hi))
+        out[j] = ld
+
+
 @njit(cache=True, parallel=True)
 def _history_kernel(
     theta: np.ndarray,
@@ -91,6 +123,15 @@ def _history_kernel(
     # log P(miss) vectorised for the paper's sensor (Gaussian, constant Pd < 1; with Pd = 1 the
     # log Φ form needs relative accuracy far in the tail, and Pd(r) needs expm1)
     vector_missed = sp.lognormal == 0.0 and sp.pd < 1.0 and sp.near_length == 0.0
+    # detections of that sensor too, where a detection's term is one Gaussian density (with
+    # the outlier component's log-sum-exp); σ_min within the range of the vectorised log
+    vector_detected = (
+        sp.lognormal == 0.0
+        and sp.near_length == 0.0
+        and sp.magnitude != 0.0
+        and sp.false_alarm == 0.0
+        and sp.sigma_min >= 2.0**-60
+    )
     missed_offset = sp.log_not_false_alarm + sp.log_keep
     for b in prange(n_blocks):
         i0 = b * _BLOCK
@@ -143,6 +184,11 @@ def _history_kernel(
                     _log_missed_gaussian(gathered, count, sp, missed)
                     for j in range(count):
                         acc[which[j]] += mk * (missed[j] + missed_offset)
+            elif zk >= sp.threshold and vector_detected:
+                _log_detected_gaussian(conc, nb, zk, sp, missed)
+                for q in range(nb):
+                    if alive[q]:
+                        acc[q] += mk * missed[q]
             else:
                 for q in range(nb):
                     if alive[q]:

@@ -7,6 +7,8 @@ import math
 import numpy as np
 from numba import njit
 
+from dcee.numeric import exp_scalar
+
 
 def systematic_resample(weights: np.ndarray, rng: np.random.Generator, n: int) -> np.ndarray:
     """n indices drawn ∝ weights by systematic sampling (one uniform, O(N + n), no sorting)."""
@@ -27,7 +29,7 @@ def normalised_weights(logw: np.ndarray) -> np.ndarray:
     return w / w.sum()
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def reweighted(logw: np.ndarray, ll: np.ndarray) -> tuple[np.ndarray, float, float]:
     """After a reading of per-particle log-likelihood ``ll`` (N,), from log weights ``logw`` (N,)
     (any offset): the new log weights logw + ll, the reading's log evidence
@@ -42,13 +44,20 @@ def reweighted(logw: np.ndarray, ll: np.ndarray) -> tuple[np.ndarray, float, flo
         new[i] = logw[i] + ll[i]
         top_old = max(top_old, logw[i])
         top = max(top, new[i])
+    # the vectorisable exp of dcee.numeric (arguments ≤ 0) in loops of their own, the sums in
+    # a fixed sequential order; a dead particle (−inf) adds its floor e^-700 ≈ 1e-304, nothing
+    # next to the particle at the top (1)
+    old_scaled = np.empty(n)
+    scaled = np.empty(n)
+    for i in range(n):
+        old_scaled[i] = exp_scalar(logw[i] - top_old)
+        scaled[i] = exp_scalar(new[i] - top)
     total_old = 0.0
     total = 0.0
     total_sq = 0.0
     for i in range(n):
-        total_old += math.exp(logw[i] - top_old)
-        e = math.exp(new[i] - top)
-        total += e
-        total_sq += e * e
+        total_old += old_scaled[i]
+        total += scaled[i]
+        total_sq += scaled[i] * scaled[i]
     log_ev = top + math.log(total) - (top_old + math.log(total_old))
     return new, log_ev, total * total / total_sq

@@ -44,9 +44,10 @@ class HypothesisPlanner(Planner):
     ``readings`` model | noise-free | miss-free and ``subsample`` (predict with a systematic
     resample of that share of the particles, equally weighted; the authors' example uses 0.2);
     ``precision`` interpolated | double | single, how the one-reading predictions are summed
-    (:data:`~dcee.planning.predicted.PRECISIONS`; the default is ``interpolated`` with a
-    horizon of one move and ``double`` with more; their decisions measured against double's in
-    docs/performance.md).
+    (:data:`~dcee.planning.predicted.PRECISIONS`; the default is ``interpolated``, which only
+    concerns predictions of one reading, a beam's first stage included: sequences of several
+    readings are computed in double precision whatever the option; decisions measured against
+    double's in docs/performance.md).
     """
 
     uses_hypotheses = True
@@ -72,10 +73,11 @@ class HypothesisPlanner(Planner):
         expectation = self.default_expectation if expectation is None else expectation
         horizon = self.default_horizon if horizon is None else horizon
         if precision is None:
-            # one-reading predictions are interpolated over the concentration where the sensor
-            # allows it (1e-8 of the exact sums, decisions measured: docs/performance.md);
-            # sequences of several readings are computed exactly
-            precision = "interpolated" if horizon == 1 else "double"
+            # one-reading predictions (one-step planners, a beam's first stage) are interpolated
+            # over the concentration where the sensor allows it (1e-8 of the exact sums,
+            # decisions measured: docs/performance.md); sequences of several readings are
+            # always computed exactly
+            precision = "interpolated"
         n_hypotheses = check_count("hypotheses", n_hypotheses)
         beam_width = check_count("beam_width", beam_width)
         if horizon not in (1, 2, 3):

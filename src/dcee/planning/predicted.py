@@ -118,7 +118,8 @@ PRECISIONS = ("double", "single", "interpolated")
 ``single`` (float32 exp and log for one-stage tasks, float64 sums; about 1e-6 relative, see
 :mod:`dcee.planning.predicted_single`) or ``interpolated`` (one-stage tasks of the paper's
 sensor family summed over nodes of the predicted concentration instead of over the particles;
-about 1e-6 relative, see :mod:`dcee.planning.interpolated_kernels`)."""
+about 1e-8 relative, see :mod:`dcee.planning.interpolated_kernels`). Tasks of several readings
+are computed in double precision under every option."""
 
 
 def check_precision(precision: object) -> None:
