@@ -357,7 +357,7 @@ def predicted_posterior_stats(
         key_bound = key_bounds(key_p, key_v, key_out, max_log_nd, max_det_offset, sp)
         product_stats(
             loc, log_nd, inv_sigma, det_offset, weights, weighted, key_p, key_v, key_out,
-            key_bound, key_of, group_start_exact, bound[exact_tasks], sp, want_moments, want_kl,
+            key_bound, key_of, bound[exact_tasks], sp, want_moments, want_kl,
             partial,
         )  # fmt: skip
     elif single:
