@@ -34,12 +34,10 @@ DEMO = ["run", "--scenario", "paper:1", "--strategy", "dcee-cl", "--seed", "0"]
 ONE_CORE = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1"}
 
 
-def _search(src: Path, out: Path, strategy: str = "dcee-cl") -> dict:
-    """One demo search (with ``strategy``) with the package under ``src`` on one pinned core;
-    its summary."""
+def _search(src: Path, out: Path) -> dict:
+    """One demo search with the package under ``src`` on one pinned core; its summary."""
     env = {**os.environ, **ONE_CORE, "PYTHONPATH": str(src)}
-    run = [*DEMO[: DEMO.index("--strategy") + 1], strategy, *DEMO[DEMO.index("--strategy") + 2 :]]
-    command = ["taskset", "-c", "0", sys.executable, "-m", "dcee.cli", *run, "--out", str(out)]
+    command = ["taskset", "-c", "0", sys.executable, "-m", "dcee.cli", *DEMO, "--out", str(out)]
     subprocess.run(command, env=env, check=True, capture_output=True, cwd=ROOT)
     return json.loads((out / "summary.json").read_text(encoding="utf-8"))
 

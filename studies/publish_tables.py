@@ -990,6 +990,51 @@ def agreement_single_table(name: str = "agreement-single", whole: str | None = N
     )
 
 
+def search_speed_table() -> str:
+    """Whole searches of the public study's five planners on one pinned core, two code
+    versions in alternation (studies/search_speed.py, docs/results/perf/search-speed.json)."""
+    record = _perf("search-speed")
+    rows = []
+    total = {"before": 0.0, "after": 0.0}
+    for planner, row in record["summary"].items():
+        c, d, u = row["wall_s"], row["decision_s"], row["update_s"]
+        for side in total:
+            total[side] += c[side]
+        rows.append(
+            [
+                f"`{planner}`",
+                f"{c['before']:.2f} → **{c['after']:.2f}** ({c['before'] / c['after']:.2f}×)",
+                f"{d['before']:.2f} → {d['after']:.2f}",
+                f"{u['before']:.2f} → {u['after']:.2f}",
+                "yes" if row["same_search"] else "no (last-digit differences diverge)",
+            ]
+        )
+    rows.append(
+        [
+            "**all five** (one search each)",
+            f"{total['before']:.1f} → **{total['after']:.1f}** "
+            f"({total['before'] / total['after']:.2f}×)",
+            "",
+            "",
+            "",
+        ]
+    )
+    study = {side: 120 * total[side] / 2 / 60 for side in total}
+    rows.append(
+        [
+            "the 600-search study on 2 workers at these costs (a projection, not a measurement: "
+            "120 × the sum / 2)",
+            f"{study['before']:.0f} → {study['after']:.0f} min",
+            "",
+            "",
+            _timed(record) + f", against `{record['before']}`",
+        ]
+    )
+    return table(["planner (`paper:1`, seed 0, 20,000 particles, 450 readings)",
+                  "wall per search (s)", "decisions (s)", "filter updates (s)",
+                  "same search"], rows)  # fmt: skip
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "learn-tuning": learn_tuning_table,
     "cross-truth": cross_truth_table,
@@ -1007,6 +1052,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "anemometer": anemometer_table,
     "sites": sites_table,
     "speed": speed_table,
+    "search-speed": search_speed_table,
     "kernel-speedup": kernel_speedup_table,
     "kernel-speedup-blas": lambda: kernel_speedup_table("kernel-speedup-blas"),
     "agreement-single": agreement_single_table,

@@ -439,9 +439,13 @@ case "${1:---list}" in
     $P studies/kernel_speedup.py --before f52a5b6 --json docs/results/perf/kernel-speedup.json
     $P studies/kernel_speedup.py --before cae7e4f --json docs/results/perf/kernel-speedup-blas.json
     $P studies/demo_decision.py --before cae7e4f --json docs/results/perf/demo-decision.json
+    $P studies/search_speed.py --before 31f49fd --json docs/results/perf/search-speed.json
     rm -rf results/perf-stonesoup-mcts  # every seed timed in this run
     $P studies/stonesoup_mcts_study.py results/perf-stonesoup-mcts --seeds "${MCTS_SEEDS:-3}" \
       --json docs/results/perf/stonesoup-mcts.json
+    $P studies/publish_tables.py ;;
+  search-speed)  # whole searches of the five default planners, before/after issue 46's second round
+    $P studies/search_speed.py --before 31f49fd --json docs/results/perf/search-speed.json
     $P studies/publish_tables.py ;;
   precision-single)  # dcee-cl in single precision beside double: the public study's 120 searches, paired
     $D bench --suite paper --repeats 10 --strategies dcee-cl,dcee-cl:precision=single \
