@@ -164,59 +164,34 @@ def _grouped_stats(
         k = group_start[g + 1] - s0
         i_start = b * _BLOCK
         i_end = min(n, i_start + _BLOCK)
-        if single_stage:
+        if vector_path:
             # the group's readings one at a time, vectorised over the block's particles
-            # (_single_stage_weights), then every sum of every reading in two matrix products
-            # (dcee.planning.block_sums.task_sums)
+            # (_single_stage_weights; several stages: dcee.planning.multi_stage_kernels), then
+            # every sum of every reading in two matrix products (block_sums.task_sums)
             p = task_positions[s0, 0]
             nb = i_end - i_start
             e = np.empty((k, nb))
             el = np.empty((k, nb))
+            ll = np.empty(nb if not single_stage else 0)
+            prod = np.empty(nb if not single_stage else 0)
             for j in range(k):
                 s = s0 + j
-                _single_stage_weights(
-                    loc[p],
-                    log_nd[p],
-                    inv_sigma[p],
-                    det_offset[p],
-                    i_start,
-                    nb,
-                    task_v[s, 0],
-                    task_out[s, 0],
-                    bound[s],
-                    sp,
-                    want_kl,
-                    e[j],
-                    el[j],
-                )
+                if single_stage:
+                    _single_stage_weights(
+                        loc[p], log_nd[p], inv_sigma[p], det_offset[p], i_start, nb,
+                        task_v[s, 0], task_out[s, 0], bound[s], sp, want_kl, e[j], el[j],
+                    )  # fmt: skip
+                else:
+                    multi_stage_weights(
+                        loc, log_nd, inv_sigma, det_offset, task_positions[s], i_start, nb,
+                        task_v[s], task_out[s], bound[s], sp, want_kl, e[j], el[j], ll, prod,
+                    )  # fmt: skip
             sums = np.empty((k, _N_ACC))
             _task_sums(e, el, weights, weighted, i_start, want_moments, want_kl, sums)
             for j in range(k):
                 for a in range(_N_ACC):
                     partial[b, s0 + j, a] = sums[j, a]
                 # Σ w e ll = Σ w e (ll − bound) + bound Σ w e
-                if want_kl:
-                    partial[b, s0 + j, 5] += bound[s0 + j] * sums[j, 0]
-            continue
-        if vector_path:
-            # several stages: each task's weights vectorised over the block's particles
-            # (dcee.planning.multi_stage_kernels), the sums as for one stage
-            nb = i_end - i_start
-            e = np.empty((k, nb))
-            el = np.empty((k, nb))
-            ll = np.empty(nb)
-            prod = np.empty(nb)
-            for j in range(k):
-                s = s0 + j
-                multi_stage_weights(
-                    loc, log_nd, inv_sigma, det_offset, task_positions[s], i_start, nb,
-                    task_v[s], task_out[s], bound[s], sp, want_kl, e[j], el[j], ll, prod,
-                )  # fmt: skip
-            sums = np.empty((k, _N_ACC))
-            _task_sums(e, el, weights, weighted, i_start, want_moments, want_kl, sums)
-            for j in range(k):
-                for a in range(_N_ACC):
-                    partial[b, s0 + j, a] = sums[j, a]
                 if want_kl:
                     partial[b, s0 + j, 5] += bound[s0 + j] * sums[j, 0]
             continue
