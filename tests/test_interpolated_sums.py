@@ -119,12 +119,23 @@ def test_interpolated_stats_do_not_depend_on_the_thread_count():
 
 
 def test_interpolation_is_the_default_of_one_reading_predictions_only():
-    for name in ("dcee", "dcee-cl", "dcee-cl-tree", "infotaxis", "entrotaxis"):
+    for name in ("dcee", "dcee-cl", "dcee-cl-tree", "infotaxis", "entrotaxis", "dcee-ms"):
         assert get_planner(name).options()["precision"] == "interpolated"
         assert get_planner(name, precision="double").options()["precision"] == "double"
-    # sequences of several readings: exact unless asked
-    assert get_planner("dcee-ms").options()["precision"] == "double"
     assert get_planner("dcee-mcts").cost.precision == "double"
+    # dcee-ms's default only touches its first stage: sequences of several readings are
+    # computed exactly under every precision (the same kernel, bit for bit)
+    conc, source, weights = _late_case()
+    task_pos = np.repeat(np.array([[0, 1], [1, 0]]), 20, axis=0)
+    rng = np.random.default_rng(5)
+    task_z = np.where(rng.random(task_pos.shape) < 0.5, 0.0, rng.lognormal(-6, 1, task_pos.shape))
+    sensor = Sensor(outlier=0.01)
+    exact = compiled_predicted_stats(conc, source, weights, task_pos, task_z, sensor)
+    default = compiled_predicted_stats(
+        conc, source, weights, task_pos, task_z, sensor, precision="interpolated"
+    )
+    for a, b in zip(exact, default, strict=True):
+        np.testing.assert_array_equal(a, b)
 
 
 def test_interpolated_decisions_agree_with_the_exact_ones():

@@ -138,9 +138,8 @@ def test_single_precision_is_a_planner_option_everywhere_it_is_used():
     for name in ("dcee", "dcee-cl", "dcee-cl-tree", "dcee-ms", "infotaxis", "entrotaxis"):
         planner = get_planner(name, precision="single")
         assert planner.options()["precision"] == "single"
-        # the default: interpolated sums for one reading, exact for sequences (dcee-ms)
-        default = "double" if name == "dcee-ms" else "interpolated"
-        assert get_planner(name).options()["precision"] == default
+        # the default: interpolated sums for one reading (dcee-ms's first stage too)
+        assert get_planner(name).options()["precision"] == "interpolated"
 
 
 @pytest.mark.parametrize("precision", ["double", "single"])
