@@ -1030,6 +1030,20 @@ def search_speed_table() -> str:
             _timed(record) + f", against `{record['before']}`",
         ]
     )
+    study_path = RESULTS / "perf" / "study-600.json"
+    if study_path.exists():  # studies/study_wall.py: the campaign itself, measured
+        run = _perf("study-600")
+        means = ", ".join(f"{k} {v['mean_wall_s']:.1f} s" for k, v in run["per_planner"].items())
+        rows.append(
+            [
+                f"the study measured: `dcee bench --suite paper --repeats 10 --workers 2`, "
+                f"{run['searches']} searches (mean per search: {means})",
+                f"**{run['wall_seconds'] / 60:.1f} min** (bar ≤ {run['target_minutes']:.0f} min)",
+                "",
+                "",
+                f"{run['campaign_code'].get('commit', '')[:7]}, 2 workers, nothing else run",
+            ]
+        )
     return table(["planner (`paper:1`, seed 0, 20,000 particles, 450 readings)",
                   "wall per search (s)", "decisions (s)", "filter updates (s)",
                   "same search"], rows)  # fmt: skip

@@ -447,6 +447,13 @@ case "${1:---list}" in
   search-speed)  # whole searches of the five default planners, before/after issue 46's second round
     $P studies/search_speed.py --before 31f49fd --json docs/results/perf/search-speed.json
     $P studies/publish_tables.py ;;
+  study-600)  # the 600-search study's wall time (five default planners x 120, 2 workers; idle machine)
+    rm -rf results/study-600
+    start=$(date +%s)
+    $D bench --suite paper --repeats 10 --workers 2 --out results/study-600
+    $P studies/study_wall.py results/study-600 --wall $(( $(date +%s) - start )) \
+      --json docs/results/perf/study-600.json
+    $P studies/publish_tables.py ;;
   precision-single)  # dcee-cl in single precision beside double: the public study's 120 searches, paired
     $D bench --suite paper --repeats 10 --strategies dcee-cl,dcee-cl:precision=single \
       --workers "${WORKERS:-2}" --out results/precision-single
