@@ -31,10 +31,11 @@ from numba import njit, prange
 from dcee.models.sensor_kernels import SensorParams
 from dcee.numeric import HALF_LOG_2PI, exp_scalar, log_scalar
 from dcee.planning.block_sums import BLOCK, task_sums
+from dcee.planning.multi_stage_kernels import EXP_FLOOR
 from dcee.planning.reading_terms import stage_bound
 
 MAX_STAGES = 3
-_FLOOR_TOTAL = -680.0  # the smallest product: e^-680 times a weight ≥ 1e-12 stays normal
+_FLOOR_TOTAL = EXP_FLOOR  # the smallest product: e^-680 times a weight ≥ 1e-12 stays normal
 _REDO_MARGIN = 80.0
 # tasks per matrix product: measured on a recorded dcee-ms decision, 8-32 alike (10.3-10.8 ms),
 # 128 slower (20.7 ms: the weights leave the cache), one product per sequence 12.3 ms (calls)
