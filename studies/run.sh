@@ -382,6 +382,11 @@ case "${1:---list}" in
       --variant 'nsl05rp05:estimator.near_source_length=0.5,estimator.repeat_power=0.5' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-nsl05-rp05-13-40/variants.csv
     $P studies/publish_tables.py ;;
+  tune-backflow)  # gas upwind of the release, learned, on the tuning range (docs/plumes.md)
+    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+      --variant base: --variant 'backflow:estimator.learn={backflow=[0.0,0.05]}' \
+      --workers "${WORKERS:-2}" --csv docs/results/tuning-backflow-13-40/variants.csv
+    $P studies/publish_tables.py ;;
   cross-truth)  # every truth at today's defaults; the lbm plume held out (docs/plumes.md, README)
     # dcee-cl, infotaxis and the tree search at today's defaults, 100 held-out configurations
     export SUITE=held-out-100 TRUTHS=lbm WORKERS=${WORKERS:-2}

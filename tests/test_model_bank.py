@@ -352,3 +352,24 @@ def test_learned_near_source_spread_is_found_from_the_readings(generating):
 def test_learned_near_source_spread_needs_a_length():
     with pytest.raises(DceeInputError, match=r"estimator\.learn\.log_sd_near.*log_sd_length > 0"):
         FLUCT.with_overrides(**{"estimator.learn": {"log_sd_near": [0.0, 3.0]}})
+
+
+@pytest.mark.parametrize("generating", ["fluctuation[backflow=0.1]", "fluctuation"])
+def test_learned_backflow_is_found_from_the_readings(generating):
+    """estimator.learn = {backflow = [0, 0.1]}: readings drawn from the plume model with gas
+    upwind of the release (a tenth of the time the wind blows back) or without; on rings round
+    the source the bank finds which (simulated data), and the member's plume carries it."""
+    learned = FLUCT.with_overrides(
+        **{"estimator.learn": {"backflow": [0.0, 0.1]}, "estimator.calm_prior": 0}
+    )
+    assert learned.reading_models == ("fluctuation", "fluctuation[backflow=0.1]")
+    assert learned.make_plume("fluctuation[backflow=0.1]").backflow == 0.1
+    assert learned.make_plume("fluctuation").backflow == 0.0
+    x0, y0, z0 = PAPER1.truth_theta()[:3]
+    angles = np.linspace(0.0, 2.0 * np.pi, 12, endpoint=False)
+    ring = np.array(
+        [(x0 + r * np.cos(a), y0 + r * np.sin(a), z0) for r in (1.5, 3.0, 6.0) for a in angles]
+    )
+    bank = _bank_on_simulated_readings(learned, generating, seed=8, copies=3, path=ring)
+    assert bank.selected_name == generating
+    assert bank.probabilities[bank.selected] > 0.9

@@ -76,3 +76,27 @@ def test_wrong_shapes_are_rejected():
         isotropic_concentration(np.zeros((3, 7)), np.zeros((2, 3)))
     with pytest.raises(DceeInputError, match="positions"):
         isotropic_concentration(np.zeros((3, 8)), np.zeros((2, 2)))
+
+
+def test_backflow_by_hand_upwind_downwind_and_crosswind():
+    """w = 0.05: the time mean over a wind from φ (95 % of the time) and from φ + π (5 %).
+    At points 5 m up- and downwind the two plumes swap (one factor e^{20} apart); crosswind
+    both plumes agree, so nothing changes; the release rate keeps its meaning."""
+    from dcee.models.plume import IsotropicPlume
+
+    w = 0.05
+    phi = math.radians(200)
+    theta = np.array([[0, 0, 0, 5.0, 4.0, phi, 1.0, 8.0]])
+    d = np.array([math.cos(phi), math.sin(phi), 0.0])
+    cross = np.array([-math.sin(phi), math.cos(phi), 0.0])
+    pts = np.stack([-5 * d, 5 * d, 3 * cross])
+    lam = math.sqrt(1.0 * 8.0 / (1 + 16.0 * 8.0 / 4.0))
+    down = 5.0 / (4 * math.pi * 5.0) * math.exp(-5.0 / lam + 10.0)  # 5 m downwind, no backflow
+    up = down * math.exp(-20.0)
+    c = IsotropicPlume(backflow=w).concentration(theta, pts)[0]
+    assert c[0] == pytest.approx((1 - w) * down + w * up, rel=1e-12)
+    assert c[1] == pytest.approx((1 - w) * up + w * down, rel=1e-12)
+    assert c[1] / c[0] == pytest.approx(w / (1 - w), rel=1e-7)  # upwind / downwind
+    assert c[2] == pytest.approx(isotropic_concentration(theta, pts[2:])[0, 0], rel=1e-13)
+    with pytest.raises(DceeInputError, match="backflow"):
+        IsotropicPlume(backflow=0.6)

@@ -112,6 +112,7 @@ def _history_kernel(
     rmin: float,
     meander: float,
     decay: float,
+    backflow: float,
     sp: SensorParams,
     threshold: np.ndarray,
     remaining_bound: np.ndarray,
@@ -158,10 +159,10 @@ def _history_kernel(
             px = positions[k, 0]
             py = positions[k, 1]
             pz = positions[k, 2]
-            if meander > 0.0 or decay != 1.0:
+            if meander > 0.0 or decay != 1.0 or backflow > 0.0:
                 for q in range(nb):
                     conc[q], dist[q] = plume_at(
-                        constants_at(pc, q), px, py, pz, rmin, meander, decay
+                        constants_at(pc, q), px, py, pz, rmin, meander, decay, backflow
                     )
             else:
                 _plume_block(pc, nb, px, py, pz, rmin, conc, dist)
@@ -241,6 +242,7 @@ def history_log_likelihood(
     rmin: float,
     meander: float,
     decay: float,
+    backflow: float,
     sp: SensorParams,
     out: np.ndarray,
     threshold: np.ndarray | None = None,
@@ -271,6 +273,7 @@ def history_log_likelihood(
         rmin,
         meander,
         decay,
+        backflow,
         sp,
         np.ascontiguousarray(threshold, dtype=np.float64),
         remaining,
@@ -288,7 +291,7 @@ def history_log_likelihood_reference(
 ) -> np.ndarray:
     """NumPy reference of the compiled history likelihood: (N,) Σ_k m_k log p(z_k | Θ_i)."""
     conc = isotropic_concentration_reference(
-        theta, positions, plume.min_distance, plume.meander, plume.decay
+        theta, positions, plume.min_distance, plume.meander, plume.decay, plume.backflow
     )
     d = positions[None, :, :] - theta[:, None, :3]
     dist = np.maximum(np.sqrt(np.einsum("nki,nki->nk", d, d)), plume.min_distance)

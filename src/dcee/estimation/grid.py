@@ -100,6 +100,7 @@ def _loglik(theta, pts, positions, readings, sensor, plume) -> np.ndarray:
         plume.min_distance,
         plume.meander,
         plume.decay,
+        plume.backflow,
         sensor.params,
         out,
     )

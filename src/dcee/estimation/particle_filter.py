@@ -259,6 +259,7 @@ class ParticleFilter(ResampleMove):
             self.plume.min_distance,
             self.plume.meander,
             self.plume.decay,
+            self.plume.backflow,
             self._sp,
             out,
         )

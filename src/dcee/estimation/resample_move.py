@@ -114,6 +114,7 @@ class ResampleMove:
             self.plume.min_distance,
             self.plume.meander,
             self.plume.decay,
+            self.plume.backflow,
             self._sp,
             ll_prop,
             np.nan_to_num(threshold, nan=-np.inf, posinf=np.inf),

@@ -39,6 +39,19 @@ point source's as x^(−1) or faster; a reading model with the wrong law places 
 upwind of a planar plume (it explains the slower fall by a more distant source). The reading
 model can weigh both (``estimator.learn = {decay = [1, 0.5]}``).
 
+Backflow (``backflow`` = w, 0 by default): near a release in strong turbulence the wind's
+direction swings through large angles, and gas is found upwind of the source. The time mean
+over a wind that blows from φ for a share 1 − w of the time and from φ + π for a share w is
+``(1 − w) · C(φ) + w · C(φ + π)`` (the release rate keeps its meaning). Why one share fits at
+every distance: in the near field, where a plume's spread grows ballistically (σ = i · u · t
+for the turbulence intensity i), the time mean a distance d upwind is P(Z > 1/i) times the
+mean the same distance downwind, whatever d (the integral over travel times is scale-free):
+w ≈ 0.02 for i = 0.5, 0.05 for i = 0.6, 0.1 for i = 0.8. Beyond the Lagrangian time scale the
+spread grows diffusively and upwind gas dies out, which this term does not model: its
+reversed plume reaches as far upwind as the plume downwind, at a share w of its strength (a
+weak term far upwind, where readings are mostly below the threshold anyway). The reading
+model can weigh it (``estimator.learn = {backflow = [0, 0.05]}``).
+
 The distance is clamped at :data:`MIN_DISTANCE` = 0.1 m, the scale of a sensor inlet, so the
 model stays finite when a hypothesised source sits on the sensor (the authors' MATLAB code uses
 1e-5 m, Stone Soup 0.1 m; a tiny clamp makes a particle at the sensor predict absurd
@@ -92,12 +105,22 @@ def isotropic_concentration_reference(
     min_distance: float = MIN_DISTANCE,
     meander: float = 0.0,
     decay: float = 1.0,
+    backflow: float = 0.0,
 ) -> np.ndarray:
     """Plain NumPy implementation of the plume; the compiled kernel is tested against it.
 
     theta: (N, 8); positions: (M, 3) in m. Returns (N, M) concentrations in g/m³.
     """
     theta, positions = _check_shapes(theta, positions)
+    if backflow > 0:
+        # the time mean over a wind that blows from φ + π for a share w of the time
+        reversed_wind = theta.copy()
+        reversed_wind[:, 5] += np.pi
+        return (1.0 - backflow) * isotropic_concentration_reference(
+            theta, positions, min_distance, meander, decay
+        ) + backflow * isotropic_concentration_reference(
+            reversed_wind, positions, min_distance, meander, decay
+        )
     x, y, z, q, u, phi, z1, z2 = (theta[:, k : k + 1] for k in range(8))
     dx = positions[None, :, 0] - x
     dy = positions[None, :, 1] - y
@@ -123,6 +146,7 @@ def isotropic_concentration(
     min_distance: float = MIN_DISTANCE,
     meander: float = 0.0,
     decay: float = 1.0,
+    backflow: float = 0.0,
 ) -> np.ndarray:
     """Expected concentration (g/m³) of the isotropic plume, compiled.
 
@@ -131,7 +155,9 @@ def isotropic_concentration(
     """
     theta, positions = _check_shapes(theta, positions)
     out = np.empty((theta.shape[0], positions.shape[0]))
-    plume_kernels.concentration_matrix(theta, positions, min_distance, meander, decay, out)
+    plume_kernels.concentration_matrix(
+        theta, positions, min_distance, meander, decay, backflow, out
+    )
     return out
 
 
@@ -145,15 +171,20 @@ class IsotropicPlume:
     decay: float = 1.0
     """exponent p of the prefactor's fall with distance, 1/r^p: 1 a point source in 3-D (the
     paper), 1/2 a planar plume (module doc)"""
+    backflow: float = 0.0
+    """share w of the time the wind blows against its mean direction: (1 − w) · the plume +
+    w · the plume of the reversed wind (module doc); 0: none"""
 
     def __post_init__(self) -> None:
         if not (0.0 <= self.meander <= 2.0):
             raise DceeInputError("meander", f"must be in [0, 2], got {self.meander}")
         if not (0.25 <= self.decay <= 2.0):
             raise DceeInputError("decay", f"must be in [0.25, 2], got {self.decay}")
+        if not (0.0 <= self.backflow <= 0.5):
+            raise DceeInputError("backflow", f"must be in [0, 0.5], got {self.backflow}")
 
     def concentration(self, theta: np.ndarray, positions: np.ndarray) -> np.ndarray:
         """(N, 8) source terms × (M, 3) positions → (N, M) concentrations in g/m³."""
         return isotropic_concentration(
-            theta, positions, self.min_distance, self.meander, self.decay
+            theta, positions, self.min_distance, self.meander, self.decay, self.backflow
         )

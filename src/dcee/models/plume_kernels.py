@@ -47,14 +47,9 @@ def plume_terms(theta: np.ndarray, i: int):
 
 
 @njit(cache=True, inline="always")
-def plume_at(terms, px: float, py: float, pz: float, rmin: float, meander: float, decay: float):
-    """(concentration, clamped distance r) at (px, py, pz) from one particle's
-    :func:`plume_terms`; see :mod:`dcee.models.plume` for ``meander`` and ``decay``."""
-    sx, sy, sz, pref, inv_lam, ax, ay, c, s, k = terms
-    dx = px - sx
-    dy = py - sy
-    dz = pz - sz
-    r0 = math.sqrt(dx * dx + dy * dy + dz * dz)
+def _advected(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay):
+    """The advected plume at offset (dx, dy, dz) from the source, wind terms (ax, ay, c, s, k)
+    as :func:`plume_terms` gives them (negated: the plume of the reversed wind)."""
     factor = 1.0
     if meander > 0.0:
         down = -(dx * c + dy * s)  # distance downwind of the source
@@ -66,10 +61,36 @@ def plume_at(terms, px: float, py: float, pz: float, rmin: float, meander: float
     r = math.sqrt(dx * dx + dy * dy + dz * dz)
     if r < rmin:
         r = rmin
+    spread = r if decay == 1.0 else r**decay
+    return factor * pref / spread * math.exp(-r * inv_lam - dx * ax - dy * ay)
+
+
+@njit(cache=True, inline="always")
+def plume_at(
+    terms,
+    px: float,
+    py: float,
+    pz: float,
+    rmin: float,
+    meander: float,
+    decay: float,
+    backflow: float,
+):
+    """(concentration, clamped distance r) at (px, py, pz) from one particle's
+    :func:`plume_terms`; see :mod:`dcee.models.plume` for ``meander``, ``decay`` and
+    ``backflow`` (w: (1 − w) · the plume + w · the plume of the reversed wind)."""
+    sx, sy, sz, pref, inv_lam, ax, ay, c, s, k = terms
+    dx = px - sx
+    dy = py - sy
+    dz = pz - sz
+    r0 = math.sqrt(dx * dx + dy * dy + dz * dz)
     if r0 < rmin:
         r0 = rmin
-    spread = r if decay == 1.0 else r**decay
-    return factor * pref / spread * math.exp(-r * inv_lam - dx * ax - dy * ay), r0
+    value = _advected(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay)
+    if backflow > 0.0:
+        reverse = _advected(dx, dy, dz, pref, inv_lam, -ax, -ay, -c, -s, k, rmin, meander, decay)
+        value = (1.0 - backflow) * value + backflow * reverse
+    return value, r0
 
 
 @njit(cache=True, inline="always")
@@ -129,6 +150,7 @@ def concentration_grid(
     rmin: float,
     meander: float,
     decay: float,
+    backflow: float,
     out: np.ndarray,
 ):
     """out[m, i] = C(positions[m]; theta[i]). theta (N, 8), positions (M, 3), out (M, N)."""
@@ -138,7 +160,14 @@ def concentration_grid(
         terms = plume_terms(theta, i)
         for m in range(m_count):
             out[m, i] = plume_at(
-                terms, positions[m, 0], positions[m, 1], positions[m, 2], rmin, meander, decay
+                terms,
+                positions[m, 0],
+                positions[m, 1],
+                positions[m, 2],
+                rmin,
+                meander,
+                decay,
+                backflow,
             )[0]
 
 
@@ -149,6 +178,7 @@ def concentration_distance_grid(
     rmin: float,
     meander: float,
     decay: float,
+    backflow: float,
     conc: np.ndarray,
     dist: np.ndarray,
 ):
@@ -159,7 +189,14 @@ def concentration_distance_grid(
         terms = plume_terms(theta, i)
         for m in range(m_count):
             c, r = plume_at(
-                terms, positions[m, 0], positions[m, 1], positions[m, 2], rmin, meander, decay
+                terms,
+                positions[m, 0],
+                positions[m, 1],
+                positions[m, 2],
+                rmin,
+                meander,
+                decay,
+                backflow,
             )
             conc[m, i] = c
             dist[m, i] = r
@@ -171,9 +208,10 @@ def concentration_matrix(
     rmin: float,
     meander: float,
     decay: float,
+    backflow: float,
     out: np.ndarray,
 ):
     """out[i, m] = C(positions[m]; theta[i]); out (N, M) C-contiguous."""
     tmp = np.empty((positions.shape[0], theta.shape[0]))
-    concentration_grid(theta, positions, rmin, meander, decay, tmp)
+    concentration_grid(theta, positions, rmin, meander, decay, backflow, tmp)
     out[...] = tmp.T

@@ -161,7 +161,14 @@ def floor_decision(
     shape = (positions.shape[0], theta.shape[0])
     conc, dist = np.empty(shape), np.empty(shape)
     concentration_distance_grid(
-        theta, positions, plume.min_distance, plume.meander, plume.decay, conc, dist
+        theta,
+        positions,
+        plume.min_distance,
+        plume.meander,
+        plume.decay,
+        plume.backflow,
+        conc,
+        dist,
     )
     terms = tuple(np.empty(shape) for _ in range(4))
     _floor_position_terms(conc, dist, sensor.params, *terms)

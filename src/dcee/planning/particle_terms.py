@@ -105,14 +105,15 @@ class ParticleTerms:
         nothing changed."""
         theta = np.asarray(theta, dtype=np.float64)
         key = self._fingerprint(theta)
-        models = (plume.min_distance, plume.meander, plume.decay), tuple(sensor.params)
+        models = (plume.min_distance, plume.meander, plume.decay, plume.backflow)
+        models = models, tuple(sensor.params)
         if key == self._key and models == (self._plume, self._sensor_params):
             return
         self._key = key
         self._plume, self._sensor_params = models
         self.sp = sensor.params
         self.min_distance, self.meander = plume.min_distance, plume.meander
-        self.decay = plume.decay
+        self.decay, self.backflow = plume.decay, plume.backflow
         if self.merge:
             self.starts = merge_runs(theta)
             self.theta = np.ascontiguousarray(theta[self.starts])
@@ -227,6 +228,7 @@ class ParticleTerms:
                 self.min_distance,
                 self.meander,
                 self.decay,
+                self.backflow,
                 self.sp,
                 *self.terms,
             )
@@ -243,7 +245,7 @@ class ParticleTerms:
         rows cached so far (copied, same row numbers)."""
         other = ParticleTerms(merge=False, max_bytes=self.max_bytes)
         other.sp, other.min_distance, other.meander = self.sp, self.min_distance, self.meander
-        other.decay = self.decay
+        other.decay, other.backflow = self.decay, self.backflow
         other._plume, other._sensor_params = self._plume, self._sensor_params
         other.theta = np.ascontiguousarray(self.theta[keep])
         other._plume_constants = np.ascontiguousarray(self._plume_constants[:, keep])

@@ -120,6 +120,7 @@ def position_rows(
     rmin: float,
     meander: float,
     decay: float,
+    backflow: float,
     sp: SensorParams,
     conc: np.ndarray,
     dist: np.ndarray,
@@ -139,8 +140,9 @@ def position_rows(
     :meth:`~dcee.models.sensor.Sensor.log_likelihood`.
 
     Blocks of particles run in parallel. The paper's sensor (Gaussian family, constant Pd < 1)
-    without meander and with decay 1 takes :func:`_rows_gaussian`, vectorised with the ``exp``,
-    ``log`` and ``erfc`` of :mod:`dcee.numeric`; every other case the scalar formulas with libm
+    without meander or backflow and with decay 1 takes :func:`_rows_gaussian`, vectorised with
+    the ``exp``, ``log`` and ``erfc`` of :mod:`dcee.numeric`; every other case the scalar
+    formulas with libm
     (with Pd = 1, log Φ needs relative accuracy far in the tail).
     """
     n = plume.shape[1]
@@ -151,6 +153,7 @@ def position_rows(
         and sp.near_length == 0.0
         and meander == 0.0
         and decay == 1.0
+        and backflow == 0.0
         and sp.sigma_min >= 2.0**-60  # σ within the range of the vectorised log
     )
     for b in prange(n_blocks):
@@ -180,7 +183,7 @@ def position_rows(
                 )
                 continue
             for i in range(i0, i1):
-                c, r = plume_at(constants_at(plume, i), px, py, pz, rmin, meander, decay)
+                c, r = plume_at(constants_at(plume, i), px, py, pz, rmin, meander, decay, backflow)
                 m, sigma = transform(c, r, sp)
                 conc[row, i] = c
                 dist[row, i] = r

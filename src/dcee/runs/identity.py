@@ -53,6 +53,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("estimator", "learn"): {},
     # the point source's 1/r before issue 42's decay setting
     ("estimator", "decay"): 1.0,
+    # no gas upwind of the release before issue 42's backflow setting
+    ("estimator", "backflow"): 0.0,
     # input only (a compass bearing converted to phi), always unset once validated
     ("truth", "wind_from"): None,
 }
@@ -72,6 +74,7 @@ FLUCTUATION_ONLY = (
     "magnitude",
     "conserve_mean",
     "decay",
+    "backflow",
     "learn",
 )
 """Estimator settings that only the fluctuation likelihood reads: under the paper's likelihood

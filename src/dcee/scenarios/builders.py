@@ -103,6 +103,7 @@ class ScenarioBuilders:
         return IsotropicPlume(
             meander=learned.get("meander", self.meander),
             decay=learned.get("decay", self.estimator.decay),
+            backflow=learned.get("backflow", self.estimator.backflow),
         )
 
     def _reading_model(self, model: str | None) -> str:

@@ -161,7 +161,7 @@ class AnemometerSpec(BaseModel):
 
 
 LearnedName = Literal[
-    "meander", "log_sd", "log_sd_near", "intermittency", "near_source_length", "decay"
+    "meander", "log_sd", "log_sd_near", "intermittency", "near_source_length", "decay", "backflow"
 ]
 """The reading model's nuisance parameters ``estimator.learn`` may weigh."""
 LEARN_RANGES: dict[str, tuple[float, float]] = {
@@ -171,6 +171,7 @@ LEARN_RANGES: dict[str, tuple[float, float]] = {
     "intermittency": (1e-3, 1.0),
     "near_source_length": (0.0, 1000.0),
     "decay": (0.25, 2.0),
+    "backflow": (0.0, 0.5),
 }
 """Allowed values of each learned setting (as for the fixed setting)."""
 LEARN_MEMBERS_MAX = 12
@@ -236,6 +237,11 @@ class EstimatorSpec(BaseModel):
     """fluctuation: the plume model's fall with distance, 1/r^decay (:mod:`dcee.models.plume`):
     1, a point source in 3-D (the paper's model); 1/2, a planar plume's far field. The paper's
     likelihood and the calm member always use 1"""
+    backflow: Annotated[float, Field(ge=0.0, le=0.5, allow_inf_nan=False)] = 0.0
+    """fluctuation: the share w of the time the plume model's wind blows against its mean
+    direction, (1 − w) · C(φ) + w · C(φ + π) (:mod:`dcee.models.plume`): gas upwind of the
+    release, as near a source in strong turbulence. 0: none (the paper's model). The paper's
+    likelihood and the calm member always use 0"""
     meander: Annotated[float | None, Field(ge=0, le=2)] = None
     """crosswind turbulence intensity of the plume model's time-mean meander broadening
     (:mod:`dcee.models.plume`); None: the likelihood's default, :data:`MEANDER_DEFAULT`"""
