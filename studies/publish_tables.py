@@ -665,8 +665,6 @@ def learn_tuning_table() -> str:
     be chosen on), paired by search (studies/precision_variants.py's rows in
     docs/results/tuning-*-13-40; the old defaults ran in the first two, reading for reading the
     same). The last candidate is today's default."""
-    from scipy.stats import binomtest, wilcoxon
-
     frame = pd.concat(
         pd.read_csv(RESULTS / folder / "variants.csv")
         for folder in (
@@ -677,8 +675,6 @@ def learn_tuning_table() -> str:
             "tuning-nsl05-rp05-13-40",
         )
     )
-    key = ["truth", "scenario", "seed"]
-    frame = frame.drop_duplicates(["variant", *key])
     names = {
         "base": "defaults before 2026-11-27 (2.5 m fall, repeat power 1/4)",
         "decay": "`learn = {decay = [1, 0.5]}`",
@@ -689,9 +685,32 @@ def learn_tuning_table() -> str:
         "nsl05": "`near_source_length = 0.5` (fixed, not learned)",
         "nsl05rp05": "**today's defaults**: `near_source_length = 0.5`, `repeat_power = 0.5`",
     }
+    order = ("base", "decay", "both", "nsl", "sd", "nearsd", "nsl05", "nsl05rp05")
+    return _variant_table(frame, names, order, "the defaults before 2026-11-27")
+
+
+def backflow_tuning_table() -> str:
+    """Gas upwind of the release, learned, against today's defaults on the tuning range, both
+    flown in one run (docs/results/tuning-backflow-13-40; the rule in its README)."""
+    frame = pd.read_csv(RESULTS / "tuning-backflow-13-40" / "variants.csv")
+    names = {
+        "base": "today's defaults",
+        "backflow": "`learn = {backflow = [0, 0.05]}`",
+    }
+    return _variant_table(frame, names, ("base", "backflow"), "today's defaults")
+
+
+def _variant_table(frame: pd.DataFrame, names: dict, order: tuple, base_name: str) -> str:
+    """Rows per variant and truth (and both truths), each variant paired by search with the
+    variant ``base``: acquisition, median final RMSE, share in the 95 % region, along-wind
+    error; Wilcoxon on the final RMSE, exact binomial on the region gained / lost."""
+    from scipy.stats import binomtest, wilcoxon
+
+    key = ["truth", "scenario", "seed"]
+    frame = frame.drop_duplicates(["variant", *key])
     base = frame[frame["variant"] == "base"]
     rows = []
-    for variant in ("base", "decay", "both", "nsl", "sd", "nearsd", "nsl05", "nsl05rp05"):
+    for variant in order:
         for truth in ("filament", "puffs", "both truths"):
             part = frame[frame["variant"] == variant]
             if truth != "both truths":
@@ -733,8 +752,7 @@ def learn_tuning_table() -> str:
         "median final RMSE (m)",
         "truth in 95 %",
         "median along-wind error (m)",
-        "paired with the defaults before 2026-11-27: final RMSE, median difference; 95 % region "
-        "gained / lost",
+        f"paired with {base_name}: final RMSE, median difference; 95 % region gained / lost",
     ]
     return table(header, rows)
 
@@ -1051,6 +1069,7 @@ def search_speed_table() -> str:
 
 TABLES: dict[str, Callable[[], str]] = {
     "learn-tuning": learn_tuning_table,
+    "backflow-tuning": backflow_tuning_table,
     "cross-truth": cross_truth_table,
     "lbm-statistics": lbm_statistics_table,
     "what-we-found": what_we_found,

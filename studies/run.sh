@@ -141,7 +141,10 @@ case "${1:---list}" in
     export SUITE=held-out-100 WORKERS=${WORKERS:-2}
     today=(--set estimator.near_source_length=0.5 --set estimator.repeat_radius=2.0
       --set estimator.repeat_power=0.5)
-    OUT_SUFFIX=-today bash studies/study_turbulent_held_out.sh "${today[@]}"
+    # with the backflow member (the default since 2026-11-27, later)
+    OUT_SUFFIX=-today-bf bash studies/study_turbulent_held_out.sh "${today[@]}"
+    # without it (the defaults of 2026-11-27 before it; pinned)
+    OUT_SUFFIX=-today bash studies/study_turbulent_held_out.sh "${today[@]}" --set 'estimator.learn={}'
     out=docs/results/turbulent-held-out-100-today
     mkdir -p "$out"
     report turbulent-puffs-held-out-100-today turbulent-filament-held-out-100-today
@@ -390,13 +393,19 @@ case "${1:---list}" in
   cross-truth)  # every truth at today's defaults; the lbm plume held out (docs/plumes.md, README)
     # dcee-cl, infotaxis and the tree search at today's defaults, 100 held-out configurations
     export SUITE=held-out-100 TRUTHS=lbm WORKERS=${WORKERS:-2}
-    bash studies/study_turbulent_held_out.sh --set truth.z=4.0
-    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-today bash studies/study_turbulent_held_out.sh \
+    # today's defaults (the backflow member learned since 2026-11-27, later)
+    OUT_SUFFIX=-bf bash studies/study_turbulent_held_out.sh --set truth.z=4.0
+    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-bf bash studies/study_turbulent_held_out.sh \
       --set truth.z=4.0
+    # the defaults of 2026-11-27 before the backflow member (pinned: no learned setting)
+    nobf=(--set truth.z=4.0 --set 'estimator.learn={}')
+    bash studies/study_turbulent_held_out.sh "${nobf[@]}"
+    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-today bash studies/study_turbulent_held_out.sh "${nobf[@]}"
     # the same at the defaults of 2026-11-23 to 11-27 (a 2.5 m near-source fall, repeat power 1/4),
     # and options measured at those defaults (they decide nothing): dcee-cl with the learned
     # decay and the learned near-source intermittency, the tree search, 20,000 particles
-    old=(--set truth.z=4.0 --set estimator.near_source_length=2.5 --set estimator.repeat_power=0.25)
+    old=(--set truth.z=4.0 --set estimator.near_source_length=2.5 --set estimator.repeat_power=0.25
+      --set 'estimator.learn={}')
     OUT_SUFFIX=-nsl25 bash studies/study_turbulent_held_out.sh "${old[@]}"
     STRATEGIES=dcee-cl OUT_SUFFIX=-decay bash studies/study_turbulent_held_out.sh "${old[@]}" \
       --set 'estimator.learn={decay=[1.0,0.5]}'

@@ -742,3 +742,30 @@ def test_an_override_that_changes_no_stored_scenario_keeps_the_campaign():
     assert settings_identity(stored) == settings_identity(now)
     moved = {**now, "scenarios": {"random:13": today.model_dump(mode="json")}}
     assert settings_identity(stored) != settings_identity(moved)
+
+
+def test_a_fluctuation_campaign_stored_before_the_backflow_member_is_not_todays_default():
+    """The fluctuation likelihood's unset ``estimator.learn`` weighs a backflow member since
+    issue 42: a campaign stored with no learned setting ({} or no key) is not today's default,
+    but resumes with the grid pinned to {}; an explicit grid equal to the default is the
+    default; under the paper's likelihood nothing changed."""
+    from dcee.runs import scenario_identity
+    from dcee.scenarios import load_scenario
+
+    fluct = load_scenario("paper:1").with_overrides(**{"estimator.likelihood": "fluctuation"})
+    now = scenario_identity(fluct.model_dump(mode="json"))
+    stored = fluct.model_dump(mode="json")
+    stored["estimator"]["learn"] = {}
+    missing = fluct.model_dump(mode="json")
+    missing["estimator"].pop("learn")
+    missing["estimator"].pop("backflow")
+    assert scenario_identity(stored) != now
+    assert scenario_identity(missing) == scenario_identity(stored)
+    pinned = fluct.with_overrides(**{"estimator.learn": {}})
+    assert scenario_identity(pinned.model_dump(mode="json")) == scenario_identity(stored)
+    explicit = fluct.with_overrides(**{"estimator.learn": {"backflow": [0.0, 0.05]}})
+    assert scenario_identity(explicit.model_dump(mode="json")) == now
+    paper = load_scenario("paper:1").model_dump(mode="json")
+    old_paper = load_scenario("paper:1").model_dump(mode="json")
+    old_paper["estimator"].pop("learn")
+    assert scenario_identity(paper) == scenario_identity(old_paper)

@@ -371,9 +371,10 @@ def test_run_with_fluctuation_likelihood_records_the_resolved_settings(tmp_path,
     assert isinstance(summary["truth_in_95"], bool)
     config = json.loads((out / "config.json").read_text())
     assert config["scenario"]["estimator"]["log_sd"] == 1.1
-    # the calm model runs beside it: the summary and the printed table name the chosen model
-    assert summary["reading_models"] == "fluctuation+paper"
-    assert summary["model"] in ("fluctuation", "paper")
+    # the backflow member and the calm model run beside it: the summary and the printed table
+    # name the chosen model
+    assert summary["reading_models"] == "fluctuation+fluctuation[backflow=0.05]+paper"
+    assert summary["model"] in ("fluctuation", "fluctuation[backflow=0.05]", "paper")
     row = next(line for line in printed.splitlines() if "reading model" in line)
     assert summary["model"] in row and f"{summary['model_probability']:.3f}" in row
 

@@ -9,6 +9,7 @@ import copy
 from typing import Any
 
 from dcee.scenarios import (
+    LEARN_DEFAULT,
     OLD_OUTLIER_DEFAULT,
     READING_WEIGHT_DEFAULT,
     REPEAT_DEFAULT,
@@ -149,6 +150,10 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
             if key in estimator and estimator[key] is None:
                 # unset: the likelihood's default, compared as the number it stands for
                 estimator[key] = _unset_repeat(likelihood, estimator)[k]
+        if "learn" in estimator and estimator["learn"] is None:
+            # unset: the grid it resolved to (Scenario.learn), compared as that grid
+            fixed_backflow = estimator.get("backflow", 0.0)
+            estimator["learn"] = {} if fixed_backflow else LEARN_DEFAULT[likelihood]
         if estimator.get("repeat_radius", 0.0) == 0.0:
             # no repeat discount: its power decides nothing
             estimator.pop("repeat_power", None)

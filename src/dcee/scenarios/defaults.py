@@ -57,6 +57,10 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
         ("filament", "puffs"), "random:13-40, dcee-cl, with repeat_power 0.5 (issue 42)"
     ),
     ("estimator", "conserve_mean"): Provenance(("filament", "puffs"), "random:13-40, dcee-cl"),
+    ("estimator", "learn"): Provenance(
+        ("filament", "puffs"),
+        "backflow = [0, 0.05] weighed beside the fixed 0: random:13-40, dcee-cl (issue 42)",
+    ),
     ("estimator", "meander"): Provenance(("filament",), "the filament truth's time mean"),
     ("estimator", "reading_weight"): Provenance(
         ("filament", "puffs"), "random:1-12, dcee-cl and infotaxis"

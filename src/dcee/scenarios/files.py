@@ -126,6 +126,7 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
         ("sensor", "dropout"): round(1.0 - scenario.instrument_pd, 12),
         ("sensor", "average"): scenario.average,
         ("estimator", "meander"): scenario.meander,
+        ("estimator", "learn"): scenario.learn,
         ("estimator", "reading_weight"): scenario.reading_weight,
         ("estimator", "repeat_radius"): scenario.repeat_radius,
         ("estimator", "repeat_power"): scenario.repeat_power,

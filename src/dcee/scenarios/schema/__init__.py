@@ -10,6 +10,7 @@ from dcee.scenarios.schema.agent import (
 )
 from dcee.scenarios.schema.common import FROZEN, Finite, Positive
 from dcee.scenarios.schema.estimator import (
+    LEARN_DEFAULT,
     LIKELIHOODS,
     MEANDER_DEFAULT,
     OLD_OUTLIER_DEFAULT,
@@ -39,6 +40,7 @@ __all__ = [
     "AUTO_CLIMB",
     "FIELD_MARK",
     "FROZEN",
+    "LEARN_DEFAULT",
     "LIKELIHOODS",
     "MEANDER_DEFAULT",
     "OLD_OUTLIER_DEFAULT",

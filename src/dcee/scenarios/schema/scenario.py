@@ -17,6 +17,7 @@ from dcee.scenarios.builders import ScenarioBuilders
 from dcee.scenarios.schema.agent import AgentSpec, SearchSpec, team_starts, unset_climb
 from dcee.scenarios.schema.common import FIELD_MARK, FROZEN, phi_prior_from_bearing
 from dcee.scenarios.schema.estimator import (
+    LEARN_DEFAULT,
     LEARN_MEMBERS_MAX,
     LEARN_RANGES,
     MEANDER_DEFAULT,
@@ -165,20 +166,21 @@ class Scenario(ScenarioBuilders, BaseModel):
         """``estimator.learn``: the fluctuation likelihood's, in range, the fixed values in the
         grid, not too many members."""
         e = self.estimator
-        if not e.learn:
+        learn = self.learn
+        if not learn:
             return
         if e.likelihood != "fluctuation":
             raise ValueError(
                 f"{FIELD_MARK}estimator.learn: weighs the fluctuation model's settings; needs "
                 f'estimator.likelihood = "fluctuation" (it is "{e.likelihood}")'
             )
-        if "log_sd_near" in e.learn and e.log_sd_length == 0:
+        if "log_sd_near" in learn and e.log_sd_length == 0:
             raise ValueError(
                 f"{FIELD_MARK}estimator.learn.log_sd_near: the near-source spread needs "
                 "estimator.log_sd_length > 0 (m; with 0 the spread is the same everywhere)"
             )
         members = 1
-        for key, values in e.learn.items():
+        for key, values in learn.items():
             low, high = LEARN_RANGES[key]
             bad = [v for v in values if not (low <= v <= high) or not np.isfinite(v)]
             if bad or len(set(values)) != len(values):
@@ -307,6 +309,17 @@ class Scenario(ScenarioBuilders, BaseModel):
         return 1.0 if self.time_varying_truth else self.sensor.pd
 
     @property
+    def learn(self) -> dict[str, list[float]]:
+        """``estimator.learn`` resolved: as given, or the likelihood's default
+        (:data:`LEARN_DEFAULT`; none where ``estimator.backflow`` was fixed by hand)."""
+        e = self.estimator
+        if e.learn is not None:
+            return e.learn
+        if e.likelihood == "fluctuation" and e.backflow != 0.0:
+            return {}
+        return LEARN_DEFAULT[e.likelihood]
+
+    @property
     def meander(self) -> float:
         e = self.estimator
         return e.meander if e.meander is not None else MEANDER_DEFAULT[e.likelihood]
@@ -363,9 +376,10 @@ class Scenario(ScenarioBuilders, BaseModel):
         e = self.estimator
         if e.likelihood != "fluctuation":
             return (("paper", {}),)
-        keys = list(e.learn)
+        learn = self.learn
+        keys = list(learn)
         fixed = tuple(self._fluctuation_value(k) for k in keys)
-        combos = [fixed, *(c for c in itertools.product(*e.learn.values()) if c != fixed)]
+        combos = [fixed, *(c for c in itertools.product(*learn.values()) if c != fixed)]
         members: list[tuple[str, dict[str, float]]] = []
         for combo in combos:
             settings = dict(zip(keys, combo, strict=True))
