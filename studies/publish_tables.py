@@ -589,11 +589,15 @@ CROSS_HEADER = [
 ]
 
 
-TODAY_DEFAULTS = "2026-11-27"
+TODAY_DEFAULTS = "2026-11-27b"
 """The ``defaults`` tag of rows flown at today's defaults (a 0.5 m near-source fall, repeat
-power 1/2)."""
-OLD_DEFAULTS = "defaults of 2026-11-23 (2.5 m fall, repeat power 1/4)"
-"""How a row flown before today's defaults says so."""
+power 1/2, the backflow member learned)."""
+EARLIER_DEFAULTS = {
+    "2026-11-27": "defaults of 2026-11-27 before the backflow member",
+    "2026-11-23": "defaults of 2026-11-23 (2.5 m fall, repeat power 1/4, no backflow member)",
+}
+"""How a row flown before today's defaults says so, by its ``defaults`` tag."""
+OLD_DEFAULTS = EARLIER_DEFAULTS["2026-11-23"]
 
 
 def cross_truth_table() -> str:
@@ -619,6 +623,9 @@ def cross_truth_table() -> str:
             ]
         )
 
+    def flown(defaults: str) -> str:
+        return "" if defaults == TODAY_DEFAULTS else f", {EARLIER_DEFAULTS[defaults]}"
+
     for strategy in ("dcee-cl", "infotaxis", "dcee-mcts"):
         add(
             "isotropic, paper's likelihood",
@@ -627,16 +634,20 @@ def cross_truth_table() -> str:
             "held-out-today",
         )
     for truth, chosen in (
-        ("filament", "**yes**: the fluctuation model's settings, climb, hold"),
-        ("puffs", "**yes**: climb, near-source fall, repeat discount"),
+        ("filament", "**yes**: the fluctuation model's settings, climb, hold, backflow member"),
+        ("puffs", "**yes**: climb, near-source fall, repeat discount, backflow member"),
     ):
-        for strategy in ("dcee-cl", "infotaxis"):
-            add(
-                f"{truth}, fluctuation likelihood",
-                chosen,
-                pick(turbulent_today, strategy, truth_model=truth),
-                "turbulent-held-out-100-today",
-            )
+        for defaults in sorted(set(turbulent_today["defaults"].astype(str)), reverse=True):
+            for strategy in ("dcee-cl", "infotaxis"):
+                part = turbulent_today[turbulent_today["defaults"].astype(str) == defaults]
+                if not ((part["strategy"] == strategy) & (part["truth_model"] == truth)).any():
+                    continue
+                add(
+                    f"{truth}, fluctuation likelihood{flown(defaults)}",
+                    chosen,
+                    pick(part, strategy, truth_model=truth),
+                    "turbulent-held-out-100-today",
+                )
         if truth == "filament":
             add(
                 f"filament, fluctuation likelihood, {OLD_DEFAULTS}",
@@ -644,15 +655,14 @@ def cross_truth_table() -> str:
                 pick(today, "dcee-mcts", study="filament"),
                 "held-out-today",
             )
-    lbm = lbm.assign(old=lbm["defaults"].astype(str) != TODAY_DEFAULTS).sort_values(
-        "old", kind="stable"
-    )
+    lbm = lbm.assign(
+        order=lbm["defaults"].astype(str).map({TODAY_DEFAULTS: 0, "2026-11-27": 1}).fillna(2)
+    ).sort_values("order", kind="stable")
     for _, r in lbm.iterrows():
         how = "" if r["learn"] == "none" else f", `estimator.learn` {r['learn']} (an option)"
         if int(r.get("particles", 10000)) != 10000:
             how += f", {int(r['particles']):,} particles (measured, not chosen on)"
-        if r["old"]:
-            how += f", {OLD_DEFAULTS}"
+        how += flown(str(r["defaults"]))
         if int(r["searches"]) < 100:
             how += f", {int(r['searches'])} configurations (small sample)"
         add(f"**lbm** (fluid solver), fluctuation likelihood{how}", "none", r, "lbm-held-out-100")
@@ -694,10 +704,10 @@ def backflow_tuning_table() -> str:
     flown in one run (docs/results/tuning-backflow-13-40; the rule in its README)."""
     frame = pd.read_csv(RESULTS / "tuning-backflow-13-40" / "variants.csv")
     names = {
-        "base": "today's defaults",
-        "backflow": "`learn = {backflow = [0, 0.05]}`",
+        "base": "defaults of 2026-11-27 before the backflow member",
+        "backflow": "**today's defaults**: `learn = {backflow = [0, 0.05]}`",
     }
-    return _variant_table(frame, names, ("base", "backflow"), "today's defaults")
+    return _variant_table(frame, names, ("base", "backflow"), "the defaults before it")
 
 
 def _variant_table(frame: pd.DataFrame, names: dict, order: tuple, base_name: str) -> str:

@@ -147,8 +147,11 @@ case "${1:---list}" in
     OUT_SUFFIX=-today bash studies/study_turbulent_held_out.sh "${today[@]}" --set 'estimator.learn={}'
     out=docs/results/turbulent-held-out-100-today
     mkdir -p "$out"
-    report turbulent-puffs-held-out-100-today turbulent-filament-held-out-100-today
+    report turbulent-puffs-held-out-100-today-bf turbulent-filament-held-out-100-today-bf \
+      turbulent-puffs-held-out-100-today turbulent-filament-held-out-100-today
     $P studies/collect_metrics.py --out "$out" \
+      "results/turbulent-puffs-held-out-100-today-bf=truth_model:puffs,defaults:2026-11-27b" \
+      "results/turbulent-filament-held-out-100-today-bf=truth_model:filament,defaults:2026-11-27b" \
       "results/turbulent-puffs-held-out-100-today=truth_model:puffs,defaults:2026-11-27" \
       "results/turbulent-filament-held-out-100-today=truth_model:filament,defaults:2026-11-27"
     # paired with the defaults of 2026-11-23 where their searches are stored (the filament's,
@@ -158,6 +161,13 @@ case "${1:---list}" in
       $P studies/ablation_table.py "docs/results/held-out-today/searches.csv=$s:study:filament" \
         "results/turbulent-filament-held-out-100-today=$s" --csv "$out/paired.csv" \
         --tag truth_model=filament --tag reference=defaults-2026-11-23
+    done
+    # the backflow member against the defaults just before it, search by search
+    rm -f "$out/backflow_vs_before.csv"
+    for t in puffs filament; do
+      $P studies/pair_campaigns.py "results/turbulent-$t-held-out-100-today" \
+        "results/turbulent-$t-held-out-100-today-bf" --csv "$out/backflow_vs_before.csv" \
+        --tag "truth_model=$t"
     done
     $P studies/publish_tables.py ;;
   turbulent-public)  # the twelve public configurations on both turbulent truths: the third round's and today's defaults
@@ -415,10 +425,13 @@ case "${1:---list}" in
     STRATEGIES=dcee-cl OUT_SUFFIX=-20k bash studies/study_turbulent_held_out.sh "${old[@]}" \
       --particles 20000
     r=results/turbulent-lbm-held-out-100
-    report turbulent-lbm-held-out-100 turbulent-lbm-held-out-100-mcts-today \
+    report turbulent-lbm-held-out-100-bf turbulent-lbm-held-out-100-mcts-bf \
+      turbulent-lbm-held-out-100 turbulent-lbm-held-out-100-mcts-today \
       turbulent-lbm-held-out-100-nsl25 turbulent-lbm-held-out-100-decay \
       turbulent-lbm-held-out-100-mcts turbulent-lbm-held-out-100-nsl turbulent-lbm-held-out-100-20k
     $P studies/collect_metrics.py --out docs/results/lbm-held-out-100 \
+      "$r-bf=defaults:2026-11-27b,learn:none,particles:10000" \
+      "$r-mcts-bf=defaults:2026-11-27b,learn:none,particles:10000" \
       "$r=defaults:2026-11-27,learn:none,particles:10000" \
       "$r-mcts-today=defaults:2026-11-27,learn:none,particles:10000" \
       "$r-nsl25=defaults:2026-11-23,learn:none,particles:10000" \
@@ -426,19 +439,28 @@ case "${1:---list}" in
       "$r-mcts=defaults:2026-11-23,learn:none,particles:10000" \
       "$r-nsl=defaults:2026-11-23,learn:near_source_length,particles:10000" \
       "$r-20k=defaults:2026-11-23,learn:none,particles:20000"
-    rm -f docs/results/lbm-held-out-100/paired.csv docs/results/lbm-held-out-100/today_vs_before.csv
+    rm -f docs/results/lbm-held-out-100/paired.csv docs/results/lbm-held-out-100/today_vs_before.csv \
+      docs/results/lbm-held-out-100/backflow_vs_before.csv
     for ref in infotaxis dcee-cl; do
       $P studies/ablation_table.py "$r-nsl25=$ref" "$r-nsl25=dcee-cl" "$r-decay=dcee-cl" \
         "$r-mcts=dcee-mcts" "$r-nsl=dcee-cl" "$r-20k=dcee-cl" \
         --csv docs/results/lbm-held-out-100/paired.csv --tag "reference=$ref" --tag defaults=2026-11-23
       $P studies/ablation_table.py "$r=$ref" "$r=dcee-cl" "$r-mcts-today=dcee-mcts" \
         --csv docs/results/lbm-held-out-100/paired.csv --tag "reference=$ref" --tag defaults=2026-11-27
+      $P studies/ablation_table.py "$r-bf=$ref" "$r-bf=dcee-cl" "$r-mcts-bf=dcee-mcts" \
+        --csv docs/results/lbm-held-out-100/paired.csv --tag "reference=$ref" --tag defaults=2026-11-27b
+    done
+    # the backflow member against the defaults just before it, search by search
+    for pair in "$r:$r-bf" "$r-mcts-today:$r-mcts-bf"; do
+      $P studies/pair_campaigns.py "${pair%%:*}" "${pair#*:}" \
+        --csv docs/results/lbm-held-out-100/backflow_vs_before.csv --tag truth_model=lbm
     done
     # today's defaults against those before, search by search
     $P studies/pair_campaigns.py "$r-nsl25" "$r" --csv docs/results/lbm-held-out-100/today_vs_before.csv \
       --tag truth_model=lbm
-    $P studies/worst_searches.py "$r=dcee-cl" "$r=infotaxis" --out docs/figures/lbm-held-out-worst.png
-    $P studies/upwind_detections.py "$r=dcee-cl" "$r=infotaxis" "$r-nsl25=dcee-cl" \
+    $P studies/worst_searches.py "$r-bf=dcee-cl" "$r-bf=infotaxis" --out docs/figures/lbm-held-out-worst.png
+    $P studies/upwind_detections.py "$r-bf=dcee-cl" "$r-bf=infotaxis" "$r-mcts-bf=dcee-mcts" \
+      "$r=dcee-cl" "$r=infotaxis" "$r-nsl25=dcee-cl" \
       "$r-nsl25=infotaxis" "$r-decay=dcee-cl" "$r-mcts=dcee-mcts" "$r-nsl=dcee-cl"
     $P studies/publish_tables.py ;;
   publish)  # the tables of README.md, docs/index.md, docs/results.md from docs/results/

@@ -44,9 +44,10 @@ direction swings through large angles, and gas is found upwind of the source. Th
 over a wind that blows from φ for a share 1 − w of the time and from φ + π for a share w is
 ``(1 − w) · C(φ) + w · C(φ + π)`` (the release rate keeps its meaning). Why one share fits at
 every distance: in the near field, where a plume's spread grows ballistically (σ = i · u · t
-for the turbulence intensity i), the time mean a distance d upwind is P(Z > 1/i) times the
-mean the same distance downwind, whatever d (the integral over travel times is scale-free):
-w ≈ 0.02 for i = 0.5, 0.05 for i = 0.6, 0.1 for i = 0.8. Beyond the Lagrangian time scale the
+for the turbulence intensity i), the time mean a distance d upwind is a fixed fraction of the
+mean the same distance downwind, whatever d (the integral over travel times is scale-free): in
+a planar plume P(Z > 1/i) / P(Z < 1/i), 0.023 for i = 0.5, 0.050 for i = 0.6, 0.12 for
+i = 0.8; in three dimensions less (0.004, 0.012, 0.039; numerical integration). Beyond the Lagrangian time scale the
 spread grows diffusively and upwind gas dies out, which this term does not model: its
 reversed plume reaches as far upwind as the plume downwind, at a share w of its strength (a
 weak term far upwind, where readings are mostly below the threshold anyway). The reading

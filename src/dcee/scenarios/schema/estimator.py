@@ -180,7 +180,8 @@ LEARN_DEFAULT: dict[str, dict[str, list[float]]] = {
 }
 """``estimator.learn`` when not given, per likelihood (with ``estimator.backflow`` left at 0;
 a backflow fixed by hand is not learned unless asked). The fluctuation likelihood weighs a
-member with gas upwind of the release (w = 0.05, a turbulence intensity of about 0.6) beside
+member with gas upwind of the release (w = 0.05: a planar plume at turbulence intensity 0.6,
+a 3-D one at 0.9) beside
 the plain plume: chosen on the tuning range random:13-40 (filament + puffs, ``dcee-cl``, 56
 paired searches, rule written before the run): 56/56 acquired either way, the truth in the
 95 % region in 100 % against 95 % (+3 / −0), the final error unchanged at the median pair
