@@ -47,11 +47,11 @@ every distance: in the near field, where a plume's spread grows ballistically (Ï
 for the turbulence intensity i), the time mean a distance d upwind is a fixed fraction of the
 mean the same distance downwind, whatever d (the integral over travel times is scale-free): in
 a planar plume P(Z > 1/i) / P(Z < 1/i), 0.023 for i = 0.5, 0.050 for i = 0.6, 0.12 for
-i = 0.8; in three dimensions less (0.004, 0.012, 0.039; numerical integration). Beyond the Lagrangian time scale the
-spread grows diffusively and upwind gas dies out, which this term does not model: its
-reversed plume reaches as far upwind as the plume downwind, at a share w of its strength (a
-weak term far upwind, where readings are mostly below the threshold anyway). The reading
-model can weigh it (``estimator.learn = {backflow = [0, 0.05]}``).
+i = 0.8; in three dimensions less (0.004, 0.012, 0.039; numerical integration). Beyond the
+Lagrangian time scale the spread grows diffusively and upwind gas dies out, which this term
+does not model: its reversed plume reaches as far upwind as the plume downwind, at a share w
+of its strength (a weak term far upwind, where readings are mostly below the threshold
+anyway). The reading model can weigh it (``estimator.learn = {backflow = [0, 0.05]}``).
 
 The distance is clamped at :data:`MIN_DISTANCE` = 0.1 m, the scale of a sensor inlet, so the
 model stays finite when a hypothesised source sits on the sensor (the authors' MATLAB code uses
