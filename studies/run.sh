@@ -400,6 +400,12 @@ case "${1:---list}" in
       --variant base: --variant 'backflow:estimator.learn={backflow=[0.0,0.05]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-backflow-13-40/variants.csv
     $P studies/publish_tables.py ;;
+  tune-source-radius)  # a release spread over a disc, learned, on the tuning range (docs/plumes.md)
+    # paired with today's defaults: the backflow rows of docs/results/tuning-backflow-13-40
+    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+      --variant 'radius:estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}' \
+      --workers "${WORKERS:-2}" --csv docs/results/tuning-source-radius-13-40/variants.csv
+    $P studies/publish_tables.py ;;
   cross-truth)  # every truth at today's defaults; the lbm plume held out (docs/plumes.md, README)
     # dcee-cl, infotaxis and the tree search at today's defaults, 100 held-out configurations
     export SUITE=held-out-100 TRUTHS=lbm WORKERS=${WORKERS:-2}

@@ -183,8 +183,14 @@ def test_vectorised_log1p_matches_math_log1p():
 
 
 @pytest.mark.parametrize(
-    ("meander", "decay", "backflow"),
-    [(0.0, 1.0, 0.0), (0.6, 1.0, 0.0), (0.0, 0.5, 0.0), (0.0, 1.0, 0.1)],
+    ("meander", "decay", "backflow", "radius"),
+    [
+        (0.0, 1.0, 0.0, 0.0),
+        (0.6, 1.0, 0.0, 0.0),
+        (0.0, 0.5, 0.0, 0.0),
+        (0.0, 1.0, 0.1, 0.0),
+        (0.15, 1.0, 0.05, 1.0),
+    ],
 )
 @pytest.mark.parametrize(
     "sensor",
@@ -198,7 +204,9 @@ def test_vectorised_log1p_matches_math_log1p():
     ],
     ids=["gauss", "gauss-pd1", "ln", "ln+near", "ln+spread", "ln+conserve"],
 )
-def test_position_rows_match_the_numpy_plume_and_likelihood(sensor, meander, decay, backflow):
+def test_position_rows_match_the_numpy_plume_and_likelihood(
+    sensor, meander, decay, backflow, radius
+):
     """The planners' per-position terms, written into chosen rows, against the NumPy plume and
     the NumPy likelihood of a non-detection and of a reading (which fixes loc, σ and Pd); the
     first and third sensors take the vectorised path (exp, log, erfc of dcee.numeric), the
@@ -225,9 +233,13 @@ def test_position_rows_match_the_numpy_plume_and_likelihood(sensor, meander, dec
     constants = np.empty((10, len(theta)))
     plume_constants(theta, constants)
     out = [np.full((5, len(theta)), np.nan) for _ in range(6)]
-    position_rows(constants, positions, rows, 1e-3, meander, decay, backflow, sensor.params, *out)
+    position_rows(
+        constants, positions, rows, 1e-3, meander, decay, backflow, radius, sensor.params, *out
+    )
     conc, dist, loc, log_nd, inv_sigma, det_offset = (a[rows] for a in out)
-    ref_c = isotropic_concentration_reference(theta, positions, 1e-3, meander, decay, backflow).T
+    ref_c = isotropic_concentration_reference(
+        theta, positions, 1e-3, meander, decay, backflow, radius
+    ).T
     np.testing.assert_allclose(conc, ref_c, rtol=1e-10, atol=1e-300)
     ref_r = np.linalg.norm(theta[None, :, :3] - positions[:, None, :], axis=2)
     np.testing.assert_allclose(dist, np.maximum(ref_r, 1e-3), rtol=1e-14)

@@ -375,3 +375,25 @@ def test_learned_backflow_is_found_from_the_readings(generating):
     bank = _bank_on_simulated_readings(learned, generating, seed=8, copies=3, path=ring)
     assert bank.selected_name == generating
     assert bank.probabilities[bank.selected] > 0.9
+
+
+@pytest.mark.parametrize("generating", ["fluctuation[source_radius=1.5]", "fluctuation"])
+def test_learned_source_radius_is_found_from_the_readings(generating):
+    """estimator.learn = {source_radius = [0, 1.5]}: readings drawn from a release spread over
+    a disc of 1.5 m or from a point; on rings round the source the bank finds which (simulated
+    data), and the member's plume carries the radius. A disc can mimic a point release more
+    easily than the reverse: after 216 readings the point member holds 0.84 (measured), the
+    disc member above 0.9."""
+    learned = FLUCT.with_overrides(
+        **{"estimator.learn": {"source_radius": [0.0, 1.5]}, "estimator.calm_prior": 0}
+    )
+    assert learned.reading_models == ("fluctuation", "fluctuation[source_radius=1.5]")
+    assert learned.make_plume("fluctuation[source_radius=1.5]").radius == 1.5
+    x0, y0, z0 = PAPER1.truth_theta()[:3]
+    angles = np.linspace(0.0, 2.0 * np.pi, 12, endpoint=False)
+    ring = np.array(
+        [(x0 + r * np.cos(a), y0 + r * np.sin(a), z0) for r in (1.0, 2.0, 4.0) for a in angles]
+    )
+    bank = _bank_on_simulated_readings(learned, generating, seed=8, copies=6, path=ring)
+    assert bank.selected_name == generating
+    assert bank.probabilities[bank.selected] > (0.75 if generating == "fluctuation" else 0.9)

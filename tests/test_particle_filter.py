@@ -176,7 +176,7 @@ def test_history_kernel_matches_reference(sensor):
     mult = rng.integers(1, 4, 30).astype(float)
     out = np.empty(500)
     history_log_likelihood(
-        theta, np.ones(500, bool), pos, z, mult, 0.1, 0.0, 1.0, 0.0, sensor.params, out
+        theta, np.ones(500, bool), pos, z, mult, 0.1, 0.0, 1.0, 0.0, 0.0, sensor.params, out
     )
     ref = history_log_likelihood_reference(theta, pos, z, mult, sensor, IsotropicPlume())
     np.testing.assert_allclose(out, ref, rtol=1e-9)
@@ -274,7 +274,9 @@ def test_history_likelihood_and_reading_bounds_against_numpy(sensor):
     plume = IsotropicPlume()
     out = np.empty(700)
     active = rng.random(700) < 0.9
-    history_log_likelihood(theta, active, pos, z, mult, 1e-3, 0.0, 1.0, 0.0, sensor.params, out)
+    history_log_likelihood(
+        theta, active, pos, z, mult, 1e-3, 0.0, 1.0, 0.0, 0.0, sensor.params, out
+    )
     ref = history_log_likelihood_reference(theta, pos, z, mult, sensor, plume)
     np.testing.assert_allclose(out[active], ref[active], rtol=1e-9)
     assert np.all(out[~active] == -np.inf)
@@ -291,7 +293,20 @@ def test_history_likelihood_and_reading_bounds_against_numpy(sensor):
     threshold = ref + rng.normal(0.0, 30.0, 700)
     early = np.empty(700)
     history_log_likelihood(
-        theta, active, pos, z, mult, 1e-3, 0.0, 1.0, 0.0, sensor.params, early, threshold, bounds
+        theta,
+        active,
+        pos,
+        z,
+        mult,
+        1e-3,
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+        sensor.params,
+        early,
+        threshold,
+        bounds,
     )
     kept = np.isfinite(early)
     np.testing.assert_array_equal(early[kept], out[kept])
@@ -321,7 +336,7 @@ def test_mcmc_move_is_unchanged_by_early_rejection(monkeypatch):
     plain = pfm.history_log_likelihood
 
     def no_exit(*args):
-        return plain(*args[:11])
+        return plain(*args[:12])
 
     monkeypatch.setattr(pfm, "history_log_likelihood", no_exit)
     np.testing.assert_array_equal(run(), with_exit)

@@ -100,3 +100,44 @@ def test_backflow_by_hand_upwind_downwind_and_crosswind():
     assert c[2] == pytest.approx(isotropic_concentration(theta, pts[2:])[0, 0], rel=1e-13)
     with pytest.raises(DceeInputError, match="backflow"):
         IsotropicPlume(backflow=0.6)
+
+
+def test_disc_source_against_a_dense_disc_integral_and_the_point_limit():
+    """source radius R: the seven-point rule against the uniform disc integrated densely
+    (200 rings × 400 angles): within 12 % at 1.5 R, 5 % at 2 R, 1.5 % at 4 R, a factor 2
+    inside the disc (measured: 50 %, 10 %, 4 %, 1.2 %; the rule smooths the disc's own
+    singular near field, well inside a log-normal reading's spread); a
+    vanishing radius is the point source; far downwind the crosswind integral (the mass flux)
+    is the point source's."""
+    from dcee.models.plume import IsotropicPlume
+
+    theta = np.array([[0, 0, 1.0, 5.0, 3.0, math.radians(30), 1.0, 8.0]])
+    radius = 1.0
+    rho = (np.arange(200) + 0.5) / 200 * radius
+    ang = (np.arange(400) + 0.5) / 400 * 2 * math.pi
+    rr, aa = np.meshgrid(rho, ang, indexing="ij")
+    weights = (rr / rr.sum()).ravel()  # uniform over the disc: weight ∝ ring radius
+    subs = np.repeat(theta, weights.size, axis=0)
+    subs[:, 0] += (rr * np.cos(aa)).ravel()
+    subs[:, 1] += (rr * np.sin(aa)).ravel()
+    rng = np.random.default_rng(0)
+    for distance, tol in ((0.5, 1.0), (1.5, 0.12), (2.0, 0.05), (4.0, 0.015)):
+        a = rng.uniform(0, 2 * math.pi, 12)
+        pts = np.column_stack([distance * np.cos(a), distance * np.sin(a), np.full(12, 1.0)])
+        dense = weights @ isotropic_concentration(subs, pts, 1e-3)
+        rule = IsotropicPlume(radius=radius).concentration(theta, pts)[0]
+        np.testing.assert_allclose(rule, dense, rtol=tol)
+    pts = np.array([[-3.0, -2.0, 1.0], [5.0, 1.0, 2.0]])
+    np.testing.assert_allclose(
+        IsotropicPlume(radius=1e-9).concentration(theta, pts),
+        isotropic_concentration(theta, pts),
+        rtol=1e-12,
+    )
+    phi = math.radians(30)
+    ys = np.linspace(-40, 40, 4001)
+    down = -30.0 * np.array([math.cos(phi), math.sin(phi)])
+    cross = np.array([-math.sin(phi), math.cos(phi)])
+    line = np.column_stack([down[0] + ys * cross[0], down[1] + ys * cross[1], np.ones_like(ys)])
+    point = np.trapezoid(isotropic_concentration(theta, line)[0], ys)
+    disc = np.trapezoid(IsotropicPlume(radius=radius).concentration(theta, line)[0], ys)
+    assert disc == pytest.approx(point, rel=0.02)

@@ -34,17 +34,19 @@ def test_meander_kernel_matches_reference_and_zero_meander_is_the_paper_plume():
     rng = np.random.default_rng(4)
     theta = random_theta(300, rng)
     pos = np.column_stack([rng.uniform(0, 50, 23), rng.uniform(0, 50, 23), np.full(23, 4.0)])
-    for meander, decay, backflow in (
-        (0.0, 1.0, 0.0),
-        (0.15, 1.0, 0.0),
-        (0.6, 1.0, 0.0),
-        (0.0, 0.5, 0.0),
-        (0.15, 0.5, 0.0),
-        (0.15, 1.0, 0.05),
-        (0.0, 0.5, 0.3),
+    for shape in (
+        (0.0, 1.0, 0.0, 0.0),
+        (0.15, 1.0, 0.0, 0.0),
+        (0.6, 1.0, 0.0, 0.0),
+        (0.0, 0.5, 0.0, 0.0),
+        (0.15, 0.5, 0.0, 0.0),
+        (0.15, 1.0, 0.05, 0.0),
+        (0.0, 0.5, 0.3, 0.0),
+        (0.15, 1.0, 0.05, 1.0),
+        (0.0, 1.0, 0.0, 3.0),
     ):
-        fast = isotropic_concentration(theta, pos, meander=meander, decay=decay, backflow=backflow)
-        ref = isotropic_concentration_reference(theta, pos, 0.1, meander, decay, backflow)
+        fast = isotropic_concentration(theta, pos, 0.1, *shape)
+        ref = isotropic_concentration_reference(theta, pos, 0.1, *shape)
         np.testing.assert_allclose(fast, ref, rtol=1e-9, atol=0)
     np.testing.assert_array_equal(
         isotropic_concentration(theta, pos, meander=0.0), isotropic_concentration(theta, pos)
@@ -78,11 +80,11 @@ def test_history_kernel_with_meander_and_near_source_intermittency_matches_refer
     z = np.where(rng.random(40) < 0.5, 0.0, rng.gamma(1.0, 5e-3, 40))
     mult = rng.integers(1, 4, 40).astype(float)
     sensor = Sensor(family="lognormal", pd=0.6, log_sd=1.3, near_length=5.4, outlier=0.01)
-    for decay, backflow in ((1.0, 0.0), (0.5, 0.0), (1.0, 0.05)):
-        plume = IsotropicPlume(meander=0.15, decay=decay, backflow=backflow)
+    for decay, backflow, radius in ((1.0, 0.0, 0.0), (0.5, 0.0, 0.0), (1.0, 0.05, 1.0)):
+        plume = IsotropicPlume(meander=0.15, decay=decay, backflow=backflow, radius=radius)
         out = np.empty(400)
         history_log_likelihood(
-            theta, np.ones(400, bool), pos, z, mult, 0.1, 0.15, decay, backflow, sensor.params, out
+            theta, np.ones(400, bool), pos, z, mult, 0.1, *plume.shape, sensor.params, out
         )
         ref = history_log_likelihood_reference(theta, pos, z, mult, sensor, plume)
         np.testing.assert_allclose(out, ref, rtol=1e-9)

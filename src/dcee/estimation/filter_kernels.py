@@ -113,6 +113,7 @@ def _history_kernel(
     meander: float,
     decay: float,
     backflow: float,
+    radius: float,
     sp: SensorParams,
     threshold: np.ndarray,
     remaining_bound: np.ndarray,
@@ -159,10 +160,10 @@ def _history_kernel(
             px = positions[k, 0]
             py = positions[k, 1]
             pz = positions[k, 2]
-            if meander > 0.0 or decay != 1.0 or backflow > 0.0:
+            if meander > 0.0 or decay != 1.0 or backflow > 0.0 or radius > 0.0:
                 for q in range(nb):
                     conc[q], dist[q] = plume_at(
-                        constants_at(pc, q), px, py, pz, rmin, meander, decay, backflow
+                        constants_at(pc, q), px, py, pz, rmin, meander, decay, backflow, radius
                     )
             else:
                 _plume_block(pc, nb, px, py, pz, rmin, conc, dist)
@@ -243,6 +244,7 @@ def history_log_likelihood(
     meander: float,
     decay: float,
     backflow: float,
+    radius: float,
     sp: SensorParams,
     out: np.ndarray,
     threshold: np.ndarray | None = None,
@@ -274,6 +276,7 @@ def history_log_likelihood(
         meander,
         decay,
         backflow,
+        radius,
         sp,
         np.ascontiguousarray(threshold, dtype=np.float64),
         remaining,
@@ -290,9 +293,7 @@ def history_log_likelihood_reference(
     plume: IsotropicPlume,
 ) -> np.ndarray:
     """NumPy reference of the compiled history likelihood: (N,) Σ_k m_k log p(z_k | Θ_i)."""
-    conc = isotropic_concentration_reference(
-        theta, positions, plume.min_distance, plume.meander, plume.decay, plume.backflow
-    )
+    conc = isotropic_concentration_reference(theta, positions, plume.min_distance, *plume.shape)
     d = positions[None, :, :] - theta[:, None, :3]
     dist = np.maximum(np.sqrt(np.einsum("nki,nki->nk", d, d)), plume.min_distance)
     ll = sensor.log_likelihood(readings[None, :], conc, dist)

@@ -101,6 +101,7 @@ def _loglik(theta, pts, positions, readings, sensor, plume) -> np.ndarray:
         plume.meander,
         plume.decay,
         plume.backflow,
+        plume.radius,
         sensor.params,
         out,
     )

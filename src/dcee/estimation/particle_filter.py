@@ -260,6 +260,7 @@ class ParticleFilter(ResampleMove):
             self.plume.meander,
             self.plume.decay,
             self.plume.backflow,
+            self.plume.radius,
             self._sp,
             out,
         )

@@ -115,6 +115,7 @@ class ResampleMove:
             self.plume.meander,
             self.plume.decay,
             self.plume.backflow,
+            self.plume.radius,
             self._sp,
             ll_prop,
             np.nan_to_num(threshold, nan=-np.inf, posinf=np.inf),

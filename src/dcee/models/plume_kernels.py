@@ -66,6 +66,21 @@ def _advected(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay):
 
 
 @njit(cache=True, inline="always")
+def _mixed(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow):
+    """The point source's plume at offset (dx, dy, dz), with ``backflow`` w mixed in."""
+    value = _advected(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay)
+    if backflow > 0.0:
+        reverse = _advected(dx, dy, dz, pref, inv_lam, -ax, -ay, -c, -s, k, rmin, meander, decay)
+        value = (1.0 - backflow) * value + backflow * reverse
+    return value
+
+
+DISC_RING = math.sqrt(2.0 / 3.0)
+"""Ring radius of the disc rule, in disc radii: the centre weighs 1/4 and six points on this
+ring 1/8 each, which matches the uniform disc's mean square offset R²/2."""
+
+
+@njit(cache=True, inline="always")
 def plume_at(
     terms,
     px: float,
@@ -75,10 +90,13 @@ def plume_at(
     meander: float,
     decay: float,
     backflow: float,
+    radius: float,
 ):
     """(concentration, clamped distance r) at (px, py, pz) from one particle's
-    :func:`plume_terms`; see :mod:`dcee.models.plume` for ``meander``, ``decay`` and
-    ``backflow`` (w: (1 − w) · the plume + w · the plume of the reversed wind)."""
+    :func:`plume_terms`; see :mod:`dcee.models.plume` for ``meander``, ``decay``, ``backflow``
+    (w: (1 − w) · the plume + w · the plume of the reversed wind) and ``radius`` (the release
+    spread over a horizontal disc: seven sub-sources, :data:`DISC_RING`). r is the distance to
+    the source location (the disc's centre)."""
     sx, sy, sz, pref, inv_lam, ax, ay, c, s, k = terms
     dx = px - sx
     dy = py - sy
@@ -86,10 +104,25 @@ def plume_at(
     r0 = math.sqrt(dx * dx + dy * dy + dz * dz)
     if r0 < rmin:
         r0 = rmin
-    value = _advected(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay)
-    if backflow > 0.0:
-        reverse = _advected(dx, dy, dz, pref, inv_lam, -ax, -ay, -c, -s, k, rmin, meander, decay)
-        value = (1.0 - backflow) * value + backflow * reverse
+    if radius <= 0.0:
+        return _mixed(
+            dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow
+        ), r0
+    ring = radius * DISC_RING
+    # a sub-source's distance clamped at half the spacing of the rule's points
+    rsub = max(rmin, 0.5 * ring)
+    value = 0.25 * _mixed(
+        dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rsub, meander, decay, backflow
+    )
+    for j in range(6):
+        # one ring point straight upwind (c, s), the others every 60°
+        cj = math.cos(j * math.pi / 3.0)
+        sj = math.sin(j * math.pi / 3.0)
+        ox = ring * (c * cj - s * sj)
+        oy = ring * (s * cj + c * sj)
+        value += 0.125 * _mixed(
+            dx - ox, dy - oy, dz, pref, inv_lam, ax, ay, c, s, k, rsub, meander, decay, backflow
+        )
     return value, r0
 
 
@@ -151,6 +184,7 @@ def concentration_grid(
     meander: float,
     decay: float,
     backflow: float,
+    radius: float,
     out: np.ndarray,
 ):
     """out[m, i] = C(positions[m]; theta[i]). theta (N, 8), positions (M, 3), out (M, N)."""
@@ -168,6 +202,7 @@ def concentration_grid(
                 meander,
                 decay,
                 backflow,
+                radius,
             )[0]
 
 
@@ -179,6 +214,7 @@ def concentration_distance_grid(
     meander: float,
     decay: float,
     backflow: float,
+    radius: float,
     conc: np.ndarray,
     dist: np.ndarray,
 ):
@@ -197,6 +233,7 @@ def concentration_distance_grid(
                 meander,
                 decay,
                 backflow,
+                radius,
             )
             conc[m, i] = c
             dist[m, i] = r
@@ -209,9 +246,10 @@ def concentration_matrix(
     meander: float,
     decay: float,
     backflow: float,
+    radius: float,
     out: np.ndarray,
 ):
     """out[i, m] = C(positions[m]; theta[i]); out (N, M) C-contiguous."""
     tmp = np.empty((positions.shape[0], theta.shape[0]))
-    concentration_grid(theta, positions, rmin, meander, decay, backflow, tmp)
+    concentration_grid(theta, positions, rmin, meander, decay, backflow, radius, tmp)
     out[...] = tmp.T

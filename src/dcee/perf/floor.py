@@ -167,6 +167,7 @@ def floor_decision(
         plume.meander,
         plume.decay,
         plume.backflow,
+        plume.radius,
         conc,
         dist,
     )

@@ -97,7 +97,7 @@ def _numpy_decision(belief, candidates: np.ndarray, readings: np.ndarray) -> Non
     (:func:`~dcee.planning.predicted_reference.predicted_posterior_stats_reference`)."""
     plume = belief.plume
     conc = isotropic_concentration_reference(
-        belief.theta, candidates, plume.min_distance, plume.meander, plume.decay, plume.backflow
+        belief.theta, candidates, plume.min_distance, *plume.shape
     ).T
     dist = np.linalg.norm(belief.source[None, :, :] - candidates[:, None, :], axis=2)
     m_count, j_count = readings.shape

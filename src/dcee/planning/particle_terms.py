@@ -105,7 +105,7 @@ class ParticleTerms:
         nothing changed."""
         theta = np.asarray(theta, dtype=np.float64)
         key = self._fingerprint(theta)
-        models = (plume.min_distance, plume.meander, plume.decay, plume.backflow)
+        models = (plume.min_distance, plume.meander, plume.decay, plume.backflow, plume.radius)
         models = models, tuple(sensor.params)
         if key == self._key and models == (self._plume, self._sensor_params):
             return
@@ -114,6 +114,7 @@ class ParticleTerms:
         self.sp = sensor.params
         self.min_distance, self.meander = plume.min_distance, plume.meander
         self.decay, self.backflow = plume.decay, plume.backflow
+        self.radius = plume.radius
         if self.merge:
             self.starts = merge_runs(theta)
             self.theta = np.ascontiguousarray(theta[self.starts])
@@ -229,6 +230,7 @@ class ParticleTerms:
                 self.meander,
                 self.decay,
                 self.backflow,
+                self.radius,
                 self.sp,
                 *self.terms,
             )
@@ -246,6 +248,7 @@ class ParticleTerms:
         other = ParticleTerms(merge=False, max_bytes=self.max_bytes)
         other.sp, other.min_distance, other.meander = self.sp, self.min_distance, self.meander
         other.decay, other.backflow = self.decay, self.backflow
+        other.radius = self.radius
         other._plume, other._sensor_params = self._plume, self._sensor_params
         other.theta = np.ascontiguousarray(self.theta[keep])
         other._plume_constants = np.ascontiguousarray(self._plume_constants[:, keep])

@@ -121,6 +121,7 @@ def position_rows(
     meander: float,
     decay: float,
     backflow: float,
+    radius: float,
     sp: SensorParams,
     conc: np.ndarray,
     dist: np.ndarray,
@@ -154,6 +155,7 @@ def position_rows(
         and meander == 0.0
         and decay == 1.0
         and backflow == 0.0
+        and radius == 0.0
         and sp.sigma_min >= 2.0**-60  # σ within the range of the vectorised log
     )
     for b in prange(n_blocks):
@@ -183,7 +185,9 @@ def position_rows(
                 )
                 continue
             for i in range(i0, i1):
-                c, r = plume_at(constants_at(plume, i), px, py, pz, rmin, meander, decay, backflow)
+                c, r = plume_at(
+                    constants_at(plume, i), px, py, pz, rmin, meander, decay, backflow, radius
+                )
                 m, sigma = transform(c, r, sp)
                 conc[row, i] = c
                 dist[row, i] = r

@@ -56,6 +56,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("estimator", "decay"): 1.0,
     # no gas upwind of the release before issue 42's backflow setting
     ("estimator", "backflow"): 0.0,
+    # a point source before issue 42's source_radius setting
+    ("estimator", "source_radius"): 0.0,
     # input only (a compass bearing converted to phi), always unset once validated
     ("truth", "wind_from"): None,
 }
@@ -76,6 +78,7 @@ FLUCTUATION_ONLY = (
     "conserve_mean",
     "decay",
     "backflow",
+    "source_radius",
     "learn",
 )
 """Estimator settings that only the fluctuation likelihood reads: under the paper's likelihood

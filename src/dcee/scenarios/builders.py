@@ -104,6 +104,7 @@ class ScenarioBuilders:
             meander=learned.get("meander", self.meander),
             decay=learned.get("decay", self.estimator.decay),
             backflow=learned.get("backflow", self.estimator.backflow),
+            radius=learned.get("source_radius", self.estimator.source_radius),
         )
 
     def _reading_model(self, model: str | None) -> str:

@@ -161,7 +161,14 @@ class AnemometerSpec(BaseModel):
 
 
 LearnedName = Literal[
-    "meander", "log_sd", "log_sd_near", "intermittency", "near_source_length", "decay", "backflow"
+    "meander",
+    "log_sd",
+    "log_sd_near",
+    "intermittency",
+    "near_source_length",
+    "decay",
+    "backflow",
+    "source_radius",
 ]
 """The reading model's nuisance parameters ``estimator.learn`` may weigh."""
 LEARN_RANGES: dict[str, tuple[float, float]] = {
@@ -172,6 +179,7 @@ LEARN_RANGES: dict[str, tuple[float, float]] = {
     "near_source_length": (0.0, 1000.0),
     "decay": (0.25, 2.0),
     "backflow": (0.0, 0.5),
+    "source_radius": (0.0, 10.0),
 }
 """Allowed values of each learned setting (as for the fixed setting)."""
 LEARN_DEFAULT: dict[str, dict[str, list[float]]] = {
@@ -253,6 +261,11 @@ class EstimatorSpec(BaseModel):
     """fluctuation: the share w of the time the plume model's wind blows against its mean
     direction, (1 − w) · C(φ) + w · C(φ + π) (:mod:`dcee.models.plume`): gas upwind of the
     release, as near a source in strong turbulence. 0: none (the paper's model). The paper's
+    likelihood and the calm member always use 0"""
+    source_radius: Annotated[float, Field(ge=0.0, le=10.0, allow_inf_nan=False)] = 0.0
+    """fluctuation: m, the plume model's release spread evenly over a horizontal disc of this
+    radius about the source location (:mod:`dcee.models.plume`): a pool, a vent, or a point
+    release recorded on a coarse grid. 0: a point source (the paper's model). The paper's
     likelihood and the calm member always use 0"""
     meander: Annotated[float | None, Field(ge=0, le=2)] = None
     """crosswind turbulence intensity of the plume model's time-mean meander broadening

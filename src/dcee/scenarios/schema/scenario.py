@@ -372,7 +372,7 @@ class Scenario(ScenarioBuilders, BaseModel):
         member per other combination of its grid (``fluctuation[meander=0.3]``), then with
         ``estimator.calm_prior`` > 0 the calm ``paper`` member. ``settings`` overrides the
         fluctuation model's values (meander, log_sd, log_sd_near, intermittency, near_source_length,
-        decay, backflow)."""
+        decay, backflow, source_radius)."""
         e = self.estimator
         if e.likelihood != "fluctuation":
             return (("paper", {}),)
