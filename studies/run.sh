@@ -413,6 +413,9 @@ case "${1:---list}" in
     OUT_SUFFIX=-bf bash studies/study_turbulent_held_out.sh --set truth.z=4.0
     STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-bf bash studies/study_turbulent_held_out.sh \
       --set truth.z=4.0
+    # an option measured at today's defaults (it decides nothing): a release spread over a disc
+    STRATEGIES=dcee-cl OUT_SUFFIX=-radius bash studies/study_turbulent_held_out.sh \
+      --set truth.z=4.0 --set 'estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}'
     # the defaults of 2026-11-27 before the backflow member (pinned: no learned setting)
     nobf=(--set truth.z=4.0 --set 'estimator.learn={}')
     bash studies/study_turbulent_held_out.sh "${nobf[@]}"
