@@ -434,13 +434,14 @@ case "${1:---list}" in
     STRATEGIES=dcee-cl OUT_SUFFIX=-20k bash studies/study_turbulent_held_out.sh "${old[@]}" \
       --particles 20000
     r=results/turbulent-lbm-held-out-100
-    report turbulent-lbm-held-out-100-bf turbulent-lbm-held-out-100-mcts-bf \
+    report turbulent-lbm-held-out-100-bf turbulent-lbm-held-out-100-mcts-bf turbulent-lbm-held-out-100-radius \
       turbulent-lbm-held-out-100 turbulent-lbm-held-out-100-mcts-today \
       turbulent-lbm-held-out-100-nsl25 turbulent-lbm-held-out-100-decay \
       turbulent-lbm-held-out-100-mcts turbulent-lbm-held-out-100-nsl turbulent-lbm-held-out-100-20k
     $P studies/collect_metrics.py --out docs/results/lbm-held-out-100 \
       "$r-bf=defaults:2026-11-27b,learn:none,particles:10000" \
       "$r-mcts-bf=defaults:2026-11-27b,learn:none,particles:10000" \
+      "$r-radius=defaults:2026-11-27b,learn:backflow+source_radius,particles:10000" \
       "$r=defaults:2026-11-27,learn:none,particles:10000" \
       "$r-mcts-today=defaults:2026-11-27,learn:none,particles:10000" \
       "$r-nsl25=defaults:2026-11-23,learn:none,particles:10000" \
@@ -460,7 +461,7 @@ case "${1:---list}" in
         --csv docs/results/lbm-held-out-100/paired.csv --tag "reference=$ref" --tag defaults=2026-11-27b
     done
     # the backflow member against the defaults just before it, search by search
-    for pair in "$r:$r-bf" "$r-mcts-today:$r-mcts-bf"; do
+    for pair in "$r:$r-bf" "$r-mcts-today:$r-mcts-bf" "$r-bf:$r-radius"; do
       $P studies/pair_campaigns.py "${pair%%:*}" "${pair#*:}" \
         --csv docs/results/lbm-held-out-100/backflow_vs_before.csv --tag truth_model=lbm
     done
