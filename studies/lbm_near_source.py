@@ -14,9 +14,8 @@ import csv
 from pathlib import Path
 
 import numpy as np
+from lbm_statistics import lbm_spec
 
-from dcee.scenarios import parse_setting
-from dcee.scenarios.schema.truth import LbmSpec
 from dcee.simulation.lbm import cached_recording, load_canonical
 
 ALONG = [-3.0, -2.0, -1.5, -1.0, -0.75, -0.5, -0.25, 0.0, 0.5, 1.0, 2.0, 3.0]
@@ -30,12 +29,7 @@ def main() -> None:
     ap.add_argument("--set", dest="settings", action="append", default=[])
     ap.add_argument("--csv", type=Path, default=Path("docs/results/lbm-plume/near_source.csv"))
     args = ap.parse_args()
-    values = {}
-    for text in args.settings:
-        key, value = parse_setting(text)
-        values[key.removeprefix("truth.model.")] = value
-    spec = LbmSpec(**values)
-    truth = load_canonical(cached_recording(spec, announce=print))
+    truth = load_canonical(cached_recording(lbm_spec(args.settings), announce=print))
     c, x, y = truth.values, truth.x, truth.y  # (T, Y, X), canonical frame: wind along +x
 
     def bilinear(px: float, py: float) -> np.ndarray:

@@ -31,17 +31,22 @@ from dcee.simulation.lbm import cached_recording, load_canonical
 DISTANCES = [2.0, 5.0, 10.0, 15.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0]
 
 
+def lbm_spec(settings: list[str]) -> LbmSpec:
+    """The plume's parameters from ``--set truth.model.KEY=VALUE`` texts (defaults otherwise)."""
+    values = {}
+    for text in settings:
+        key, value = parse_setting(text)
+        values[key.removeprefix("truth.model.")] = value
+    return LbmSpec(**values)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--set", dest="settings", action="append", default=[])
     ap.add_argument("--out", type=Path, default=Path("docs/results/lbm-plume"))
     ap.add_argument("--figure", type=Path, default=Path("docs/figures/lbm-plume.png"))
     args = ap.parse_args()
-    values = {}
-    for text in args.settings:
-        key, value = parse_setting(text)
-        values[key.removeprefix("truth.model.")] = value
-    spec = LbmSpec(**values)
+    spec = lbm_spec(args.settings)
     path = cached_recording(spec, announce=print)
     truth = load_canonical(path)
     c, x, y = truth.values, truth.x, truth.y

@@ -74,6 +74,13 @@ def test_log_evidence_of_the_first_reading_by_hand():
     assert pf.log_evidence == info.log_evidence
 
 
+def _rings(radii: tuple[float, ...]) -> np.ndarray:
+    """(12 · len(radii), 3) m: twelve points on each ring round the true source, at its height."""
+    x0, y0, z0 = PAPER1.truth_theta()[:3]
+    angles = np.linspace(0.0, 2.0 * np.pi, 12, endpoint=False)
+    return np.array([(x0 + r * np.cos(a), y0 + r * np.sin(a), z0) for r in radii for a in angles])
+
+
 def _bank_on_simulated_readings(
     scenario,
     generating: str,
@@ -341,11 +348,7 @@ def test_learned_near_source_spread_is_found_from_the_readings(generating):
     assert (near.log_sd_near, near.log_sd_length) == (4.0, 5.0)
     assert learned.make_estimator_sensor("fluctuation").log_sd_near == 0.0
     # rings round the source at its height, 1.5 to 6 m out, where the two spreads differ
-    x0, y0, z0 = PAPER1.truth_theta()[:3]
-    angles = np.linspace(0.0, 2.0 * np.pi, 12, endpoint=False)
-    ring = np.array(
-        [(x0 + r * np.cos(a), y0 + r * np.sin(a), z0) for r in (1.5, 3.0, 6.0) for a in angles]
-    )
+    ring = _rings((1.5, 3.0, 6.0))
     bank = _bank_on_simulated_readings(learned, generating, seed=8, copies=3, path=ring)
     assert bank.selected_name == generating
     assert bank.probabilities[bank.selected] > 0.9
@@ -367,11 +370,7 @@ def test_learned_backflow_is_found_from_the_readings(generating):
     assert learned.reading_models == ("fluctuation", "fluctuation[backflow=0.1]")
     assert learned.make_plume("fluctuation[backflow=0.1]").backflow == 0.1
     assert learned.make_plume("fluctuation").backflow == 0.0
-    x0, y0, z0 = PAPER1.truth_theta()[:3]
-    angles = np.linspace(0.0, 2.0 * np.pi, 12, endpoint=False)
-    ring = np.array(
-        [(x0 + r * np.cos(a), y0 + r * np.sin(a), z0) for r in (1.5, 3.0, 6.0) for a in angles]
-    )
+    ring = _rings((1.5, 3.0, 6.0))
     bank = _bank_on_simulated_readings(learned, generating, seed=8, copies=3, path=ring)
     assert bank.selected_name == generating
     assert bank.probabilities[bank.selected] > 0.9
@@ -389,11 +388,7 @@ def test_learned_source_radius_is_found_from_the_readings(generating):
     )
     assert learned.reading_models == ("fluctuation", "fluctuation[source_radius=1.5]")
     assert learned.make_plume("fluctuation[source_radius=1.5]").radius == 1.5
-    x0, y0, z0 = PAPER1.truth_theta()[:3]
-    angles = np.linspace(0.0, 2.0 * np.pi, 12, endpoint=False)
-    ring = np.array(
-        [(x0 + r * np.cos(a), y0 + r * np.sin(a), z0) for r in (1.0, 2.0, 4.0) for a in angles]
-    )
+    ring = _rings((1.0, 2.0, 4.0))
     bank = _bank_on_simulated_readings(learned, generating, seed=8, copies=6, path=ring)
     assert bank.selected_name == generating
     assert bank.probabilities[bank.selected] > (0.75 if generating == "fluctuation" else 0.9)

@@ -177,36 +177,6 @@ def plume_from_terms(
 
 
 @njit(cache=True, parallel=True)
-def concentration_grid(
-    theta: np.ndarray,
-    positions: np.ndarray,
-    rmin: float,
-    meander: float,
-    decay: float,
-    backflow: float,
-    radius: float,
-    out: np.ndarray,
-):
-    """out[m, i] = C(positions[m]; theta[i]). theta (N, 8), positions (M, 3), out (M, N)."""
-    n = theta.shape[0]
-    m_count = positions.shape[0]
-    for i in prange(n):
-        terms = plume_terms(theta, i)
-        for m in range(m_count):
-            out[m, i] = plume_at(
-                terms,
-                positions[m, 0],
-                positions[m, 1],
-                positions[m, 2],
-                rmin,
-                meander,
-                decay,
-                backflow,
-                radius,
-            )[0]
-
-
-@njit(cache=True, parallel=True)
 def concentration_distance_grid(
     theta: np.ndarray,
     positions: np.ndarray,
@@ -251,5 +221,6 @@ def concentration_matrix(
 ):
     """out[i, m] = C(positions[m]; theta[i]); out (N, M) C-contiguous."""
     tmp = np.empty((positions.shape[0], theta.shape[0]))
-    concentration_grid(theta, positions, rmin, meander, decay, backflow, radius, tmp)
+    dist = np.empty_like(tmp)
+    concentration_distance_grid(theta, positions, rmin, meander, decay, backflow, radius, tmp, dist)
     out[...] = tmp.T

@@ -9,11 +9,11 @@ import copy
 from typing import Any
 
 from dcee.scenarios import (
-    LEARN_DEFAULT,
     OLD_OUTLIER_DEFAULT,
     READING_WEIGHT_DEFAULT,
     REPEAT_DEFAULT,
     UnicycleSpec,
+    default_learn,
     unset_climb,
 )
 
@@ -155,8 +155,7 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
                 estimator[key] = _unset_repeat(likelihood, estimator)[k]
         if "learn" in estimator and estimator["learn"] is None:
             # unset: the grid it resolved to (Scenario.learn), compared as that grid
-            fixed_backflow = estimator.get("backflow", 0.0)
-            estimator["learn"] = {} if fixed_backflow else LEARN_DEFAULT[likelihood]
+            estimator["learn"] = default_learn(likelihood, estimator.get("backflow", 0.0))
         if estimator.get("repeat_radius", 0.0) == 0.0:
             # no repeat discount: its power decides nothing
             estimator.pop("repeat_power", None)

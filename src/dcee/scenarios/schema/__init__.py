@@ -22,6 +22,7 @@ from dcee.scenarios.schema.estimator import (
     Likelihood,
     PriorSpec,
     SensorSpec,
+    default_learn,
     default_priors,
 )
 from dcee.scenarios.schema.scenario import FIELD_MARK, Scenario, validate_scenario
@@ -66,6 +67,7 @@ __all__ = [
     "TruthKind",
     "UnicycleSpec",
     "Volume",
+    "default_learn",
     "default_priors",
     "team_starts",
     "unset_climb",

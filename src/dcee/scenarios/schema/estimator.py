@@ -194,6 +194,14 @@ the plain plume: chosen on the tuning range random:13-40 (filament + puffs, ``dc
 paired searches, rule written before the run): 56/56 acquired either way, the truth in the
 95 % region in 100 % against 95 % (+3 / −0), the final error unchanged at the median pair
 (−0.00 m, Wilcoxon p = 0.59) (docs/plumes.md, docs/results/tuning-backflow-13-40)."""
+
+
+def default_learn(likelihood: str, backflow: float) -> dict[str, list[float]]:
+    """What an unset ``estimator.learn`` weighs: :data:`LEARN_DEFAULT` for the likelihood,
+    nothing where ``estimator.backflow`` was fixed by hand."""
+    return {} if backflow != 0.0 else LEARN_DEFAULT[likelihood]
+
+
 LEARN_MEMBERS_MAX = 12
 """Most fluctuation members a learned grid may make (each costs one filter update per reading)."""
 

@@ -17,7 +17,6 @@ from dcee.scenarios.builders import ScenarioBuilders
 from dcee.scenarios.schema.agent import AgentSpec, SearchSpec, team_starts, unset_climb
 from dcee.scenarios.schema.common import FIELD_MARK, FROZEN, phi_prior_from_bearing
 from dcee.scenarios.schema.estimator import (
-    LEARN_DEFAULT,
     LEARN_MEMBERS_MAX,
     LEARN_RANGES,
     MEANDER_DEFAULT,
@@ -27,6 +26,7 @@ from dcee.scenarios.schema.estimator import (
     EstimatorSpec,
     PriorSpec,
     SensorSpec,
+    default_learn,
     default_priors,
 )
 from dcee.scenarios.schema.messages import one_line_error
@@ -313,11 +313,7 @@ class Scenario(ScenarioBuilders, BaseModel):
         """``estimator.learn`` resolved: as given, or the likelihood's default
         (:data:`LEARN_DEFAULT`; none where ``estimator.backflow`` was fixed by hand)."""
         e = self.estimator
-        if e.learn is not None:
-            return e.learn
-        if e.likelihood == "fluctuation" and e.backflow != 0.0:
-            return {}
-        return LEARN_DEFAULT[e.likelihood]
+        return e.learn if e.learn is not None else default_learn(e.likelihood, e.backflow)
 
     @property
     def meander(self) -> float:
