@@ -600,10 +600,11 @@ EARLIER_DEFAULTS = {
 OLD_DEFAULTS = EARLIER_DEFAULTS["2026-11-23"]
 
 
-def cross_truth_table() -> str:
+def cross_truth_table(latest_only: bool = False) -> str:
     """Every truth family, all eight unknown, at today's defaults, with the rows flown at the
     defaults before marked: which defaults were chosen on it (docs/plumes.md;
-    dcee.scenarios.defaults.DEFAULTS)."""
+    dcee.scenarios.defaults.DEFAULTS). ``latest_only`` (the README's): per truth only the
+    latest defaults flown on it, and no options."""
     today = study("held-out-today")
     turbulent_today = study("turbulent-held-out-100-today")
     lbm = study("lbm-held-out-100")
@@ -637,7 +638,8 @@ def cross_truth_table() -> str:
         ("filament", "**yes**: the fluctuation model's settings, climb, hold, backflow member"),
         ("puffs", "**yes**: climb, near-source fall, repeat discount, backflow member"),
     ):
-        for defaults in sorted(set(turbulent_today["defaults"].astype(str)), reverse=True):
+        generations = sorted(set(turbulent_today["defaults"].astype(str)), reverse=True)
+        for defaults in generations[:1] if latest_only else generations:
             for strategy in ("dcee-cl", "infotaxis"):
                 part = turbulent_today[turbulent_today["defaults"].astype(str) == defaults]
                 if not ((part["strategy"] == strategy) & (part["truth_model"] == truth)).any():
@@ -648,7 +650,7 @@ def cross_truth_table() -> str:
                     pick(part, strategy, truth_model=truth),
                     "turbulent-held-out-100-today",
                 )
-        if truth == "filament":
+        if truth == "filament" and not latest_only:
             add(
                 f"filament, fluctuation likelihood, {OLD_DEFAULTS}",
                 chosen,
@@ -658,6 +660,8 @@ def cross_truth_table() -> str:
     lbm = lbm.assign(
         order=lbm["defaults"].astype(str).map({TODAY_DEFAULTS: 0, "2026-11-27": 1}).fillna(2)
     ).sort_values("order", kind="stable")
+    if latest_only:
+        lbm = lbm[(lbm["order"] == 0) & (lbm["learn"] == "none")]
     for _, r in lbm.iterrows():
         how = "" if r["learn"] == "none" else f", `estimator.learn` {r['learn']} (an option)"
         if int(r.get("particles", 10000)) != 10000:
@@ -674,7 +678,7 @@ def learn_tuning_table() -> str:
     fall, repeat power 1/4) on the tuning range (filament and puffs only: the truths defaults may
     be chosen on), paired by search (studies/precision_variants.py's rows in
     docs/results/tuning-*-13-40; the old defaults ran in the first two, reading for reading the
-    same). The last candidate is today's default."""
+    same). The last candidate was the default until the backflow member joined it."""
     frame = pd.concat(
         pd.read_csv(RESULTS / folder / "variants.csv")
         for folder in (
@@ -693,7 +697,8 @@ def learn_tuning_table() -> str:
         "sd": "`learn = {log_sd = [1.3, 2, 3]}`",
         "nearsd": "`learn = {log_sd_near = [0, 3, 6]}`, `log_sd_length = 1.5`",
         "nsl05": "`near_source_length = 0.5` (fixed, not learned)",
-        "nsl05rp05": "**today's defaults**: `near_source_length = 0.5`, `repeat_power = 0.5`",
+        "nsl05rp05": "the defaults of 2026-11-27 (before the backflow member): "
+        "`near_source_length = 0.5`, `repeat_power = 0.5`",
     }
     order = ("base", "decay", "both", "nsl", "sd", "nearsd", "nsl05", "nsl05rp05")
     return _variant_table(frame, names, order, "the defaults before 2026-11-27")
@@ -1121,6 +1126,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "source-radius-tuning": source_radius_tuning_table,
     "lbm-near-source": lbm_near_source_table,
     "cross-truth": cross_truth_table,
+    "cross-truth-latest": lambda: cross_truth_table(latest_only=True),
     "lbm-statistics": lbm_statistics_table,
     "what-we-found": what_we_found,
     "wind-known": public_table("paper-source"),
