@@ -98,10 +98,7 @@ def _loglik(theta, pts, positions, readings, sensor, plume) -> np.ndarray:
         np.ascontiguousarray(readings, dtype=np.float64),
         np.ones(len(readings)),
         plume.min_distance,
-        plume.meander,
-        plume.decay,
-        plume.backflow,
-        plume.radius,
+        *plume.shape,
         sensor.params,
         out,
     )

@@ -257,10 +257,7 @@ class ParticleFilter(ResampleMove):
             np.array([reading], dtype=np.float64),
             np.array([w], dtype=np.float64),
             self.plume.min_distance,
-            self.plume.meander,
-            self.plume.decay,
-            self.plume.backflow,
-            self.plume.radius,
+            *self.plume.shape,
             self._sp,
             out,
         )

@@ -80,6 +80,11 @@ DISC_RING = math.sqrt(2.0 / 3.0)
 ring 1/8 each, which matches the uniform disc's mean square offset R²/2."""
 
 
+_RING_COS = tuple(math.cos(j * math.pi / 3.0) for j in range(6))
+_RING_SIN = tuple(math.sin(j * math.pi / 3.0) for j in range(6))
+"""cos and sin of the disc rule's ring angles, j · 60° (computed once, not per evaluation)."""
+
+
 @njit(cache=True, inline="always")
 def plume_at(
     terms,
@@ -116,8 +121,8 @@ def plume_at(
     )
     for j in range(6):
         # one ring point straight upwind (c, s), the others every 60°
-        cj = math.cos(j * math.pi / 3.0)
-        sj = math.sin(j * math.pi / 3.0)
+        cj = _RING_COS[j]
+        sj = _RING_SIN[j]
         ox = ring * (c * cj - s * sj)
         oy = ring * (s * cj + c * sj)
         value += 0.125 * _mixed(

@@ -164,10 +164,7 @@ def floor_decision(
         theta,
         positions,
         plume.min_distance,
-        plume.meander,
-        plume.decay,
-        plume.backflow,
-        plume.radius,
+        *plume.shape,
         conc,
         dist,
     )

@@ -105,16 +105,13 @@ class ParticleTerms:
         nothing changed."""
         theta = np.asarray(theta, dtype=np.float64)
         key = self._fingerprint(theta)
-        models = (plume.min_distance, plume.meander, plume.decay, plume.backflow, plume.radius)
-        models = models, tuple(sensor.params)
+        models = (plume.min_distance, *plume.shape), tuple(sensor.params)
         if key == self._key and models == (self._plume, self._sensor_params):
             return
         self._key = key
         self._plume, self._sensor_params = models
         self.sp = sensor.params
-        self.min_distance, self.meander = plume.min_distance, plume.meander
-        self.decay, self.backflow = plume.decay, plume.backflow
-        self.radius = plume.radius
+        self.min_distance, self.shape = plume.min_distance, plume.shape
         if self.merge:
             self.starts = merge_runs(theta)
             self.theta = np.ascontiguousarray(theta[self.starts])
@@ -227,10 +224,7 @@ class ParticleTerms:
                 pts,
                 new_rows,
                 self.min_distance,
-                self.meander,
-                self.decay,
-                self.backflow,
-                self.radius,
+                *self.shape,
                 self.sp,
                 *self.terms,
             )
@@ -246,9 +240,7 @@ class ParticleTerms:
         """A new :class:`ParticleTerms` of the particles where ``keep`` (M,) is True, with the
         rows cached so far (copied, same row numbers)."""
         other = ParticleTerms(merge=False, max_bytes=self.max_bytes)
-        other.sp, other.min_distance, other.meander = self.sp, self.min_distance, self.meander
-        other.decay, other.backflow = self.decay, self.backflow
-        other.radius = self.radius
+        other.sp, other.min_distance, other.shape = self.sp, self.min_distance, self.shape
         other._plume, other._sensor_params = self._plume, self._sensor_params
         other.theta = np.ascontiguousarray(self.theta[keep])
         other._plume_constants = np.ascontiguousarray(self._plume_constants[:, keep])

@@ -199,7 +199,8 @@ paired searches, rule written before the run): 56/56 acquired either way, the tr
 def default_learn(likelihood: str, backflow: float) -> dict[str, list[float]]:
     """What an unset ``estimator.learn`` weighs: :data:`LEARN_DEFAULT` for the likelihood,
     nothing where ``estimator.backflow`` was fixed by hand."""
-    return {} if backflow != 0.0 else LEARN_DEFAULT[likelihood]
+    grid = {} if backflow != 0.0 else LEARN_DEFAULT[likelihood]
+    return {key: list(values) for key, values in grid.items()}  # a copy: callers may edit it
 
 
 LEARN_MEMBERS_MAX = 12
