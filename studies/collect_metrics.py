@@ -11,6 +11,8 @@ campaign needs no search folder
         results/turbulent-puffs-held-out-100-climb=truth_model:puffs,climb:1 …
 
 Run ``dcee report DIR`` on every campaign first (this reads its tables, it computes nothing).
+``--keep KEY:VALUE`` keeps the rows of the study already in ``--out`` that carry that tag (a
+generation of campaigns whose search folders are gone; its rows were collected from them).
 """
 
 from __future__ import annotations
@@ -51,10 +53,26 @@ def _tagged(arg: str) -> tuple[Path, dict[str, object]]:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("campaigns", nargs="+", help="DIR=key:value,key:value")
+    ap.add_argument("campaigns", nargs="*", help="DIR=key:value,key:value")
     ap.add_argument("--out", required=True, help="the study folder to write")
+    ap.add_argument("--keep", action="append", default=[], help="KEY:VALUE rows to keep")
     args = ap.parse_args(argv)
     metrics, pairwise, searches = [], [], []
+    for keep in args.keep:
+        key, _, value = keep.partition(":")
+        for name, into in (("metrics.csv", metrics), ("pairwise.csv", pairwise),
+                           ("searches.csv", searches)):  # fmt: skip
+            path = Path(args.out) / name
+            if not path.exists():
+                continue  # a study of one planner has no pairs
+            stored = pd.read_csv(path)
+            if key not in stored.columns:
+                print(f"collect_metrics: {path} has no tag {key!r}", file=sys.stderr)
+                return 2
+            into.append(stored[stored[key].astype(str) == value])
+    if not args.campaigns and not any(len(frame) for frame in metrics):
+        print("collect_metrics: nothing to collect", file=sys.stderr)
+        return 2
     for arg in args.campaigns:
         folder, tags = _tagged(arg)
         for name, into in (("metrics.csv", metrics), ("pairwise.csv", pairwise)):

@@ -4,6 +4,11 @@ acquisition and on the truth lying in the 95 % region, Wilcoxon on the final RMS
 
     .venv/bin/python studies/pair_campaigns.py results/turbulent-puffs-held-out-100 \\
         results/turbulent-puffs-held-out-100-climb [--csv out.csv --tag truth_model=puffs]
+
+Either side may be a stored study's rows instead of a campaign folder whose searches are gone
+(``searches.csv`` of studies/collect_metrics.py), its rows picked by their tags as
+studies/ablation_table.py picks them (``FILE.csv=KEY:VALUE[:KEY:VALUE…]``):
+``docs/results/turbulent-held-out-100-today/searches.csv=truth_model:puffs:defaults:2026-11-27``.
 """
 
 from __future__ import annotations
@@ -19,7 +24,31 @@ from scipy.stats import binomtest, wilcoxon
 COLUMNS = ["scenario", "seed", "strategy", "source_acquired", "final_rmse", "truth_in_95"]
 
 
+def _stored(spec: str) -> pd.DataFrame:
+    """A stored study's rows: ``FILE.csv[=KEY:VALUE[:KEY:VALUE…]]``."""
+    path, _, picks = spec.partition("=")
+    if not Path(path).is_file():
+        print(f"pair_campaigns: {path}: no such stored study", file=sys.stderr)
+        raise SystemExit(2)
+    rows = pd.read_csv(path)
+    tags = picks.split(":") if picks else []
+    if len(tags) % 2:
+        print(f"pair_campaigns: {spec}: tags come as KEY:VALUE pairs", file=sys.stderr)
+        raise SystemExit(2)
+    for key, value in zip(tags[::2], tags[1::2], strict=True):
+        if key not in rows.columns:
+            print(f"pair_campaigns: {path} has no column {key!r}", file=sys.stderr)
+            raise SystemExit(2)
+        rows = rows[rows[key].astype(str) == value]
+    if rows.empty or rows.duplicated(["scenario", "seed", "strategy"]).any():
+        print(f"pair_campaigns: {spec}: pick one search per configuration", file=sys.stderr)
+        raise SystemExit(2)
+    return rows[COLUMNS]
+
+
 def _load(folder: str) -> pd.DataFrame:
+    if folder.partition("=")[0].endswith(".csv"):
+        return _stored(folder)
     paths = sorted(Path(folder).glob("runs/**/summary.json"))
     if not paths:
         print(f"pair_campaigns: no searches under {folder}", file=sys.stderr)

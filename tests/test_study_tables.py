@@ -1,5 +1,6 @@
-"""The paired study table (studies/ablation_table.py) against hand counts, read from a stored
-study's per-search rows (the searches.csv that studies/collect_metrics.py writes)."""
+"""The paired study tables (studies/ablation_table.py, studies/pair_campaigns.py) against hand
+counts, read from a stored study's per-search rows (the searches.csv that
+studies/collect_metrics.py writes), and a stored generation kept by collect_metrics."""
 
 from __future__ import annotations
 
@@ -89,3 +90,45 @@ def test_paired_table_refuses_rows_of_several_studies(tmp_path: Path, capsys) ->
         assert stop.value.code == 2
         err = capsys.readouterr().err
         assert says in err and err.count("\n") == 1
+
+
+def test_pair_campaigns_pairs_two_generations_of_a_stored_study(tmp_path: Path, capsys) -> None:
+    pair = _script("pair_campaigns")
+    path = _stored(tmp_path)
+    frame = pd.read_csv(path)
+    # a second generation: the reference planner ("ref") 0.2 m closer everywhere, covering k = 5
+    later = frame[frame["truth_model"] == "a"].assign(truth_model="later")
+    later.loc[later["strategy"] == "ref", "final_rmse"] -= 0.2
+    later.loc[later["strategy"] == "ref", "source_acquired"] = True
+    pd.concat([frame, later]).to_csv(path, index=False)
+    out = tmp_path / "pairs.csv"
+    assert pair.main([f"{path}=truth_model:a", f"{path}=truth_model:later", "--csv", str(out)]) == 0
+    rows = pd.read_csv(out).set_index("strategy")
+    ref, var = rows.loc["ref"], rows.loc["var"]
+    assert (ref["pairs"], ref["acquired_a_only"], ref["acquired_b_only"]) == (6, 0, 2)
+    assert ref["median_rmse_b_minus_a"] == pytest.approx(-0.2)
+    assert ref["rmse_wilcoxon_p"] == pytest.approx(2 / 2**6)  # exact, n = 6, every sign negative
+    assert (var["acquired_b_only"], var["median_rmse_b_minus_a"], var["rmse_wilcoxon_p"]) == (
+        0, 0.0, 1.0,
+    )  # fmt: skip
+    for spec, says in ((f"{path}=truth_model", "KEY:VALUE pairs"), (f"{path}", "pick one")):
+        with pytest.raises(SystemExit) as stop:
+            pair.main([spec, f"{path}=truth_model:a"])
+        assert stop.value.code == 2 and says in capsys.readouterr().err
+
+
+def test_collect_metrics_keeps_a_stored_generation(tmp_path: Path, capsys) -> None:
+    collect = _script("collect_metrics")
+    out = _stored(tmp_path).parent
+    pd.DataFrame(
+        [{"strategy": s, "truth_model": t, "searches": 6} for s in ("ref", "var") for t in "ab"]
+    ).to_csv(out / "metrics.csv", index=False)
+    # no campaign to add: the kept generation alone is written back, the rest dropped
+    assert collect.main(["--out", str(out), "--keep", "truth_model:a"]) == 0
+    assert set(pd.read_csv(out / "metrics.csv")["truth_model"]) == {"a"}
+    kept = pd.read_csv(out / "searches.csv")
+    assert set(kept["truth_model"]) == {"a"} and len(kept) == 12
+    assert not (out / "pairwise.csv").exists()
+    assert collect.main(["--out", str(out), "--keep", "truth_model:c"]) == 2
+    assert collect.main(["--out", str(out), "--keep", "planner:a"]) == 2
+    assert capsys.readouterr().err.count("\n") == 2
