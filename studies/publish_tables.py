@@ -213,11 +213,12 @@ def what_we_found() -> str:
         rows.append(
             planners_row(
                 f"**held-out**, {what}, all eight unknown, fluctuation likelihood, "
-                "`held-out-100`, today's defaults (since 2026-11-27), `dcee-cl` / `infotaxis` "
-                "(`turbulent-held-out-100-today`)",
+                "`held-out-100`, today's defaults (since 2026-11-27, the backflow member "
+                "learned), `dcee-cl` / `infotaxis` (`turbulent-held-out-100-today`)",
                 study("turbulent-held-out-100-today"),
                 ("dcee-cl", "infotaxis"),
                 truth_model=truth,
+                defaults=TODAY_DEFAULTS,
             )
         )
     return table(
