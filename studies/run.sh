@@ -414,6 +414,11 @@ case "${1:---list}" in
       --variant 'radius:estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-source-radius-13-40/variants.csv
     $P studies/publish_tables.py ;;
+  tune-area-release)  # the tuning truths released over an area: do they reproduce the lbm failure? (docs/plumes.md)
+    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+      --variant 'area:truth.model.puff_radius=0.5' \
+      --variant 'area-radius:truth.model.puff_radius=0.5,estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}' \
+      --workers "${WORKERS:-2}" --csv docs/results/tuning-area-release-13-40/variants.csv ;;
   cross-truth)  # every truth at today's defaults; the lbm plume held out (docs/plumes.md, README)
     # dcee-cl, infotaxis and the tree search at today's defaults, 100 held-out configurations
     export SUITE=held-out-100 TRUTHS=lbm WORKERS=${WORKERS:-2}
