@@ -317,6 +317,40 @@ def test_learn_is_checked_before_any_work():
         )
 
 
+def test_learn_prior_weighs_the_members_by_hand_computed_products():
+    """estimator.learn_prior: each value's probability (normalised), members' priors the
+    products, the calm member's share apart; a setting it does not name weighs equally."""
+    prior = LEARNED.with_overrides(**{"estimator.learn_prior": {"log_sd": [3.0, 1.0]}})
+    # members: (0.15, 1.3), (0.15, 2), (0.5, 1.3), (0.5, 2); meander equal, log_sd 3/4 : 1/4
+    assert prior.reading_model_priors == pytest.approx((0.375, 0.125, 0.375, 0.125))
+    both = LEARNED.with_overrides(
+        **{
+            "estimator.learn_prior": {"meander": [0.9, 0.1], "log_sd": [0.5, 0.5]},
+            "estimator.calm_prior": 0.2,
+        }
+    )
+    assert both.reading_models[-1] == "paper"
+    assert both.reading_model_priors == pytest.approx(
+        (0.8 * 0.45, 0.8 * 0.45, 0.8 * 0.05, 0.8 * 0.05, 0.2)
+    )
+    # the default grid (backflow) can be weighed without restating it
+    default = PAPER1.with_overrides(
+        **{"estimator.likelihood": "fluctuation", "estimator.learn_prior": {"backflow": [1.0, 4.0]}}
+    )
+    assert default.reading_models == ("fluctuation", "fluctuation[backflow=0.05]", "paper")
+    assert default.reading_model_priors == pytest.approx((0.9 * 0.2, 0.9 * 0.8, 0.1))
+
+
+def test_learn_prior_is_checked_before_any_work():
+    for prior, says in (
+        ({"decay": [1.0, 1.0]}, r"learn_prior\.decay: decay is not learned"),
+        ({"log_sd": [1.0]}, r"learn_prior\.log_sd: one positive probability per value"),
+        ({"log_sd": [1.0, 0.0]}, r"learn_prior\.log_sd: one positive probability per value"),
+    ):
+        with pytest.raises(DceeInputError, match=says):
+            LEARNED.with_overrides(**{"estimator.learn_prior": prior})
+
+
 @pytest.mark.parametrize("generating", ["fluctuation[decay=0.5]", "fluctuation"])
 def test_learned_decay_tells_a_planar_plume_from_a_point_source(generating):
     """estimator.learn = {decay = [1, 0.5]}: readings from the plume model with the planar

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal, get_args
 
+import numpy as np
 from pydantic import BaseModel, Field, field_validator, model_validator
 
 from dcee.models.sensor import OUTLIER_DEFAULT
@@ -207,6 +208,39 @@ LEARN_MEMBERS_MAX = 12
 """Most fluctuation members a learned grid may make (each costs one filter update per reading)."""
 
 
+def learn_prior_problem(
+    learn_prior: dict[str, list[float]] | None, learn: dict[str, list[float]]
+) -> str | None:
+    """Why ``estimator.learn_prior`` does not fit the resolved ``learn`` grid (a message naming
+    the field), or None."""
+    for key, probs in (learn_prior or {}).items():
+        values = learn.get(key)
+        if values is None:
+            return f"estimator.learn_prior.{key}: {key} is not learned (estimator.learn)"
+        if len(probs) != len(values) or not all(np.isfinite(p) and p > 0 for p in probs):
+            return (
+                f"estimator.learn_prior.{key}: one positive probability per value of "
+                f"estimator.learn.{key} {values} (got {probs})"
+            )
+    return None
+
+
+def learn_member_weight(
+    settings: dict[str, float],
+    learn: dict[str, list[float]],
+    learn_prior: dict[str, list[float]] | None,
+) -> float:
+    """The prior weight of the fluctuation member with these learned ``settings``: the product,
+    over the settings ``learn_prior`` names, of each value's normalised probability (a setting it
+    does not name weighs its values equally: the same factor for every member)."""
+    weight = 1.0
+    for key, probs in (learn_prior or {}).items():
+        values = learn[key]
+        index = int(np.argmin([abs(v - settings[key]) for v in values]))
+        weight *= probs[index] / sum(probs)
+    return weight
+
+
 class EstimatorSpec(BaseModel):
     """The reading model the filter and every planner use (one :class:`Sensor` for both).
 
@@ -311,6 +345,13 @@ class EstimatorSpec(BaseModel):
     preferred (first) member and must be in the grid. Empty: every value fixed. None: the
     likelihood's default, :data:`LEARN_DEFAULT` (the fluctuation likelihood weighs
     ``backflow = [0, 0.05]``); a grid given replaces it"""
+    learn_prior: (
+        dict[LearnedName, Annotated[list[float], Field(min_length=1, max_length=8)]] | None
+    ) = None
+    """fluctuation: the prior probability of each value of a learned setting, in the order of
+    its ``estimator.learn`` grid (normalised), e.g. ``{source_radius = [0.9, 0.1]}``: a member
+    then leads only when the readings' evidence outweighs the prior odds. A setting not named
+    weighs its values equally; None: every setting does. Members' priors are the products"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the

@@ -28,6 +28,8 @@ from dcee.scenarios.schema.estimator import (
     SensorSpec,
     default_learn,
     default_priors,
+    learn_member_weight,
+    learn_prior_problem,
 )
 from dcee.scenarios.schema.messages import one_line_error
 from dcee.scenarios.schema.truth import TURBULENT_HOLD, Truth, Volume
@@ -195,6 +197,8 @@ class Scenario(ScenarioBuilders, BaseModel):
                     "(the preferred member)"
                 )
             members *= len(values)
+        if problem := learn_prior_problem(e.learn_prior, learn):
+            raise ValueError(f"{FIELD_MARK}{problem}")
         if members > LEARN_MEMBERS_MAX:
             raise ValueError(
                 f"{FIELD_MARK}estimator.learn: {members} combinations; at most "
@@ -364,11 +368,9 @@ class Scenario(ScenarioBuilders, BaseModel):
     @property
     def reading_model_variants(self) -> tuple[tuple[str, dict[str, float]], ...]:
         """(name, settings) of each reading model the filter runs, the preferred first:
-        ``paper``; or ``fluctuation`` (the fixed values), then with ``estimator.learn`` one
-        member per other combination of its grid (``fluctuation[meander=0.3]``), then with
-        ``estimator.calm_prior`` > 0 the calm ``paper`` member. ``settings`` overrides the
-        fluctuation model's values (meander, log_sd, log_sd_near, intermittency, near_source_length,
-        decay, backflow, source_radius)."""
+        ``paper``; or ``fluctuation`` (the fixed values), then one member per other combination
+        of the ``estimator.learn`` grid (``fluctuation[meander=0.3]``; ``settings`` overrides
+        those values), then with ``estimator.calm_prior`` > 0 the calm ``paper`` member."""
         e = self.estimator
         if e.likelihood != "fluctuation":
             return (("paper", {}),)
@@ -386,29 +388,30 @@ class Scenario(ScenarioBuilders, BaseModel):
         return tuple(members)
 
     def _fluctuation_value(self, key: str) -> float:
-        """The fixed (resolved) value of a fluctuation-model setting ``estimator.learn`` may
-        weigh."""
+        """The fixed (resolved) value of a setting ``estimator.learn`` may weigh."""
         return self.meander if key == "meander" else float(getattr(self.estimator, key))
 
     @property
     def reading_models(self) -> tuple[str, ...]:
-        """The reading models the filter runs, the preferred first (:attr:`reading_model_variants`):
-        ``("paper",)``, ``("fluctuation",)``, or with ``estimator.calm_prior`` > 0
-        ``("fluctuation", "paper")``; with ``estimator.learn`` the other fluctuation members
-        between."""
+        """The names of :attr:`reading_model_variants`, the preferred first."""
         return tuple(name for name, _ in self.reading_model_variants)
 
     @property
     def reading_model_priors(self) -> tuple[float, ...]:
         """Prior probability of each of :attr:`reading_models`: ``calm_prior`` for the calm
-        member, the rest shared equally by the fluctuation members."""
-        names = self.reading_models
-        if len(names) == 1:
+        member, the rest shared by the fluctuation members as ``estimator.learn_prior`` says
+        (equally where it is unset)."""
+        variants = self.reading_model_variants
+        if len(variants) == 1:
             return (1.0,)
-        calm = self.estimator.calm_prior if names[-1] == "paper" else 0.0
-        turbulent = len(names) - (1 if calm > 0 else 0)
+        calm = self.estimator.calm_prior if variants[-1][0] == "paper" else 0.0
+        prior = self.estimator.learn_prior
+        weights = [
+            0.0 if n == "paper" else learn_member_weight(s, self.learn, prior) for n, s in variants
+        ]
         return tuple(
-            calm if (n == "paper" and calm > 0) else (1.0 - calm) / turbulent for n in names
+            calm if n == "paper" else (1.0 - calm) * w / sum(weights)
+            for (n, _), w in zip(variants, weights, strict=True)
         )
 
     @property
