@@ -754,6 +754,33 @@ def source_radius_tuning_table() -> str:
     return _variant_table(frame, names, ("base", "radius"), "the defaults it was measured against")
 
 
+def radius_prior_table(release: str) -> str:
+    """Disc members on the tuning range, each search paired with today's defaults on the same
+    configuration: on the point releases (``release="point"``; today's defaults: the backflow
+    rows of docs/results/tuning-backflow-13-40) or on the releases over an area (``"area"``,
+    ``puff_radius`` 0.5 m; today's defaults: the ``area`` rows of
+    docs/results/tuning-area-release-13-40). The rule: docs/results/tuning-radius-prior-13-40."""
+    if release == "point":
+        base = pd.read_csv(RESULTS / "tuning-backflow-13-40" / "variants.csv")
+        base = base[base["variant"] == "backflow"]
+        radius = pd.read_csv(RESULTS / "tuning-source-radius-13-40" / "variants.csv")
+        prior, label = "prior", "point releases"
+    else:
+        area = pd.read_csv(RESULTS / "tuning-area-release-13-40" / "variants.csv")
+        base = area[area["variant"] == "area"]
+        radius = area[area["variant"] == "area-radius"].assign(variant="radius")
+        prior, label = "area-prior", "releases over an area (`puff_radius = 0.5`)"
+    candidate = pd.read_csv(RESULTS / "tuning-radius-prior-13-40" / "variants.csv")
+    candidate = candidate[candidate["variant"] == prior].assign(variant="prior")
+    frame = pd.concat([base.assign(variant="base"), radius, candidate])
+    names = {
+        "base": f"today's defaults, {label}",
+        "radius": "`learn = {backflow = [0, 0.05], source_radius = [0, 1]}` (equal priors)",
+        "prior": "the same with `learn_prior = {source_radius = [0.9, 0.1]}`",
+    }
+    return _variant_table(frame, names, ("base", "radius", "prior"), "today's defaults")
+
+
 def _variant_table(frame: pd.DataFrame, names: dict, order: tuple, base_name: str) -> str:
     """Rows per variant and truth (and both truths), each variant paired by search with the
     variant ``base``: acquisition, median final RMSE, share in the 95 % region, along-wind
@@ -1128,6 +1155,8 @@ TABLES: dict[str, Callable[[], str]] = {
     "lbm-near-source": lbm_near_source_table,
     "cross-truth": cross_truth_table,
     "cross-truth-latest": lambda: cross_truth_table(latest_only=True),
+    "radius-prior-point": lambda: radius_prior_table("point"),
+    "radius-prior-area": lambda: radius_prior_table("area"),
     "lbm-statistics": lbm_statistics_table,
     "what-we-found": what_we_found,
     "wind-known": public_table("paper-source"),

@@ -434,6 +434,10 @@ case "${1:---list}" in
     # an option measured at today's defaults (it decides nothing): a release spread over a disc
     STRATEGIES=dcee-cl OUT_SUFFIX=-radius bash studies/study_turbulent_held_out.sh \
       --set truth.z=4.0 --set 'estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}'
+    # the same with prior odds 9:1 against the disc (tune-radius-prior decides whether it is a default)
+    STRATEGIES=dcee-cl OUT_SUFFIX=-radius-prior bash studies/study_turbulent_held_out.sh \
+      --set truth.z=4.0 --set 'estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}' \
+      --set 'estimator.learn_prior={source_radius=[0.9,0.1]}'
     # the defaults of 2026-11-27 before the backflow member (pinned: no learned setting)
     nobf=(--set truth.z=4.0 --set 'estimator.learn={}')
     bash studies/study_turbulent_held_out.sh "${nobf[@]}"
@@ -453,6 +457,7 @@ case "${1:---list}" in
       --particles 20000
     r=results/turbulent-lbm-held-out-100
     report turbulent-lbm-held-out-100-bf turbulent-lbm-held-out-100-mcts-bf turbulent-lbm-held-out-100-radius \
+      turbulent-lbm-held-out-100-radius-prior \
       turbulent-lbm-held-out-100 turbulent-lbm-held-out-100-mcts-today \
       turbulent-lbm-held-out-100-nsl25 turbulent-lbm-held-out-100-decay \
       turbulent-lbm-held-out-100-mcts turbulent-lbm-held-out-100-nsl turbulent-lbm-held-out-100-20k
@@ -460,6 +465,7 @@ case "${1:---list}" in
       "$r-bf=defaults:2026-11-27b,learn:none,particles:10000" \
       "$r-mcts-bf=defaults:2026-11-27b,learn:none,particles:10000" \
       "$r-radius=defaults:2026-11-27b,learn:backflow+source_radius,particles:10000" \
+      "$r-radius-prior=defaults:2026-11-27b,learn:backflow+source_radius with prior odds 9:1 against the disc,particles:10000" \
       "$r=defaults:2026-11-27,learn:none,particles:10000" \
       "$r-mcts-today=defaults:2026-11-27,learn:none,particles:10000" \
       "$r-nsl25=defaults:2026-11-23,learn:none,particles:10000" \
@@ -479,7 +485,7 @@ case "${1:---list}" in
         --csv docs/results/lbm-held-out-100/paired.csv --tag "reference=$ref" --tag defaults=2026-11-27b
     done
     # the backflow member against the defaults just before it, search by search
-    for pair in "$r:$r-bf" "$r-mcts-today:$r-mcts-bf" "$r-bf:$r-radius"; do
+    for pair in "$r:$r-bf" "$r-mcts-today:$r-mcts-bf" "$r-bf:$r-radius" "$r-bf:$r-radius-prior"; do
       $P studies/pair_campaigns.py "${pair%%:*}" "${pair#*:}" \
         --csv docs/results/lbm-held-out-100/backflow_vs_before.csv --tag truth_model=lbm
     done
