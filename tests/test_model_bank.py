@@ -349,6 +349,8 @@ def test_learn_prior_is_checked_before_any_work():
     ):
         with pytest.raises(DceeInputError, match=says):
             LEARNED.with_overrides(**{"estimator.learn_prior": prior})
+    with pytest.raises(DceeInputError, match=r"learn_prior\.backflow: backflow is not learned"):
+        PAPER1.with_overrides(**{"estimator.learn_prior": {"backflow": [1.0, 1.0]}})
 
 
 @pytest.mark.parametrize("generating", ["fluctuation[decay=0.5]", "fluctuation"])

@@ -169,6 +169,8 @@ class Scenario(ScenarioBuilders, BaseModel):
         grid, not too many members."""
         e = self.estimator
         learn = self.learn
+        if problem := learn_prior_problem(e.learn_prior, learn):
+            raise ValueError(f"{FIELD_MARK}{problem}")
         if not learn:
             return
         if e.likelihood != "fluctuation":
@@ -197,8 +199,6 @@ class Scenario(ScenarioBuilders, BaseModel):
                     "(the preferred member)"
                 )
             members *= len(values)
-        if problem := learn_prior_problem(e.learn_prior, learn):
-            raise ValueError(f"{FIELD_MARK}{problem}")
         if members > LEARN_MEMBERS_MAX:
             raise ValueError(
                 f"{FIELD_MARK}estimator.learn: {members} combinations; at most "
