@@ -9,6 +9,9 @@ P=.venv/bin/python
 [ -x "$D" ] || bash scripts/setup.sh
 report() { for dir in "$@"; do $D report "results/$dir"; cat "results/$dir/report/metrics.md"; done; }
 
+# The whole dispatch is one brace group, read before any of it runs: bash otherwise reads a
+# script as it goes, and an edit to this file during a study (hours) would run the wrong lines.
+{
 case "${1:---list}" in
   first-look)  # docs/results.md "First look": paper:1-12, seed 0, every planner
     mkdir -p results/first-look
@@ -560,3 +563,5 @@ case "${1:---list}" in
     echo "studies/run.sh: error: unknown study ${1@Q}; see bash studies/run.sh --list" >&2
     exit 2 ;;
 esac
+exit
+}
