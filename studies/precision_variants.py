@@ -5,7 +5,8 @@ Each variant is a set of scenario overrides; every variant flies the same config
 seeds on each truth (all eight parameters unknown, fluctuation likelihood, 10,000 particles
 unless overridden). Prints per variant and truth: acquired (final RMSE < 3 m), median final RMSE,
 the share with the truth in the 95 % region, and the median signed along-wind and absolute
-cross-wind error of the final mean (m; along > 0 means the estimate lies downwind).
+cross-wind error of the final mean (m; along > 0 means the estimate lies downwind); each row
+also records the reading model that led at the end and its posterior probability.
 
     .venv/bin/python studies/precision_variants.py --configs random:1-12 --truths puffs filament \\
         --variant base: --variant hold8:agent.dwell=8 --variant n20k:search.particles=20000 \\
@@ -84,7 +85,14 @@ def one(task: tuple) -> dict:
         "cross": float(abs(err @ np.array([-down[1], down[0]]))),
         "steps": s["steps"],
         "longest_stall": s["longest_stall"],
+        "model": s.get("model", ""),  # the reading model that led at the end (a bank's member)
+        "model_probability": s.get("model_probability", 1.0),
     }
+
+
+def _header(path: str) -> list[str]:
+    with open(path, newline="") as fh:
+        return next(csv.reader(fh))
 
 
 def main() -> None:
@@ -124,8 +132,10 @@ def main() -> None:
             rows.append(row)
             if args.csv:
                 new_file = not os.path.exists(args.csv)
+                # a file begun before a column existed keeps its header (the new column dropped)
+                fields = list(row) if new_file else _header(args.csv)
                 with open(args.csv, "a", newline="") as fh:
-                    w = csv.DictWriter(fh, fieldnames=list(row))
+                    w = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
                     if new_file:
                         w.writeheader()
                     w.writerow(row)

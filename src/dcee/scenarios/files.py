@@ -141,6 +141,7 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
             f"{DEFAULT_STOP_SHARE * scenario.search.acquired_rmse:g} m, in a simulation never"
         ),
         ("world", "map"): "unset: no occupancy-grid map",
+        ("estimator", "learn_prior"): "unset: the values of each learned setting equally likely",
     }
     lines = [f"# dcee scenario {scenario.name}"]
     tables = []
