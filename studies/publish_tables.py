@@ -781,6 +781,47 @@ def radius_prior_table(release: str) -> str:
     return _variant_table(frame, names, ("base", "radius", "prior"), "today's defaults")
 
 
+def mixture_region_table() -> str:
+    """The truth in the selected member's 95 % region and in the reading models' mixture's, on
+    the same searches (docs/results/mixture-region-13-40, studies/mixture_region.py)."""
+    from scipy.stats import binomtest
+
+    frame = pd.read_csv(RESULTS / "mixture-region-13-40" / "searches.csv")
+    releases = {"radius": "point", "area-radius": "area (`puff_radius = 0.5`)"}
+    rows = []
+    for variant, release in releases.items():
+        for truth in ("filament", "puffs", "both truths"):
+            part = frame[frame["variant"] == variant]
+            if truth != "both truths":
+                part = part[part["truth"] == truth]
+            elif part["truth"].nunique() < 2:
+                continue  # one truth only: its own row says it all
+            if part.empty:
+                continue
+            sel, mix = part["truth_in_95"].astype(bool), part["mixture_in_95"].astype(bool)
+            gained, lost = int((mix & ~sel).sum()), int((sel & ~mix).sum())
+            p = binomtest(gained, gained + lost).pvalue if gained + lost else 1.0
+            rows.append(
+                [
+                    release,
+                    truth,
+                    str(len(part)),
+                    f"{100 * sel.mean():.0f} %",
+                    f"{100 * mix.mean():.0f} %",
+                    f"+{gained} / −{lost} (p = {p:.2g})",
+                ]
+            )
+    header = [
+        "releases",
+        "truth",
+        "n",
+        "truth in the selected member's 95 % region",
+        "in the mixture's",
+        "mixture against selected, gained / lost (exact binomial)",
+    ]
+    return table(header, rows)
+
+
 def _variant_table(frame: pd.DataFrame, names: dict, order: tuple, base_name: str) -> str:
     """Rows per variant and truth (and both truths), each variant paired by search with the
     variant ``base``: acquisition, median final RMSE, share in the 95 % region, along-wind
@@ -1157,6 +1198,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "cross-truth-latest": lambda: cross_truth_table(latest_only=True),
     "radius-prior-point": lambda: radius_prior_table("point"),
     "radius-prior-area": lambda: radius_prior_table("area"),
+    "mixture-region": mixture_region_table,
     "lbm-statistics": lbm_statistics_table,
     "what-we-found": what_we_found,
     "wind-known": public_table("paper-source"),
