@@ -24,7 +24,7 @@ import json
 import math
 import re
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pandas as pd
@@ -781,6 +781,17 @@ def radius_prior_table(release: str) -> str:
     return _variant_table(frame, names, ("base", "radius", "prior"), "today's defaults")
 
 
+def _by_truth(rows: pd.DataFrame) -> Iterator[tuple[str, pd.DataFrame]]:
+    """(truth, rows) for the filament, the puffs and both together (the last only when both
+    are there: one truth's own row says it all); truths without rows are skipped."""
+    for truth in ("filament", "puffs", "both truths"):
+        part = rows if truth == "both truths" else rows[rows["truth"] == truth]
+        if truth == "both truths" and rows["truth"].nunique() < 2:
+            continue
+        if not part.empty:
+            yield truth, part
+
+
 def mixture_region_table() -> str:
     """The truth in the selected member's 95 % region and in the reading models' mixture's, on
     the same searches (docs/results/mixture-region-13-40, studies/mixture_region.py)."""
@@ -790,14 +801,7 @@ def mixture_region_table() -> str:
     releases = {"radius": "point", "area-radius": "area (`puff_radius = 0.5`)"}
     rows = []
     for variant, release in releases.items():
-        for truth in ("filament", "puffs", "both truths"):
-            part = frame[frame["variant"] == variant]
-            if truth != "both truths":
-                part = part[part["truth"] == truth]
-            elif part["truth"].nunique() < 2:
-                continue  # one truth only: its own row says it all
-            if part.empty:
-                continue
+        for truth, part in _by_truth(frame[frame["variant"] == variant]):
             sel, mix = part["truth_in_95"].astype(bool), part["mixture_in_95"].astype(bool)
             gained, lost = int((mix & ~sel).sum()), int((sel & ~mix).sum())
             p = binomtest(gained, gained + lost).pvalue if gained + lost else 1.0
@@ -833,14 +837,7 @@ def _variant_table(frame: pd.DataFrame, names: dict, order: tuple, base_name: st
     base = frame[frame["variant"] == "base"]
     rows = []
     for variant in order:
-        for truth in ("filament", "puffs", "both truths"):
-            part = frame[frame["variant"] == variant]
-            if truth != "both truths":
-                part = part[part["truth"] == truth]
-            elif part["truth"].nunique() < 2:
-                continue  # one truth only: its own row says it all
-            if part.empty:
-                continue
+        for truth, part in _by_truth(frame[frame["variant"] == variant]):
             n = len(part)
             paired = "—"
             if variant != "base":
