@@ -22,7 +22,7 @@ import os
 from multiprocessing import Pool
 
 import numpy as np
-from precision_variants import parse_variant, variant_scenario
+from precision_variants import append_row, parse_variant, variant_scenario
 
 from dcee.scenarios import expand_names
 
@@ -37,7 +37,9 @@ def one(task: tuple) -> dict:
     scenario = variant_scenario(name, truth, over)
     planner = get_planner("dcee-cl", **planner_defaults("dcee-cl", scenario, None))
     sim = SearchSimulation(scenario, seed, planner, None)
-    while True:  # the loop of dcee.runs.run_episode, for one agent
+    # the loop of dcee.runs.run_episode, for one agent: run_episode keeps only the selected
+    # member's particles, and the mixture needs every member's
+    while True:
         sim.sense()
         waypoint = None if sim.finished else sim.searcher.ask()
         if waypoint is None:
@@ -92,12 +94,7 @@ def main() -> None:
         for row in pool.imap_unordered(one, todo, chunksize=1):
             print(row, flush=True)
             if args.csv:
-                new_file = not os.path.exists(args.csv)
-                with open(args.csv, "a", newline="") as fh:
-                    w = csv.DictWriter(fh, fieldnames=list(row))
-                    if new_file:
-                        w.writeheader()
-                    w.writerow(row)
+                append_row(args.csv, row)
 
 
 if __name__ == "__main__":

@@ -90,9 +90,20 @@ def one(task: tuple) -> dict:
     }
 
 
-def _header(path: str) -> list[str]:
-    with open(path, newline="") as fh:
-        return next(csv.reader(fh))
+def append_row(path: str, row: dict) -> None:
+    """Append one search's row to the CSV at ``path`` (header first in a new file); a file
+    begun before a column existed keeps its header (the new column is dropped)."""
+    new_file = not os.path.exists(path)
+    if new_file:
+        fields = list(row)
+    else:
+        with open(path, newline="") as fh:
+            fields = next(csv.reader(fh))
+    with open(path, "a", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
+        if new_file:
+            w.writeheader()
+        w.writerow(row)
 
 
 def main() -> None:
@@ -131,14 +142,7 @@ def main() -> None:
         for row in pool.imap_unordered(one, todo, chunksize=1):
             rows.append(row)
             if args.csv:
-                new_file = not os.path.exists(args.csv)
-                # a file begun before a column existed keeps its header (the new column dropped)
-                fields = list(row) if new_file else _header(args.csv)
-                with open(args.csv, "a", newline="") as fh:
-                    w = csv.DictWriter(fh, fieldnames=fields, extrasaction="ignore")
-                    if new_file:
-                        w.writeheader()
-                    w.writerow(row)
+                append_row(args.csv, row)
     print("| variant | truth | n | acquired | median final RMSE (m) | truth in 95 % | "
           "median along-wind error (m) | median cross-wind error (m) |")  # fmt: skip
     print("|---|---|---|---|---|---|---|---|")
