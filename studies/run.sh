@@ -432,6 +432,11 @@ case "${1:---list}" in
     $P studies/mixture_region.py --configs random:13-40 --truths puffs filament \
       --variant "radius:$cand" --variant "area-radius:truth.model.puff_radius=0.5,$cand" \
       --workers "${WORKERS:-2}" --csv docs/results/mixture-region-13-40/searches.csv ;;
+  mixture-region-prior)  # disc members with prior odds 9:1 against and the mixture's region, point and area releases (docs/plumes.md)
+    cand='estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]},estimator.learn_prior={source_radius=[0.9,0.1]}'
+    $P studies/mixture_region.py --configs random:13-40 --truths puffs filament \
+      --variant "prior:$cand" --variant "area-prior:truth.model.puff_radius=0.5,$cand" \
+      --workers "${WORKERS:-2}" --csv docs/results/mixture-region-prior-13-40/searches.csv ;;
   cross-truth)  # every truth at today's defaults; the lbm plume held out (docs/plumes.md, README)
     # dcee-cl, infotaxis and the tree search at today's defaults, 100 held-out configurations
     export SUITE=held-out-100 TRUTHS=lbm WORKERS=${WORKERS:-2}
