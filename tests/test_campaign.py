@@ -745,10 +745,11 @@ def test_an_override_that_changes_no_stored_scenario_keeps_the_campaign():
 
 
 def test_a_fluctuation_campaign_stored_before_the_backflow_member_is_not_todays_default():
-    """The fluctuation likelihood's unset ``estimator.learn`` weighs a backflow member since
-    issue 42: a campaign stored with no learned setting ({} or no key) is not today's default,
-    but resumes with the grid pinned to {}; an explicit grid equal to the default is the
-    default; under the paper's likelihood nothing changed."""
+    """The fluctuation likelihood's unset ``estimator.learn`` weighs a backflow member and a
+    disc member (at prior odds 9 : 1 against, ``learn_prior``) since issue 42: a campaign stored
+    with no learned setting ({} or no key) or with the backflow member alone is not today's
+    default, but resumes with the grid pinned; an explicit grid and prior equal to the default
+    are the default; under the paper's likelihood nothing changed."""
     from dcee.runs import scenario_identity
     from dcee.scenarios import load_scenario
 
@@ -763,8 +764,22 @@ def test_a_fluctuation_campaign_stored_before_the_backflow_member_is_not_todays_
     assert scenario_identity(missing) == scenario_identity(stored)
     pinned = fluct.with_overrides(**{"estimator.learn": {}})
     assert scenario_identity(pinned.model_dump(mode="json")) == scenario_identity(stored)
-    explicit = fluct.with_overrides(**{"estimator.learn": {"backflow": [0.0, 0.05]}})
+    grid = {"backflow": [0.0, 0.05], "source_radius": [0.0, 1.0]}
+    explicit = fluct.with_overrides(
+        **{"estimator.learn": grid, "estimator.learn_prior": {"source_radius": [0.9, 0.1]}}
+    )
     assert scenario_identity(explicit.model_dump(mode="json")) == now
+    # the default grid given without its prior weighs every value equally: not the default
+    equal = fluct.with_overrides(**{"estimator.learn": grid})
+    assert scenario_identity(equal.model_dump(mode="json")) != now
+    # stored at the defaults before the disc member (backflow only, no learn_prior key)
+    backflow_only = fluct.with_overrides(**{"estimator.learn": {"backflow": [0.0, 0.05]}})
+    before_disc = backflow_only.model_dump(mode="json")
+    before_disc["estimator"].pop("learn_prior")
+    assert scenario_identity(before_disc) != now
+    assert scenario_identity(before_disc) == scenario_identity(
+        backflow_only.model_dump(mode="json")
+    )
     paper = load_scenario("paper:1").model_dump(mode="json")
     old_paper = load_scenario("paper:1").model_dump(mode="json")
     old_paper["estimator"].pop("learn")

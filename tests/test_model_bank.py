@@ -144,6 +144,38 @@ def test_bank_prior_probabilities_and_bad_input():
         ModelBank(pf, ("a", "b"), prior_probabilities=(1.0, 0.0))
 
 
+def _clouds(centres_x: tuple[float, ...], n: int = 4000) -> list[ParticleFilter]:
+    """One filter per centre, its particles by hand: x ~ N(centre, 0.3²), y ~ N(25, 0.3²) m,
+    equal weights (no reading)."""
+    rng = np.random.default_rng(3)
+    filters = []
+    for i, cx in enumerate(centres_x):
+        pf = ParticleFilter(_xy_prior(), PAPER1.make_sensor(), n_particles=n, seed=i)
+        pf.theta[:, 0] = rng.normal(cx, 0.3, n)
+        pf.theta[:, 1] = rng.normal(25.0, 0.3, n)
+        filters.append(pf)
+    return filters
+
+
+def test_the_region_is_the_models_mixture_weighted_by_their_probabilities():
+    """Two members whose beliefs sit 6 m apart: with equal probabilities the region of their
+    mixture holds the second member's centre (the selected, first member's does not); at 99 : 1
+    the second member holds 1 % of the mass, less than the 5 % outside a 95 % region, so its
+    centre falls outside; one member: its own region, truth by truth."""
+    a, b = _clouds((10.0, 16.0))
+    at_b = np.array([16.0, 25.0, 1.0])
+    even = ModelBank([a, b], ("a", "b"))
+    assert even.selected_name == "a" and not a.in_credible_region(at_b)
+    assert even.in_credible_region(at_b) and even.in_credible_region(np.array([10, 25, 1.0]))
+    assert not even.in_credible_region(np.array([10.0, 28.0, 1.0]))  # 10 sd across
+    assert not ModelBank([a, b], ("a", "b"), (99.0, 1.0)).in_credible_region(at_b)
+    assert ModelBank([a, b], ("a", "b"), (1.0, 99.0)).in_credible_region(at_b)
+    alone = ModelBank([a], ("a",))
+    for dx in np.linspace(-1.5, 1.5, 13):
+        truth = np.array([10.0 + dx, 25.0 + dx / 2, 1.0])
+        assert alone.in_credible_region(truth) == a.in_credible_region(truth)
+
+
 def test_fluctuation_likelihood_runs_the_calm_model_unless_told_not_to():
     assert PAPER1.reading_models == ("paper",)
     assert FLUCT.reading_models == ("fluctuation", "paper")
@@ -333,12 +365,30 @@ def test_learn_prior_weighs_the_members_by_hand_computed_products():
     assert both.reading_model_priors == pytest.approx(
         (0.8 * 0.45, 0.8 * 0.45, 0.8 * 0.05, 0.8 * 0.05, 0.2)
     )
-    # the default grid (backflow) can be weighed without restating it
-    default = PAPER1.with_overrides(
-        **{"estimator.likelihood": "fluctuation", "estimator.learn_prior": {"backflow": [1.0, 4.0]}}
+    # the default grid (backflow x source_radius) with its default prior: odds 9 : 1 against
+    # the disc, backflow equal, calm 0.1
+    default = PAPER1.with_overrides(**{"estimator.likelihood": "fluctuation"})
+    assert default.reading_models == (
+        "fluctuation",
+        "fluctuation[backflow=0,source_radius=1]",
+        "fluctuation[backflow=0.05,source_radius=0]",
+        "fluctuation[backflow=0.05,source_radius=1]",
+        "paper",
     )
-    assert default.reading_models == ("fluctuation", "fluctuation[backflow=0.05]", "paper")
-    assert default.reading_model_priors == pytest.approx((0.9 * 0.2, 0.9 * 0.8, 0.1))
+    assert default.learn_prior == {"source_radius": [0.9, 0.1]}
+    assert default.reading_model_priors == pytest.approx(
+        (0.9 * 0.45, 0.9 * 0.05, 0.9 * 0.45, 0.9 * 0.05, 0.1)
+    )
+    # the default grid weighed without restating it: a prior given replaces the default one
+    # (source_radius then equal)
+    weighed = default.with_overrides(**{"estimator.learn_prior": {"backflow": [1.0, 4.0]}})
+    assert weighed.reading_model_priors == pytest.approx(
+        (0.9 * 0.1, 0.9 * 0.1, 0.9 * 0.4, 0.9 * 0.4, 0.1)
+    )
+    # a grid given: no default prior (every value equally likely)
+    given = default.with_overrides(**{"estimator.learn": {"source_radius": [0.0, 1.0]}})
+    assert given.learn_prior == {}
+    assert given.reading_model_priors == pytest.approx((0.45, 0.45, 0.1))
 
 
 def test_learn_prior_is_checked_before_any_work():

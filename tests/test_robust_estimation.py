@@ -373,10 +373,17 @@ def test_run_with_fluctuation_likelihood_records_the_resolved_settings(tmp_path,
     assert isinstance(summary["truth_in_95"], bool)
     config = json.loads((out / "config.json").read_text())
     assert config["scenario"]["estimator"]["log_sd"] == 1.1
-    # the backflow member and the calm model run beside it: the summary and the printed table
-    # name the chosen model
-    assert summary["reading_models"] == "fluctuation+fluctuation[backflow=0.05]+paper"
-    assert summary["model"] in ("fluctuation", "fluctuation[backflow=0.05]", "paper")
+    # the backflow and disc members and the calm model run beside it: the summary and the
+    # printed table name the chosen model
+    members = (
+        "fluctuation",
+        "fluctuation[backflow=0,source_radius=1]",
+        "fluctuation[backflow=0.05,source_radius=0]",
+        "fluctuation[backflow=0.05,source_radius=1]",
+        "paper",
+    )
+    assert summary["reading_models"] == "+".join(members)
+    assert summary["model"] in members
     row = next(line for line in printed.splitlines() if "reading model" in line)
     assert summary["model"] in row and f"{summary['model_probability']:.3f}" in row
 

@@ -14,6 +14,7 @@ from dcee.scenarios import (
     REPEAT_DEFAULT,
     UnicycleSpec,
     default_learn,
+    default_learn_prior,
     unset_climb,
 )
 
@@ -58,6 +59,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("estimator", "backflow"): 0.0,
     # a point source before issue 42's source_radius setting
     ("estimator", "source_radius"): 0.0,
+    # every learned value equally likely before issue 42's learn_prior setting
+    ("estimator", "learn_prior"): {},
     # input only (a compass bearing converted to phi), always unset once validated
     ("truth", "wind_from"): None,
 }
@@ -153,6 +156,12 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
             if key in estimator and estimator[key] is None:
                 # unset: the likelihood's default, compared as the number it stands for
                 estimator[key] = _unset_repeat(likelihood, estimator)[k]
+        if "learn_prior" in estimator and estimator["learn_prior"] is None:
+            # unset: the prior it resolved to (Scenario.learn_prior), compared as that prior
+            # (no learn key: stored before the learned bank, which ran no grid)
+            estimator["learn_prior"] = default_learn_prior(
+                likelihood, estimator.get("backflow", 0.0), estimator.get("learn", {})
+            )
         if "learn" in estimator and estimator["learn"] is None:
             # unset: the grid it resolved to (Scenario.learn), compared as that grid
             estimator["learn"] = default_learn(likelihood, estimator.get("backflow", 0.0))

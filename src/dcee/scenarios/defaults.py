@@ -59,7 +59,11 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
     ("estimator", "conserve_mean"): Provenance(("filament", "puffs"), "random:13-40, dcee-cl"),
     ("estimator", "learn"): Provenance(
         ("filament", "puffs"),
-        "backflow = [0, 0.05] weighed beside the fixed 0: random:13-40, dcee-cl (issue 42)",
+        "backflow = [0, 0.05] and source_radius = [0, 1] weighed beside the fixed 0: "
+        "random:13-40 released at a point and over an area, dcee-cl (issue 42)",
+    ),
+    ("estimator", "learn_prior"): Provenance(
+        (), "prior odds 9:1 against the disc: Jeffreys' 'strong' evidence, not a search"
     ),
     ("estimator", "meander"): Provenance(("filament",), "the filament truth's time mean"),
     ("estimator", "reading_weight"): Provenance(

@@ -127,6 +127,7 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
         ("sensor", "average"): scenario.average,
         ("estimator", "meander"): scenario.meander,
         ("estimator", "learn"): scenario.learn,
+        ("estimator", "learn_prior"): scenario.learn_prior,
         ("estimator", "reading_weight"): scenario.reading_weight,
         ("estimator", "repeat_radius"): scenario.repeat_radius,
         ("estimator", "repeat_power"): scenario.repeat_power,
@@ -141,7 +142,6 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
             f"{DEFAULT_STOP_SHARE * scenario.search.acquired_rmse:g} m, in a simulation never"
         ),
         ("world", "map"): "unset: no occupancy-grid map",
-        ("estimator", "learn_prior"): "unset: the values of each learned setting equally likely",
     }
     lines = [f"# dcee scenario {scenario.name}"]
     tables = []

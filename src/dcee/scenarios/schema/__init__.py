@@ -11,6 +11,7 @@ from dcee.scenarios.schema.agent import (
 from dcee.scenarios.schema.common import FROZEN, Finite, Positive
 from dcee.scenarios.schema.estimator import (
     LEARN_DEFAULT,
+    LEARN_PRIOR_DEFAULT,
     LIKELIHOODS,
     MEANDER_DEFAULT,
     OLD_OUTLIER_DEFAULT,
@@ -23,6 +24,7 @@ from dcee.scenarios.schema.estimator import (
     PriorSpec,
     SensorSpec,
     default_learn,
+    default_learn_prior,
     default_priors,
 )
 from dcee.scenarios.schema.scenario import FIELD_MARK, Scenario, validate_scenario
@@ -42,6 +44,7 @@ __all__ = [
     "FIELD_MARK",
     "FROZEN",
     "LEARN_DEFAULT",
+    "LEARN_PRIOR_DEFAULT",
     "LIKELIHOODS",
     "MEANDER_DEFAULT",
     "OLD_OUTLIER_DEFAULT",
@@ -68,6 +71,7 @@ __all__ = [
     "UnicycleSpec",
     "Volume",
     "default_learn",
+    "default_learn_prior",
     "default_priors",
     "team_starts",
     "unset_climb",

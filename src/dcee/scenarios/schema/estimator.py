@@ -185,16 +185,28 @@ LEARN_RANGES: dict[str, tuple[float, float]] = {
 """Allowed values of each learned setting (as for the fixed setting)."""
 LEARN_DEFAULT: dict[str, dict[str, list[float]]] = {
     "paper": {},
-    "fluctuation": {"backflow": [0.0, 0.05]},
+    "fluctuation": {"backflow": [0.0, 0.05], "source_radius": [0.0, 1.0]},
 }
 """``estimator.learn`` when not given, per likelihood (with ``estimator.backflow`` left at 0;
 a backflow fixed by hand is not learned unless asked). The fluctuation likelihood weighs a
 member with gas upwind of the release (w = 0.05: a planar plume at turbulence intensity 0.6,
-a 3-D one at 0.9) beside
-the plain plume: chosen on the tuning range random:13-40 (filament + puffs, ``dcee-cl``, 56
-paired searches, rule written before the run): 56/56 acquired either way, the truth in the
-95 % region in 100 % against 95 % (+3 / −0), the final error unchanged at the median pair
-(−0.00 m, Wilcoxon p = 0.59) (docs/plumes.md, docs/results/tuning-backflow-13-40)."""
+a 3-D one at 0.9) beside the plain plume, chosen on the tuning range random:13-40 (filament +
+puffs, ``dcee-cl``, 56 paired searches, rule written before the run): 56/56 acquired either
+way, the truth in the 95 % region in 100 % against 95 % (+3 / −0), the final error unchanged at
+the median pair (−0.00 m, Wilcoxon p = 0.59) (docs/results/tuning-backflow-13-40); and a
+release spread over a disc of radius 1 m beside the point release, at prior odds 9 : 1 against
+(:data:`LEARN_PRIOR_DEFAULT`), with the bank's region the members' mixture's, chosen on the same
+range released at a point and over an area (``truth.model.puff_radius = 0.5``), 112 paired
+searches, rule written before the run (docs/plumes.md,
+docs/results/mixture-region-prior-13-40)."""
+LEARN_PRIOR_DEFAULT: dict[str, dict[str, list[float]]] = {
+    "paper": {},
+    "fluctuation": {"source_radius": [0.9, 0.1]},
+}
+"""``estimator.learn_prior`` when neither it nor ``estimator.learn`` is given, per likelihood:
+the disc member leads only where the readings favour it by a Bayes factor above 9, about where
+Jeffreys' scale calls evidence strong (the value from that convention, not from a search; the
+equal prior let the disc lead on point releases: docs/results/tuning-source-radius-13-40)."""
 
 
 def default_learn(likelihood: str, backflow: float) -> dict[str, list[float]]:
@@ -202,6 +214,18 @@ def default_learn(likelihood: str, backflow: float) -> dict[str, list[float]]:
     nothing where ``estimator.backflow`` was fixed by hand."""
     grid = {} if backflow != 0.0 else LEARN_DEFAULT[likelihood]
     return {key: list(values) for key, values in grid.items()}  # a copy: callers may edit it
+
+
+def default_learn_prior(
+    likelihood: str, backflow: float, learn: dict[str, list[float]] | None
+) -> dict[str, list[float]]:
+    """What an unset ``estimator.learn_prior`` says: :data:`LEARN_PRIOR_DEFAULT` with the
+    default grid (``learn`` None), nothing (every value equally likely) with a grid given."""
+    if learn is not None:
+        return {}
+    grid = default_learn(likelihood, backflow)
+    prior = LEARN_PRIOR_DEFAULT[likelihood]
+    return {key: list(probs) for key, probs in prior.items() if key in grid}
 
 
 LEARN_MEMBERS_MAX = 12
@@ -344,14 +368,16 @@ class EstimatorSpec(BaseModel):
     member (:mod:`dcee.estimation.model_bank`); the combination of the values above is the
     preferred (first) member and must be in the grid. Empty: every value fixed. None: the
     likelihood's default, :data:`LEARN_DEFAULT` (the fluctuation likelihood weighs
-    ``backflow = [0, 0.05]``); a grid given replaces it"""
+    ``backflow = [0, 0.05]`` and ``source_radius = [0, 1]``); a grid given replaces it"""
     learn_prior: (
         dict[LearnedName, Annotated[list[float], Field(min_length=1, max_length=8)]] | None
     ) = None
     """fluctuation: the prior probability of each value of a learned setting, in the order of
     its ``estimator.learn`` grid (normalised), e.g. ``{source_radius = [0.9, 0.1]}``: a member
     then leads only when the readings' evidence outweighs the prior odds. A setting not named
-    weighs its values equally; None: every setting does. Members' priors are the products"""
+    weighs its values equally. None: with ``estimator.learn`` unset the likelihood's default,
+    :data:`LEARN_PRIOR_DEFAULT` (the fluctuation likelihood: ``{source_radius = [0.9, 0.1]}``),
+    with a grid given every value equally likely. Members' priors are the products"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the

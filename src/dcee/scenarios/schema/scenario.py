@@ -4,7 +4,6 @@ errors of a bad file (:func:`validate_scenario`). How a scenario becomes model o
 
 from __future__ import annotations
 
-import itertools
 from typing import Any, Literal
 
 import numpy as np
@@ -17,8 +16,6 @@ from dcee.scenarios.builders import ScenarioBuilders
 from dcee.scenarios.schema.agent import AgentSpec, SearchSpec, team_starts, unset_climb
 from dcee.scenarios.schema.common import FIELD_MARK, FROZEN, phi_prior_from_bearing
 from dcee.scenarios.schema.estimator import (
-    LEARN_MEMBERS_MAX,
-    LEARN_RANGES,
     MEANDER_DEFAULT,
     READING_WEIGHT_DEFAULT,
     REPEAT_DEFAULT,
@@ -26,17 +23,15 @@ from dcee.scenarios.schema.estimator import (
     EstimatorSpec,
     PriorSpec,
     SensorSpec,
-    default_learn,
     default_priors,
-    learn_member_weight,
-    learn_prior_problem,
 )
 from dcee.scenarios.schema.messages import one_line_error
+from dcee.scenarios.schema.reading_models import ReadingModelSettings
 from dcee.scenarios.schema.truth import TURBULENT_HOLD, Truth, Volume
 from dcee.scenarios.schema.world import WorldSpec
 
 
-class Scenario(ScenarioBuilders, BaseModel):
+class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
     """A validated, immutable scenario."""
 
     model_config = FROZEN
@@ -164,47 +159,6 @@ class Scenario(ScenarioBuilders, BaseModel):
             raise ValueError("sensor.max_reading must be above sensor.threshold")
         return self
 
-    def _checked_learn(self) -> None:
-        """``estimator.learn``: the fluctuation likelihood's, in range, the fixed values in the
-        grid, not too many members."""
-        e = self.estimator
-        learn = self.learn
-        if problem := learn_prior_problem(e.learn_prior, learn):
-            raise ValueError(f"{FIELD_MARK}{problem}")
-        if not learn:
-            return
-        if e.likelihood != "fluctuation":
-            raise ValueError(
-                f"{FIELD_MARK}estimator.learn: weighs the fluctuation model's settings; needs "
-                f'estimator.likelihood = "fluctuation" (it is "{e.likelihood}")'
-            )
-        if "log_sd_near" in learn and e.log_sd_length == 0:
-            raise ValueError(
-                f"{FIELD_MARK}estimator.learn.log_sd_near: the near-source spread needs "
-                "estimator.log_sd_length > 0 (m; with 0 the spread is the same everywhere)"
-            )
-        members = 1
-        for key, values in learn.items():
-            low, high = LEARN_RANGES[key]
-            bad = [v for v in values if not (low <= v <= high) or not np.isfinite(v)]
-            if bad or len(set(values)) != len(values):
-                raise ValueError(
-                    f"{FIELD_MARK}estimator.learn.{key}: distinct values in [{low:g}, {high:g}] "
-                    f"(got {values})"
-                )
-            fixed = self._fluctuation_value(key)
-            if not any(abs(v - fixed) < 1e-12 for v in values):
-                raise ValueError(
-                    f"{FIELD_MARK}estimator.learn.{key}: must include the fixed value {fixed:g} "
-                    "(the preferred member)"
-                )
-            members *= len(values)
-        if members > LEARN_MEMBERS_MAX:
-            raise ValueError(
-                f"{FIELD_MARK}estimator.learn: {members} combinations; at most "
-                f"{LEARN_MEMBERS_MAX} (each is a filter updated at every reading)"
-            )
-
     def _checked_planar(self, start: np.ndarray) -> None:
         """Read the truth's layout once (a recording's header) and refuse what cannot work over
         a planar truth: a climbing agent (the readings do not change with height, the reading
@@ -313,13 +267,6 @@ class Scenario(ScenarioBuilders, BaseModel):
         return 1.0 if self.time_varying_truth else self.sensor.pd
 
     @property
-    def learn(self) -> dict[str, list[float]]:
-        """``estimator.learn`` resolved: as given, or the likelihood's default
-        (:data:`LEARN_DEFAULT`; none where ``estimator.backflow`` was fixed by hand)."""
-        e = self.estimator
-        return e.learn if e.learn is not None else default_learn(e.likelihood, e.backflow)
-
-    @property
     def meander(self) -> float:
         e = self.estimator
         return e.meander if e.meander is not None else MEANDER_DEFAULT[e.likelihood]
@@ -364,55 +311,6 @@ class Scenario(ScenarioBuilders, BaseModel):
             "repeat_power": self.repeat_power,
             "climb": self.climb,
         }
-
-    @property
-    def reading_model_variants(self) -> tuple[tuple[str, dict[str, float]], ...]:
-        """(name, settings) of each reading model the filter runs, the preferred first:
-        ``paper``; or ``fluctuation`` (the fixed values), then one member per other combination
-        of the ``estimator.learn`` grid (``fluctuation[meander=0.3]``; ``settings`` overrides
-        those values), then with ``estimator.calm_prior`` > 0 the calm ``paper`` member."""
-        e = self.estimator
-        if e.likelihood != "fluctuation":
-            return (("paper", {}),)
-        learn = self.learn
-        keys = list(learn)
-        fixed = tuple(self._fluctuation_value(k) for k in keys)
-        combos = [fixed, *(c for c in itertools.product(*learn.values()) if c != fixed)]
-        members: list[tuple[str, dict[str, float]]] = []
-        for combo in combos:
-            settings = dict(zip(keys, combo, strict=True))
-            label = ",".join(f"{k}={v:g}" for k, v in settings.items())
-            members.append(("fluctuation" if combo == fixed else f"fluctuation[{label}]", settings))
-        if e.calm_prior > 0:
-            members.append(("paper", {}))
-        return tuple(members)
-
-    def _fluctuation_value(self, key: str) -> float:
-        """The fixed (resolved) value of a setting ``estimator.learn`` may weigh."""
-        return self.meander if key == "meander" else float(getattr(self.estimator, key))
-
-    @property
-    def reading_models(self) -> tuple[str, ...]:
-        """The names of :attr:`reading_model_variants`, the preferred first."""
-        return tuple(name for name, _ in self.reading_model_variants)
-
-    @property
-    def reading_model_priors(self) -> tuple[float, ...]:
-        """Prior probability of each of :attr:`reading_models`: ``calm_prior`` for the calm
-        member, the rest shared by the fluctuation members as ``estimator.learn_prior`` says
-        (equally where it is unset)."""
-        variants = self.reading_model_variants
-        if len(variants) == 1:
-            return (1.0,)
-        calm = self.estimator.calm_prior if variants[-1][0] == "paper" else 0.0
-        prior = self.estimator.learn_prior
-        weights = [
-            0.0 if n == "paper" else learn_member_weight(s, self.learn, prior) for n, s in variants
-        ]
-        return tuple(
-            calm if n == "paper" else (1.0 - calm) * w / sum(weights)
-            for (n, _), w in zip(variants, weights, strict=True)
-        )
 
     @property
     def unknown_names(self) -> tuple[str, ...]:

@@ -1,0 +1,132 @@
+"""The reading models a scenario's filter runs: the fluctuation likelihood's learned settings
+(``estimator.learn`` and ``estimator.learn_prior`` resolved and checked), one member per
+combination, and each member's prior probability (a mixin of
+:class:`~dcee.scenarios.schema.scenario.Scenario`; the bank itself is
+:class:`~dcee.estimation.model_bank.ModelBank`)."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+from dcee.scenarios.schema.common import FIELD_MARK
+from dcee.scenarios.schema.estimator import (
+    LEARN_MEMBERS_MAX,
+    LEARN_RANGES,
+    default_learn,
+    default_learn_prior,
+    learn_member_weight,
+    learn_prior_problem,
+)
+
+
+class ReadingModelSettings:
+    """The reading-model members of a scenario (a mixin: every attribute it reads, ``estimator``
+    and ``meander``, is a validated scenario field or property)."""
+
+    def _checked_learn(self) -> None:
+        """``estimator.learn``: the fluctuation likelihood's, in range, the fixed values in the
+        grid, not too many members."""
+        e = self.estimator
+        learn = self.learn
+        if problem := learn_prior_problem(self.learn_prior, learn):
+            raise ValueError(f"{FIELD_MARK}{problem}")
+        if not learn:
+            return
+        if e.likelihood != "fluctuation":
+            raise ValueError(
+                f"{FIELD_MARK}estimator.learn: weighs the fluctuation model's settings; needs "
+                f'estimator.likelihood = "fluctuation" (it is "{e.likelihood}")'
+            )
+        if "log_sd_near" in learn and e.log_sd_length == 0:
+            raise ValueError(
+                f"{FIELD_MARK}estimator.learn.log_sd_near: the near-source spread needs "
+                "estimator.log_sd_length > 0 (m; with 0 the spread is the same everywhere)"
+            )
+        members = 1
+        for key, values in learn.items():
+            low, high = LEARN_RANGES[key]
+            bad = [v for v in values if not (low <= v <= high) or not np.isfinite(v)]
+            if bad or len(set(values)) != len(values):
+                raise ValueError(
+                    f"{FIELD_MARK}estimator.learn.{key}: distinct values in [{low:g}, {high:g}] "
+                    f"(got {values})"
+                )
+            fixed = self._fluctuation_value(key)
+            if not any(abs(v - fixed) < 1e-12 for v in values):
+                raise ValueError(
+                    f"{FIELD_MARK}estimator.learn.{key}: must include the fixed value {fixed:g} "
+                    "(the preferred member)"
+                )
+            members *= len(values)
+        if members > LEARN_MEMBERS_MAX:
+            raise ValueError(
+                f"{FIELD_MARK}estimator.learn: {members} combinations; at most "
+                f"{LEARN_MEMBERS_MAX} (each is a filter updated at every reading)"
+            )
+
+    @property
+    def learn(self) -> dict[str, list[float]]:
+        """``estimator.learn`` resolved: as given, or the likelihood's default
+        (:data:`LEARN_DEFAULT`; none where ``estimator.backflow`` was fixed by hand)."""
+        e = self.estimator
+        return e.learn if e.learn is not None else default_learn(e.likelihood, e.backflow)
+
+    @property
+    def learn_prior(self) -> dict[str, list[float]]:
+        """``estimator.learn_prior`` resolved: as given, or the default with the default grid
+        (:data:`LEARN_PRIOR_DEFAULT`), or nothing (every value equally likely)."""
+        e = self.estimator
+        if e.learn_prior is not None:
+            return e.learn_prior
+        return default_learn_prior(e.likelihood, e.backflow, e.learn)
+
+    @property
+    def reading_model_variants(self) -> tuple[tuple[str, dict[str, float]], ...]:
+        """(name, settings) of each reading model the filter runs, the preferred first:
+        ``paper``; or ``fluctuation`` (the fixed values), then one member per other combination
+        of the ``estimator.learn`` grid (``fluctuation[meander=0.3]``; ``settings`` overrides
+        those values), then with ``estimator.calm_prior`` > 0 the calm ``paper`` member."""
+        e = self.estimator
+        if e.likelihood != "fluctuation":
+            return (("paper", {}),)
+        learn = self.learn
+        keys = list(learn)
+        fixed = tuple(self._fluctuation_value(k) for k in keys)
+        combos = [fixed, *(c for c in itertools.product(*learn.values()) if c != fixed)]
+        members: list[tuple[str, dict[str, float]]] = []
+        for combo in combos:
+            settings = dict(zip(keys, combo, strict=True))
+            label = ",".join(f"{k}={v:g}" for k, v in settings.items())
+            members.append(("fluctuation" if combo == fixed else f"fluctuation[{label}]", settings))
+        if e.calm_prior > 0:
+            members.append(("paper", {}))
+        return tuple(members)
+
+    def _fluctuation_value(self, key: str) -> float:
+        """The fixed (resolved) value of a setting ``estimator.learn`` may weigh."""
+        return self.meander if key == "meander" else float(getattr(self.estimator, key))
+
+    @property
+    def reading_models(self) -> tuple[str, ...]:
+        """The names of :attr:`reading_model_variants`, the preferred first."""
+        return tuple(name for name, _ in self.reading_model_variants)
+
+    @property
+    def reading_model_priors(self) -> tuple[float, ...]:
+        """Prior probability of each of :attr:`reading_models`: ``calm_prior`` for the calm
+        member, the rest shared by the fluctuation members as ``estimator.learn_prior`` says
+        (equally where it is unset)."""
+        variants = self.reading_model_variants
+        if len(variants) == 1:
+            return (1.0,)
+        calm = self.estimator.calm_prior if variants[-1][0] == "paper" else 0.0
+        prior = self.learn_prior
+        weights = [
+            0.0 if n == "paper" else learn_member_weight(s, self.learn, prior) for n, s in variants
+        ]
+        return tuple(
+            calm if n == "paper" else (1.0 - calm) * w / sum(weights)
+            for (n, _), w in zip(variants, weights, strict=True)
+        )
