@@ -826,6 +826,58 @@ def mixture_region_table() -> str:
     return table(header, rows)
 
 
+def mixture_prior_table() -> str:
+    """The default since 2026-11-27 (c), disc members at prior odds 9 : 1 with the mixture's
+    region, against the defaults before it on the same configurations, point and area releases
+    (docs/results/mixture-region-prior-13-40; the rule in its README)."""
+    from scipy.stats import binomtest, wilcoxon
+
+    frame = pd.read_csv(RESULTS / "mixture-region-prior-13-40" / "searches.csv")
+    before = pd.read_csv(RESULTS / "tuning-backflow-13-40" / "variants.csv")
+    area = pd.read_csv(RESULTS / "tuning-area-release-13-40" / "variants.csv")
+    bases = {
+        "prior": ("point", before[before["variant"] == "backflow"]),
+        "area-prior": ("area (`puff_radius = 0.5`)", area[area["variant"] == "area"]),
+    }
+    rows = []
+    for variant, (release, base) in bases.items():
+        both = frame[frame["variant"] == variant].merge(
+            base, on=["truth", "scenario", "seed"], suffixes=("", "_before")
+        )
+        for truth, part in _by_truth(both):
+            old, new = part["truth_in_95_before"].astype(bool), part["mixture_in_95"].astype(bool)
+            gained, lost = int((new & ~old).sum()), int((old & ~new).sum())
+            p = binomtest(gained, gained + lost).pvalue if gained + lost else 1.0
+            diff = part["final_rmse"] - part["final_rmse_before"]
+            p_rmse = wilcoxon(diff).pvalue if (diff != 0).any() else 1.0
+            acquired = part["acquired"].astype(bool).sum()
+            rows.append(
+                [
+                    release,
+                    truth,
+                    str(len(part)),
+                    f"{acquired} / {part['acquired_before'].astype(bool).sum()}",
+                    f"{100 * old.mean():.0f} %",
+                    f"{100 * part['truth_in_95'].astype(bool).mean():.0f} %",
+                    f"**{100 * new.mean():.0f} %**",
+                    f"+{gained} / −{lost} (p = {p:.2g})",
+                    f"{diff.median():+.2f} m (p = {p_rmse:.2g})",
+                ]
+            )
+    header = [
+        "releases",
+        "truth",
+        "n",
+        "acquired (today's / before)",
+        "truth in 95 %, before",
+        "today's, selected member's region",
+        "today's, the mixture's region",
+        "region against before, gained / lost (exact binomial)",
+        "final RMSE against before, paired median (Wilcoxon)",
+    ]
+    return table(header, rows)
+
+
 def _variant_table(frame: pd.DataFrame, names: dict, order: tuple, base_name: str) -> str:
     """Rows per variant and truth (and both truths), each variant paired by search with the
     variant ``base``: acquisition, median final RMSE, share in the 95 % region, along-wind
@@ -1196,6 +1248,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "radius-prior-point": lambda: radius_prior_table("point"),
     "radius-prior-area": lambda: radius_prior_table("area"),
     "mixture-region": mixture_region_table,
+    "mixture-prior": mixture_prior_table,
     "lbm-statistics": lbm_statistics_table,
     "what-we-found": what_we_found,
     "wind-known": public_table("paper-source"),

@@ -422,6 +422,10 @@ case "${1:---list}" in
       --variant 'area:truth.model.puff_radius=0.5' \
       --variant 'area-radius:truth.model.puff_radius=0.5,estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-area-release-13-40/variants.csv ;;
+  tune-area-release-1m)  # the tuning truths released over a 1 m disc at today's defaults: a closer stand-in for the lbm plume? (docs/plumes.md)
+    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+      --variant 'area1:truth.model.puff_radius=1.0' \
+      --workers "${WORKERS:-2}" --csv docs/results/tuning-area-release-1m-13-40/variants.csv ;;
   tune-radius-prior)  # disc members with prior odds 9:1 against, on point and area releases (docs/plumes.md)
     cand='estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]},estimator.learn_prior={source_radius=[0.9,0.1]}'
     $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
@@ -440,10 +444,17 @@ case "${1:---list}" in
   cross-truth)  # every truth at today's defaults; the lbm plume held out (docs/plumes.md, README)
     # dcee-cl, infotaxis and the tree search at today's defaults, 100 held-out configurations
     export SUITE=held-out-100 TRUTHS=lbm WORKERS=${WORKERS:-2}
-    # today's defaults (the backflow member learned since 2026-11-27, later)
-    OUT_SUFFIX=-bf bash studies/study_turbulent_held_out.sh --set truth.z=4.0
-    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-bf bash studies/study_turbulent_held_out.sh \
+    # today's defaults (since 2026-11-27 (c): the disc member at prior odds 9:1, the mixture's
+    # region; the same searches as -radius-prior below, the region now the mixture's)
+    STRATEGIES=dcee-cl OUT_SUFFIX=-dm bash studies/study_turbulent_held_out.sh --set truth.z=4.0
+    STRATEGIES=infotaxis OUT_SUFFIX=-dm-info bash studies/study_turbulent_held_out.sh \
       --set truth.z=4.0
+    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-dm bash studies/study_turbulent_held_out.sh \
+      --set truth.z=4.0
+    # the defaults of 2026-11-27 (b): the backflow member learned, alone (pinned)
+    bf=(--set truth.z=4.0 --set 'estimator.learn={backflow=[0.0,0.05]}')
+    OUT_SUFFIX=-bf bash studies/study_turbulent_held_out.sh "${bf[@]}"
+    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-bf bash studies/study_turbulent_held_out.sh "${bf[@]}"
     # an option measured at today's defaults (it decides nothing): a release spread over a disc
     STRATEGIES=dcee-cl OUT_SUFFIX=-radius bash studies/study_turbulent_held_out.sh \
       --set truth.z=4.0 --set 'estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}'
@@ -469,12 +480,16 @@ case "${1:---list}" in
     STRATEGIES=dcee-cl OUT_SUFFIX=-20k bash studies/study_turbulent_held_out.sh "${old[@]}" \
       --particles 20000
     r=results/turbulent-lbm-held-out-100
-    report turbulent-lbm-held-out-100-bf turbulent-lbm-held-out-100-mcts-bf turbulent-lbm-held-out-100-radius \
+    report turbulent-lbm-held-out-100-dm turbulent-lbm-held-out-100-dm-info turbulent-lbm-held-out-100-mcts-dm \
+      turbulent-lbm-held-out-100-bf turbulent-lbm-held-out-100-mcts-bf turbulent-lbm-held-out-100-radius \
       turbulent-lbm-held-out-100-radius-prior \
       turbulent-lbm-held-out-100 turbulent-lbm-held-out-100-mcts-today \
       turbulent-lbm-held-out-100-nsl25 turbulent-lbm-held-out-100-decay \
       turbulent-lbm-held-out-100-mcts turbulent-lbm-held-out-100-nsl turbulent-lbm-held-out-100-20k
     $P studies/collect_metrics.py --out docs/results/lbm-held-out-100 \
+      "$r-dm=defaults:2026-11-27c,learn:none,particles:10000" \
+      "$r-dm-info=defaults:2026-11-27c,learn:none,particles:10000" \
+      "$r-mcts-dm=defaults:2026-11-27c,learn:none,particles:10000" \
       "$r-bf=defaults:2026-11-27b,learn:none,particles:10000" \
       "$r-mcts-bf=defaults:2026-11-27b,learn:none,particles:10000" \
       "$r-radius=defaults:2026-11-27b,learn:backflow+source_radius,particles:10000" \
@@ -505,8 +520,15 @@ case "${1:---list}" in
     # today's defaults against those before, search by search
     $P studies/pair_campaigns.py "$r-nsl25" "$r" --csv docs/results/lbm-held-out-100/today_vs_before.csv \
       --tag truth_model=lbm
-    $P studies/worst_searches.py "$r-bf=dcee-cl" "$r-bf=infotaxis" --out docs/figures/lbm-held-out-worst.png
-    $P studies/upwind_detections.py "$r-bf=dcee-cl" "$r-bf=infotaxis" "$r-mcts-bf=dcee-mcts" \
+    # the disc member at prior odds 9:1 with the mixture's region against the backflow member alone
+    rm -f docs/results/lbm-held-out-100/disc_vs_before.csv
+    for pair in "$r-bf:$r-dm" "$r-bf:$r-dm-info" "$r-mcts-bf:$r-mcts-dm"; do
+      $P studies/pair_campaigns.py "${pair%%:*}" "${pair#*:}" \
+        --csv docs/results/lbm-held-out-100/disc_vs_before.csv --tag truth_model=lbm
+    done
+    $P studies/worst_searches.py "$r-dm=dcee-cl" "$r-dm-info=infotaxis" --out docs/figures/lbm-held-out-worst.png
+    $P studies/upwind_detections.py "$r-dm=dcee-cl" "$r-dm-info=infotaxis" "$r-mcts-dm=dcee-mcts" \
+      "$r-bf=dcee-cl" "$r-bf=infotaxis" "$r-mcts-bf=dcee-mcts" \
       "$r=dcee-cl" "$r=infotaxis" "$r-nsl25=dcee-cl" \
       "$r-nsl25=infotaxis" "$r-decay=dcee-cl" "$r-mcts=dcee-mcts" "$r-nsl=dcee-cl"
     $P studies/publish_tables.py ;;
