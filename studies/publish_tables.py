@@ -213,12 +213,12 @@ def what_we_found() -> str:
         rows.append(
             planners_row(
                 f"**held-out**, {what}, all eight unknown, fluctuation likelihood, "
-                "`held-out-100`, today's defaults (since 2026-11-27, the backflow member "
+                "`held-out-100`, the defaults of 2026-11-27 (b) (the backflow member "
                 "learned), `dcee-cl` / `infotaxis` (`turbulent-held-out-100-today`)",
                 study("turbulent-held-out-100-today"),
                 ("dcee-cl", "infotaxis"),
                 truth_model=truth,
-                defaults=TODAY_DEFAULTS,
+                defaults="2026-11-27b",
             )
         )
     return table(
@@ -590,10 +590,13 @@ CROSS_HEADER = [
 ]
 
 
-TODAY_DEFAULTS = "2026-11-27b"
+TODAY_DEFAULTS = "2026-11-27c"
 """The ``defaults`` tag of rows flown at today's defaults (a 0.5 m near-source fall, repeat
-power 1/2, the backflow member learned)."""
+power 1/2, the backflow member and the disc member at prior odds 9 : 1 learned, the 95 % region
+the members' mixture's)."""
 EARLIER_DEFAULTS = {
+    "2026-11-27b": "defaults of 2026-11-27 (b): the backflow member alone, the selected "
+    "member's region",
     "2026-11-27": "defaults of 2026-11-27 before the backflow member",
     "2026-11-23": "defaults of 2026-11-23 (2.5 m fall, repeat power 1/4, no backflow member)",
 }
@@ -636,8 +639,11 @@ def cross_truth_table(latest_only: bool = False) -> str:
             "held-out-today",
         )
     for truth, chosen in (
-        ("filament", "**yes**: the fluctuation model's settings, climb, hold, backflow member"),
-        ("puffs", "**yes**: climb, near-source fall, repeat discount, backflow member"),
+        (
+            "filament",
+            "**yes**: the fluctuation model's settings, climb, hold, backflow and disc members",
+        ),
+        ("puffs", "**yes**: climb, near-source fall, repeat discount, backflow and disc members"),
     ):
         generations = sorted(set(turbulent_today["defaults"].astype(str)), reverse=True)
         for defaults in generations[:1] if latest_only else generations:
@@ -659,7 +665,10 @@ def cross_truth_table(latest_only: bool = False) -> str:
                 "held-out-today",
             )
     lbm = lbm.assign(
-        order=lbm["defaults"].astype(str).map({TODAY_DEFAULTS: 0, "2026-11-27": 1}).fillna(2)
+        order=lbm["defaults"]
+        .astype(str)
+        .map({TODAY_DEFAULTS: 0, "2026-11-27b": 1, "2026-11-27": 2})
+        .fillna(3)
     ).sort_values("order", kind="stable")
     if latest_only:
         lbm = lbm[(lbm["order"] == 0) & (lbm["learn"] == "none")]
@@ -774,11 +783,13 @@ def radius_prior_table(release: str) -> str:
     candidate = candidate[candidate["variant"] == prior].assign(variant="prior")
     frame = pd.concat([base.assign(variant="base"), radius, candidate])
     names = {
-        "base": f"today's defaults, {label}",
+        "base": f"the defaults of 2026-11-27 (b), {label}",
         "radius": "`learn = {backflow = [0, 0.05], source_radius = [0, 1]}` (equal priors)",
         "prior": "the same with `learn_prior = {source_radius = [0.9, 0.1]}`",
     }
-    return _variant_table(frame, names, ("base", "radius", "prior"), "today's defaults")
+    return _variant_table(
+        frame, names, ("base", "radius", "prior"), "the defaults of 2026-11-27 (b)"
+    )
 
 
 def _by_truth(rows: pd.DataFrame) -> Iterator[tuple[str, pd.DataFrame]]:

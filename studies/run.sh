@@ -181,6 +181,32 @@ case "${1:---list}" in
         --tag "truth_model=$t"
     done
     $P studies/publish_tables.py ;;
+  turbulent-held-out-disc)  # both turbulent truths at today's defaults (the disc member, the mixture's region), held-out-100
+    # chosen on these two truths (tuning range random:13-40): a check, not an independent
+    # result; stored beside the earlier generations, paired with the backflow member alone
+    # (defaults 2026-11-27b) from the stored rows
+    export SUITE=held-out-100 WORKERS=${WORKERS:-2}
+    pinned=(--set estimator.near_source_length=0.5 --set estimator.repeat_radius=2.0
+      --set estimator.repeat_power=0.5)
+    STRATEGIES=dcee-cl OUT_SUFFIX=-today-dm bash studies/study_turbulent_held_out.sh "${pinned[@]}"
+    STRATEGIES=infotaxis OUT_SUFFIX=-today-dm-info bash studies/study_turbulent_held_out.sh "${pinned[@]}"
+    out=docs/results/turbulent-held-out-100-today
+    runs=()
+    for t in puffs filament; do
+      for s in -today-dm -today-dm-info; do
+        runs+=("results/turbulent-$t-held-out-100$s=truth_model:$t,defaults:2026-11-27c")
+      done
+    done
+    $P studies/collect_metrics.py --out "$out" --keep defaults:2026-11-27 --keep defaults:2026-11-27b \
+      "${runs[@]}"
+    rm -f "$out/disc_vs_before.csv"
+    for t in puffs filament; do
+      for s in -today-dm -today-dm-info; do
+        $P studies/pair_campaigns.py "$out/searches.csv=truth_model:$t:defaults:2026-11-27b" \
+          "results/turbulent-$t-held-out-100$s" --csv "$out/disc_vs_before.csv" --tag "truth_model=$t"
+      done
+    done
+    $P studies/publish_tables.py ;;
   turbulent-public)  # the twelve public configurations on both turbulent truths: the third round's and today's defaults
     # 5 repeats and 10,000 particles: ~10 min per truth and setting on 2 cores. "defaults": the
     # third round's (a detection's mean C, no repeat discount; flown at commit 69b6ea3, hence
