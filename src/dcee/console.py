@@ -165,6 +165,16 @@ def print_summary(summary: dict[str, Any], out_dir: Path | None, where: str = "r
     rows = [
         ("final RMSE (m)", f"{summary['final_rmse']:.3f}"),
         ("source acquired", str(summary["source_acquired"])),
+        *(
+            [
+                (
+                    f"OSPA to the {summary['true_sources']} releases (m, 3 m cut-off)",
+                    f"{summary['final_ospa']:.2f}",
+                )
+            ]
+            if summary.get("true_sources", 1) > 1
+            else []
+        ),
         ("plume acquired", str(summary["plume_acquired"])),
         ("time to RMSE < 1 m (s)", _seconds(summary["time_to_rmse_1m"])),
         ("time to RMSE < 0.5 m (s)", _seconds(summary["time_to_rmse_0_5m"])),

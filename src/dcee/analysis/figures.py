@@ -114,8 +114,9 @@ def _draw_map(
             lw=0.8,
             label="detection (size ∝ √reading)",
         )
-    t = scenario.truth
-    ax.plot(t.x, t.y, "*", ms=14, mec="k", mfc="gold", label="true source")
+    sources = scenario.truth.source_locations()
+    label = "true source" if len(sources) == 1 else f"true sources ({len(sources)})"
+    ax.plot(sources[:, 0], sources[:, 1], "*", ms=14, mec="k", mfc="gold", ls="none", label=label)
     last = recs[-1]
     ax.plot(
         last["mean_x"], last["mean_y"], "P", ms=9, mec="k", mfc="tab:cyan", label="posterior mean"
@@ -203,7 +204,12 @@ def draw_search_figure(result: EpisodeResult, scenario: Scenario, truth: TruthMo
     fig.suptitle(
         f"{s['scenario']} · {s['strategy']} · seed {s['seed']} · {truth.name} truth"
         f" · final RMSE {s['final_rmse']:.2f} m"
-        f" · source {'acquired' if s['source_acquired'] else 'not acquired'}",
+        f" · source {'acquired' if s['source_acquired'] else 'not acquired'}"
+        + (
+            f" · {s['true_sources']} releases, OSPA {s['final_ospa']:.2f} m"
+            if s.get("true_sources", 1) > 1
+            else ""
+        ),
         fontsize=11,
     )
     # room below the map for its legend (placed under the axes), also when the figure is shown

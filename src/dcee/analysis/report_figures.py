@@ -94,7 +94,7 @@ def figure_grid(runs: pd.DataFrame) -> tuple[bytes, str] | None:
     reps = runs[(runs["seed"] == 0) & (runs["scenario"] == config)].sort_values("strategy")
     reps = reps.drop_duplicates("strategy")
     scenario = Scenario.model_validate(load_config(reps["run_dir"].iloc[0])["scenario"])
-    truth = scenario.truth_theta()
+    sources = scenario.truth.source_locations()
     lo, hi = scenario.volume.low, scenario.volume.high
     snaps = []
     for run_dir in reps["run_dir"]:
@@ -125,7 +125,7 @@ def figure_grid(runs: pd.DataFrame) -> tuple[bytes, str] | None:
                 path = steps[steps["time"] <= times[col] + 1e-9]
                 ax.plot(path["x"], path["y"], color="tab:red", lw=1)
                 ax.set_title(f"t = {times[col]:.0f} s", fontsize=9)
-            ax.plot(truth[0], truth[1], marker="*", color="gold", mec="k", ms=12)
+            ax.plot(sources[:, 0], sources[:, 1], "*", color="gold", mec="k", ms=12, ls="none")
             ax.set_xlim(lo[0], hi[0])
             ax.set_ylim(lo[1], hi[1])
             ax.set_aspect("equal")

@@ -63,6 +63,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("estimator", "learn_prior"): {},
     # input only (a compass bearing converted to phi), always unset once validated
     ("truth", "wind_from"): None,
+    # one release before issue 45's further releases
+    ("truth", "extra_sources"): [],
 }
 """Scenario settings added after campaigns were first stored, with the value a stored scenario
 without one ran with, so the two compare equal."""

@@ -155,9 +155,17 @@ class ScenarioBuilders:
         )
 
     def truth_theta(self) -> np.ndarray:
-        """(8,) true source term (φ in radians)."""
+        """(8,) true source term (φ in radians): of the release at (truth.x, y, z)."""
         t = self.truth
         return np.array([t.x, t.y, t.z, t.q, t.u, math.radians(t.phi), t.zeta1, t.zeta2])
+
+    def truth_thetas(self) -> np.ndarray:
+        """(K, 8) the source term of every release (``truth.extra_sources`` after the first):
+        its own location and rate, the wind and dispersion shared."""
+        out = np.tile(self.truth_theta(), (1 + len(self.truth.extra_sources), 1))
+        out[:, :3] = self.truth.source_locations()
+        out[:, 3] = self.truth.source_rates()
+        return out
 
     def make_anemometer(self) -> Anemometer | None:
         """The ``[anemometer]``'s reading model, or None when the robot has none."""

@@ -58,10 +58,17 @@ class _State:
     centres: np.ndarray  # (P, 3) m
     ages: np.ndarray  # (P,) s
     meander: np.ndarray  # (2, 2): [along, cross] x [displacement-like state, its rate]
-    released: int  # puffs released so far
+    released: int  # puffs released so far by each release
+    origins: np.ndarray  # (P,) int: the release each puff came from
 
     def copy(self) -> _State:
-        return _State(self.centres.copy(), self.ages.copy(), self.meander.copy(), self.released)
+        return _State(
+            self.centres.copy(),
+            self.ages.copy(),
+            self.meander.copy(),
+            self.released,
+            self.origins.copy(),
+        )
 
 
 def gaussian_puffs_field(
@@ -85,7 +92,10 @@ class FilamentTruth(SteppedTruth):
 
     Parameters
     ----------
-    theta : (8,) true source term (x, y, z, q, u, φ rad, ζ1, ζ2).
+    theta : (8,) true source term (x, y, z, q, u, φ rad, ζ1, ζ2), or (K, 8) for K releases in
+        one flow (``truth.extra_sources``: each row its own location and rate; the wind and
+        dispersion are the first row's). Every release puffs on the same schedule and rides the
+        same meander.
     spec : the scenario's :class:`~dcee.scenarios.FilamentSpec`.
     rng : generator for the meander and the puff random walks (the episode's truth stream).
     low, high : (3,) corners of the search volume, m; puffs far outside it are dropped.
@@ -102,8 +112,10 @@ class FilamentTruth(SteppedTruth):
         low: np.ndarray,
         high: np.ndarray,
     ) -> None:
-        theta = np.asarray(theta, dtype=np.float64).reshape(8)
-        self.source = theta[:3].copy()
+        releases = np.asarray(theta, dtype=np.float64).reshape(-1, 8)
+        theta = releases[0]
+        self.sources = releases[:, :3].copy()  # (K, 3) m
+        self.source = self.sources[0]
         self.q, self.u, phi, zeta1, self.tau = (float(v) for v in theta[3:])
         self.spec = spec
         self.direction = -np.array([math.cos(phi), math.sin(phi), 0.0])
@@ -111,6 +123,7 @@ class FilamentTruth(SteppedTruth):
         self.puff_diffusivity = spec.puff_share * zeta1
         self.walk_scale = math.sqrt(2.0 * (1.0 - spec.puff_share) * zeta1 * spec.dt)
         self.puff_mass = self.q / spec.puff_rate
+        self.puff_masses = releases[:, 3] / spec.puff_rate  # (K,) g: each release's puffs
         self.max_age = self.tau * math.log(1.0 / DECAY_CUTOFF)
         self.low = np.asarray(low, dtype=np.float64)
         self.high = np.asarray(high, dtype=np.float64)
@@ -122,7 +135,7 @@ class FilamentTruth(SteppedTruth):
         meander = np.zeros((2, 2))
         meander[:, 0] = sd * rng.standard_normal(2)  # start in the stationary distribution
         meander[:, 1] = w * sd * rng.standard_normal(2)
-        self._state = _State(np.empty((0, 3)), np.empty(0), meander, 0)
+        self._state = _State(np.empty((0, 3)), np.empty(0), meander, 0, np.empty(0, np.int64))
         # spin-up: the oldest puff alive in steady state; then the field no longer depends on
         # the empty start
         self._start_stepping(spec.dt, math.ceil(self.max_age / spec.dt), rng)
@@ -151,16 +164,19 @@ class FilamentTruth(SteppedTruth):
         if due > s.released:
             k = np.arange(s.released, due, dtype=np.float64)
             ages = step * dt - k / self.spec.puff_rate
-            new = self.source + np.outer(ages, velocity)
+            # every release puffs at once: (K · n) new puffs, release by release
+            new = (self.sources[:, None, :] + np.outer(ages, velocity)[None]).reshape(-1, 3)
+            count = len(self.sources)
             s.centres = np.concatenate([s.centres, new])
-            s.ages = np.concatenate([s.ages, ages])
+            s.ages = np.concatenate([s.ages, np.tile(ages, count)])
+            s.origins = np.concatenate([s.origins, np.repeat(np.arange(count), len(ages))])
             s.released = due
         if step % PRUNE_EVERY == 0 and s.ages.size:
             sigma = np.sqrt(self._sigma_sq(s.ages))
             margin = (5.0 * sigma + 1.0)[:, None]
             near = np.all((s.centres > self.low - margin) & (s.centres < self.high + margin), 1)
             keep = near & (s.ages < self.max_age)
-            s.centres, s.ages = s.centres[keep], s.ages[keep]
+            s.centres, s.ages, s.origins = s.centres[keep], s.ages[keep], s.origins[keep]
 
     def _sigma_sq(self, ages: np.ndarray) -> np.ndarray:
         return self.spec.puff_radius**2 + 2.0 * self.puff_diffusivity * ages
@@ -176,7 +192,8 @@ class FilamentTruth(SteppedTruth):
         """(centres (P, 3) as a view of the state, variances σ² (P,), masses (P,))."""
         self._advance_to(self._step_for(time))
         s = self._state
-        return s.centres, self._sigma_sq(s.ages), self.puff_mass * np.exp(-s.ages / self.tau)
+        masses = self.puff_masses[s.origins] * np.exp(-s.ages / self.tau)
+        return s.centres, self._sigma_sq(s.ages), masses
 
     def field(self, positions: np.ndarray, time: float) -> np.ndarray:
         """(K,) instantaneous concentrations (g/m³) at (K, 3) positions at ``time`` s."""
@@ -192,7 +209,7 @@ def filament_truth(scenario: Scenario, seed: int) -> FilamentTruth:
     """The filament truth of ``truth.model`` for episode ``seed`` (its own random stream)."""
     low, high = np.array(scenario.volume.low), np.array(scenario.volume.high)
     spec = scenario.truth.model
-    return FilamentTruth(scenario.truth_theta(), spec, plume_stream(seed), low, high)
+    return FilamentTruth(scenario.truth_thetas(), spec, plume_stream(seed), low, high)
 
 
 __all__ = ["FilamentTruth"]

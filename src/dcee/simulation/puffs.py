@@ -59,6 +59,7 @@ class _State:
     anchors: np.ndarray  # (A, 2) m/s: boundary noise at the anchors
     centres: np.ndarray  # (P, 3) m
     ages: np.ndarray  # (P,) s
+    origins: np.ndarray  # (P,) int: the release each puff came from
     released: int = 0  # puffs released since the start of the spin-up
 
     def copy(self) -> _State:
@@ -67,6 +68,7 @@ class _State:
             self.anchors.copy(),
             self.centres.copy(),
             self.ages.copy(),
+            self.origins.copy(),
             self.released,
         )
 
@@ -76,7 +78,9 @@ class PuffTruth(SteppedTruth):
 
     Parameters
     ----------
-    theta : (8,) true source term (x, y, z, q, u, φ rad, ζ1, ζ2); ζ1 and ζ2 are not used.
+    theta : (8,) true source term (x, y, z, q, u, φ rad, ζ1, ζ2); ζ1 and ζ2 are not used. Or
+        (K, 8) for K releases in one wind field (``truth.extra_sources``: each row its own
+        location and rate, the wind the first row's), each releasing its own Poisson puffs.
     spec : the scenario's :class:`~dcee.scenarios.PuffsSpec`.
     rng : generator for the wind noise, the releases and the puff random walks.
     low, high : (3,) corners of the search volume, m.
@@ -93,12 +97,15 @@ class PuffTruth(SteppedTruth):
         low: np.ndarray,
         high: np.ndarray,
     ) -> None:
-        theta = np.asarray(theta, dtype=np.float64).reshape(8)
-        self.source = theta[:3].copy()
+        releases = np.asarray(theta, dtype=np.float64).reshape(-1, 8)
+        theta = releases[0]
+        self.sources = releases[:, :3].copy()  # (K, 3) m
+        self.source = self.sources[0]
         self.q, self.u, phi = float(theta[3]), float(theta[4]), float(theta[5])
         self.spec = spec
         self.mean_wind = -self.u * np.array([math.cos(phi), math.sin(phi)])
         self.puff_mass = self.q / spec.puff_rate
+        self.puff_masses = releases[:, 3] / spec.puff_rate  # (K,) g: each release's puffs
         self.low = np.asarray(low, dtype=np.float64)
         self.high = np.asarray(high, dtype=np.float64)
         # wind grid: the area plus the margin, nodes wind_spacing apart (at least 3 per axis)
@@ -129,7 +136,7 @@ class PuffTruth(SteppedTruth):
         anchors = sd * rng.standard_normal((count, 2))  # start in the stationary distribution
         wind = np.empty((2, ny, nx))
         wind[0], wind[1] = self.mean_wind[0], self.mean_wind[1]
-        self._state = _State(wind, anchors, np.empty((0, 3)), np.empty(0))
+        self._state = _State(wind, anchors, np.empty((0, 3)), np.empty(0), np.empty(0, np.int64))
         self._set_boundary(self._state)
         # spin-up: long enough for a puff to cross the whole grid twice (the field then no
         # longer depends on the empty start) and for the wind noise to decorrelate
@@ -203,22 +210,25 @@ class PuffTruth(SteppedTruth):
             s.centres[:, :2] += velocity * dt
             s.centres += self._walk * rng.standard_normal(s.centres.shape)
             s.ages += dt
-        born = int(rng.poisson(self.spec.puff_rate * dt))
-        if born:
+        for origin, source in enumerate(self.sources):  # each release its own Poisson puffs
+            born = int(rng.poisson(self.spec.puff_rate * dt))
+            if not born:
+                continue
             ages = dt * rng.random(born)  # released at a uniform instant within the step
-            here = self._wind_at(s.wind, self.source[None, :2])[0]
-            new = np.repeat(self.source[None, :], born, axis=0)
+            here = self._wind_at(s.wind, source[None, :2])[0]
+            new = np.repeat(source[None, :], born, axis=0)
             new[:, :2] += np.outer(ages, here)
             new += np.sqrt(2.0 * self.spec.centre_diffusivity * ages)[
                 :, None
             ] * rng.standard_normal((born, 3))
             s.centres = np.concatenate([s.centres, new])
             s.ages = np.concatenate([s.ages, ages])
+            s.origins = np.concatenate([s.origins, np.full(born, origin)])
             s.released += born
         if self.step_count % PRUNE_EVERY == 0 and s.ages.size:
             margin = (4.0 * np.sqrt(self._sigma_sq(s.ages)) + 1.0)[:, None]
             near = np.all((s.centres > self.low - margin) & (s.centres < self.high + margin), 1)
-            s.centres, s.ages = s.centres[near], s.ages[near]
+            s.centres, s.ages, s.origins = s.centres[near], s.ages[near], s.origins[near]
 
     def _sigma_sq(self, ages: np.ndarray) -> np.ndarray:
         return self.spec.puff_radius**2 + 2.0 * self.spec.puff_diffusivity * ages
@@ -232,7 +242,7 @@ class PuffTruth(SteppedTruth):
         return (
             s.centres.copy(),
             np.sqrt(self._sigma_sq(s.ages)),
-            np.full(s.ages.size, self.puff_mass),
+            self.puff_masses[s.origins],
         )
 
     def released(self, time: float) -> int:
@@ -245,7 +255,7 @@ class PuffTruth(SteppedTruth):
         positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
         self._advance_to(self._step_for(time))
         s = self._state
-        masses = np.full(s.ages.size, self.puff_mass)
+        masses = self.puff_masses[s.origins]
         return gaussian_puffs_field(positions, s.centres, self._sigma_sq(s.ages), masses)
 
     def concentration(self, position: np.ndarray, time: float) -> float:
@@ -265,7 +275,7 @@ def _perimeter(nx: int, ny: int) -> np.ndarray:
 def puff_truth(scenario: Scenario, seed: int) -> PuffTruth:
     """The puff truth of ``truth.model`` for episode ``seed`` (the episode's plume stream)."""
     low, high = np.array(scenario.volume.low), np.array(scenario.volume.high)
-    return PuffTruth(scenario.truth_theta(), scenario.truth.model, plume_stream(seed), low, high)
+    return PuffTruth(scenario.truth_thetas(), scenario.truth.model, plume_stream(seed), low, high)
 
 
 __all__ = ["PuffTruth"]

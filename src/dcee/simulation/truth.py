@@ -76,14 +76,18 @@ class IsotropicTruth(TruthModel):
     label = "isotropic truth (mean field)"
 
     def __init__(self, theta: np.ndarray, plume: IsotropicPlume | None = None) -> None:
-        self.theta = np.asarray(theta, dtype=np.float64).reshape(1, 8)
+        """theta: (8,) the source term, or (K, 8) for K releases (their fields add: the
+        advection-diffusion equation is linear in its sources)."""
+        self.theta = np.asarray(theta, dtype=np.float64).reshape(-1, 8)
         self.plume = plume or IsotropicPlume()
 
     def concentration(self, position: np.ndarray, time: float) -> float:
-        return float(self.plume.concentration(self.theta, np.reshape(position, (1, 3)))[0, 0])
+        c = self.plume.concentration(self.theta, np.reshape(position, (1, 3)))
+        return float(c[0, 0] if len(c) == 1 else c[:, 0].sum())
 
     def field(self, positions: np.ndarray, time: float) -> np.ndarray:
-        return self.plume.concentration(self.theta, positions)[0]
+        c = self.plume.concentration(self.theta, positions)
+        return c[0] if len(c) == 1 else c.sum(axis=0)
 
 
 CHECKPOINT_SECONDS = 10.0
@@ -236,7 +240,9 @@ def truth_kind(spec: object) -> str:
 
 def make_truth(scenario: Scenario, seed: int) -> TruthModel:
     """The scenario's ``truth.model`` for episode ``seed``, built by the factory registered for
-    its kind (isotropic here; filament and playback in their modules)."""
+    its kind (isotropic here; filament and playback in their modules). Every factory builds all
+    the releases of ``truth.extra_sources`` into one truth (:meth:`Scenario.truth_thetas`);
+    the recordings refuse them at validation."""
     kind = truth_kind(scenario.truth.model)
     entry = TRUTH_KINDS.get(kind)
     factory = entry.build if entry is not None else None
@@ -249,4 +255,4 @@ def make_truth(scenario: Scenario, seed: int) -> TruthModel:
 
 @register_truth("isotropic")
 def _isotropic(scenario: Scenario, seed: int) -> TruthModel:
-    return IsotropicTruth(scenario.truth_theta())
+    return IsotropicTruth(scenario.truth_thetas())

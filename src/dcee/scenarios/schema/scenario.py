@@ -80,12 +80,13 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
     @model_validator(mode="after")
     def _consistent(self) -> Scenario:
         lo, hi = np.array(self.volume.low), np.array(self.volume.high)
-        src = np.array([self.truth.x, self.truth.y, self.truth.z])
-        if np.any(src < lo) or np.any(src > hi):
-            raise ValueError(
-                f"truth: source ({src[0]}, {src[1]}, {src[2]}) is outside the search volume "
-                f"{tuple(self.volume.low)}..{tuple(self.volume.high)}"
-            )
+        for k, src in enumerate(self.truth.source_locations()):
+            if np.any(src < lo) or np.any(src > hi):
+                where = "truth: source" if k == 0 else f"{FIELD_MARK}truth.extra_sources: release"
+                raise ValueError(
+                    f"{where} ({src[0]:g}, {src[1]:g}, {src[2]:g}) is outside the search volume "
+                    f"{tuple(self.volume.low)}..{tuple(self.volume.high)}"
+                )
         start = np.array(self.agent.start)
         if np.any(start < lo) or np.any(start > hi):
             raise ValueError(

@@ -7,10 +7,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
+import numpy as np
 from pydantic import BaseModel, Field, field_validator, model_validator
 
 from dcee.recordings import recording_layout
-from dcee.scenarios.schema.common import FROZEN, Finite, Positive, phi_fields
+from dcee.scenarios.schema.common import FIELD_MARK, FROZEN, Finite, Positive, phi_fields
 
 TURBULENT_HOLD = 4.0
 """Default hold (s) at each waypoint for a time-varying truth, over which a reading averages.
@@ -219,6 +220,28 @@ TruthModelSpec = Annotated[
 ]
 
 
+MAX_SOURCES = 4
+"""Most releases one truth may hold: the one at (``x``, ``y``, ``z``, ``q``) and three more."""
+MIN_SOURCE_SEPARATION = 1.0
+"""Closest two releases of one truth may be, m: nearer than this (half the paper's 2 m step)
+no reading of the search can tell them from one release of their summed rate."""
+
+
+class ExtraSource(BaseModel):
+    """A further release of the truth (``[[truth.extra_sources]]``), in the same wind and the
+    same truth model as the one at (``truth.x``, ``truth.y``, ``truth.z``)."""
+
+    model_config = FROZEN
+    x: Finite
+    """release x, m"""
+    y: Finite
+    """release y, m"""
+    z: Finite
+    """release height, m"""
+    q: Positive
+    """release rate, g/s"""
+
+
 class Truth(BaseModel):
     """The true source term (what the search must find) and what the sensor sees."""
 
@@ -250,6 +273,47 @@ class Truth(BaseModel):
     """what the sensor really sees: "isotropic" (the estimator's own model, the paper's
     simulation), "filament" or "puffs" (or a table with that kind and parameters: two turbulent
     truths written apart), or a table ``{file = "plume.h5"}`` to play a recording back"""
+    extra_sources: tuple[ExtraSource, ...] = ()
+    """further releases beside the one at (``x``, ``y``, ``z``) with rate ``q``, each its own
+    position and rate, in the same wind (``[[truth.extra_sources]]``; at most
+    :data:`MAX_SOURCES` releases in all, at least :data:`MIN_SOURCE_SEPARATION` m apart; not
+    with a recording or the solver's plume, which hold their own releases). Empty: one source"""
+
+    @model_validator(mode="after")
+    def _releases(self) -> Truth:
+        extra = self.extra_sources
+        if not extra:
+            return self
+        if len(extra) + 1 > MAX_SOURCES:
+            raise ValueError(
+                f"{FIELD_MARK}truth.extra_sources: {len(extra) + 1} releases in all; at most "
+                f"{MAX_SOURCES} (the one at truth.x, y, z and {MAX_SOURCES - 1} more)"
+            )
+        if isinstance(self.model, PlaybackSpec | LbmSpec):
+            raise ValueError(
+                f"{FIELD_MARK}truth.extra_sources: a {self.model.kind} truth holds its own "
+                "releases; further ones need truth.model isotropic, filament or puffs"
+            )
+        xyz = self.source_locations()
+        for i in range(len(xyz)):
+            for j in range(i):
+                gap = float(np.linalg.norm(xyz[i] - xyz[j]))
+                if gap < MIN_SOURCE_SEPARATION:
+                    raise ValueError(
+                        f"{FIELD_MARK}truth.extra_sources: releases {j} and {i} are {gap:.2g} m "
+                        f"apart (0: the one at truth.x, y, z); at least "
+                        f"{MIN_SOURCE_SEPARATION:g} m, or one release of their summed rate"
+                    )
+        return self
+
+    def source_locations(self) -> np.ndarray:
+        """(K, 3) every release's location, m: the one at (x, y, z) first."""
+        rows = [(self.x, self.y, self.z), *((e.x, e.y, e.z) for e in self.extra_sources)]
+        return np.array(rows, dtype=np.float64)
+
+    def source_rates(self) -> np.ndarray:
+        """(K,) every release's rate, g/s, in the order of :meth:`source_locations`."""
+        return np.array([self.q, *(e.q for e in self.extra_sources)], dtype=np.float64)
 
     @model_validator(mode="before")
     @classmethod
