@@ -391,6 +391,24 @@ def test_learn_prior_weighs_the_members_by_hand_computed_products():
     assert given.reading_model_priors == pytest.approx((0.45, 0.45, 0.1))
 
 
+def test_a_setting_fixed_by_hand_leaves_the_default_grid():
+    """A setting of the default grid fixed by hand is not learned (and its prior goes with
+    it); the other setting still is, at its default prior; fixed at the plain model's value it
+    is still learned."""
+    fluct = PAPER1.with_overrides(**{"estimator.likelihood": "fluctuation"})
+    disc = fluct.with_overrides(**{"estimator.source_radius": 0.5})
+    assert disc.learn == {"backflow": [0.0, 0.05]} and disc.learn_prior == {}
+    assert disc.reading_model_priors == pytest.approx((0.45, 0.45, 0.1))
+    upwind = fluct.with_overrides(**{"estimator.backflow": 0.05})
+    assert upwind.learn == {"source_radius": [0.0, 1.0]}
+    assert upwind.learn_prior == {"source_radius": [0.9, 0.1]}
+    assert upwind.reading_model_priors == pytest.approx((0.9 * 0.9, 0.9 * 0.1, 0.1))
+    both = fluct.with_overrides(**{"estimator.backflow": 0.05, "estimator.source_radius": 1.0})
+    assert both.learn == {} and both.reading_models == ("fluctuation", "paper")
+    plain = fluct.with_overrides(**{"estimator.source_radius": 0.0})
+    assert plain.learn == fluct.learn
+
+
 def test_learn_prior_is_checked_before_any_work():
     for prior, says in (
         ({"decay": [1.0, 1.0]}, r"learn_prior\.decay: decay is not learned"),

@@ -138,6 +138,12 @@ def settings_identity(settings: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
+def _by_hand(estimator: dict[str, Any]) -> dict[str, float]:
+    """A stored estimator's values of the settings the default grids weigh (absent: the plain
+    model's 0, as before the settings existed)."""
+    return {key: estimator.get(key, 0.0) for key in ("backflow", "source_radius")}
+
+
 def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
     """A stored scenario (its JSON dump) reduced to what decides the results: without its
     free-text description and without later-added settings at their defaults."""
@@ -162,11 +168,11 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
             # unset: the prior it resolved to (Scenario.learn_prior), compared as that prior
             # (no learn key: stored before the learned bank, which ran no grid)
             estimator["learn_prior"] = default_learn_prior(
-                likelihood, estimator.get("backflow", 0.0), estimator.get("learn", {})
+                likelihood, _by_hand(estimator), estimator.get("learn", {})
             )
         if "learn" in estimator and estimator["learn"] is None:
             # unset: the grid it resolved to (Scenario.learn), compared as that grid
-            estimator["learn"] = default_learn(likelihood, estimator.get("backflow", 0.0))
+            estimator["learn"] = default_learn(likelihood, _by_hand(estimator))
         if estimator.get("repeat_radius", 0.0) == 0.0:
             # no repeat discount: its power decides nothing
             estimator.pop("repeat_power", None)

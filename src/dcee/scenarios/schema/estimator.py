@@ -4,6 +4,7 @@ the instrument, and the reading model of the filter and the planners."""
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Annotated, Literal, get_args
 
 import numpy as np
@@ -187,18 +188,18 @@ LEARN_DEFAULT: dict[str, dict[str, list[float]]] = {
     "paper": {},
     "fluctuation": {"backflow": [0.0, 0.05], "source_radius": [0.0, 1.0]},
 }
-"""``estimator.learn`` when not given, per likelihood (with ``estimator.backflow`` left at 0;
-a backflow fixed by hand is not learned unless asked). The fluctuation likelihood weighs a
-member with gas upwind of the release (w = 0.05: a planar plume at turbulence intensity 0.6,
-a 3-D one at 0.9) beside the plain plume, chosen on the tuning range random:13-40 (filament +
-puffs, ``dcee-cl``, 56 paired searches, rule written before the run): 56/56 acquired either
-way, the truth in the 95 % region in 100 % against 95 % (+3 / −0), the final error unchanged at
-the median pair (−0.00 m, Wilcoxon p = 0.59) (docs/results/tuning-backflow-13-40); and a
-release spread over a disc of radius 1 m beside the point release, at prior odds 9 : 1 against
-(:data:`LEARN_PRIOR_DEFAULT`), with the bank's region the members' mixture's, chosen on the same
-range released at a point and over an area (``truth.model.puff_radius = 0.5``), 112 paired
-searches, rule written before the run (docs/plumes.md,
-docs/results/mixture-region-prior-13-40)."""
+"""``estimator.learn`` when not given, per likelihood (a setting fixed by hand, e.g.
+``estimator.backflow = 0.05``, is not learned unless asked; the others still are). The
+fluctuation likelihood weighs a member with gas upwind of the release (w = 0.05: a planar plume
+at turbulence intensity 0.6, a 3-D one at 0.9) beside the plain plume, chosen on the tuning
+range random:13-40 (filament + puffs, ``dcee-cl``, 56 paired searches, rule written before the
+run): 56/56 acquired either way, the truth in the 95 % region in 100 % against 95 % (+3 / −0),
+the final error unchanged at the median pair (−0.00 m, Wilcoxon p = 0.59)
+(docs/results/tuning-backflow-13-40); and a release spread over a disc of radius 1 m beside the
+point release, at prior odds 9 : 1 against (:data:`LEARN_PRIOR_DEFAULT`), with the bank's region
+the members' mixture's, chosen on the same range released at a point and over an area
+(``truth.model.puff_radius = 0.5``), 112 paired searches, rule written before the run
+(docs/plumes.md, docs/results/mixture-region-prior-13-40)."""
 LEARN_PRIOR_DEFAULT: dict[str, dict[str, list[float]]] = {
     "paper": {},
     "fluctuation": {"source_radius": [0.9, 0.1]},
@@ -209,21 +210,23 @@ Jeffreys' scale calls evidence strong (the value from that convention, not from 
 equal prior let the disc lead on point releases: docs/results/tuning-source-radius-13-40)."""
 
 
-def default_learn(likelihood: str, backflow: float) -> dict[str, list[float]]:
+def default_learn(likelihood: str, fixed: Mapping[str, float]) -> dict[str, list[float]]:
     """What an unset ``estimator.learn`` weighs: :data:`LEARN_DEFAULT` for the likelihood,
-    nothing where ``estimator.backflow`` was fixed by hand."""
-    grid = {} if backflow != 0.0 else LEARN_DEFAULT[likelihood]
-    return {key: list(values) for key, values in grid.items()}  # a copy: callers may edit it
+    without the settings fixed by hand (``fixed``: the estimator's values of the default grid's
+    settings; one other than its grid's first value, the plain model's, is not learned)."""
+    grid = LEARN_DEFAULT[likelihood]
+    # a copy: callers may edit it
+    return {key: list(v) for key, v in grid.items() if fixed.get(key, v[0]) == v[0]}
 
 
 def default_learn_prior(
-    likelihood: str, backflow: float, learn: dict[str, list[float]] | None
+    likelihood: str, fixed: Mapping[str, float], learn: dict[str, list[float]] | None
 ) -> dict[str, list[float]]:
     """What an unset ``estimator.learn_prior`` says: :data:`LEARN_PRIOR_DEFAULT` with the
     default grid (``learn`` None), nothing (every value equally likely) with a grid given."""
     if learn is not None:
         return {}
-    grid = default_learn(likelihood, backflow)
+    grid = default_learn(likelihood, fixed)
     prior = LEARN_PRIOR_DEFAULT[likelihood]
     return {key: list(probs) for key, probs in prior.items() if key in grid}
 
