@@ -607,8 +607,8 @@ OLD_DEFAULTS = EARLIER_DEFAULTS["2026-11-23"]
 def cross_truth_table(latest_only: bool = False) -> str:
     """Every truth family, all eight unknown, at today's defaults, with the rows flown at the
     defaults before marked: which defaults were chosen on it (docs/plumes.md;
-    dcee.scenarios.defaults.DEFAULTS). ``latest_only`` (the README's): per truth only the
-    latest defaults flown on it, and no options."""
+    dcee.scenarios.defaults.DEFAULTS). ``latest_only`` (the README's): per truth and planner
+    only the latest defaults flown, and no options."""
     today = study("held-out-today")
     turbulent_today = study("turbulent-held-out-100-today")
     lbm = study("lbm-held-out-100")
@@ -646,11 +646,15 @@ def cross_truth_table(latest_only: bool = False) -> str:
         ("puffs", "**yes**: climb, near-source fall, repeat discount, backflow and disc members"),
     ):
         generations = sorted(set(turbulent_today["defaults"].astype(str)), reverse=True)
-        for defaults in generations[:1] if latest_only else generations:
+        latest: set[str] = set()  # planners already given a row (latest_only: one each)
+        for defaults in generations:
             for strategy in ("dcee-cl", "infotaxis"):
                 part = turbulent_today[turbulent_today["defaults"].astype(str) == defaults]
                 if not ((part["strategy"] == strategy) & (part["truth_model"] == truth)).any():
                     continue
+                if latest_only and strategy in latest:
+                    continue
+                latest.add(strategy)
                 add(
                     f"{truth}, fluctuation likelihood{flown(defaults)}",
                     chosen,
@@ -670,8 +674,8 @@ def cross_truth_table(latest_only: bool = False) -> str:
         .map({TODAY_DEFAULTS: 0, "2026-11-27b": 1, "2026-11-27": 2})
         .fillna(3)
     ).sort_values("order", kind="stable")
-    if latest_only:
-        lbm = lbm[(lbm["order"] == 0) & (lbm["learn"] == "none")]
+    if latest_only:  # per planner, the latest defaults flown, no options
+        lbm = lbm[lbm["learn"] == "none"].drop_duplicates("strategy", keep="first")
     for _, r in lbm.iterrows():
         how = "" if r["learn"] == "none" else f", `estimator.learn` {r['learn']} (an option)"
         if int(r.get("particles", 10000)) != 10000:
