@@ -893,6 +893,49 @@ def mixture_prior_table() -> str:
     return table(header, rows)
 
 
+def release_area_table() -> str:
+    """Today's defaults (since 2026-11-27 (c)) on the tuning range released at a point, over
+    0.5 m and over 1 m (``truth.model.puff_radius``): is the lbm failure an area-release one?
+    (docs/results/mixture-region-prior-13-40, whose point and 0.5 m searches are today's
+    defaults', and docs/results/tuning-area-release-1m-13-40)."""
+    today = pd.read_csv(RESULTS / "mixture-region-prior-13-40" / "searches.csv")
+    today = today.assign(truth_in_95=today["mixture_in_95"])  # the region every summary now has
+    # the same searches, flown first by tuning-radius-prior, which recorded the along-wind error
+    first = pd.read_csv(RESULTS / "tuning-radius-prior-13-40" / "variants.csv")
+    today = today.merge(first[["variant", "truth", "scenario", "along"]], how="left")
+    wide = pd.read_csv(RESULTS / "tuning-area-release-1m-13-40" / "variants.csv")
+    releases = {
+        "point (`puff_radius = 0.1`)": today[today["variant"] == "prior"],
+        "over 0.5 m (`puff_radius = 0.5`)": today[today["variant"] == "area-prior"],
+        "over 1 m (`puff_radius = 1.0`)": wide[wide["variant"] == "area1"],
+    }
+    rows = []
+    for release, frame in releases.items():
+        for truth, part in _by_truth(frame):
+            n = len(part)
+            rows.append(
+                [
+                    release,
+                    truth,
+                    str(n),
+                    f"{int(part['acquired'].astype(bool).sum())}/{n}",
+                    f"{part['final_rmse'].median():.2f}",
+                    f"{100 * part['truth_in_95'].astype(bool).mean():.0f} %",
+                    f"{part['along'].median():+.2f}",
+                ]
+            )
+    header = [
+        "released",
+        "truth",
+        "n",
+        "acquired",
+        "median final RMSE (m)",
+        "truth in 95 % (the mixture's region)",
+        "median along-wind error (m)",
+    ]
+    return table(header, rows)
+
+
 def _variant_table(frame: pd.DataFrame, names: dict, order: tuple, base_name: str) -> str:
     """Rows per variant and truth (and both truths), each variant paired by search with the
     variant ``base``: acquisition, median final RMSE, share in the 95 % region, along-wind
@@ -1264,6 +1307,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "radius-prior-area": lambda: radius_prior_table("area"),
     "mixture-region": mixture_region_table,
     "mixture-prior": mixture_prior_table,
+    "release-area": release_area_table,
     "lbm-statistics": lbm_statistics_table,
     "what-we-found": what_we_found,
     "wind-known": public_table("paper-source"),
