@@ -213,12 +213,13 @@ def what_we_found() -> str:
         rows.append(
             planners_row(
                 f"**held-out**, {what}, all eight unknown, fluctuation likelihood, "
-                "`held-out-100`, the defaults of 2026-11-27 (b) (the backflow member "
-                "learned), `dcee-cl` / `infotaxis` (`turbulent-held-out-100-today`)",
+                "`held-out-100`, today's defaults (since 2026-11-27 (c): the backflow and "
+                "disc members learned, the mixture's region), `dcee-cl` / `infotaxis` "
+                "(`turbulent-held-out-100-today`)",
                 study("turbulent-held-out-100-today"),
                 ("dcee-cl", "infotaxis"),
                 truth_model=truth,
-                defaults="2026-11-27b",
+                defaults=TODAY_DEFAULTS,
             )
         )
     return table(
