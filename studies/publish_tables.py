@@ -808,10 +808,18 @@ def _by_truth(rows: pd.DataFrame) -> Iterator[tuple[str, pd.DataFrame]]:
             yield truth, part
 
 
+def _gained_lost(new: pd.Series, old: pd.Series) -> tuple[int, int, float]:
+    """Paired yes/no outcomes (bool Series, aligned): (new only, old only, exact binomial
+    p of the discordant pairs, McNemar's exact test; 1 when there are none)."""
+    from scipy.stats import binomtest
+
+    gained, lost = int((new & ~old).sum()), int((old & ~new).sum())
+    return gained, lost, binomtest(gained, gained + lost).pvalue if gained + lost else 1.0
+
+
 def mixture_region_table() -> str:
     """The truth in the selected member's 95 % region and in the reading models' mixture's, on
     the same searches (docs/results/mixture-region-13-40, studies/mixture_region.py)."""
-    from scipy.stats import binomtest
 
     frame = pd.read_csv(RESULTS / "mixture-region-13-40" / "searches.csv")
     releases = {"radius": "point", "area-radius": "area (`puff_radius = 0.5`)"}
@@ -819,8 +827,7 @@ def mixture_region_table() -> str:
     for variant, release in releases.items():
         for truth, part in _by_truth(frame[frame["variant"] == variant]):
             sel, mix = part["truth_in_95"].astype(bool), part["mixture_in_95"].astype(bool)
-            gained, lost = int((mix & ~sel).sum()), int((sel & ~mix).sum())
-            p = binomtest(gained, gained + lost).pvalue if gained + lost else 1.0
+            gained, lost, p = _gained_lost(mix, sel)
             rows.append(
                 [
                     release,
@@ -846,7 +853,7 @@ def mixture_prior_table() -> str:
     """The default since 2026-11-27 (c), disc members at prior odds 9 : 1 with the mixture's
     region, against the defaults before it on the same configurations, point and area releases
     (docs/results/mixture-region-prior-13-40; the rule in its README)."""
-    from scipy.stats import binomtest, wilcoxon
+    from scipy.stats import wilcoxon
 
     frame = pd.read_csv(RESULTS / "mixture-region-prior-13-40" / "searches.csv")
     before = pd.read_csv(RESULTS / "tuning-backflow-13-40" / "variants.csv")
@@ -862,8 +869,7 @@ def mixture_prior_table() -> str:
         )
         for truth, part in _by_truth(both):
             old, new = part["truth_in_95_before"].astype(bool), part["mixture_in_95"].astype(bool)
-            gained, lost = int((new & ~old).sum()), int((old & ~new).sum())
-            p = binomtest(gained, gained + lost).pvalue if gained + lost else 1.0
+            gained, lost, p = _gained_lost(new, old)
             diff = part["final_rmse"] - part["final_rmse_before"]
             p_rmse = wilcoxon(diff).pvalue if (diff != 0).any() else 1.0
             acquired = part["acquired"].astype(bool).sum()
@@ -941,7 +947,7 @@ def _variant_table(frame: pd.DataFrame, names: dict, order: tuple, base_name: st
     """Rows per variant and truth (and both truths), each variant paired by search with the
     variant ``base``: acquisition, median final RMSE, share in the 95 % region, along-wind
     error; Wilcoxon on the final RMSE, exact binomial on the region gained / lost."""
-    from scipy.stats import binomtest, wilcoxon
+    from scipy.stats import wilcoxon
 
     key = ["truth", "scenario", "seed"]
     frame = frame.drop_duplicates(["variant", *key])
@@ -955,9 +961,9 @@ def _variant_table(frame: pd.DataFrame, names: dict, order: tuple, base_name: st
                 joined = part.merge(base, on=key, suffixes=("", "_base"))
                 diff = joined["final_rmse"] - joined["final_rmse_base"]
                 p_rmse = wilcoxon(diff).pvalue if (diff != 0).any() else 1.0
-                gained = int((joined["truth_in_95"] & ~joined["truth_in_95_base"]).sum())
-                lost = int((~joined["truth_in_95"] & joined["truth_in_95_base"]).sum())
-                p_cov = binomtest(gained, gained + lost).pvalue if gained + lost else 1.0
+                gained, lost, p_cov = _gained_lost(
+                    joined["truth_in_95"], joined["truth_in_95_base"]
+                )
                 paired = (
                     f"{diff.median():+.2f} m (Wilcoxon p = {p_rmse:.2g}); 95 % region "
                     f"+{gained} / −{lost} (p = {p_cov:.2g}), {len(joined)} pairs"

@@ -124,6 +124,35 @@ def test_bad_release_on_the_command_line_exits_2_before_any_work(tmp_path, capsy
     assert not out.exists()
 
 
+def test_a_search_over_two_releases_reports_them(tmp_path, capsys):
+    """``dcee run`` over two releases: the table gives the OSPA to both, the summary counts
+    them, the figure is written (it draws every release)."""
+    out = tmp_path / "run"
+    code, printed, err = run_cli(
+        [
+            "run",
+            "--scenario",
+            "paper:1",
+            "--particles",
+            "1000",
+            "--set",
+            "search.budget=60.0",
+            "--set",
+            "truth.extra_sources=[{x=15.0,y=35.0,z=1.0,q=2.5}]",
+            "--out",
+            str(out),
+        ],
+        capsys,
+    )
+    assert code == 0, err
+    assert "OSPA to the 2 releases" in printed
+    import json
+
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["true_sources"] == 2 and 0.0 < summary["final_ospa"] <= 3.0
+    assert (out / "figure.png").stat().st_size > 0
+
+
 def test_ospa_by_hand():
     """OSPA (cut-off c, order p) against hand calculations: a matched pair is its distance; a
     missed source costs c over the larger set's size; order 2 averages squares; the best

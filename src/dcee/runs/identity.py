@@ -138,12 +138,6 @@ def settings_identity(settings: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _by_hand(estimator: dict[str, Any]) -> dict[str, float]:
-    """A stored estimator's values of the settings the default grids weigh (absent: the plain
-    model's 0, as before the settings existed)."""
-    return {key: estimator.get(key, 0.0) for key in ("backflow", "source_radius")}
-
-
 def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
     """A stored scenario (its JSON dump) reduced to what decides the results: without its
     free-text description and without later-added settings at their defaults."""
@@ -166,13 +160,14 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
                 estimator[key] = _unset_repeat(likelihood, estimator)[k]
         if "learn_prior" in estimator and estimator["learn_prior"] is None:
             # unset: the prior it resolved to (Scenario.learn_prior), compared as that prior
-            # (no learn key: stored before the learned bank, which ran no grid)
+            # (no learn key: stored before the learned bank, which ran no grid; a setting
+            # stored before it existed ran at the plain model's value, as default_learn takes)
             estimator["learn_prior"] = default_learn_prior(
-                likelihood, _by_hand(estimator), estimator.get("learn", {})
+                likelihood, estimator, estimator.get("learn", {})
             )
         if "learn" in estimator and estimator["learn"] is None:
             # unset: the grid it resolved to (Scenario.learn), compared as that grid
-            estimator["learn"] = default_learn(likelihood, _by_hand(estimator))
+            estimator["learn"] = default_learn(likelihood, estimator)
         if estimator.get("repeat_radius", 0.0) == 0.0:
             # no repeat discount: its power decides nothing
             estimator.pop("repeat_power", None)

@@ -212,8 +212,9 @@ equal prior let the disc lead on point releases: docs/results/tuning-source-radi
 
 def default_learn(likelihood: str, fixed: Mapping[str, float]) -> dict[str, list[float]]:
     """What an unset ``estimator.learn`` weighs: :data:`LEARN_DEFAULT` for the likelihood,
-    without the settings fixed by hand (``fixed``: the estimator's values of the default grid's
-    settings; one other than its grid's first value, the plain model's, is not learned)."""
+    without the settings fixed by hand (``fixed``: the estimator's settings by name; one of the
+    grid's whose value is not its grid's first, the plain model's, is not learned; one absent
+    counts as the plain model's)."""
     grid = LEARN_DEFAULT[likelihood]
     # a copy: callers may edit it
     return {key: list(v) for key, v in grid.items() if fixed.get(key, v[0]) == v[0]}

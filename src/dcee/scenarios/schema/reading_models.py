@@ -71,7 +71,7 @@ class ReadingModelSettings:
         """``estimator.learn`` resolved: as given, or the likelihood's default
         (:data:`LEARN_DEFAULT`, without a setting fixed by hand)."""
         e = self.estimator
-        return e.learn if e.learn is not None else default_learn(e.likelihood, self._by_hand())
+        return e.learn if e.learn is not None else default_learn(e.likelihood, dict(e))
 
     @property
     def learn_prior(self) -> dict[str, list[float]]:
@@ -80,13 +80,7 @@ class ReadingModelSettings:
         e = self.estimator
         if e.learn_prior is not None:
             return e.learn_prior
-        return default_learn_prior(e.likelihood, self._by_hand(), e.learn)
-
-    def _by_hand(self) -> dict[str, float]:
-        """The estimator's values of the settings the default grids weigh (one other than the
-        plain model's is fixed by hand, not learned)."""
-        e = self.estimator
-        return {"backflow": e.backflow, "source_radius": e.source_radius}
+        return default_learn_prior(e.likelihood, dict(e), e.learn)
 
     @property
     def reading_model_variants(self) -> tuple[tuple[str, dict[str, float]], ...]:
