@@ -558,6 +558,19 @@ case "${1:---list}" in
       "$r=dcee-cl" "$r=infotaxis" "$r-nsl25=dcee-cl" \
       "$r-nsl25=infotaxis" "$r-decay=dcee-cl" "$r-mcts=dcee-mcts" "$r-nsl=dcee-cl"
     $P studies/publish_tables.py ;;
+  source-count)  # issue 45: an unknown number of releases, dcee-cl, 100 held-out configurations of two and of three releases (docs/multi-source.md)
+    for N in two three; do
+      $D bench --suite "$N-source-held-out-100" --repeats 1 --strategies dcee-cl \
+        --workers "${WORKERS:-2}" --out "results/$N-source-held-out-100"
+    done
+    $P studies/source_count_table.py results/two-source-held-out-100 \
+      results/three-source-held-out-100 --csv docs/results/source-count/searches.csv ;;
+  source-count-tune)  # issue 45: the same on the tuning range random2/3:1-20 (never reported as a result)
+    for N in two three; do
+      $D bench --suite "$N-source-tune" --repeats 1 --strategies dcee-cl \
+        --workers "${WORKERS:-2}" --out "results/$N-source-tune"
+    done
+    $P studies/source_count_table.py results/two-source-tune results/three-source-tune ;;
   publish)  # the tables of README.md, docs/index.md, docs/results.md from docs/results/
     $P studies/publish_tables.py ;;
   stonesoup-mcts)  # our tree search against Stone Soup's MCTS on its own example, 10 seeds

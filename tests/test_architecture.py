@@ -37,6 +37,7 @@ LAYERS = {
     "dcee.planning": 3,
     "dcee.planners": 3,  # the public alias of dcee.planning
     "dcee.scenarios": 3,  # configuration: builds models and priors, knows no planner
+    "dcee.exploration": 4,  # where readings become informative when no move within reach is
     "dcee.searcher": 4,
     "dcee.simulation": 5,  # the truths
     "dcee.runs": 6,  # one search: assemble, step, record, score, save

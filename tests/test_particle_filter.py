@@ -316,8 +316,9 @@ def test_history_likelihood_and_reading_bounds_against_numpy(sensor):
 
 
 def test_mcmc_move_is_unchanged_by_early_rejection(monkeypatch):
-    """The same filter run with and without the early exit gives identical particles."""
-    import dcee.estimation.particle_filter as pfm
+    """The same filter run with and without the early exit of the MCMC move gives identical
+    particles."""
+    import dcee.estimation.resample_move as rmm
     from dcee.scenarios import load_scenario
 
     scenario = load_scenario("paper:1")
@@ -333,13 +334,16 @@ def test_mcmc_move_is_unchanged_by_early_rejection(monkeypatch):
         return pf.theta.copy()
 
     with_exit = run()
-    plain = pfm.history_log_likelihood
+    plain = rmm.history_log_likelihood
+    calls = []
 
     def no_exit(*args):
+        calls.append(len(args))
         return plain(*args[:12])
 
-    monkeypatch.setattr(pfm, "history_log_likelihood", no_exit)
+    monkeypatch.setattr(rmm, "history_log_likelihood", no_exit)
     np.testing.assert_array_equal(run(), with_exit)
+    assert 14 in calls  # the move's calls, with a threshold and bounds, ran without them
 
 
 def test_both_estimators_implement_the_estimator_interface_and_resample_on_demand():

@@ -14,6 +14,7 @@ import numpy as np
 from dcee.blas import one_blas_thread
 from dcee.errors import DceeInputError
 from dcee.estimation.base import Estimator, UpdateInfo
+from dcee.exploration import ApproachingAgent, exploration_goal
 from dcee.io import write_atomic
 from dcee.models.agent import GridAgent, stall_start
 from dcee.planning.base import Belief, Decision, Planner
@@ -117,6 +118,7 @@ class Searcher:
         stall_guard: float = DEFAULT_STALL_GUARD,
         guard_spread: float = DEFAULT_GUARD_SPREAD,
         stop_rule: StopRule | None = DEFAULT_STOP_RULE,
+        explore_guard: bool = False,
     ) -> None:
         for name, value in (("stall_guard", stall_guard), ("guard_spread", guard_spread)):
             if isinstance(value, bool) or not (
@@ -134,6 +136,9 @@ class Searcher:
         """(time s, position (3,) m) of the last told readings, for the stall guard"""
         self.guard_fired = 0
         """how many decisions the stall guard restricted"""
+        self.explore_guard = bool(explore_guard)
+        self.explore_fired = 0
+        """how many decisions the exploration guard restricted (:mod:`dcee.exploration`)"""
         self.filter = particle_filter
         self.planner = planner
         self.agent = agent
@@ -204,14 +209,22 @@ class Searcher:
         self.last_decision_seconds = _time.perf_counter() - t0
         return self.last_decision.position.copy()
 
-    def decision_agent(self) -> GridAgent | LeavingAgent:
-        """The agent the next :meth:`ask` plans with: :attr:`agent`, or a
-        :class:`LeavingAgent` that only offers moves away from the stall while the stall guard
-        fires (:meth:`stall_anchor`)."""
+    def decision_agent(self) -> GridAgent | LeavingAgent | ApproachingAgent:
+        """The agent the next :meth:`ask` plans with: :attr:`agent`, a :class:`LeavingAgent`
+        that only offers moves away from the stall while the stall guard fires
+        (:meth:`stall_anchor`), or with ``explore_guard`` an
+        :class:`~dcee.exploration.ApproachingAgent` that only offers moves towards where
+        readings are informative when no move within reach is
+        (:func:`~dcee.exploration.exploration_goal`)."""
         anchor = self.stall_anchor()
-        if anchor is None:
-            return self.agent
-        return LeavingAgent(self.agent, anchor, self.position)
+        if anchor is not None:
+            return LeavingAgent(self.agent, anchor, self.position)
+        if self.explore_guard:
+            goal = exploration_goal(self.belief(), self.position, self.agent)
+            if goal is not None:
+                self.explore_fired += 1
+                return ApproachingAgent(self.agent, goal, self.position)
+        return self.agent
 
     def stall_anchor(self) -> np.ndarray | None:
         """The position (3,) m the robot has stayed within one step of for at least
@@ -269,6 +282,8 @@ class Searcher:
             "guard_fired": 0,
             "stop_rule": None,
             "below_since": math.nan,
+            "explore_guard": False,
+            "explore_fired": 0,
             **state,
         }
         self.__dict__.update(state)

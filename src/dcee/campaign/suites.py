@@ -77,6 +77,19 @@ SUITES: dict[str, dict] = {
         ],
         "overrides": {},
     },
+    # several releases, their number unknown (issue 45): the estimator over 0-3 releases at
+    # 10,000 particles, wind known; tuning (random2/3:1-20) and reporting (1000-1099) ranges
+    **{
+        f"{word}-source-{use}": {
+            "configs": [f"random{n}:{k}" for k in ks],
+            "overrides": {"estimator.max_sources": 3, "search.particles": 10_000},
+        }
+        for n, word in ((2, "two"), (3, "three"))
+        for use, ks in (
+            ("tune", range(1, 21)),
+            ("held-out-100", range(RANDOM_REPORTING_FROM, RANDOM_REPORTING_FROM + 100)),
+        )
+    },
     # tuning configurations for slow studies (never report them)
     "random-tune-12": {"configs": [f"random:{k}" for k in range(1, 13)], "overrides": {}},
     "smoke": {

@@ -35,7 +35,6 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.estimation.base import ReadingModelChoice, UpdateInfo
-from dcee.estimation.filter_kernels import history_log_likelihood
 from dcee.estimation.priors import SourcePrior
 from dcee.estimation.resample_move import ResampleMove
 from dcee.estimation.resampling import (
@@ -250,15 +249,12 @@ class ParticleFilter(ResampleMove):
         as the reading's multiplicity in the kernel."""
         w = self.reading_weight if weight is None else weight
         out = np.empty(theta.shape[0])
-        history_log_likelihood(
+        self._history_ll(
             theta,
             np.ones(theta.shape[0], dtype=np.bool_),
             np.asarray(position, dtype=np.float64).reshape(1, 3),
             np.array([reading], dtype=np.float64),
             np.array([w], dtype=np.float64),
-            self.plume.min_distance,
-            *self.plume.shape,
-            self._sp,
             out,
         )
         return out

@@ -69,13 +69,14 @@ class ResampleMove:
         """One Metropolis–Hastings move of every particle, full-history target: a share
         ``global_share`` proposes its location from the prior, the rest a random walk.
         Returns the (N,) accepted mask."""
+        self._align()
         d = len(self._unknown)
         x = self.theta[:, self._unknown]
         cov = np.atleast_2d(np.cov(x, rowvar=False))
         # Gaussian kernel bandwidth of the regularised particle filter (Musso et al.),
         # as in the authors' code; a floor keeps the kernel alive if the particles collapse.
         h = (4.0 / (self.n * (d + 2))) ** (1.0 / (d + 4))
-        floor = (1e-3 * self.prior.scales) ** 2
+        floor = (1e-3 * self._unknown_scales()) ** 2
         cov = h * h * cov + np.diag(floor)
         try:
             chol = np.linalg.cholesky(cov)
@@ -88,14 +89,8 @@ class ResampleMove:
         jump = self.rng.random(self.n) < self.global_share if self._loc_block else None
         log_q_ratio = np.zeros(self.n)
         if jump is not None and jump.any():
-            k = int(jump.sum())
-            dists = self.prior.distributions
             proposal[jump] = self.theta[jump]
-            for col in self._loc_block:
-                proposal[jump, col] = dists[col].sample(self.rng, k)
-                log_q_ratio[jump] += dists[col].log_pdf(self.theta[jump, col]) - dists[col].log_pdf(
-                    proposal[jump, col]
-                )
+            self._propose_jump(proposal, jump, log_q_ratio)
         lp_prop = self._log_prior(proposal)
         lp_cur = self._log_prior(self.theta)
         active = np.isfinite(lp_prop)
@@ -105,15 +100,12 @@ class ResampleMove:
         # accepted iff ll_prop > threshold: lets the kernel abandon hopeless proposals early
         with np.errstate(invalid="ignore"):
             threshold = log_u - lp_prop + self._hist_loglik + lp_cur - log_q_ratio
-        history_log_likelihood(
+        self._history_ll(
             proposal,
             active,
             pos,
             z,
             mult,
-            self.plume.min_distance,
-            *self.plume.shape,
-            self._sp,
             ll_prop,
             np.nan_to_num(threshold, nan=-np.inf, posinf=np.inf),
             reading_upper_bounds(z, self.sensor),
@@ -124,6 +116,55 @@ class ResampleMove:
         self.theta[accept] = proposal[accept]
         self._hist_loglik[accept] = ll_prop[accept]
         return accept
+
+    # --- what a filter with another particle layout overrides -------------------------------
+
+    def _align(self) -> None:
+        """Before a sweep: nothing for one release (a K-source filter relabels its releases)."""
+
+    def _unknown_scales(self) -> np.ndarray:
+        """(D,) the prior spread of each unknown column (the random walk's floor)."""
+        return self.prior.scales
+
+    def _propose_jump(
+        self, proposal: np.ndarray, jump: np.ndarray, log_q_ratio: np.ndarray
+    ) -> None:
+        """Redraw the location block of the particles ``jump`` (N,) in ``proposal`` from the
+        prior, adding log q(current) − log q(proposed) to ``log_q_ratio``."""
+        k = int(jump.sum())
+        dists = self.prior.distributions
+        for col in self._loc_block:
+            proposal[jump, col] = dists[col].sample(self.rng, k)
+            log_q_ratio[jump] += dists[col].log_pdf(self.theta[jump, col]) - dists[col].log_pdf(
+                proposal[jump, col]
+            )
+
+    def _history_ll(
+        self,
+        theta: np.ndarray,
+        active: np.ndarray,
+        positions: np.ndarray,
+        readings: np.ndarray,
+        multiplicity: np.ndarray,
+        out: np.ndarray,
+        threshold: np.ndarray | None = None,
+        bounds: np.ndarray | None = None,
+    ) -> None:
+        """out (N,) = the history log-likelihood of particles ``theta`` (see
+        :func:`~dcee.estimation.filter_kernels.history_log_likelihood`)."""
+        history_log_likelihood(
+            theta,
+            active,
+            positions,
+            readings,
+            multiplicity,
+            self.plume.min_distance,
+            *self.plume.shape,
+            self._sp,
+            out,
+            threshold,
+            bounds,
+        )
 
     def _tempered_update(
         self, ll_new: np.ndarray, entry: int, base_mult: float, ess0: float

@@ -1,7 +1,8 @@
-"""Assemble a search from a configuration: the scenario's estimator (one filter, or a bank of
-them when several reading models compete) and a planner's constructor defaults, in a
-:class:`~dcee.searcher.Searcher`. The simulation, the ROS node and ``dcee replay`` all build
-their searches here, so one scenario gives the same search wherever it runs."""
+"""Assemble a search from a configuration: the scenario's estimator (one filter, a bank of
+them when several reading models compete, or one per source count when the count is unknown)
+and a planner's constructor defaults, in a :class:`~dcee.searcher.Searcher`. The simulation, the
+ROS node and ``dcee replay`` all build their searches here, so one scenario gives the same search
+wherever it runs."""
 
 from __future__ import annotations
 
@@ -10,10 +11,14 @@ from typing import Any
 import numpy as np
 
 from dcee.estimation.model_bank import ModelBank
+from dcee.estimation.multi_source import MultiSourceFilter
 from dcee.estimation.particle_filter import ParticleFilter
+from dcee.estimation.source_count import SourceCountBank
 from dcee.planning.base import Planner, planner_class
 from dcee.scenarios import Scenario
+from dcee.scenarios.schema.truth import MIN_SOURCE_SEPARATION
 from dcee.searcher import Searcher
+from dcee.stopping import DEFAULT_STOP_SHARE
 
 
 def make_searcher(
@@ -35,30 +40,54 @@ def make_searcher(
     # from children of it (spawning does not move filter_rng). So a second model changes nothing
     # while it is not selected, and comparisons with and without it are paired exactly.
     rngs = [filter_rng, *filter_rng.spawn(len(models) - 1)]
+    settings = {
+        "n_particles": search.particles,
+        "resample_threshold": search.resample_threshold,
+        "mcmc_steps": search.mcmc_steps,
+        "global_share": search.global_share,
+        "diversify": search.diversify,
+        "max_sweeps": search.max_sweeps,
+        "reading_weight": scenario.reading_weight,
+        "repeat_radius": scenario.repeat_radius,
+        "repeat_power": scenario.repeat_power,
+        "anemometer": scenario.make_anemometer(),
+    }
     filters = [
         ParticleFilter(
             scenario.make_prior(),
             scenario.make_estimator_sensor(model),  # the reading model of filter and planners
             scenario.make_plume(model),
-            n_particles=search.particles,
             seed=rng,
-            resample_threshold=search.resample_threshold,
-            mcmc_steps=search.mcmc_steps,
-            global_share=search.global_share,
-            diversify=search.diversify,
-            max_sweeps=search.max_sweeps,
-            reading_weight=scenario.reading_weight,
-            repeat_radius=scenario.repeat_radius,
-            repeat_power=scenario.repeat_power,
-            anemometer=scenario.make_anemometer(),
+            **settings,
         )
         for model, rng in zip(models, rngs, strict=True)
     ]
-    estimator = (
-        filters[0]
-        if len(filters) == 1
-        else ModelBank(filters, models, scenario.reading_model_priors)
-    )
+    estimator: ParticleFilter | ModelBank | SourceCountBank
+    if len(filters) > 1:
+        estimator = ModelBank(filters, models, scenario.reading_model_priors)
+    elif scenario.estimator.max_sources > 1:
+        # one filter per count; K >= 2 draw from children of filter_rng (spawning does not move
+        # it), so the one-release filter is the lone filter's, draw for draw
+        kmax = scenario.estimator.max_sources
+        more = [
+            MultiSourceFilter(
+                k,
+                scenario.make_prior(),
+                filters[0].sensor,
+                filters[0].plume,
+                seed=rng,
+                min_separation=MIN_SOURCE_SEPARATION,
+                **settings,
+            )
+            for k, rng in zip(range(2, kmax + 1), filter_rng.spawn(kmax - 1), strict=True)
+        ]
+        estimator = SourceCountBank(
+            [filters[0], *more],
+            scenario.estimator.count_prior,
+            localised=DEFAULT_STOP_SHARE * search.acquired_rmse,
+        )
+    else:
+        estimator = filters[0]
     return Searcher(
         estimator,
         planner,
@@ -67,6 +96,8 @@ def make_searcher(
         stall_guard=search.stall_guard,
         guard_spread=search.guard_share * search.acquired_rmse,
         stop_rule=scenario.stop_rule(on_robot),
+        # several releases: a further one may be anywhere, far from every move (dcee.exploration)
+        explore_guard=scenario.estimator.max_sources > 1,
     )
 
 

@@ -8,6 +8,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from dcee.estimation.source_count import SourceCountBank
+
 if TYPE_CHECKING:
     from dcee.scenarios import Scenario
     from dcee.searcher import Searcher
@@ -186,6 +188,11 @@ def search_summary(
     out.update(scenario.resolved_settings())
     out["resamples"] = pf.n_resamples
     out["stall_guard_fired"] = searcher.guard_fired  # decisions the stall guard restricted
+    if isinstance(pf, SourceCountBank):  # the count was unknown: what the search made of it
+        out.update(pf.count_summary())
+        out["count_correct"] = out["estimated_count"] == out["true_sources"]
+        out["explore_guard_fired"] = searcher.explore_fired
+        out["final_ospa"] = ospa(pf.estimated_sources(), scenario.truth.source_locations())
     choice = pf.reading_model()
     if choice is not None:  # which reading model the readings chose, and how firmly
         out["model"] = choice.name

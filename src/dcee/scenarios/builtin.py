@@ -160,7 +160,11 @@ RANDOM_REPORTING_FROM = 1000
 """K ≥ 1000 is the reporting range (the ``held-out`` suite: K = 1000-1199): no default is ever
 chosen on it, so what the studies report there was measured on configurations nothing was
 tuned on."""
-RANDOM_FAMILIES = ("random", "random-start")
+RANDOM_FAMILIES = ("random", "random-start", "random2", "random3")
+"""``random2:K`` and ``random3:K``: two and three releases
+(:func:`random_sources_configuration`)."""
+MULTI_SOURCE_SEPARATION = 5.0
+"""m: the least distance between two releases of ``random2:K`` and ``random3:K`` (issue 45)."""
 
 
 def random_configuration(k: int, random_start: bool = False) -> dict[str, Any]:
@@ -199,8 +203,60 @@ def random_configuration(k: int, random_start: bool = False) -> dict[str, Any]:
     return scenario
 
 
+def random_sources_configuration(k: int, n_sources: int) -> dict[str, Any]:
+    """The raw scenario ``random2:K`` (``n_sources`` 2) or ``random3:K`` (3): ``n_sources``
+    releases drawn independently from :data:`RANDOM_RANGES` (each its own location and rate; a
+    draw closer than :data:`MULTI_SOURCE_SEPARATION` m to an earlier release is drawn again), one
+    wind and diffusion, the paper's start. Its own stream (RANDOM_STREAM, n_sources, K), so
+    ``random2:K`` shares nothing with ``random:K``; the tuning and reporting ranges are
+    ``random:K``'s."""
+    if isinstance(k, bool) or not isinstance(k, int) or k < 1:
+        raise ValueError(f"K must be an integer >= 1, got {k!r}")
+    rng = np.random.Generator(np.random.PCG64([RANDOM_STREAM, n_sources, k]))
+
+    def draw(name: str) -> float:
+        low, high = RANDOM_RANGES[name]
+        if name == "q":
+            return round(math.exp(rng.uniform(math.log(low), math.log(high))), 2)
+        return round(float(rng.uniform(low, high)), 2)
+
+    flow = {name: draw(name) for name in ("u", "phi", "zeta1", "zeta2")}
+    flow["phi"] = flow["phi"] % 360.0
+    releases: list[dict[str, float]] = []
+    while len(releases) < n_sources:
+        release = {name: draw(name) for name in ("x", "y", "z", "q")}
+        if all(
+            math.dist([release[c] for c in "xyz"], [r[c] for c in "xyz"]) >= MULTI_SOURCE_SEPARATION
+            for r in releases
+        ):
+            releases.append(release)
+    family = f"random{n_sources}"
+    use = "tuning" if k in RANDOM_TUNING else "reporting"
+    where = "; ".join(f"({r['x']}, {r['y']}, {r['z']}) m, q {r['q']} g/s" for r in releases)
+    scenario = _paper(1)
+    scenario.update(
+        name=f"{family}:{k}",
+        description=(
+            f"Random {n_sources}-release configuration {k} ({use} range): {where}; "
+            f"{wind_from_words(flow['phi'])} at {flow['u']} m/s; UAV at 4 m from (2, 2)."
+        ),
+        truth={**releases[0], **flow, "extra_sources": releases[1:]},
+    )
+    scenario["prior"] = {**scenario["prior"], "phi": {**scenario["prior"]["phi"]}}
+    scenario["prior"]["phi"]["mean"] = flow["phi"]
+    return scenario
+
+
+def random_family_configuration(family: str, k: int) -> dict[str, Any]:
+    """The raw scenario ``family:K`` of :data:`RANDOM_FAMILIES`."""
+    if family.startswith("random") and family[6:].isdigit():
+        return random_sources_configuration(k, int(family[6:]))
+    return random_configuration(k, random_start=family == "random-start")
+
+
 def random_family_name(name: str) -> tuple[str, int] | None:
-    """(family, K) if ``name`` is ``random:K`` or ``random-start:K``, else None."""
+    """(family, K) if ``name`` is ``random:K``, ``random-start:K``, ``random2:K`` or
+    ``random3:K``, else None."""
     family, sep, k = name.partition(":")
     if not sep or family not in RANDOM_FAMILIES:
         return None

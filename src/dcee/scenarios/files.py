@@ -10,7 +10,11 @@ from pathlib import Path
 from typing import Any
 
 from dcee.errors import DceeInputError
-from dcee.scenarios.builtin import builtin_scenarios, random_configuration, random_family_name
+from dcee.scenarios.builtin import (
+    builtin_scenarios,
+    random_family_configuration,
+    random_family_name,
+)
 from dcee.scenarios.defaults import DEFAULTS
 from dcee.scenarios.schema import Scenario, validate_scenario
 from dcee.stopping import DEFAULT_STOP_SHARE
@@ -40,15 +44,13 @@ def load_scenario(name_or_path: str) -> Scenario:
     except ValueError as exc:
         raise DceeInputError("scenario", str(exc)) from None
     if family is not None:
-        return validate_scenario(
-            random_configuration(family[1], random_start=family[0] == "random-start")
-        )
+        return validate_scenario(random_family_configuration(*family))
     path = Path(name_or_path)
     if not path.suffix == ".toml" and ":" in name_or_path:
         raise DceeInputError(
             "scenario",
             f"unknown built-in {name_or_path!r}; choose one of {', '.join(builtins)}, "
-            "random:K or random-start:K (K an integer >= 1)",
+            "random:K, random-start:K, random2:K or random3:K (K an integer >= 1)",
         )
     if not path.is_file():
         raise DceeInputError("scenario", f"no such file {str(path)!r} and no such built-in")
@@ -142,6 +144,7 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
             f"{DEFAULT_STOP_SHARE * scenario.search.acquired_rmse:g} m, in a simulation never"
         ),
         ("world", "map"): "unset: no occupancy-grid map",
+        ("estimator", "count_prior"): "unset: every count 0 … max_sources equally likely",
     }
     lines = [f"# dcee scenario {scenario.name}"]
     tables = []

@@ -13,6 +13,9 @@ from pydantic import BaseModel, Field, field_validator, model_validator
 from dcee.models.sensor import OUTLIER_DEFAULT
 from dcee.scenarios.schema.common import FROZEN, Finite, Positive
 
+MAX_ESTIMATED_SOURCES = 4
+"""The most releases ``estimator.max_sources`` may allow (the truth's limit too)."""
+
 PHYSICAL_TRUNCATION = {"u": 0.0, "zeta1": 0.0, "zeta2": 0.0}
 
 
@@ -382,6 +385,16 @@ class EstimatorSpec(BaseModel):
     weighs its values equally. None: with ``estimator.learn`` unset the likelihood's default,
     :data:`LEARN_PRIOR_DEFAULT` (the fluctuation likelihood: ``{source_radius = [0.9, 0.1]}``),
     with a grid given every value equally likely. Members' priors are the products"""
+    max_sources: Annotated[int, Field(ge=1, le=MAX_ESTIMATED_SOURCES)] = 1
+    """the most releases the estimator considers. 1: one release (the paper's filter). K > 1:
+    the number of releases is unknown, 0 … K, estimated with the releases: one filter per count
+    on the same readings, selected by their evidence (:mod:`dcee.estimation.source_count`); the
+    planners and the stop rule follow the least-localised release of every plausible count. Needs
+    one reading model (the paper's likelihood, or the fluctuation likelihood with
+    ``calm_prior = 0`` and ``learn = {}``)"""
+    count_prior: Annotated[list[Annotated[float, Field(gt=0)]], Field(min_length=2)] | None = None
+    """with ``max_sources`` K > 1: the prior probability of 0, 1, …, K releases (K + 1 positive
+    numbers, normalised); None: every count equally likely"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the

@@ -25,6 +25,23 @@ class ReadingModelSettings:
     """The reading-model members of a scenario (a mixin: every attribute it reads, ``estimator``
     and ``meander``, is a validated scenario field or property)."""
 
+    def _checked_source_count(self) -> None:
+        """``estimator.max_sources`` > 1 needs one reading model; ``count_prior`` one positive
+        number per count 0 … max_sources."""
+        e = self.estimator
+        if e.count_prior is not None and len(e.count_prior) != e.max_sources + 1:
+            raise ValueError(
+                f"{FIELD_MARK}estimator.count_prior: {len(e.count_prior)} numbers; needs "
+                f"{e.max_sources + 1}, P(K) for K = 0 … estimator.max_sources ({e.max_sources})"
+            )
+        if e.max_sources > 1 and len(self.reading_models) > 1:
+            raise ValueError(
+                f"{FIELD_MARK}estimator.max_sources: {e.max_sources} releases need one reading "
+                f"model, got {len(self.reading_models)} ({', '.join(self.reading_models)}); use "
+                'likelihood = "paper", or the fluctuation likelihood with calm_prior = 0 and '
+                "learn = {}"
+            )
+
     def _checked_learn(self) -> None:
         """``estimator.learn``: the fluctuation likelihood's, in range, the fixed values in the
         grid, not too many members."""

@@ -113,6 +113,7 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
         if extra:
             raise ValueError(f"prior: unknown parameter name(s) {extra}; allowed {PARAMETER_NAMES}")
         self._checked_learn()
+        self._checked_source_count()
         self._checked_planar(start)
         site = self._checked_site(start, src)
         agent = GridAgent(

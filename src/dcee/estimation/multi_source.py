@@ -1,0 +1,222 @@
+"""A particle filter over a fixed number K ≥ 2 of releases that share one flow.
+
+Each particle is a row of 8 + 4 (K − 1) numbers (:mod:`dcee.estimation.multi_source_kernels`):
+the first release's source term, then (x, y, z, q) of every further release. Each further
+release has the first one's prior for its location and rate; releases closer than
+``min_separation`` m have prior density 0 (two releases on one spot are one release of their
+summed rate, and a prior without that gap would let K releases mimic fewer).
+
+Everything else is :class:`~dcee.estimation.particle_filter.ParticleFilter`'s: the weights, the
+full-history resample-move step, tempering, the SMC evidence that
+:class:`~dcee.estimation.source_count.SourceCountBank` compares source counts with. Three
+things change:
+
+* the likelihood sums the releases' plumes (compiled kernel);
+* a sweep's global proposal redraws the location of *one* release, chosen at random (redrawing
+  all K at once would almost never be accepted once one release is found);
+* the labels are aligned before every sweep. The likelihood and the prior do not change when
+  two releases swap labels, so a particle may hold release A as "release 1" and another
+  particle as "release 2"; a random walk scaled by the particles' covariance, and any summary
+  per release, would mix them. Before each sweep every particle's releases are permuted to
+  the permutation closest to a reference set of locations (its squared distances; the
+  reference starts at the best particle and is refined to the aligned means, three rounds,
+  as k-means does; Stephens 2000 relabels the same way). A permutation leaves the target
+  unchanged, so the filter's posterior is the same; the labels become meaningful.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import Any
+
+import numpy as np
+
+from dcee.errors import DceeInputError
+from dcee.estimation.multi_source_kernels import EXTRA_COLUMNS, multi_history_log_likelihood
+from dcee.estimation.particle_filter import ParticleFilter
+from dcee.estimation.priors import PHYSICAL_LOWER, SourcePrior
+from dcee.estimation.summaries import weighted_moments, weighted_rmse
+from dcee.models.sensor import Sensor
+
+_ALIGN_ROUNDS = 3
+
+
+class MultiSourceFilter(ParticleFilter):
+    """A particle filter over ``n_sources`` releases in one wind (see the module doc).
+
+    Parameters
+    ----------
+    n_sources: K ≥ 2.
+    min_separation: m, the least distance between two releases of one particle (prior).
+    Everything else: :class:`ParticleFilter`'s.
+    """
+
+    def __init__(
+        self,
+        n_sources: int,
+        prior: SourcePrior,
+        sensor: Sensor,
+        *args: Any,
+        min_separation: float = 1.0,
+        **kwargs: Any,
+    ) -> None:
+        if isinstance(n_sources, bool) or not isinstance(n_sources, int) or n_sources < 2:
+            raise DceeInputError("n_sources", f"must be an integer >= 2, got {n_sources!r}")
+        if not (math.isfinite(min_separation) and min_separation >= 0):
+            raise DceeInputError(
+                "min_separation", f"must be a number of m >= 0, got {min_separation!r}"
+            )
+        super().__init__(prior, sensor, *args, **kwargs)
+        self.n_sources = n_sources
+        self.min_separation = float(min_separation)
+        base = [int(i) for i in prior.unknown]
+        per_source = [c for c in base if c < 4]  # the release's own unknown columns
+        # (K, 4) columns of (x, y, z, q) of each release
+        self._blocks = np.array(
+            [[0, 1, 2, 3]]
+            + [[8 + EXTRA_COLUMNS * (j - 1) + c for c in range(4)] for j in range(1, n_sources)],
+            dtype=np.int64,
+        )
+        self._unknown = np.array(
+            base + [int(self._blocks[j, c]) for j in range(1, n_sources) for c in per_source]
+        )
+        self._per_source = per_source
+        self._perms = np.array(list(itertools.permutations(range(n_sources))), dtype=np.int64)
+        extra = np.empty((self.n, EXTRA_COLUMNS * (n_sources - 1)))
+        self.theta = np.hstack([self.theta, extra])
+        self._draw_extra(np.ones(self.n, dtype=bool))
+
+    # --- prior --------------------------------------------------------------------------------
+
+    def _draw_extra(self, which: np.ndarray) -> None:
+        """Draw the further releases of the particles ``which`` (N,) from their prior,
+        rejecting draws that break the separation or the physical bounds."""
+        dists = self.prior.distributions
+        todo = which.copy()
+        for _ in range(1000):
+            k = int(todo.sum())
+            if k == 0:
+                return
+            for j in range(1, self.n_sources):
+                for c in range(4):
+                    self.theta[todo, self._blocks[j, c]] = dists[c].sample(self.rng, k)
+            todo &= ~np.isfinite(self._log_prior(self.theta))
+        raise DceeInputError(
+            "prior",
+            f"puts (almost) no mass on {self.n_sources} releases at least "
+            f"{self.min_separation:g} m apart",
+        )
+
+    def _log_prior(self, theta: np.ndarray) -> np.ndarray:
+        """(N,) log prior of every release (the first one's prior for each further release's
+        location and rate), 0 density where two releases lie closer than ``min_separation``;
+        times the wind readings' likelihood."""
+        lp = super()._log_prior(theta)
+        dists = self.prior.distributions
+        q_low, _ = PHYSICAL_LOWER["q"]
+        for j in range(1, self.n_sources):
+            for c in self._per_source:
+                lp = lp + dists[c].log_pdf(theta[:, self._blocks[j, c]])
+            lp[theta[:, self._blocks[j, 3]] <= q_low] = -np.inf
+        if self.min_separation > 0:
+            loc = theta[:, self._blocks[:, :3]]  # (N, K, 3)
+            for a, b in itertools.combinations(range(self.n_sources), 2):
+                gap = np.linalg.norm(loc[:, a] - loc[:, b], axis=1)
+                lp[gap < self.min_separation] = -np.inf
+        return lp
+
+    def _unknown_scales(self) -> np.ndarray:
+        scales = {int(i): s for i, s in zip(self.prior.unknown, self.prior.scales, strict=True)}
+        per = [scales[c] for c in self._per_source]
+        return np.concatenate([self.prior.scales, np.tile(per, self.n_sources - 1)])
+
+    # --- moves --------------------------------------------------------------------------------
+
+    def _propose_jump(
+        self, proposal: np.ndarray, jump: np.ndarray, log_q_ratio: np.ndarray
+    ) -> None:
+        """Redraw the location of one release per jumping particle (chosen uniformly) from its
+        prior; the proposal density cancels that block's prior in the target."""
+        rows = np.flatnonzero(jump)
+        which = self.rng.integers(self.n_sources, size=len(rows))
+        dists = self.prior.distributions
+        for c in self._loc_block:
+            cols = self._blocks[which, c]
+            draw = dists[c].sample(self.rng, len(rows))
+            log_q_ratio[rows] += dists[c].log_pdf(self.theta[rows, cols]) - dists[c].log_pdf(draw)
+            proposal[rows, cols] = draw
+
+    def _history_ll(
+        self,
+        theta: np.ndarray,
+        active: np.ndarray,
+        positions: np.ndarray,
+        readings: np.ndarray,
+        multiplicity: np.ndarray,
+        out: np.ndarray,
+        threshold: np.ndarray | None = None,
+        bounds: np.ndarray | None = None,
+    ) -> None:
+        multi_history_log_likelihood(
+            theta,
+            active,
+            positions,
+            readings,
+            multiplicity,
+            self.plume.min_distance,
+            *self.plume.shape,
+            self._sp,
+            out,
+            threshold,
+            bounds,
+        )
+
+    def _align(self) -> None:
+        """Permute every particle's releases to the labelling closest to a reference set (see
+        the module doc). Changes no particle's source term set, its likelihood or prior."""
+        blocks = self._blocks
+        w = self.weights
+        loc = self.theta[:, blocks[:, :3]]  # (N, K, 3)
+        score = self._hist_loglik + np.where(np.isfinite(self._logw), self._logw, -np.inf)
+        ref = loc[int(np.argmax(score))].copy()
+        k_range = np.arange(self.n_sources)
+        for _ in range(_ALIGN_ROUNDS):
+            d2 = ((loc[:, :, None, :] - ref[None, None, :, :]) ** 2).sum(-1)  # (N, src, ref)
+            cost = d2[:, self._perms, k_range].sum(-1)  # (N, P)
+            best = self._perms[np.argmin(cost, axis=1)]  # (N, K): release for each label
+            block = self.theta[:, blocks]  # (N, K, 4)
+            self.theta[:, blocks] = np.take_along_axis(block, best[:, :, None], axis=1)
+            loc = self.theta[:, blocks[:, :3]]
+            ref = np.einsum("n,nkc->kc", w, loc)
+
+    # --- per-release summaries --------------------------------------------------------------
+
+    def release_locations(self, j: int) -> np.ndarray:
+        """(N, 3) release j's location in every particle (labels as aligned at the last
+        sweep)."""
+        return self.theta[:, self._blocks[j, :3]]
+
+    def release_rows(self, j: int) -> np.ndarray:
+        """(N, 8) release j of every particle as an ordinary source term (its location and
+        rate, the shared wind and diffusion): what a planner reads of it."""
+        rows = self.theta[:, :8].copy()
+        rows[:, :4] = self.theta[:, self._blocks[j]]
+        return rows
+
+    def release_means(self) -> np.ndarray:
+        """(K, 3) posterior mean location of each release, m."""
+        return np.stack([self.weights @ self.release_locations(j) for j in range(self.n_sources)])
+
+    def release_covs(self) -> np.ndarray:
+        """(K, 3, 3) posterior covariance of each release's location, m²."""
+        return np.stack(
+            [
+                weighted_moments(self.release_locations(j), self.weights)[1]
+                for j in range(self.n_sources)
+            ]
+        )
+
+    def release_rmse(self, j: int, true_location: np.ndarray) -> float:
+        """RMSE of release j's particles about ``true_location`` (3,), m."""
+        return weighted_rmse(self.release_locations(j), self.weights, true_location)

@@ -1,0 +1,122 @@
+"""The unknown-count study's table (issue 45): per campaign (two or three releases, held out),
+how often the search ended with the right number of releases (Wilson 95 % interval), the
+confusion of the estimated against the true count, the OSPA distance (3 m cut-off, order 1;
+median with its 95 % interval), each true release's distance to the nearest estimated one,
+P(K̂) and the worst searches.
+
+    python studies/source_count_table.py results/two-source-held-out-100 \\
+        results/three-source-held-out-100 [--csv docs/results/source-count/searches.csv]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from dcee.analysis.results import find_runs
+from dcee.analysis.statistics import median_ci, wilson
+from dcee.scenarios.schema.scenario import validate_scenario
+
+
+def rows_of(folder: Path) -> list[dict]:
+    out = []
+    for run in find_runs(folder):
+        summary = json.loads((run / "summary.json").read_text())
+        config = json.loads((run / "config.json").read_text())
+        truth = validate_scenario(config["scenario"]).truth.source_locations()
+        est = np.array(summary.get("estimated_sources", []), dtype=float).reshape(-1, 3)
+        near = (
+            np.linalg.norm(truth[:, None, :] - est[None, :, :], axis=2).min(axis=1)
+            if len(est)
+            else np.full(len(truth), np.inf)
+        )
+        probs = summary.get("count_probabilities", [])
+        k_hat = int(summary.get("estimated_count", 1))
+        out.append(
+            {
+                "campaign": folder.name,
+                "scenario": summary["scenario"],
+                "strategy": summary["strategy"],
+                "seed": summary["seed"],
+                "true_count": int(summary["true_sources"]),
+                "estimated_count": k_hat,
+                "count_correct": k_hat == int(summary["true_sources"]),
+                "p_estimated": float(probs[k_hat]) if probs else np.nan,
+                "p_true": float(probs[summary["true_sources"]]) if probs else np.nan,
+                "final_ospa": float(summary["final_ospa"]),
+                "worst_release_error": float(near.max()),
+                "mean_release_error": float(near.mean()),
+                "explore_guard_fired": int(summary.get("explore_guard_fired", 0)),
+                "decision_ms": 1e3 * float(summary["decision_seconds_mean"]),
+                "code": summary.get("code", {}).get("commit", "")
+                if isinstance(summary.get("code"), dict)
+                else "",
+            }
+        )
+    return out
+
+
+def table(df: pd.DataFrame) -> str:
+    lines = [
+        "| campaign | planner | searches | right count | confusion (K̂: searches) | median OSPA "
+        "(m) [95 % CI] | OSPA ≤ 1 m | median P(K̂) | worst release within 1 m |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for (campaign, strategy), g in df.groupby(["campaign", "strategy"], sort=False):
+        n = len(g)
+        right = int(g["count_correct"].sum())
+        _, lo, hi = wilson(right, n)
+        med, mlo, mhi = median_ci(g["final_ospa"].to_numpy())
+        conf = ", ".join(
+            f"{k}: {c}" for k, c in sorted(g["estimated_count"].value_counts().items())
+        )
+        within = int((g["worst_release_error"] <= 1.0).sum())
+        lines.append(
+            f"| {campaign} | {strategy} | {n} | {right}/{n} ({100 * right / n:.0f} %) "
+            f"[{100 * lo:.0f}, {100 * hi:.0f}] | {conf} | {med:.2f} [{mlo:.2f}, {mhi:.2f}] | "
+            f"{int((g['final_ospa'] <= 1.0).sum())}/{n} | {g['p_estimated'].median():.2f} | "
+            f"{within}/{n} |"
+        )
+    return "\n".join(lines)
+
+
+def worst(df: pd.DataFrame, k: int = 5) -> str:
+    lines = [
+        "| campaign | scenario | true K | K̂ | P(true K) | OSPA (m) | worst release error (m) |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for campaign, g in df.groupby("campaign", sort=False):
+        for _, r in g.sort_values("final_ospa", ascending=False).head(k).iterrows():
+            lines.append(
+                f"| {campaign} | {r.scenario} | {r.true_count} | {r.estimated_count} | "
+                f"{r.p_true:.2f} | {r.final_ospa:.2f} | {r.worst_release_error:.2f} |"
+            )
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("folders", nargs="+", type=Path)
+    ap.add_argument("--csv", type=Path, help="write every search's row here")
+    args = ap.parse_args(argv)
+    rows = [r for f in args.folders for r in rows_of(f)]
+    if not rows:
+        print("no finished searches in " + ", ".join(map(str, args.folders)), file=sys.stderr)
+        return 2
+    df = pd.DataFrame(rows)
+    if args.csv:
+        args.csv.parent.mkdir(parents=True, exist_ok=True)
+        df.to_csv(args.csv, index=False)
+    print(table(df))
+    print()
+    print(worst(df))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

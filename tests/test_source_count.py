@@ -1,0 +1,325 @@
+"""An unknown number of releases (issue 45): the K-release likelihood against its NumPy
+reference, the K-release filter's labels, the bank over K against exact evidences and
+simulated readings, the exploration guard, and the scenario's settings."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+from dcee import DceeInputError
+from dcee.estimation import ParticleFilter
+from dcee.estimation.multi_source import MultiSourceFilter
+from dcee.estimation.multi_source_kernels import (
+    multi_history_log_likelihood,
+    multi_history_log_likelihood_reference,
+    source_rows,
+)
+from dcee.estimation.source_count import NoSource, SourceCountBank
+from dcee.exploration import ApproachingAgent, detection_entropy, exploration_goal
+from dcee.models.plume import IsotropicPlume
+from dcee.models.sensor import Sensor
+from dcee.planning.base import Belief
+from dcee.runs import make_searcher
+from dcee.scenarios import load_scenario
+from tests.helpers import run_cli
+
+PAPER1 = load_scenario("paper:1")
+SENSOR = PAPER1.make_estimator_sensor()
+PRIOR = PAPER1.make_prior()
+
+
+def _theta(n: int, k: int, rng: np.random.Generator) -> np.ndarray:
+    """(n, 8 + 4 (k − 1)) particles: releases over the area, the paper's wind."""
+    base = np.tile(PAPER1.truth_theta(), (n, 1))
+    cols = [base]
+    base[:, 0:2] = rng.uniform(0, 50, (n, 2))
+    base[:, 2] = rng.uniform(0, 3, n)
+    base[:, 3] = rng.uniform(1, 20, n)
+    for _ in range(k - 1):
+        extra = np.column_stack(
+            [rng.uniform(0, 50, (n, 2)), rng.uniform(0, 3, n), rng.uniform(1, 20, n)]
+        )
+        cols.append(extra)
+    return np.hstack(cols)
+
+
+def _readings(rng: np.random.Generator, m: int = 40) -> tuple[np.ndarray, np.ndarray]:
+    pos = np.column_stack([rng.uniform(0, 50, (m, 2)), np.full(m, 4.0)])
+    z = np.where(rng.random(m) < 0.5, 0.0, rng.uniform(5e-4, 0.05, m))
+    return pos, z
+
+
+@pytest.mark.parametrize("k", [2, 3])
+@pytest.mark.parametrize(
+    "sensor, plume",
+    [
+        (SENSOR, IsotropicPlume()),
+        (
+            Sensor(threshold=5e-4, pd=0.9, family="lognormal", log_sd=1.3, near_length=0.5),
+            IsotropicPlume(meander=0.15, backflow=0.05, radius=1.0),
+        ),
+    ],
+)
+def test_k_release_kernel_matches_reference(k, sensor, plume):
+    """The compiled K-release history likelihood equals the NumPy reference (sum of the
+    releases' plumes, the nearest release's distance), for both likelihood families and every
+    plume option."""
+    rng = np.random.default_rng(k)
+    theta = _theta(300, k, rng)
+    pos, z = _readings(rng)
+    mult = rng.uniform(0.5, 2.0, len(z))
+    out = np.empty(len(theta))
+    multi_history_log_likelihood(
+        theta,
+        np.ones(len(theta), dtype=bool),
+        pos,
+        z,
+        mult,
+        plume.min_distance,
+        *plume.shape,
+        sensor.params,
+        out,
+    )
+    ref = multi_history_log_likelihood_reference(theta, pos, z, mult, sensor, plume)
+    np.testing.assert_allclose(out, ref, rtol=1e-9, atol=1e-9)
+
+
+def test_k_release_kernel_rejects_early_only_what_cannot_be_accepted():
+    """With a threshold, a particle is returned −inf only if its full sum lies below it; the
+    others are summed in full."""
+    rng = np.random.default_rng(5)
+    theta = _theta(400, 2, rng)
+    pos, z = _readings(rng, 64)
+    mult = np.ones(len(z))
+    plume = IsotropicPlume()
+    full = multi_history_log_likelihood_reference(theta, pos, z, mult, SENSOR, plume)
+    threshold = full + rng.normal(0, 20, len(full))
+    from dcee.estimation.filter_kernels import reading_upper_bounds
+
+    out = np.empty(len(theta))
+    multi_history_log_likelihood(
+        theta,
+        np.ones(len(theta), dtype=bool),
+        pos,
+        z,
+        mult,
+        plume.min_distance,
+        *plume.shape,
+        SENSOR.params,
+        out,
+        threshold,
+        reading_upper_bounds(z, SENSOR),
+    )
+    dropped = ~np.isfinite(out)
+    assert dropped.any() and not dropped.all()
+    assert np.all(full[dropped] < threshold[dropped])
+    np.testing.assert_allclose(out[~dropped], full[~dropped], rtol=1e-9)
+
+
+def test_one_release_of_a_k_release_row_is_its_own_source_term():
+    """source_rows: release j keeps its location and rate and the shared wind and diffusion."""
+    rng = np.random.default_rng(1)
+    theta = _theta(5, 3, rng)
+    rows = source_rows(theta)
+    assert rows.shape == (3, 5, 8)
+    np.testing.assert_array_equal(rows[0], theta[:, :8])
+    np.testing.assert_array_equal(rows[2, :, :4], theta[:, 12:16])
+    np.testing.assert_array_equal(rows[2, :, 4:], theta[:, 4:8])
+
+
+def _filter(k: int, n: int = 2000, seed: int = 0) -> ParticleFilter:
+    if k == 1:
+        return ParticleFilter(PRIOR, SENSOR, n_particles=n, seed=seed)
+    return MultiSourceFilter(k, PRIOR, SENSOR, n_particles=n, seed=seed, min_separation=1.0)
+
+
+def test_k_release_prior_draws_are_valid_and_separated():
+    f = _filter(3, 3000)
+    assert f.theta.shape == (3000, 16)
+    assert np.all(np.isfinite(f._log_prior(f.theta)))
+    loc = f.theta[:, f._blocks[:, :3]]
+    for a, b in itertools.combinations(range(3), 2):
+        assert np.linalg.norm(loc[:, a] - loc[:, b], axis=1).min() >= 1.0
+    assert np.all(f.theta[:, f._blocks[:, 3]] > 0)
+    # the wind and diffusion are the paper's, known, in every particle
+    np.testing.assert_array_equal(f.theta[:, 4:8], np.tile(PAPER1.truth_theta()[4:], (3000, 1)))
+
+
+def test_relabelling_changes_no_particles_set_and_sorts_the_labels():
+    """Aligning permutes each particle's releases only (the set, its likelihood and prior are
+    unchanged), and afterwards each label's particles sit on one release."""
+    f = _filter(2, 2000, seed=3)
+    rng = np.random.default_rng(0)
+    a, b = np.array([10.0, 40.0, 1.0]), np.array([40.0, 10.0, 1.0])
+    swap = rng.random(f.n) < 0.5
+    f.theta[:, 0:3] = np.where(swap[:, None], b, a) + rng.normal(0, 0.3, (f.n, 3))
+    f.theta[:, 8:11] = np.where(swap[:, None], a, b) + rng.normal(0, 0.3, (f.n, 3))
+    before = {tuple(sorted([tuple(r[:3]), tuple(r[8:11])])) for r in np.round(f.theta, 9)}
+    lp = np.sort(f._log_prior(f.theta))
+    f._align()
+    after = {tuple(sorted([tuple(r[:3]), tuple(r[8:11])])) for r in np.round(f.theta, 9)}
+    assert before == after
+    np.testing.assert_allclose(np.sort(f._log_prior(f.theta)), lp)
+    means = f.release_means()
+    spreads = np.sqrt(np.trace(f.release_covs(), axis1=1, axis2=2))
+    assert np.all(spreads < 1.0)
+    assert {tuple(np.round(m[:2])) for m in means} == {(10.0, 40.0), (40.0, 10.0)}
+
+
+def test_no_release_evidence_by_hand():
+    """K = 0: the evidence is the sum of log p(z | C = 0) of the readings."""
+    none = NoSource(_filter(1, 10))
+    zs = [0.0, 0.0, 2e-3, 0.0]
+    for i, z in enumerate(zs):
+        none.update(np.array([i, 0.0, 4.0]), z)
+    expected = sum(float(SENSOR.log_likelihood(z, 0.0)) for z in zs)
+    assert none.log_evidence == pytest.approx(expected, rel=1e-12)
+
+
+def _simulate(truth: np.ndarray, path: np.ndarray, seed: int) -> np.ndarray:
+    """Readings of the paper's sensor along ``path`` (M, 3) for releases ``truth`` (K, 8)."""
+    rng = np.random.default_rng(seed)
+    conc = IsotropicPlume().concentration(truth, path).sum(axis=0)
+    return SENSOR.simulate(conc, rng)
+
+
+def _bank(kmax: int = 3, n: int = 3000, seed: int = 0) -> SourceCountBank:
+    return SourceCountBank([_filter(k, n, seed + k) for k in range(1, kmax + 1)])
+
+
+def _lawnmower() -> np.ndarray:
+    """A survey across the wind (the paper's wind blows along −x): legs along y every 3 m."""
+    ys = np.arange(1.0, 50.0, 2.0)
+    legs = [
+        np.column_stack([np.full(len(ys), x), ys if i % 2 == 0 else ys[::-1]])
+        for i, x in enumerate(np.arange(2.0, 50.0, 3.0))
+    ]
+    xy = np.vstack(legs)
+    return np.column_stack([xy, np.full(len(xy), 4.0)])
+
+
+@pytest.mark.parametrize("count", [1, 2])
+def test_bank_finds_the_number_of_releases_from_a_survey(count):
+    """Readings of a lawnmower survey over one or two releases (wind known): the bank's most
+    probable count is the truth's, P(K) above 0.8, and each release is found within 1.5 m."""
+    truth = np.tile(PAPER1.truth_theta(), (count, 1))
+    truth[:, :4] = [[37.5, 12.5, 1.0, 5.0], [15.0, 35.0, 1.0, 5.0]][:count]
+    path = _lawnmower()
+    readings = _simulate(truth, path, 7)
+    bank = _bank()
+    for p, z in zip(path, readings, strict=True):
+        bank.update(p, float(z))
+    probs = bank.count_probabilities
+    assert bank.estimated_count == count and probs[count] > 0.8, probs
+    est = bank.estimated_sources()
+    for true in truth[:, :3]:
+        assert np.min(np.linalg.norm(est[:, :2] - true[:2], axis=1)) < 1.5
+
+
+def test_no_gas_means_no_release():
+    """A survey that reads nothing anywhere: K = 0 is the most probable count."""
+    bank = _bank(2, 1000)
+    for p in _lawnmower():
+        bank.update(p, 0.0)
+    assert bank.estimated_count == 0
+    assert bank.estimated_sources().shape == (0, 3)
+
+
+def test_bank_one_release_member_is_the_lone_filter_draw_for_draw():
+    """The bank's K = 1 member, from the same generator, is the lone filter, bit for bit."""
+    path = _lawnmower()[:60]
+    readings = _simulate(PAPER1.truth_thetas(), path, 3)
+    lone = _filter(1, 1500, seed=11)
+    bank = SourceCountBank([_filter(1, 1500, seed=11), _filter(2, 1500, seed=12)])
+    for p, z in zip(path, readings, strict=True):
+        lone.update(p, float(z))
+        bank.update(p, float(z))
+    np.testing.assert_array_equal(lone.theta, bank.member(1).theta)
+    np.testing.assert_array_equal(lone.weights, bank.member(1).weights)
+
+
+def test_bad_bank_input_is_refused():
+    with pytest.raises(DceeInputError, match="count_prior"):
+        SourceCountBank([_filter(1, 10), _filter(2, 10)], count_prior=[1.0, 1.0])
+    with pytest.raises(DceeInputError, match="member 2"):
+        SourceCountBank([_filter(1, 10), _filter(3, 10)])
+    with pytest.raises(DceeInputError, match="n_sources"):
+        MultiSourceFilter(1, PRIOR, SENSOR, n_particles=10)
+
+
+def test_detection_entropy_by_hand():
+    """Two equally weighted hypotheses, one whose plume covers a point and one whose does not:
+    the outcome there is a coin of P = Pd · P(above threshold); far from both it is certain."""
+    theta = np.tile(PAPER1.truth_theta(), (2, 1))
+    theta[1, :2] = [5.0, 45.0]
+    belief = Belief(theta, np.array([0.5, 0.5]), SENSOR, IsotropicPlume())
+    point = np.array([[30.0, 12.5, 4.0], [49.0, 1.0, 4.0]])  # in one plume; upwind of both
+    conc = IsotropicPlume().concentration(theta[:1], point[:1])[0, 0]
+    base = float(SENSOR.log_likelihood(0.0, 0.0))
+    p_miss = math.exp(float(SENSOR.log_likelihood(0.0, conc)) - base)
+    p = 0.5 * (1 - p_miss)
+    h = detection_entropy(belief, point)
+    assert h[0] == pytest.approx(-(p * math.log(p) + (1 - p) * math.log(1 - p)), rel=1e-9)
+    assert h[1] < 1e-6
+
+
+def test_exploration_goal_heads_for_informative_ground():
+    """A belief far from the robot: no move is informative, the goal is where the hypotheses'
+    plumes are, and only moves towards it are offered; a belief at hand: no goal."""
+    agent = PAPER1.make_agent()
+    rng = np.random.default_rng(0)
+    theta = np.tile(PAPER1.truth_theta(), (500, 1))
+    theta[:, :2] = rng.uniform([35, 35], [45, 45], (500, 2))  # wind from +x: plumes run to −x
+    belief = Belief(theta, np.full(500, 1 / 500), SENSOR, IsotropicPlume())
+    here = np.array([40.0, 3.0, 4.0])
+    goal = exploration_goal(belief, here, agent)
+    assert goal is not None and goal[1] > 30.0 and goal[0] < 45.0
+    cands, _ = ApproachingAgent(agent, goal, here).candidates(here)
+    before = np.hypot(*(here[:2] - goal[:2]))
+    assert len(cands) and np.all(np.hypot(*(cands[:, :2] - goal[:2]).T) < before - 1.0)
+    assert exploration_goal(belief, np.array([30.0, 40.0, 4.0]), agent) is None
+
+
+def test_scenario_settings_build_the_bank_and_refuse_what_cannot_work(tmp_path, capsys):
+    two = PAPER1.with_overrides(**{"estimator.max_sources": 3, "search.particles": 500})
+    searcher = make_searcher(two, None, np.random.default_rng(0), np.random.default_rng(1))
+    assert isinstance(searcher.filter, SourceCountBank)
+    assert searcher.filter.max_sources == 3 and searcher.explore_guard
+    one = make_searcher(
+        PAPER1.with_overrides(**{"search.particles": 500}),
+        None,
+        np.random.default_rng(0),
+        np.random.default_rng(1),
+    )
+    assert type(one.filter) is ParticleFilter and not one.explore_guard
+    for sets, says in [
+        (["estimator.max_sources=5"], "estimator.max_sources"),
+        (["estimator.max_sources=2", "estimator.count_prior=[1,1]"], "estimator.count_prior"),
+        (['estimator.likelihood="fluctuation"', "estimator.max_sources=2"], "one reading"),
+    ]:
+        args = ["run", "--scenario", "paper:1", "--out", str(tmp_path / "x")]
+        for s in sets:
+            args += ["--set", s]
+        code, out, err = run_cli(args, capsys)
+        assert code == 2, (sets, out, err)
+        assert says in err and "Traceback" not in err
+        assert len(err.strip().splitlines()) == 1
+        assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.parametrize("n", [2, 3])
+def test_random_multi_release_configurations(n):
+    """random2:K / random3:K: n releases at least 5 m apart inside the area, one wind, the
+    same draws every time, and nothing shared with random:K."""
+    for k in (1, 2, 1000):
+        s = load_scenario(f"random{n}:{k}")
+        locs = s.truth.source_locations()
+        assert locs.shape == (n, 3)
+        for a, b in itertools.combinations(range(n), 2):
+            assert np.linalg.norm(locs[a] - locs[b]) >= 5.0
+        assert load_scenario(f"random{n}:{k}").truth == s.truth
+    assert load_scenario("random2:1").truth.x != load_scenario("random:1").truth.x
