@@ -39,6 +39,7 @@ PAGES = (
     "docs/scenarios.md",
     "docs/plumes.md",
     "docs/performance.md",
+    "docs/multi-source.md",
 )
 MARKER = re.compile(
     r"(<!-- generated: (?P<name>[a-z0-9-]+) \(studies/publish_tables\.py\) -->\n)"
@@ -1303,7 +1304,23 @@ def search_speed_table() -> str:
                   "same search"], rows)  # fmt: skip
 
 
+def _source_count(kind: str) -> str:
+    """Issue 45's unknown-count study: studies/source_count_table.py's tables of the stored
+    searches (``kind`` "table" or "worst")."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "source_count_table", ROOT / "studies" / "source_count_table.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    frame = pd.read_csv(RESULTS / "source-count" / "searches.csv")
+    return getattr(module, kind)(frame) + "\n"
+
+
 TABLES: dict[str, Callable[[], str]] = {
+    "source-count": lambda: _source_count("table"),
+    "source-count-worst": lambda: _source_count("worst"),
     "learn-tuning": learn_tuning_table,
     "backflow-tuning": backflow_tuning_table,
     "source-radius-tuning": source_radius_tuning_table,

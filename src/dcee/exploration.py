@@ -6,11 +6,12 @@ The planners look one move ahead (the tree search a few). A belief that is wide 
 (measured: on two releases, ``dcee-cl`` spent 400 s within 15 m once the first release was
 localised while a second was still plausible). The stall guard only sees pacing within one step.
 
-The exploration guard asks, before a decision, how uncertain the next reading's outcome is,
-detection or not, under the belief: the binary entropy H(P_det(p)) with P_det(p) = Σᵢ wᵢ
-P(detection | Cᵢ(p)) — the part of a reading's information that does not depend on its size,
-and the one that is zero wherever every hypothesis agrees. It compares the best candidate move
-with a coarse grid over the area at the robot's altitude. When the best move's entropy is below
+The exploration guard asks, before a decision, how much the next reading's outcome, detection
+or not, would tell about the hypotheses: the mutual information between the outcome and the
+hypothesis under the joint belief (every release's gas; :func:`detection_information`) — the
+part of a reading's information that does not depend on its size, zero wherever every
+hypothesis predicts the same. It compares the best candidate move with a coarse grid over the
+area at the robot's altitude. When the best move's entropy is below
 ``share`` of the grid's best, the robot is offered only the moves that bring it closer to the
 nearest grid point whose entropy is at least ``share`` of the best (:class:`ApproachingAgent`);
 the planner chooses among them as usual.
@@ -23,11 +24,14 @@ from typing import Any
 
 import numpy as np
 
+from dcee.estimation.base import Estimator
+from dcee.estimation.multi_source_kernels import source_rows
 from dcee.models.agent import GridAgent, travel_xy
-from dcee.planning.base import Belief
+from dcee.models.plume import IsotropicPlume
+from dcee.models.sensor import Sensor
 
 DEFAULT_EXPLORE_SHARE = 0.5
-"""The guard acts when the best move's outcome entropy is below this share of the area's best,
+"""The guard acts when the best move's information is below this share of the area's best,
 and heads for the nearest grid point at or above it."""
 
 THINNED = 1000
@@ -38,29 +42,45 @@ GRID_CELLS = 12
 """Grid points per side of the area (a 50 m area: about 4 m apart)."""
 
 
-def detection_entropy(belief: Belief, points: np.ndarray) -> np.ndarray:
-    """(M,) binary entropy (nats) of "a detection or not" at points (M, 3) under the belief:
-    P_det(p) = 1 − Σᵢ wᵢ P(miss | Cᵢ(p)) / P(miss | 0) (the miss probability relative to
-    no gas: false alarms and outliers alike in every hypothesis)."""
-    theta, weights = _thinned(belief)
-    conc = belief.plume.concentration(theta, points)  # (n, M)
-    sensor = belief.sensor
+def detection_information(
+    theta: np.ndarray,
+    weights: np.ndarray,
+    sensor: Sensor,
+    plume: IsotropicPlume,
+    points: np.ndarray,
+) -> np.ndarray:
+    """(M,) mutual information (nats) between "a detection or not" at points (M, 3) and the
+    hypothesis, for particles ``theta`` (N, 8 + 4 (K − 1)) with normalised ``weights`` (N,):
+    I = H(Σᵢ wᵢ Pᵢ) − Σᵢ wᵢ H(Pᵢ), Pᵢ = 1 − P(miss | Cᵢ(p)) / P(miss | 0) the detection
+    probability hypothesis i predicts (Cᵢ the sum of its releases' plumes; false alarms and
+    outliers alike in every hypothesis). Zero where every hypothesis predicts the same, however
+    noisy the sensor (a bare outcome entropy is not: with Pd = 0.7 a plume's core is a coin)."""
+    theta, weights = _thinned(theta, weights)
+    rows = source_rows(theta)
+    conc = sum(plume.concentration(r, points) for r in rows)  # (n, M)
+    near = np.min([np.linalg.norm(points[None, :, :] - r[:, None, :3], axis=2) for r in rows], 0)
     base = float(sensor.log_likelihood(0.0, 0.0, np.inf))
-    far = np.linalg.norm(points[None, :, :] - theta[:, None, :3], axis=2)
-    miss = np.exp(np.minimum(sensor.log_likelihood(0.0, conc, far) - base, 0.0))
-    p = np.clip(1.0 - weights @ miss, 1e-12, 1.0 - 1e-12)
+    miss = np.exp(np.minimum(sensor.log_likelihood(0.0, conc, near) - base, 0.0))
+    p_each = np.clip(1.0 - miss, 1e-12, 1.0 - 1e-12)
+    p_mean = np.clip(weights @ p_each, 1e-12, 1.0 - 1e-12)
+    return _entropy(p_mean) - weights @ _entropy(p_each)
+
+
+def _entropy(p: np.ndarray) -> np.ndarray:
     return -(p * np.log(p) + (1.0 - p) * np.log1p(-p))
 
 
-def _thinned(belief: Belief, n: int = THINNED) -> tuple[np.ndarray, np.ndarray]:
-    """At most ``n`` particles of the belief with their weights: systematic resampling at the
-    fixed offset 1/2 (no random draw, so the guard moves no generator), weights equal."""
-    if len(belief.weights) <= n:
-        return belief.theta, belief.weights
-    edges = np.cumsum(belief.weights)
+def _thinned(
+    theta: np.ndarray, weights: np.ndarray, n: int = THINNED
+) -> tuple[np.ndarray, np.ndarray]:
+    """At most ``n`` particles with their weights: systematic resampling at the fixed offset
+    1/2 (no random draw, so the guard moves no generator), weights equal."""
+    if len(weights) <= n:
+        return theta, weights
+    edges = np.cumsum(weights)
     idx = np.searchsorted(edges, (np.arange(n) + 0.5) / n * edges[-1])
     idx = np.minimum(idx, len(edges) - 1)
-    return belief.theta[idx], np.full(n, 1.0 / n)
+    return theta[idx], np.full(n, 1.0 / n)
 
 
 def area_grid(agent: GridAgent, altitude: float, cells: int = GRID_CELLS) -> np.ndarray:
@@ -73,17 +93,24 @@ def area_grid(agent: GridAgent, altitude: float, cells: int = GRID_CELLS) -> np.
 
 
 def exploration_goal(
-    belief: Belief,
+    estimator: Estimator,
     position: np.ndarray,
     agent: GridAgent,
     share: float = DEFAULT_EXPLORE_SHARE,
 ) -> np.ndarray | None:
     """The grid point (3,) m to head for, or None when a move within reach is informative
-    enough (see the module doc)."""
+    enough (see the module doc). The information is the estimator's joint belief's
+    (:func:`detection_information`; a count bank's target count, every release's gas)."""
     cands, _ = agent.candidates(position)
     if len(cands) == 0:
         return None
-    local = float(detection_entropy(belief, cands).max())
+    joint = getattr(estimator, "joint_particles", None)
+    theta, weights = joint() if joint is not None else (estimator.theta, estimator.weights)
+
+    def info(points: np.ndarray) -> np.ndarray:
+        return detection_information(theta, weights, estimator.sensor, estimator.plume, points)
+
+    local = float(info(cands).max())
     if local >= share * math.log(2.0):  # no grid point can beat ln 2: the move is informative
         return None
     grid = area_grid(agent, float(position[2]))
@@ -91,7 +118,7 @@ def exploration_goal(
         grid = grid[agent.site.reachable(position, grid)]
         if len(grid) == 0:
             return None
-    h_grid = detection_entropy(belief, grid)
+    h_grid = info(grid)
     best = float(h_grid.max())
     if best <= 0.0 or local >= share * best:
         return None

@@ -220,7 +220,7 @@ class Searcher:
         if anchor is not None:
             return LeavingAgent(self.agent, anchor, self.position)
         if self.explore_guard:
-            goal = exploration_goal(self.belief(), self.position, self.agent)
+            goal = exploration_goal(self.filter, self.position, self.agent)
             if goal is not None:
                 self.explore_fired += 1
                 return ApproachingAgent(self.agent, goal, self.position)

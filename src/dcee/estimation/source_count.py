@@ -200,6 +200,12 @@ class SourceCountBank:
     def weights(self) -> np.ndarray:
         return self._target_member()[0].weights
 
+    def joint_particles(self) -> tuple[np.ndarray, np.ndarray]:
+        """((N, 8 + 4 (K − 1)) particles, (N,) weights) of the target's filter: every release,
+        for what needs the gas of all of them (:mod:`dcee.exploration`)."""
+        f = self._target_member()[0]
+        return f.theta, f.weights
+
     def _target_locations(self) -> np.ndarray:
         f, j = self._target_member()
         return f.release_locations(j) if isinstance(f, MultiSourceFilter) else f.source_locations
