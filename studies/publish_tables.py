@@ -1318,9 +1318,35 @@ def _source_count(kind: str) -> str:
     return getattr(module, kind)(frame) + "\n"
 
 
+def source_count_timing_table() -> str:
+    """Decision and update time with the count unknown (studies/source_count_timing.py)."""
+    frame = pd.read_csv(RESULTS / "source-count" / "timing.csv")
+    rows = [
+        [
+            str(r["truth"]),
+            str(int(r["max_sources"])),
+            f"{r['decision_ms_mean']:.1f} ({r['decision_ratio']:.2f}×)",
+            f"{r['update_ms_mean']:.1f} ({r['update_ratio']:.2f}×)",
+            f"{r['load_before']:.2f}",
+        ]
+        for _, r in frame.iterrows()
+    ]
+    return table(
+        [
+            "truth (dcee-cl, seed 0, 10,000 particles, one pinned core)",
+            "estimator.max_sources",
+            "mean decision (ms) (× one release)",
+            "mean update per reading (ms) (× one release)",
+            "load before",
+        ],
+        rows,
+    )
+
+
 TABLES: dict[str, Callable[[], str]] = {
     "source-count": lambda: _source_count("table"),
     "source-count-worst": lambda: _source_count("worst"),
+    "source-count-timing": source_count_timing_table,
     "learn-tuning": learn_tuning_table,
     "backflow-tuning": backflow_tuning_table,
     "source-radius-tuning": source_radius_tuning_table,

@@ -20,6 +20,7 @@ import pandas as pd
 
 from dcee.analysis.results import find_runs
 from dcee.analysis.statistics import median_ci, wilson
+from dcee.errors import DceeInputError
 from dcee.scenarios.schema.scenario import validate_scenario
 
 
@@ -104,7 +105,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("folders", nargs="+", type=Path)
     ap.add_argument("--csv", type=Path, help="write every search's row here")
     args = ap.parse_args(argv)
-    rows = [r for f in args.folders for r in rows_of(f)]
+    try:
+        rows = [r for f in args.folders for r in rows_of(f)]
+    except DceeInputError as exc:
+        print(f"source_count_table: {exc}", file=sys.stderr)
+        return 2
     if not rows:
         print("no finished searches in " + ", ".join(map(str, args.folders)), file=sys.stderr)
         return 2

@@ -202,7 +202,7 @@ class Searcher:
             raise DceeInputError("planner", "this searcher has no planner to ask")
         t0 = _time.perf_counter()
         agent = self.decision_agent()
-        if agent is not self.agent:
+        if isinstance(agent, LeavingAgent):
             self.guard_fired += 1
         with one_blas_thread():
             self.last_decision = self.planner.decide(self.belief(), self.position, agent, self.rng)
