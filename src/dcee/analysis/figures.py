@@ -12,6 +12,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import LogNorm
 
+from dcee.estimation.multi_source_kernels import source_rows
+
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
@@ -56,6 +58,10 @@ def _draw_site(ax: plt.Axes, scenario: Scenario) -> None:
     ax.plot([], [], "s", color="0.6", label="obstacle / no-go zone")
 
 
+RELEASE_COLOURS = ("tab:green", "tab:purple", "tab:olive", "tab:pink")
+"""The particles' colour of each release of a search whose count was unknown."""
+
+
 def _draw_map(
     ax: plt.Axes,
     result: EpisodeResult,
@@ -80,15 +86,20 @@ def _draw_map(
         ax.contour(xs, ys, conc, levels=[thr], colors="k", linewidths=0.6, linestyles="--")
     _draw_site(ax, scenario)
     recs = [r for r in result.records if r["time"] <= until + 1e-9]
-    ax.scatter(
-        particles[:, 0],
-        particles[:, 1],
-        s=1.0,
-        c="tab:green",
-        alpha=0.35,
-        lw=0,
-        label="particles (source hypotheses)",
-    )
+    # several releases (a count bank's answer): each release's particles in its own colour
+    releases = source_rows(particles) if particles.shape[1] > 8 else particles[None, :, :3]
+    for j, rel in enumerate(releases):
+        ax.scatter(
+            rel[:, 0],
+            rel[:, 1],
+            s=1.0,
+            c=RELEASE_COLOURS[j % len(RELEASE_COLOURS)],
+            alpha=0.35,
+            lw=0,
+            label="particles (source hypotheses)"
+            if len(releases) == 1
+            else f"release {j + 1} particles",
+        )
     px = np.array([r["x"] for r in recs])
     py = np.array([r["y"] for r in recs])
     robot = np.array([r.get("robot", 0) for r in recs])
@@ -118,9 +129,29 @@ def _draw_map(
     label = "true source" if len(sources) == 1 else f"true sources ({len(sources)})"
     ax.plot(sources[:, 0], sources[:, 1], "*", ms=14, mec="k", mfc="gold", ls="none", label=label)
     last = recs[-1]
-    ax.plot(
-        last["mean_x"], last["mean_y"], "P", ms=9, mec="k", mfc="tab:cyan", label="posterior mean"
-    )
+    found = result.summary.get("estimated_sources")
+    if found is not None:  # the count was unknown: the answer is a set
+        est = np.array(found, dtype=float).reshape(-1, 3)
+        ax.plot(
+            est[:, 0],
+            est[:, 1],
+            "P",
+            ms=9,
+            mec="k",
+            mfc="tab:cyan",
+            ls="none",
+            label=f"estimated releases (K̂ = {len(est)})",
+        )
+    else:
+        ax.plot(
+            last["mean_x"],
+            last["mean_y"],
+            "P",
+            ms=9,
+            mec="k",
+            mfc="tab:cyan",
+            label="posterior mean",
+        )
     starts = scenario.starts()
     ax.plot(starts[:, 0], starts[:, 1], "x", ms=9, color="k", mew=2, ls="none", label="start")
     ax.set_xlim(scenario.volume.low[0], scenario.volume.high[0])
@@ -194,9 +225,7 @@ def draw_search_figure(result: EpisodeResult, scenario: Scenario, truth: TruthMo
         size=min(3000, len(result.final_weights)),
         p=result.final_weights,
     )
-    _draw_map(
-        ax_map, result, scenario, truth, result.records[-1]["time"], result.final_theta[idx, :3]
-    )
+    _draw_map(ax_map, result, scenario, truth, result.records[-1]["time"], result.final_theta[idx])
     ax_map.legend(
         fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=4, markerscale=0.8
     )
@@ -207,7 +236,7 @@ def draw_search_figure(result: EpisodeResult, scenario: Scenario, truth: TruthMo
         f" · source {'acquired' if s['source_acquired'] else 'not acquired'}"
         + (
             f" · {s['true_sources']} releases, OSPA {s['final_ospa']:.2f} m"
-            if s.get("true_sources", 1) > 1
+            if s.get("true_sources", 1) > 1 or "estimated_count" in s
             else ""
         ),
         fontsize=11,

@@ -13,8 +13,7 @@ things change:
 
 * the likelihood sums the releases' plumes (compiled kernel);
 * a sweep's global proposal redraws the location of *one* release, chosen at random (redrawing
-  all K at once would almost never be accepted once one release is found), and its random walk
-  moves one block per particle (one release, or the shared wind and diffusion);
+  all K at once would almost never be accepted once one release is found);
 * the labels are aligned before every sweep. The likelihood and the prior do not change when
   two releases swap labels, so a particle may hold release A as "release 1" and another
   particle as "release 2"; a random walk scaled by the particles' covariance, and any summary
@@ -37,7 +36,6 @@ from dcee.errors import DceeInputError
 from dcee.estimation.multi_source_kernels import EXTRA_COLUMNS, multi_history_log_likelihood
 from dcee.estimation.particle_filter import ParticleFilter
 from dcee.estimation.priors import PHYSICAL_LOWER, SourcePrior
-from dcee.estimation.resample_move import walk_step
 from dcee.estimation.summaries import weighted_moments, weighted_rmse
 from dcee.models.sensor import Sensor
 
@@ -128,27 +126,10 @@ class MultiSourceFilter(ParticleFilter):
                 lp[gap < self.min_separation] = -np.inf
         return lp
 
-    def _random_walk(self, proposal: np.ndarray) -> None:
-        """A random walk on one block per particle, chosen uniformly: one release's unknown
-        columns, or the shared unknown ones (wind, diffusion), each with its own covariance.
-        A joint step in all 4 K (+ 4) columns is almost never accepted once the releases are
-        found (measured on random3:12, tuning range: the three-release filter never localised
-        a release that the two-release filter held within 0.5 m)."""
-        scale = {int(i): s for i, s in zip(self.prior.unknown, self.prior.scales, strict=True)}
-        shared = [c for c in self.prior.unknown if c >= 4]
-        blocks = [
-            [int(self._blocks[j, c]) for c in self._per_source] for j in range(self.n_sources)
-        ]
-        scales = [[scale[c] for c in self._per_source]] * self.n_sources
-        if shared:
-            blocks.append([int(c) for c in shared])
-            scales.append([scale[int(c)] for c in shared])
-        blocks_scales = [(b, s) for b, s in zip(blocks, scales, strict=True) if b]
-        which = self.rng.integers(len(blocks_scales), size=self.n)
-        for k, (cols, sc) in enumerate(blocks_scales):
-            rows = np.flatnonzero(which == k)
-            if len(rows):
-                walk_step(self, proposal, rows, np.array(cols), np.array(sc))
+    def _unknown_scales(self) -> np.ndarray:
+        scales = {int(i): s for i, s in zip(self.prior.unknown, self.prior.scales, strict=True)}
+        per = [scales[c] for c in self._per_source]
+        return np.concatenate([self.prior.scales, np.tile(per, self.n_sources - 1)])
 
     # --- moves --------------------------------------------------------------------------------
 

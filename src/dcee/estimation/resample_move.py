@@ -34,29 +34,6 @@ from dcee.estimation.resampling import (
 )
 
 
-def walk_step(
-    f: ResampleMove, proposal: np.ndarray, rows: np.ndarray, cols: np.ndarray, scales: np.ndarray
-) -> None:
-    """proposal[rows, cols] += a Gaussian step whose covariance is the particles' covariance of
-    ``cols`` times the regularised particle filter's bandwidth h² (Musso et al., as in the
-    authors' code), with a floor (1e-3 · ``scales``)² that keeps the kernel alive if the
-    particles collapse."""
-    d = len(cols)
-    cov = np.atleast_2d(np.cov(f.theta[:, cols], rowvar=False))
-    h = (4.0 / (f.n * (d + 2))) ** (1.0 / (d + 4))
-    floor = (1e-3 * scales) ** 2
-    cov = h * h * cov + np.diag(floor)
-    try:
-        chol = np.linalg.cholesky(cov)
-    except np.linalg.LinAlgError:
-        chol = np.diag(np.sqrt(np.maximum(np.diag(cov), floor)))
-    step = f.rng.standard_normal((len(rows), d)) @ chol.T
-    if len(rows) == f.n:
-        proposal[:, cols] += step
-    else:
-        proposal[np.ix_(rows, cols)] += step
-
-
 class ResampleMove:
     """Resampling, MCMC rejuvenation and tempering for the particle filter (a mixin: it reads
     and writes the filter's particles ``theta`` (N, 8), log weights, cached history
@@ -93,8 +70,20 @@ class ResampleMove:
         ``global_share`` proposes its location from the prior, the rest a random walk.
         Returns the (N,) accepted mask."""
         self._align()
+        d = len(self._unknown)
+        x = self.theta[:, self._unknown]
+        cov = np.atleast_2d(np.cov(x, rowvar=False))
+        # Gaussian kernel bandwidth of the regularised particle filter (Musso et al.),
+        # as in the authors' code; a floor keeps the kernel alive if the particles collapse.
+        h = (4.0 / (self.n * (d + 2))) ** (1.0 / (d + 4))
+        floor = (1e-3 * self._unknown_scales()) ** 2
+        cov = h * h * cov + np.diag(floor)
+        try:
+            chol = np.linalg.cholesky(cov)
+        except np.linalg.LinAlgError:
+            chol = np.diag(np.sqrt(np.maximum(np.diag(cov), floor)))
         proposal = self.theta.copy()
-        self._random_walk(proposal)
+        proposal[:, self._unknown] += self.rng.standard_normal((self.n, d)) @ chol.T
         # Independence proposals of the location block from its prior: for these particles the
         # proposal density (the block's prior) cancels the block's prior in the target.
         jump = self.rng.random(self.n) < self.global_share if self._loc_block else None
@@ -133,11 +122,9 @@ class ResampleMove:
     def _align(self) -> None:
         """Before a sweep: nothing for one release (a K-source filter relabels its releases)."""
 
-    def _random_walk(self, proposal: np.ndarray) -> None:
-        """Add the regularised random walk to every particle's unknown columns of
-        ``proposal`` (a copy of the particles)."""
-        rows = np.arange(self.n)
-        walk_step(self, proposal, rows, self._unknown, self.prior.scales)
+    def _unknown_scales(self) -> np.ndarray:
+        """(D,) the prior spread of each unknown column (the random walk's floor)."""
+        return self.prior.scales
 
     def _propose_jump(
         self, proposal: np.ndarray, jump: np.ndarray, log_q_ratio: np.ndarray

@@ -200,6 +200,12 @@ class SourceCountBank:
     def weights(self) -> np.ndarray:
         return self._target_member()[0].weights
 
+    def estimate_particles(self) -> tuple[np.ndarray, np.ndarray]:
+        """((N, 8 + 4 (K̂ − 1)) particles, (N,) weights) of the most probable count's filter
+        (the one-release filter's when it is 0): the answer's particles, every release."""
+        f = self.member(max(self.estimated_count, 1))
+        return f.theta, f.weights
+
     def joint_particles(self) -> tuple[np.ndarray, np.ndarray]:
         """((N, 8 + 4 (K − 1)) particles, (N,) weights) of the target's filter: every release,
         for what needs the gas of all of them (:mod:`dcee.exploration`)."""

@@ -161,7 +161,10 @@ def search_result(searcher: Searcher, readings: int, finish_reason: str) -> dict
     or the budget spent with a reading; False when cancelled or failed), ``reason``, the
     estimate's ``mean`` (3,) m and location ``covariance`` (3 × 3) m², ``spread`` m,
     ``readings``, and the believed wind: ``wind_from`` (a compass bearing, °, where it comes
-    from, clockwise from north) and ``wind_speed`` m/s."""
+    from, clockwise from north) and ``wind_speed`` m/s; with the count of releases unknown
+    also ``estimated_count``, ``count_probabilities`` (P(K), K = 0 …), ``count_switches`` and
+    ``estimated_sources`` (each release's mean, m), the mean above being the release the
+    search goes after."""
     est = searcher.estimate()
     belief, weights = searcher.filter.theta, searcher.filter.weights
     phi, u = (belief[:, PARAMETER_NAMES.index(k)] for k in ("phi", "u"))
@@ -174,6 +177,8 @@ def search_result(searcher: Searcher, readings: int, finish_reason: str) -> dict
         "readings": readings,
         "wind_from": estimated_bearing(phi, weights),
         "wind_speed": float(weights @ u),
+        # the count unknown (estimator.max_sources > 1): how many releases, P(K), where each is
+        **(counted() if (counted := getattr(searcher.filter, "count_summary", None)) else {}),
     }
 
 

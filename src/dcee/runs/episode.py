@@ -76,7 +76,10 @@ def run_episode(
     }
     summary["code"] = config["code"]
     summary["version"] = config["code"]["version"]
-    return EpisodeResult(records, summary, pf.theta.copy(), pf.weights.copy(), snapshots, config)
+    # a count bank's most probable count, every release (figures colour each); else the filter's
+    final = getattr(pf, "estimate_particles", None)
+    theta, weights = final() if final is not None else (pf.theta, pf.weights)
+    return EpisodeResult(records, summary, theta.copy(), weights.copy(), snapshots, config)
 
 
 def _subsample(pf: Estimator, n: int, rng: np.random.Generator) -> np.ndarray:
