@@ -335,3 +335,36 @@ def test_random_multi_release_configurations(n):
             assert np.linalg.norm(locs[a] - locs[b]) >= 5.0
         assert load_scenario(f"random{n}:{k}").truth == s.truth
     assert load_scenario("random2:1").truth.x != load_scenario("random:1").truth.x
+
+
+def test_report_counts_right_counts_and_ospa():
+    """A campaign with the count unknown: the report adds the right-count rate (Wilson
+    interval) and the median OSPA; other campaigns' reports are unchanged."""
+    import pandas as pd
+
+    from dcee.analysis.report import markdown_table
+    from dcee.analysis.statistics import metrics_table
+
+    n = 10
+    runs = pd.DataFrame(
+        {
+            "strategy": ["dcee-cl"] * n,
+            "budget": [900.0] * n,
+            "source_acquired": [True] * n,
+            "plume_acquired": [True] * n,
+            "truth_in_95": [True] * n,
+            "final_rmse": np.linspace(0.1, 1.0, n),
+            "time_to_rmse_1m": [100.0] * n,
+            "time_to_rmse_0_5m": [200.0] * n,
+            "longest_stall": [0.0] * n,
+            "path_length": [900.0] * n,
+            "decision_seconds_mean": [0.02] * n,
+        }
+    )
+    plain = markdown_table(metrics_table(runs))
+    assert "right count" not in plain
+    runs["count_correct"] = [True] * 8 + [False] * 2
+    runs["final_ospa"] = np.arange(n, dtype=float) / 10
+    text = markdown_table(metrics_table(runs))
+    assert text.startswith(plain.rstrip("\n"))
+    assert "| dcee-cl | 10 | 80 [49, 94]% | 0.45 [" in text

@@ -123,6 +123,17 @@ def markdown_table(table: pd.DataFrame) -> str:
             f"| {_fmt(r.truth_in_95_rate, r.truth_in_95_lo, r.truth_in_95_hi, pct=True)} "
             f"| {_fmt_stall(r.longest_stall, r.stalled)} |"
         )
+    if "count_correct_rate" in table and table["count_correct_rate"].notna().any():
+        # the count of releases was unknown: its own table, the set's error beside it
+        lines += [
+            "",
+            "| strategy | n | right count of releases | median OSPA (m, 3 m cut-off) |",
+            "|---|---|---|---|",
+        ]
+        for _, r in table.iterrows():
+            right = _fmt(r.count_correct_rate, r.count_correct_lo, r.count_correct_hi, pct=True)
+            ospa = _fmt(r.median_ospa, r.median_ospa_lo, r.median_ospa_hi)
+            lines.append(f"| {r.strategy} | {r.searches} | {right} | {ospa} |")
     return "\n".join(lines) + "\n"
 
 

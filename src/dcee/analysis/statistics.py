@@ -140,6 +140,13 @@ def metrics_table(runs: pd.DataFrame) -> pd.DataFrame:
         stall = pd.to_numeric(g.get("longest_stall", pd.Series(np.nan, g.index)), errors="coerce")
         row["longest_stall"] = float(stall.max()) if stall.notna().all() else math.nan
         row["stalled"] = int((stall > STALL_SECONDS).sum()) if stall.notna().all() else -1
+        # the count of releases unknown (issue 45): how often it came out right, and the OSPA
+        # distance between the estimated and the true set; NaN for other campaigns
+        if "count_correct" in g and g["count_correct"].notna().all():
+            r, lo, hi = wilson(int(g["count_correct"].astype(bool).sum()), n)
+            v, olo, ohi = median_ci(g["final_ospa"].to_numpy(dtype=float))
+            row.update({"count_correct_rate": r, "count_correct_lo": lo, "count_correct_hi": hi})
+            row.update({"median_ospa": v, "median_ospa_lo": olo, "median_ospa_hi": ohi})
         for key, col in (("path_length", "path_length"), ("decision_ms", "decision_seconds_mean")):
             scale = 1e3 if key == "decision_ms" else 1.0
             v, lo, hi = mean_ci(g[col].to_numpy() * scale)

@@ -79,6 +79,12 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
     ("estimator", "calm_prior"): Provenance(
         ("isotropic", "filament"), "which model the evidence selects, docs/scenarios.md"
     ),
+    ("estimator", "max_sources"): Provenance(
+        (), "1: the paper's one release; the unknown-count estimator is opt-in (issue 45)"
+    ),
+    ("estimator", "count_prior"): Provenance(
+        (), "unset: every count 0 … max_sources equally likely (no count is preferred)"
+    ),
     ("search", "stall_guard"): Provenance(("isotropic",), "held-out tuning, docs/held-out.md"),
     ("search", "guard_share"): Provenance(("filament", "puffs"), "random:13-40, dcee-cl"),
     ("search", "stop_hold"): Provenance(("isotropic",), "random-tune, 40 configurations"),
