@@ -140,23 +140,35 @@ def exploration_goal(
     return good[int(np.argmin(d))]
 
 
-class ApproachingAgent:
-    """An agent's move set without the moves that fail to bring it closer (horizontally) to
-    ``goal`` (3,) m by at least half a step; every other attribute is the wrapped agent's.
-    Where no move does, every move (the planner decides)."""
+class RestrictedAgent:
+    """An agent whose next move from ``start`` (3,) m is restricted to those :meth:`allowed`
+    keeps (every move where it keeps none); later moves of a look-ahead are not restricted.
+    Every other attribute is the wrapped agent's. What the searcher's guards hand a planner."""
 
-    def __init__(self, agent: GridAgent, goal: np.ndarray, start: np.ndarray) -> None:
+    def __init__(self, agent: GridAgent, target: np.ndarray, start: np.ndarray) -> None:
         self.agent = agent
-        self.goal = np.asarray(goal, dtype=np.float64)
+        self.target = np.asarray(target, dtype=np.float64)
         self.start = np.asarray(start, dtype=np.float64)
+
+    def allowed(self, cands: np.ndarray) -> np.ndarray:
+        """(M,) bool: which of the candidate next positions (M, 3) m are offered."""
+        raise NotImplementedError
 
     def candidates(self, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         cands, headings = self.agent.candidates(position)
         if not np.allclose(position, self.start):  # later moves of a look-ahead: unrestricted
             return cands, headings
-        now = math.hypot(*(self.start[:2] - self.goal[:2]))
-        closer = np.hypot(*(cands[:, :2] - self.goal[:2]).T) < now - 0.5 * self.agent.step
-        return (cands[closer], headings[closer]) if closer.any() else (cands, headings)
+        keep = self.allowed(cands)
+        return (cands[keep], headings[keep]) if keep.any() else (cands, headings)
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self.agent, name)
+
+
+class ApproachingAgent(RestrictedAgent):
+    """The moves that bring the agent closer (horizontally) to ``target`` (3,) m by at least
+    half a step: what the exploration guard hands a planner."""
+
+    def allowed(self, cands: np.ndarray) -> np.ndarray:
+        now = math.hypot(*(self.start[:2] - self.target[:2]))
+        return np.hypot(*(cands[:, :2] - self.target[:2]).T) < now - 0.5 * self.agent.step

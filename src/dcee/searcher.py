@@ -14,7 +14,7 @@ import numpy as np
 from dcee.blas import one_blas_thread
 from dcee.errors import DceeInputError
 from dcee.estimation.base import Estimator, UpdateInfo
-from dcee.exploration import ApproachingAgent, exploration_goal
+from dcee.exploration import ApproachingAgent, RestrictedAgent, exploration_goal
 from dcee.io import write_atomic
 from dcee.models.agent import GridAgent, stall_start
 from dcee.planning.base import Belief, Decision, Planner
@@ -50,30 +50,19 @@ STALL_HISTORY = 64
 """Told positions the stall guard looks back over (more than 30 s of readings at 1 s)."""
 
 
-class LeavingAgent:
-    """An agent's move set without the moves that fail to take the agent further from
-    ``anchor`` (3,) m than it is: what the stall guard hands a planner. Every other attribute
-    is the wrapped agent's. Where no move leaves the anchor (a corner), the moves that leave
-    the agent's own horizontal position: a climbing agent could otherwise hold its stall by
-    climbing and descending on one spot (random:1049, filament, held out: 75 s in a corner)."""
+class LeavingAgent(RestrictedAgent):
+    """The moves that take the agent further from ``target`` (3,) m, the stall's anchor, than
+    it is: what the stall guard hands a planner. Where no move leaves the anchor (a corner),
+    the moves that leave the agent's own horizontal position: a climbing agent could otherwise
+    hold its stall by climbing and descending on one spot (random:1049, filament, held out:
+    75 s in a corner)."""
 
-    def __init__(self, agent: GridAgent, anchor: np.ndarray, start: np.ndarray) -> None:
-        self.agent = agent
-        self.anchor = np.asarray(anchor, dtype=np.float64)
-        self.start = np.asarray(start, dtype=np.float64)
-
-    def candidates(self, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        cands, headings = self.agent.candidates(position)
-        if not np.allclose(position, self.start):  # later moves of a look-ahead: unrestricted
-            return cands, headings
-        now = math.hypot(*(self.start[:2] - self.anchor[:2]))
-        away = np.hypot(*(cands[:, :2] - self.anchor[:2]).T) > now + 0.5 * self.agent.step
+    def allowed(self, cands: np.ndarray) -> np.ndarray:
+        now = math.hypot(*(self.start[:2] - self.target[:2]))
+        away = np.hypot(*(cands[:, :2] - self.target[:2]).T) > now + 0.5 * self.agent.step
         if not away.any():  # cornered: at least leave this spot (no climb or descent in place)
             away = np.hypot(*(cands[:, :2] - self.start[:2]).T) > 0.5 * self.agent.step
-        return (cands[away], headings[away]) if away.any() else (cands, headings)
-
-    def __getattr__(self, name: str) -> Any:
-        return getattr(self.agent, name)
+        return away
 
 
 CHECKPOINT_FORMAT = "dcee-searcher-checkpoint-1"

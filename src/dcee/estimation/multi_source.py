@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -147,30 +148,9 @@ class MultiSourceFilter(ParticleFilter):
             log_q_ratio[rows] += dists[c].log_pdf(self.theta[rows, cols]) - dists[c].log_pdf(draw)
             proposal[rows, cols] = draw
 
-    def _history_ll(
-        self,
-        theta: np.ndarray,
-        active: np.ndarray,
-        positions: np.ndarray,
-        readings: np.ndarray,
-        multiplicity: np.ndarray,
-        out: np.ndarray,
-        threshold: np.ndarray | None = None,
-        bounds: np.ndarray | None = None,
-    ) -> None:
-        multi_history_log_likelihood(
-            theta,
-            active,
-            positions,
-            readings,
-            multiplicity,
-            self.plume.min_distance,
-            *self.plume.shape,
-            self._sp,
-            out,
-            threshold,
-            bounds,
-        )
+    def _likelihood_kernel(self) -> Callable[..., None]:
+        """The K-release history likelihood (:mod:`dcee.estimation.multi_source_kernels`)."""
+        return multi_history_log_likelihood
 
     def _align(self) -> None:
         """Permute every particle's releases to the labelling closest to a reference set (see

@@ -22,6 +22,7 @@ such event is recorded in :attr:`ParticleFilter.recoveries`.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -139,6 +140,10 @@ class ResampleMove:
                 proposal[jump, col]
             )
 
+    def _likelihood_kernel(self) -> Callable[..., None]:
+        """The compiled history likelihood of this filter's particle layout (one release)."""
+        return history_log_likelihood
+
     def _history_ll(
         self,
         theta: np.ndarray,
@@ -151,8 +156,9 @@ class ResampleMove:
         bounds: np.ndarray | None = None,
     ) -> None:
         """out (N,) = the history log-likelihood of particles ``theta`` (see
-        :func:`~dcee.estimation.filter_kernels.history_log_likelihood`)."""
-        history_log_likelihood(
+        :func:`~dcee.estimation.filter_kernels.history_log_likelihood`; the kernel is
+        :meth:`_likelihood_kernel`'s)."""
+        self._likelihood_kernel()(
             theta,
             active,
             positions,
