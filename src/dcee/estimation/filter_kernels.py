@@ -234,6 +234,18 @@ def reading_upper_bounds(readings: np.ndarray, sensor: Sensor) -> np.ndarray:
     return np.where(det, density, sp.log_not_false_alarm + sp.log_keep)
 
 
+def rejection_bounds(
+    n: int, multiplicity: np.ndarray, threshold: np.ndarray | None, bounds: np.ndarray | None
+) -> tuple[np.ndarray, np.ndarray]:
+    """The early-rejection inputs of the history kernels: ((N,) thresholds, (K + 1,)
+    remaining[k] = Σ_{k' ≥ k} m_k' · bound_k'); without a threshold or bounds none is
+    rejected (−inf thresholds, zero bounds)."""
+    if threshold is None or bounds is None:
+        return np.full(n, -np.inf), np.zeros(len(multiplicity) + 1)
+    weighted = np.asarray(bounds, dtype=np.float64) * multiplicity
+    return threshold, np.append(np.cumsum(weighted[::-1])[::-1], 0.0)
+
+
 def history_log_likelihood(
     theta: np.ndarray,
     active: np.ndarray,
@@ -259,13 +271,7 @@ def history_log_likelihood(
     """
     n = theta.shape[0]
     multiplicity = np.ascontiguousarray(multiplicity, dtype=np.float64)
-    if threshold is None or bounds is None:
-        threshold = np.full(n, -np.inf)
-        remaining = np.zeros(len(readings) + 1)
-    else:
-        # remaining[k] = Σ_{k' ≥ k} m_k' · bound_k'
-        weighted = np.asarray(bounds, dtype=np.float64) * multiplicity
-        remaining = np.append(np.cumsum(weighted[::-1])[::-1], 0.0)
+    threshold, remaining = rejection_bounds(n, multiplicity, threshold, bounds)
     _history_kernel(
         np.ascontiguousarray(theta, dtype=np.float64),
         np.ascontiguousarray(active, dtype=np.bool_),

@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from dcee.estimation.filter_kernels import rejection_bounds
 from dcee.models.plume import IsotropicPlume, isotropic_concentration_reference
 from dcee.models.plume_kernels import constants_at, plume_at, plume_terms
 from dcee.models.sensor import Sensor
@@ -138,12 +139,7 @@ def multi_history_log_likelihood(
     :func:`dcee.estimation.filter_kernels.history_log_likelihood` takes them."""
     n = theta.shape[0]
     multiplicity = np.ascontiguousarray(multiplicity, dtype=np.float64)
-    if threshold is None or bounds is None:
-        threshold = np.full(n, -np.inf)
-        remaining = np.zeros(len(readings) + 1)
-    else:
-        weighted = np.asarray(bounds, dtype=np.float64) * multiplicity
-        remaining = np.append(np.cumsum(weighted[::-1])[::-1], 0.0)
+    threshold, remaining = rejection_bounds(n, multiplicity, threshold, bounds)
     _multi_history_kernel(
         np.ascontiguousarray(source_rows(np.asarray(theta, dtype=np.float64))),
         np.ascontiguousarray(active, dtype=np.bool_),
