@@ -368,3 +368,36 @@ def test_report_counts_right_counts_and_ospa():
     text = markdown_table(metrics_table(runs))
     assert text.startswith(plain.rstrip("\n"))
     assert "| dcee-cl | 10 | 80 [49, 94]% | 0.45 [" in text
+
+
+def test_target_localises_the_likeliest_count_first_then_the_plausible_rest():
+    """The target: the most probable count's least-localised release while any of its
+    releases is wider than ``localised``; once all are localised, the widest release of every
+    count at least ``plausible``; the planners' rows are that release's."""
+    truth = np.tile(PAPER1.truth_theta(), (2, 1))
+    truth[:, :4] = [[37.5, 12.5, 1.0, 5.0], [15.0, 35.0, 1.0, 5.0]]
+    path = _lawnmower()[:200]
+    bank = _bank(3, 1500)
+    for p, z in zip(path, _simulate(truth, path, 7), strict=True):
+        bank.update(p, float(z))
+    probs = bank.count_probabilities
+    k_hat = max(bank.estimated_count, 1)
+
+    def widest(k: int) -> tuple[int, float]:
+        traces = np.trace(bank.release_summary(k)[1], axis1=1, axis2=2)
+        return int(np.argmax(traces)), float(traces.max())
+
+    bank.localised = 0.0  # nothing counts as localised: the likeliest count first
+    bank._target = None
+    assert bank.target() == (k_hat, widest(k_hat)[0])
+    bank.localised = 1e6  # everything localised: the widest plausible release
+    bank._target = None
+    plausible = [k for k in range(1, 4) if probs[k] >= bank.plausible]
+    k_best = max(plausible, key=lambda k: widest(k)[1])
+    assert bank.target() == (k_best, widest(k_best)[0])
+    k, j = bank.target()
+    f = bank.member(k)
+    rows = f.release_rows(j) if k > 1 else f.theta
+    np.testing.assert_array_equal(bank.theta, rows)
+    np.testing.assert_array_equal(bank.weights, f.weights)
+    assert bank.source_mean() == pytest.approx(f.weights @ rows[:, :3])

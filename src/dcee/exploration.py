@@ -11,10 +11,10 @@ or not, would tell about the hypotheses: the mutual information between the outc
 hypothesis under the joint belief (every release's gas; :func:`detection_information`) — the
 part of a reading's information that does not depend on its size, zero wherever every
 hypothesis predicts the same. It compares the best candidate move with a coarse grid over the
-area at the robot's altitude. When the best move's entropy is below
-``share`` of the grid's best, the robot is offered only the moves that bring it closer to the
-nearest grid point whose entropy is at least ``share`` of the best (:class:`ApproachingAgent`);
-the planner chooses among them as usual.
+area at the robot's altitude. When the best move's information is below ``share`` of the
+grid's best, the robot is offered only the moves that bring it closer to the nearest grid point
+with at least ``share`` of the best (:class:`ApproachingAgent`); the planner chooses among them
+as usual.
 """
 
 from __future__ import annotations
@@ -29,6 +29,7 @@ from dcee.estimation.base import Estimator
 from dcee.estimation.multi_source_kernels import source_rows
 from dcee.models.agent import GridAgent, travel_xy
 from dcee.models.plume import IsotropicPlume
+from dcee.models.plume_kernels import concentration_distance_grid
 from dcee.models.sensor import Sensor
 from dcee.models.sensor_kernels import SensorParams, log_likelihood
 
@@ -59,14 +60,20 @@ def detection_information(
     outliers alike in every hypothesis). Zero where every hypothesis predicts the same, however
     noisy the sensor (a bare outcome entropy is not: with Pd = 0.7 a plume's core is a coin)."""
     theta, weights = _thinned(theta, weights)
-    rows = source_rows(theta)
-    conc = sum(plume.concentration(r, points) for r in rows)  # (n, M)
-    near = np.min([np.linalg.norm(points[None, :, :] - r[:, None, :3], axis=2) for r in rows], 0)
+    points = np.ascontiguousarray(points, dtype=np.float64)
+    conc = np.zeros((len(points), len(theta)))  # (M, n): summed over the releases
+    near = np.full_like(conc, np.inf)  # the nearest release's clamped distance
+    c, r = np.empty_like(conc), np.empty_like(conc)
+    for rows in source_rows(theta):
+        grid = np.ascontiguousarray(rows)
+        concentration_distance_grid(grid, points, plume.min_distance, *plume.shape, c, r)
+        conc += c
+        np.minimum(near, r, out=near)
     miss = np.empty_like(conc)
-    _relative_miss(conc, np.maximum(near, plume.min_distance), sensor.params, miss)
+    _relative_miss(conc, near, sensor.params, miss)
     p_each = np.clip(1.0 - miss, 1e-12, 1.0 - 1e-12)
-    p_mean = np.clip(weights @ p_each, 1e-12, 1.0 - 1e-12)
-    return _entropy(p_mean) - weights @ _entropy(p_each)
+    p_mean = np.clip(p_each @ weights, 1e-12, 1.0 - 1e-12)
+    return _entropy(p_mean) - _entropy(p_each) @ weights
 
 
 @njit(cache=True)

@@ -113,8 +113,9 @@ class SourceCountBank:
         self.localised = float(localised)
         self.switches = 0
         self._count = int(np.argmax(self.log_prior))
-        self._target: tuple[int, int] | None = None
-        self._target_rows: tuple[tuple[int, int, int, int], np.ndarray] | None = None
+        # the target and its rows, kept while the belief is unchanged (:meth:`_state`)
+        self._target: tuple[tuple[int, ...], tuple[int, int]] | None = None
+        self._target_rows: tuple[tuple[int, ...], np.ndarray] | None = None
 
     @property
     def max_sources(self) -> int:
@@ -159,12 +160,25 @@ class SourceCountBank:
 
     # --- the target: the least-localised plausible release ------------------------------------
 
+    def _state(self) -> tuple[int, ...]:
+        """What changes the belief: a reading (every member counts it), a wind reading or a
+        resampling (the members' particles move only then)."""
+        first = self.members[0]
+        return (first.n_readings, first.wind.n, *(m.n_resamples for m in self.members))
+
     def target(self) -> tuple[int, int]:
         """(K, j): the release the planners go after. First the most probable count's
         least-localised release, while its spread √tr P exceeds ``localised`` m; then the
         release with the largest spread among the counts K ≥ 1 with P(K) ≥ ``plausible``
         (a further release the readings have not ruled out). Count 0 most probable: the
-        one-release filter's."""
+        one-release filter's. Computed once per belief state (the planners, the stop rule and
+        the records each ask)."""
+        state = self._state()
+        if self._target is None or self._target[0] != state:
+            self._target = (state, self._choose_target())
+        return self._target[1]
+
+    def _choose_target(self) -> tuple[int, int]:
         probs = self.count_probabilities
         best_count = max(int(np.argmax(probs)), 1)
         traces = np.trace(self.release_summary(best_count)[1], axis1=1, axis2=2)
@@ -189,7 +203,7 @@ class SourceCountBank:
     def theta(self) -> np.ndarray:
         """(N, 8) the target release of every particle of its filter (what planners read)."""
         f, j = self._target_member()
-        key = (id(f), j, f.n_resamples, id(f.theta))
+        key = (*self.target(), f.n_resamples)  # the rows move only when the filter resamples
         if self._target_rows is not None and self._target_rows[0] == key:
             return self._target_rows[1]
         rows = f.release_rows(j) if isinstance(f, MultiSourceFilter) else f.theta

@@ -12,9 +12,7 @@ from pydantic import BaseModel, Field, field_validator, model_validator
 
 from dcee.models.sensor import OUTLIER_DEFAULT
 from dcee.scenarios.schema.common import FROZEN, Finite, Positive
-
-MAX_ESTIMATED_SOURCES = 4
-"""The most releases ``estimator.max_sources`` may allow (the truth's limit too)."""
+from dcee.scenarios.schema.truth import MAX_SOURCES
 
 PHYSICAL_TRUNCATION = {"u": 0.0, "zeta1": 0.0, "zeta2": 0.0}
 
@@ -385,7 +383,7 @@ class EstimatorSpec(BaseModel):
     weighs its values equally. None: with ``estimator.learn`` unset the likelihood's default,
     :data:`LEARN_PRIOR_DEFAULT` (the fluctuation likelihood: ``{source_radius = [0.9, 0.1]}``),
     with a grid given every value equally likely. Members' priors are the products"""
-    max_sources: Annotated[int, Field(ge=1, le=MAX_ESTIMATED_SOURCES)] = 1
+    max_sources: Annotated[int, Field(ge=1, le=MAX_SOURCES)] = 1
     """the most releases the estimator considers. 1: one release (the paper's filter). K > 1:
     the number of releases is unknown, 0 … K, estimated with the releases: one filter per count
     on the same readings, selected by their evidence (:mod:`dcee.estimation.source_count`); the
