@@ -373,7 +373,9 @@ def test_report_counts_right_counts_and_ospa():
 def test_target_localises_the_likeliest_count_first_then_the_plausible_rest():
     """The target: the most probable count's least-localised release while any of its
     releases is wider than ``localised``; once all are localised, the widest release of every
-    count at least ``plausible``; the planners' rows are that release's."""
+    count at least ``plausible`` and of the count one above the most probable (the settled
+    target, which the stop rule reads, without that count); the planners' rows are the
+    target's, the estimate the settled target's."""
     truth = np.tile(PAPER1.truth_theta(), (2, 1))
     truth[:, :4] = [[37.5, 12.5, 1.0, 5.0], [15.0, 35.0, 1.0, 5.0]]
     path = _lawnmower()[:200]
@@ -392,12 +394,20 @@ def test_target_localises_the_likeliest_count_first_then_the_plausible_rest():
     assert bank.target() == (k_hat, widest(k_hat)[0])
     bank.localised = 1e6  # everything localised: the widest plausible release
     bank._target = None
+    bank.plausible = 0.999 * probs.max()  # only the likeliest count is plausible
     plausible = [k for k in range(1, 4) if probs[k] >= bank.plausible]
-    k_best = max(plausible, key=lambda k: widest(k)[1])
+    further = sorted({*plausible, k_hat + 1} & {1, 2, 3})
+    assert len(further) > len(plausible)  # the count above is improbable here: a real test
+    k_settled = max(plausible, key=lambda k: widest(k)[1])
+    assert bank.settled_target() == (k_settled, widest(k_settled)[0])
+    k_best = max(further, key=lambda k: widest(k)[1])
     assert bank.target() == (k_best, widest(k_best)[0])
     k, j = bank.target()
     f = bank.member(k)
     rows = f.release_rows(j) if k > 1 else f.theta
     np.testing.assert_array_equal(bank.theta, rows)
     np.testing.assert_array_equal(bank.weights, f.weights)
+    k, j = bank.settled_target()
+    f = bank.member(k)
+    rows = f.release_rows(j) if k > 1 else f.theta
     assert bank.source_mean() == pytest.approx(f.weights @ rows[:, :3])

@@ -14,13 +14,17 @@ posterior over the count and each count's posterior over the releases, without m
 dimensions. The Occam factor that keeps a surplus release from being believed is the evidence's
 own: a K + 1 model pays for the prior volume of a release the readings never saw.
 
-What the planners and the stop rule read: the *target*. First the most probable count's
-least-localised release, until each of its releases is localised (spread √tr P at most the
-stop rule's threshold); then the least-localised release among the counts K ≥ 1 still
-plausible (P(K) ≥ ``plausible``): while a further release is plausible its broad marginal is
-the target, so the robot explores where it could be until the readings rule it out or find it.
-The stop rule reads the target's spread, so it holds only once every plausible count's
-releases are localised. The planners
+What the planners read: the *target*. First the most probable count's least-localised
+release, until each of its releases is localised (spread √tr P at most the stop rule's
+threshold); then the least-localised release among the counts K ≥ 1 still plausible
+(P(K) ≥ ``plausible``) and the count one above the most probable (however improbable): the
+broad marginal of a further release is the target, so the robot looks where one could still
+be, until the readings rule it out or find it. Without that last count the robot stayed at the
+releases it had found once a further one had become improbable, although the readings had
+never reached most of the places where it could be (issue 45: in 9 of the 9 three-release
+tuning searches that answered two, the third release's gas had reached at most 6 of ~450
+readings). The stop rule reads the *settled* target, the same without the count above, so a
+search may stop once every plausible count's releases are localised. The planners
 see the target release as a one-release belief (its location and rate with the shared wind):
 their hypothesised readings leave out the other releases' gas, an approximation of planning,
 not of estimation (the filters' likelihood sums every release).
@@ -114,7 +118,7 @@ class SourceCountBank:
         self.switches = 0
         self._count = int(np.argmax(self.log_prior))
         # the target and its rows, kept while the belief is unchanged (:meth:`_state`)
-        self._target: tuple[tuple[int, ...], tuple[int, int]] | None = None
+        self._target: tuple[tuple[int, ...], tuple[int, int], tuple[int, int]] | None = None
         self._target_rows: tuple[tuple[int, ...], np.ndarray] | None = None
 
     @property
@@ -169,16 +173,25 @@ class SourceCountBank:
     def target(self) -> tuple[int, int]:
         """(K, j): the release the planners go after. First the most probable count's
         least-localised release, while its spread √tr P exceeds ``localised`` m; then the
-        release with the largest spread among the counts K ≥ 1 with P(K) ≥ ``plausible``
-        (a further release the readings have not ruled out). Count 0 most probable: the
-        one-release filter's. Computed once per belief state (the planners, the stop rule and
-        the records each ask)."""
+        release with the largest spread among the counts K ≥ 1 with P(K) ≥ ``plausible`` and
+        the count one above the most probable (a further release the readings have not ruled
+        out). Count 0 most probable: the one-release filter's. Computed once per belief state
+        (the planners, the stop rule and the records each ask)."""
+        return self._targets()[0]
+
+    def settled_target(self) -> tuple[int, int]:
+        """(K, j): :meth:`target` without the count above the most probable one unless it is
+        plausible itself: the release the stop rule and the estimate (:meth:`source_cov`)
+        read, so that a search may stop once every plausible release is localised."""
+        return self._targets()[1]
+
+    def _targets(self) -> tuple[tuple[int, int], tuple[int, int]]:
         state = self._state()
         if self._target is None or self._target[0] != state:
-            self._target = (state, self._choose_target())
-        return self._target[1]
+            self._target = (state, self._choose_target(True), self._choose_target(False))
+        return self._target[1], self._target[2]
 
-    def _choose_target(self) -> tuple[int, int]:
+    def _choose_target(self, further: bool) -> tuple[int, int]:
         probs = self.count_probabilities
         best_count = max(int(np.argmax(probs)), 1)
         traces = np.trace(self.release_summary(best_count)[1], axis1=1, axis2=2)
@@ -187,7 +200,7 @@ class SourceCountBank:
             return best_count, j
         best, best_trace = (best_count, j), -1.0
         for k in range(1, self.max_sources + 1):
-            if probs[k] < self.plausible:
+            if probs[k] < self.plausible and not (further and k == best_count + 1):
                 continue
             traces = np.trace(self.release_summary(k)[1], axis1=1, axis2=2)
             j = int(np.argmax(traces))
@@ -234,14 +247,25 @@ class SourceCountBank:
     def source_locations(self) -> np.ndarray:
         return self._target_locations()
 
+    def _settled_release(self) -> tuple[np.ndarray, np.ndarray]:
+        """((N, 3) locations, (N,) weights) of :meth:`settled_target`."""
+        k, j = self.settled_target()
+        f = self.member(k)
+        locations = (
+            f.release_locations(j) if isinstance(f, MultiSourceFilter) else f.source_locations
+        )
+        return locations, f.weights
+
     def source_mean(self) -> np.ndarray:
-        """(3,) the target release's posterior mean (the stop rule's and the guard's estimate)."""
-        return self.weights @ self._target_locations()
+        """(3,) the settled target's posterior mean (the estimate the stop rule and the
+        records read)."""
+        locations, weights = self._settled_release()
+        return weights @ locations
 
     def source_cov(self) -> np.ndarray:
-        """(3, 3) the target release's posterior covariance: its spread is the largest of
+        """(3, 3) the settled target's posterior covariance: its spread is the largest of
         every plausible release's, so the stop rule holds only when all are localised."""
-        return weighted_moments(self._target_locations(), self.weights)[1]
+        return weighted_moments(*self._settled_release())[1]
 
     # --- updates ------------------------------------------------------------------------------
 
