@@ -54,6 +54,15 @@ DEFAULT_PLAUSIBLE = 0.05
 ends only when every count at least this probable has its releases localised."""
 
 
+FOUND_SHARE = 1 / 3
+"""A release whose spread √tr P is at most this share of ``search.acquired_rmse`` (1 m at the
+default 3 m) counts as found for the planners' target: once every release of the most probable
+count is found, they look for a further one (:meth:`SourceCountBank.target`). Chosen on the
+tuning range random3:1-20 (docs/results/source-count-tune): with the stop rule's 0.45 m a
+found release whose height stayed uncertain (spread 0.5-0.9 m) held the robot for the rest of
+the search."""
+
+
 class NoSource:
     """K = 0: no release; every reading is noise (a detection a false alarm or an outlier).
     Its evidence is exact: Σ_k w_k log p(z_k | C = 0), w_k each reading's weight as the
@@ -95,6 +104,7 @@ class SourceCountBank:
         count_prior: Sequence[float] | None = None,
         plausible: float = DEFAULT_PLAUSIBLE,
         localised: float = 0.45,
+        found: float = 0.45,
     ) -> None:
         members = list(members)
         if not members or not isinstance(members[0], ParticleFilter):
@@ -115,6 +125,7 @@ class SourceCountBank:
         self.log_prior = np.log(probs / probs.sum())
         self.plausible = float(plausible)
         self.localised = float(localised)
+        self.found = float(found)
         self.switches = 0
         self._count = int(np.argmax(self.log_prior))
         # the target and its rows, kept while the belief is unchanged (:meth:`_state`)
@@ -196,7 +207,7 @@ class SourceCountBank:
         best_count = max(int(np.argmax(probs)), 1)
         traces = np.trace(self.release_summary(best_count)[1], axis1=1, axis2=2)
         j = int(np.argmax(traces))
-        if traces[j] > self.localised**2:
+        if traces[j] > (self.found if further else self.localised) ** 2:
             return best_count, j
         best, best_trace = (best_count, j), -1.0
         for k in range(1, self.max_sources + 1):

@@ -13,7 +13,7 @@ import numpy as np
 from dcee.estimation.model_bank import ModelBank
 from dcee.estimation.multi_source import MultiSourceFilter
 from dcee.estimation.particle_filter import ParticleFilter
-from dcee.estimation.source_count import SourceCountBank
+from dcee.estimation.source_count import FOUND_SHARE, SourceCountBank
 from dcee.planning.base import Planner, planner_class
 from dcee.scenarios import Scenario
 from dcee.scenarios.schema.truth import MIN_SOURCE_SEPARATION
@@ -85,6 +85,7 @@ def make_searcher(
             [filters[0], *more],
             scenario.estimator.count_prior,
             localised=DEFAULT_STOP_SHARE * search.acquired_rmse,
+            found=FOUND_SHARE * search.acquired_rmse,
         )
     else:
         estimator = filters[0]
