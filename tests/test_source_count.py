@@ -389,10 +389,10 @@ def test_target_localises_the_likeliest_count_first_then_the_plausible_rest():
         traces = np.trace(bank.release_summary(k)[1], axis1=1, axis2=2)
         return int(np.argmax(traces)), float(traces.max())
 
-    bank.localised = 0.0  # nothing counts as localised: the likeliest count first
+    bank.localised = bank.found = 0.0  # nothing counts as found: the likeliest count first
     bank._target = None
     assert bank.target() == (k_hat, widest(k_hat)[0])
-    bank.localised = 1e6  # everything localised: the widest plausible release
+    bank.localised = bank.found = 1e6  # everything found: the widest plausible release
     bank._target = None
     bank.plausible = 0.999 * probs.max()  # only the likeliest count is plausible
     plausible = [k for k in range(1, 4) if probs[k] >= bank.plausible]
