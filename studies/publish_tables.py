@@ -1306,7 +1306,7 @@ def search_speed_table() -> str:
 
 def _source_count(kind: str) -> str:
     """Issue 45's unknown-count study: studies/source_count_table.py's tables of the stored
-    searches (``kind`` "table" or "worst")."""
+    searches (``kind`` "table", "paired" or "worst")."""
     import importlib.util
 
     spec = importlib.util.spec_from_file_location(
@@ -1346,6 +1346,7 @@ def source_count_timing_table() -> str:
 TABLES: dict[str, Callable[[], str]] = {
     "source-count": lambda: _source_count("table"),
     "source-count-worst": lambda: _source_count("worst"),
+    "source-count-paired": lambda: _source_count("paired"),
     "source-count-timing": source_count_timing_table,
     "learn-tuning": learn_tuning_table,
     "backflow-tuning": backflow_tuning_table,

@@ -5,7 +5,11 @@ median with its 95 % interval), each true release's distance to the nearest esti
 P(K̂) and the worst searches.
 
     python studies/source_count_table.py results/two-source-held-out-100 \\
-        results/three-source-held-out-100 [--csv docs/results/source-count/searches.csv]
+        results/three-source-held-out-100 [results/two-source-held-out-100-before …] \\
+        [--csv docs/results/source-count/searches.csv]
+
+A folder named X-before holds the same searches run with the code before a change; the paired
+table compares X with it.
 """
 
 from __future__ import annotations
@@ -17,11 +21,25 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from scipy import stats
 
 from dcee.analysis.results import find_runs
 from dcee.analysis.statistics import median_ci, wilson
 from dcee.errors import DceeInputError
+from dcee.models import IsotropicPlume
+from dcee.scenarios import Scenario
 from dcee.scenarios.schema.scenario import validate_scenario
+
+
+def release_readings(scenario: Scenario, run: Path) -> np.ndarray:
+    """(K,) how many of the search's readings each true release's mean gas reached (its
+    isotropic concentration above the sensor's threshold at the reading's position): which
+    releases the robot ever sampled. A release that never reached a reading cannot be counted
+    however good the estimator: an exploration failure, not an estimation one."""
+    steps = pd.read_parquet(run / "steps.parquet", columns=["x", "y", "z"])
+    positions = steps[["x", "y", "z"]].to_numpy()
+    conc = IsotropicPlume().concentration(scenario.truth_thetas(), positions)  # (K, steps)
+    return (conc > scenario.sensor.threshold).sum(axis=1)
 
 
 def rows_of(folder: Path) -> list[dict]:
@@ -29,7 +47,9 @@ def rows_of(folder: Path) -> list[dict]:
     for run in find_runs(folder):
         summary = json.loads((run / "summary.json").read_text())
         config = json.loads((run / "config.json").read_text())
-        truth = validate_scenario(config["scenario"]).truth.source_locations()
+        scenario = validate_scenario(config["scenario"])
+        truth = scenario.truth.source_locations()
+        reached = release_readings(scenario, run)
         est = np.array(summary.get("estimated_sources", []), dtype=float).reshape(-1, 3)
         near = (
             np.linalg.norm(truth[:, None, :] - est[None, :, :], axis=2).min(axis=1)
@@ -53,6 +73,7 @@ def rows_of(folder: Path) -> list[dict]:
                 "worst_release_error": float(near.max()),
                 "mean_release_error": float(near.mean()),
                 "explore_guard_fired": int(summary.get("explore_guard_fired", 0)),
+                "least_reached_readings": int(reached.min()),
                 "decision_ms": 1e3 * float(summary["decision_seconds_mean"]),
                 "code": summary.get("code", {}).get("commit", "")
                 if isinstance(summary.get("code"), dict)
@@ -86,16 +107,54 @@ def table(df: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
+BEFORE = "-before"
+"""A campaign named X-before is the same searches as X with the code before a change: the
+paired table compares them, the worst-search table leaves them out."""
+
+
+def paired(df: pd.DataFrame) -> str:
+    """Each campaign X against X-before on the same configurations: right count by one only
+    (exact McNemar p) and the median paired OSPA difference (Wilcoxon signed-rank p)."""
+    lines = [
+        "| campaign (after − before, same configurations) | pairs | right count: after only / "
+        "before only (McNemar p) | median OSPA difference (m) (Wilcoxon p) |",
+        "|---|---|---|---|",
+    ]
+    keyed = df.set_index(["campaign", "scenario", "strategy", "seed"])
+    for campaign in df["campaign"].unique():
+        if campaign.endswith(BEFORE) or campaign + BEFORE not in set(df["campaign"]):
+            continue
+        after, before = keyed.loc[campaign], keyed.loc[campaign + BEFORE]
+        common = after.index.intersection(before.index)
+        a = after.loc[common, "count_correct"].astype(bool).to_numpy()
+        b = before.loc[common, "count_correct"].astype(bool).to_numpy()
+        only_a, only_b = int((a & ~b).sum()), int((~a & b).sum())
+        p_count = stats.binomtest(only_a, only_a + only_b, 0.5).pvalue if only_a + only_b else 1.0
+        diff = after.loc[common, "final_ospa"].to_numpy(float) - before.loc[
+            common, "final_ospa"
+        ].to_numpy(float)
+        p_ospa = float(stats.wilcoxon(diff).pvalue) if np.any(diff != 0) else 1.0
+        lines.append(
+            f"| {campaign} | {len(common)} | {only_a} / {only_b} (p = {p_count:.2g}) | "
+            f"{np.median(diff):+.2f} (p = {p_ospa:.2g}) |"
+        )
+    return "\n".join(lines)
+
+
 def worst(df: pd.DataFrame, k: int = 5) -> str:
     lines = [
-        "| campaign | scenario | true K | K̂ | P(true K) | OSPA (m) | worst release error (m) |",
-        "|---|---|---|---|---|---|---|",
+        "| campaign | scenario | true K | K̂ | P(true K) | OSPA (m) | worst release error (m) "
+        "| readings the least-sampled release's gas reached |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for campaign, g in df.groupby("campaign", sort=False):
+        if campaign.endswith(BEFORE):
+            continue
         for _, r in g.sort_values("final_ospa", ascending=False).head(k).iterrows():
             lines.append(
                 f"| {campaign} | {r.scenario} | {r.true_count} | {r.estimated_count} | "
-                f"{r.p_true:.2f} | {r.final_ospa:.2f} | {r.worst_release_error:.2f} |"
+                f"{r.p_true:.2f} | {r.final_ospa:.2f} | {r.worst_release_error:.2f} | "
+                f"{r.least_reached_readings} |"
             )
     return "\n".join(lines)
 
@@ -118,6 +177,8 @@ def main(argv: list[str] | None = None) -> int:
         args.csv.parent.mkdir(parents=True, exist_ok=True)
         df.to_csv(args.csv, index=False)
     print(table(df))
+    print()
+    print(paired(df))
     print()
     print(worst(df))
     return 0
