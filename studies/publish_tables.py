@@ -1285,9 +1285,12 @@ def search_speed_table() -> str:
             _timed(record) + f", against `{record['before']}`",
         ]
     )
-    study_path = RESULTS / "perf" / "study-600.json"
-    if study_path.exists():  # studies/study_wall.py: the campaign itself, measured
-        run = _perf("study-600")
+    # studies/study_wall.py: the campaign itself, measured; every stored run (the machine's
+    # speed differs from day to day: the same code took 25.1 and 13.5 min), the latest last
+    for study_path in sorted(
+        (RESULTS / "perf").glob("study-600*.json"), key=lambda p: (p.stem == "study-600", p.stem)
+    ):
+        run = _perf(study_path.stem)
         means = ", ".join(f"{k} {v['mean_wall_s']:.1f} s" for k, v in run["per_planner"].items())
         rows.append(
             [
@@ -1297,6 +1300,27 @@ def search_speed_table() -> str:
                 "",
                 "",
                 f"{run['campaign_code'].get('commit', '')[:7]}, 2 workers, nothing else run",
+            ]
+        )
+    for extra in sorted((RESULTS / "perf").glob("search-speed-*.json")):
+        # the code of an earlier study run against today's, in one run: how much of a change in
+        # the study's wall time is the code's and how much the machine's day
+        rec = _perf(extra.stem)
+        sums = {
+            side: sum(row["wall_s"][side] for row in rec["summary"].values())
+            for side in ("before", "after")
+        }
+        same = all(v["same_search"] for v in rec["summary"].values())
+        rows.append(
+            [
+                f"the five searches with the code of `{rec['before']}` and of today, in one run "
+                "(`studies/search_speed.py`): the two study rows above differ by the machine's "
+                "day, not the code",
+                f"{sums['before']:.1f} → {sums['after']:.1f} s "
+                f"({sums['before'] / sums['after']:.2f}×)",
+                "",
+                "",
+                ("yes" if same else "no") + "; " + _timed(rec),
             ]
         )
     return table(["planner (`paper:1`, seed 0, 20,000 particles, 450 readings)",

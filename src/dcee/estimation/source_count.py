@@ -15,16 +15,17 @@ dimensions. The Occam factor that keeps a surplus release from being believed is
 own: a K + 1 model pays for the prior volume of a release the readings never saw.
 
 What the planners read: the *target*. First the most probable count's least-localised
-release, until each of its releases is localised (spread √tr P at most the stop rule's
-threshold); then the least-localised release among the counts K ≥ 1 still plausible
+release, until each of its releases is found (spread √tr P at most ``found``, 1 m at the
+paper's scale: :data:`FOUND_SHARE`); then the least-localised release among the counts K ≥ 1 still plausible
 (P(K) ≥ ``plausible``) and the count one above the most probable (however improbable): the
 broad marginal of a further release is the target, so the robot looks where one could still
 be, until the readings rule it out or find it. Without that last count the robot stayed at the
 releases it had found once a further one had become improbable, although the readings had
-never reached most of the places where it could be (issue 45: in 9 of the 9 three-release
-tuning searches that answered two, the third release's gas had reached at most 6 of ~450
-readings). The stop rule reads the *settled* target, the same without the count above, so a
-search may stop once every plausible count's releases are localised. The planners
+never reached most of the places where it could be (issue 45: in each of the nine
+three-release tuning searches that answered two, the third release's gas had reached at most 6
+of ~450 readings). The stop rule reads the *settled* target, the same without the count above
+and with "localised" (the stop rule's threshold) for "found", so a search may stop once every
+plausible count's releases are localised. The planners
 see the target release as a one-release belief (its location and rate with the shared wind):
 their hypothesised readings leave out the other releases' gas, an approximation of planning,
 not of estimation (the filters' likelihood sums every release).
@@ -94,8 +95,11 @@ class SourceCountBank:
         :class:`MultiSourceFilter` with 2, 3, … releases), on the same prior and readings.
     count_prior: P(K) for K = 0 … K_max, positive; None: equal.
     plausible: the least P(K) whose releases the target and the stop rule consider.
-    localised: m; the most probable count's releases are the target until every one's spread
-        √tr P is at most this (the stop rule's threshold: :func:`dcee.runs.make_searcher`).
+    localised: m; the settled target (:meth:`settled_target`, what the stop rule reads) is the
+        most probable count's releases until every one's spread √tr P is at most this (the
+        stop rule's threshold: :func:`dcee.runs.make_searcher`).
+    found: m; the same for the planners' :meth:`target`, after which they also look for one
+        release more (:data:`FOUND_SHARE` of ``search.acquired_rmse`` in a search).
     """
 
     def __init__(
@@ -183,7 +187,7 @@ class SourceCountBank:
 
     def target(self) -> tuple[int, int]:
         """(K, j): the release the planners go after. First the most probable count's
-        least-localised release, while its spread √tr P exceeds ``localised`` m; then the
+        least-localised release, while its spread √tr P exceeds ``found`` m; then the
         release with the largest spread among the counts K ≥ 1 with P(K) ≥ ``plausible`` and
         the count one above the most probable (a further release the readings have not ruled
         out). Count 0 most probable: the one-release filter's. Computed once per belief state
