@@ -16,8 +16,9 @@ own: a K + 1 model pays for the prior volume of a release the readings never saw
 
 What the planners read: the *target*. First the most probable count's least-localised
 release, until each of its releases is found (spread √tr P at most ``found``, 1 m at the
-paper's scale: :data:`FOUND_SHARE`); then the least-localised release among the counts K ≥ 1 still plausible
-(P(K) ≥ ``plausible``) and the count one above the most probable (however improbable): the
+paper's scale: :data:`FOUND_SHARE`); then the least-localised release among the counts K ≥ 1
+still plausible (P(K) ≥ ``plausible``) and the count one above the most probable (however
+improbable): the
 broad marginal of a further release is the target, so the robot looks where one could still
 be, until the readings rule it out or find it. Without that last count the robot stayed at the
 releases it had found once a further one had become improbable, although the readings had
