@@ -14,22 +14,21 @@ posterior over the count and each count's posterior over the releases, without m
 dimensions. The Occam factor that keeps a surplus release from being believed is the evidence's
 own: a K + 1 model pays for the prior volume of a release the readings never saw.
 
-What the planners read: the *target*. First the most probable count's least-localised
-release, until each of its releases is found (spread √tr P at most ``found``, 1 m at the
-paper's scale: :data:`FOUND_SHARE`); then the least-localised release among the counts K ≥ 1
-still plausible (P(K) ≥ ``plausible``) and the count one above the most probable (however
-improbable): the
-broad marginal of a further release is the target, so the robot looks where one could still
-be, until the readings rule it out or find it. Without that last count the robot stayed at the
-releases it had found once a further one had become improbable, although the readings had
-never reached most of the places where it could be (issue 45: in each of the nine
-three-release tuning searches that answered two, the third release's gas had reached at most 6
-of ~450 readings). The stop rule reads the *settled* target, the same without the count above
-and with "localised" (the stop rule's threshold) for "found", so a search may stop once every
-plausible count's releases are localised. The planners
-see the target release as a one-release belief (its location and rate with the shared wind):
-their hypothesised readings leave out the other releases' gas, an approximation of planning,
-not of estimation (the filters' likelihood sums every release).
+What the planners read: the *target*. First the most probable count's least-localised release,
+until each of its releases is found (spread √tr P at most ``found``, 1 m at the paper's scale:
+:data:`FOUND_SHARE`); then the least-localised release among the counts K ≥ 1 still plausible
+(P(K) ≥ ``plausible``) and the count one above the most probable (however improbable): the
+broad marginal of a further release is the target, so the robot looks where one could still be,
+until the readings rule it out or find it. Without that last count the robot stayed at the
+releases it had found once a further one had become improbable, although the readings had never
+reached most of the places where it could be (issue 45: in each of the nine three-release
+tuning searches that answered two, the third release's gas had reached at most 6 of ~450
+readings). The stop rule reads the *settled* target, the same without the count above and with
+"localised" (the stop rule's threshold) for "found", so a search may stop once every plausible
+count's releases are localised. The planners see the target release as a one-release belief
+(its location and rate with the shared wind): their hypothesised readings leave out the other
+releases' gas, an approximation of planning, not of estimation (the filters' likelihood sums
+every release).
 
 The answer (:meth:`SourceCountBank.estimated_sources`) is the most probable count's releases, at
 their posterior means.
