@@ -108,7 +108,7 @@ class SourceCountBank:
         count_prior: Sequence[float] | None = None,
         plausible: float = DEFAULT_PLAUSIBLE,
         localised: float = 0.45,
-        found: float = 0.45,
+        found: float = 1.0,
     ) -> None:
         members = list(members)
         if not members or not isinstance(members[0], ParticleFilter):
@@ -201,27 +201,38 @@ class SourceCountBank:
         return self._targets()[1]
 
     def _targets(self) -> tuple[tuple[int, int], tuple[int, int]]:
+        """(:meth:`target`, :meth:`settled_target`), chosen once per belief state from each
+        count's widest release (its moments computed once for both)."""
         state = self._state()
         if self._target is None or self._target[0] != state:
-            self._target = (state, self._choose_target(True), self._choose_target(False))
-        return self._target[1], self._target[2]
+            probs = self.count_probabilities
+            best_count = max(int(np.argmax(probs)), 1)
+            widest: dict[int, tuple[int, float]] = {}
 
-    def _choose_target(self, further: bool) -> tuple[int, int]:
-        probs = self.count_probabilities
-        best_count = max(int(np.argmax(probs)), 1)
-        traces = np.trace(self.release_summary(best_count)[1], axis1=1, axis2=2)
-        j = int(np.argmax(traces))
-        if traces[j] > (self.found if further else self.localised) ** 2:
-            return best_count, j
-        best, best_trace = (best_count, j), -1.0
-        for k in range(1, self.max_sources + 1):
-            if probs[k] < self.plausible and not (further and k == best_count + 1):
-                continue
-            traces = np.trace(self.release_summary(k)[1], axis1=1, axis2=2)
-            j = int(np.argmax(traces))
-            if traces[j] > best_trace:
-                best, best_trace = (k, j), float(traces[j])
-        return best
+            def widest_of(k: int) -> tuple[int, float]:
+                if k not in widest:
+                    traces = np.trace(self.release_summary(k)[1], axis1=1, axis2=2)
+                    widest[k] = int(np.argmax(traces)), float(traces.max())
+                return widest[k]
+
+            def choose(threshold: float, extra: int | None) -> tuple[int, int]:
+                j, trace = widest_of(best_count)
+                if trace > threshold**2:
+                    return best_count, j
+                counts = [k for k in range(1, self.max_sources + 1) if probs[k] >= self.plausible]
+                if extra is not None and extra <= self.max_sources and extra not in counts:
+                    counts = sorted([*counts, extra])
+                if not counts:
+                    return best_count, j
+                k = max(counts, key=lambda k: widest_of(k)[1])  # the first of equals
+                return k, widest_of(k)[0]
+
+            self._target = (
+                state,
+                choose(self.found, best_count + 1),
+                choose(self.localised, None),
+            )
+        return self._target[1], self._target[2]
 
     def _target_member(self) -> tuple[ParticleFilter, int]:
         k, j = self.target()
