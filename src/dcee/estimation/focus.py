@@ -67,9 +67,8 @@ def densest_window(
     weights: (N,); visits: readings taken in each lattice cell (floor of m / ``cell``)."""
     xy = np.asarray(xy, dtype=np.float64)
     cells = np.floor(xy / cell)
-    # every window that holds a particle's cell, whatever the particles' extent
-    origin = cells.min(axis=0) - (FOCUS_CELLS - 1)
-    shape = tuple(int(v) for v in cells.max(axis=0) - origin + FOCUS_CELLS)
+    origin = cells.min(axis=0)
+    shape = tuple(int(v) for v in np.maximum(cells.max(axis=0) - origin + 1, FOCUS_CELLS))
     masses = window_sums(cells, weights, origin, shape)
     spent = np.zeros(masses.shape, dtype=bool)
     if visits:
