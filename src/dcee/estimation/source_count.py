@@ -43,7 +43,6 @@ from scipy.special import logsumexp
 
 from dcee.errors import DceeInputError
 from dcee.estimation.base import ReadingModelChoice, UpdateInfo
-from dcee.estimation.focus import FOCUS_CELL, FOCUS_CELLS, densest_window
 from dcee.estimation.multi_source import MultiSourceFilter
 from dcee.estimation.particle_filter import ParticleFilter
 from dcee.estimation.priors import SourcePrior
@@ -135,11 +134,7 @@ class SourceCountBank:
         self._count = int(np.argmax(self.log_prior))
         # the target and its rows, kept while the belief is unchanged (:meth:`_state`)
         self._target: tuple[tuple[int, ...], tuple[int, int], tuple[int, int]] | None = None
-        self._target_rows: tuple[tuple, np.ndarray] | None = None
-        # the focus window of a release still to be found: ((K, j), lower-left corner, m)
-        self._focus: tuple[tuple[int, int], tuple[float, float]] | None = None
-        self._focus_cache: tuple[tuple, np.ndarray] | None = None
-        self._visits: dict[tuple[int, int], int] = {}  # readings per focus lattice cell
+        self._target_rows: tuple[tuple[int, ...], np.ndarray] | None = None
 
     @property
     def max_sources(self) -> int:
@@ -220,49 +215,24 @@ class SourceCountBank:
                     widest[k] = int(np.argmax(traces)), float(traces.max())
                 return widest[k]
 
-            def choose(threshold: float, extra: int | None) -> tuple[int, int, bool]:
-                """(K, j, whether the likeliest count's releases were all localised)."""
+            def choose(threshold: float, extra: int | None) -> tuple[int, int]:
                 j, trace = widest_of(best_count)
                 if trace > threshold**2:
-                    return best_count, j, False
+                    return best_count, j
                 counts = [k for k in range(1, self.max_sources + 1) if probs[k] >= self.plausible]
                 if extra is not None and extra <= self.max_sources and extra not in counts:
                     counts = sorted([*counts, extra])
                 if not counts:
-                    return best_count, j, True
+                    return best_count, j
                 k = max(counts, key=lambda k: widest_of(k)[1])  # the first of equals
-                return k, widest_of(k)[0], True
+                return k, widest_of(k)[0]
 
-            k, j, beyond = choose(self.found, best_count + 1)
-            corner = None
-            if beyond and widest_of(k)[1] > self.found**2:  # a release still to be found
-                f = self.member(k)
-                locations = self._locations(f, j)
-                keep = self._focus[1] if self._focus and self._focus[0] == (k, j) else None
-                corner = densest_window(locations[:, :2], f.weights, keep, self._visits)
-            self._focus = ((k, j), corner) if corner is not None else None
-            self._target = (state, (k, j), choose(self.localised, None)[:2])
+            self._target = (
+                state,
+                choose(self.found, best_count + 1),
+                choose(self.localised, None),
+            )
         return self._target[1], self._target[2]
-
-    @staticmethod
-    def _locations(f: ParticleFilter, j: int) -> np.ndarray:
-        """(N, 3) release j's location in every particle of ``f``."""
-        return f.release_locations(j) if isinstance(f, MultiSourceFilter) else f.source_locations
-
-    def _focus_mask(self) -> np.ndarray | None:
-        """(N,) the target's particles inside the focus window (:mod:`dcee.estimation.focus`)
-        or None (the planners read every particle)."""
-        self._targets()
-        if self._focus is None:
-            return None
-        (k, j), corner = self._focus
-        f = self.member(k)
-        key = (k, j, f.n_resamples, corner)
-        if self._focus_cache is None or self._focus_cache[0] != key:
-            xy = self._locations(f, j)[:, :2]
-            inside = np.all((xy >= corner) & (xy < np.add(corner, FOCUS_CELLS * FOCUS_CELL)), 1)
-            self._focus_cache = (key, inside)
-        return self._focus_cache[1]
 
     def _target_member(self) -> tuple[ParticleFilter, int]:
         k, j = self.target()
@@ -270,24 +240,18 @@ class SourceCountBank:
 
     @property
     def theta(self) -> np.ndarray:
-        """(N', 8) the target release of every particle of its filter, or of those in its
-        focus window (what planners read)."""
+        """(N, 8) the target release of every particle of its filter (what planners read)."""
         f, j = self._target_member()
-        mask = self._focus_mask()
-        key = (*self.target(), f.n_resamples, self._focus)  # rows move only at a resampling
+        key = (*self.target(), f.n_resamples)  # the rows move only when the filter resamples
         if self._target_rows is not None and self._target_rows[0] == key:
             return self._target_rows[1]
         rows = f.release_rows(j) if isinstance(f, MultiSourceFilter) else f.theta
-        rows = rows if mask is None else rows[mask]
         self._target_rows = (key, rows)
         return rows
 
     @property
     def weights(self) -> np.ndarray:
-        """(N',) the weights of :attr:`theta`'s particles (renormalised in a focus window)."""
-        w = self._target_member()[0].weights
-        mask = self._focus_mask()
-        return w if mask is None else w[mask] / w[mask].sum()
+        return self._target_member()[0].weights
 
     def estimate_particles(self) -> tuple[np.ndarray, np.ndarray]:
         """((N, 8 + 4 (K̂ − 1)) particles, (N,) weights) of the most probable count's filter
@@ -301,19 +265,22 @@ class SourceCountBank:
         f = self._target_member()[0]
         return f.theta, f.weights
 
+    def _target_locations(self) -> np.ndarray:
+        f, j = self._target_member()
+        return f.release_locations(j) if isinstance(f, MultiSourceFilter) else f.source_locations
+
     @property
     def source_locations(self) -> np.ndarray:
-        """(N', 3) :attr:`theta`'s release locations."""
-        f, j = self._target_member()
-        mask = self._focus_mask()
-        locations = self._locations(f, j)
-        return locations if mask is None else locations[mask]
+        return self._target_locations()
 
     def _settled_release(self) -> tuple[np.ndarray, np.ndarray]:
         """((N, 3) locations, (N,) weights) of :meth:`settled_target`."""
         k, j = self.settled_target()
         f = self.member(k)
-        return self._locations(f, j), f.weights
+        locations = (
+            f.release_locations(j) if isinstance(f, MultiSourceFilter) else f.source_locations
+        )
+        return locations, f.weights
 
     def source_mean(self) -> np.ndarray:
         """(3,) the settled target's posterior mean (the estimate the stop rule and the
@@ -332,8 +299,6 @@ class SourceCountBank:
         """Assimilate one reading into every count's filter; returns the one-release filter's
         :class:`UpdateInfo` (it validates the reading first)."""
         info = self.members[0].update(position, reading)
-        cell = tuple(int(v) for v in np.floor(np.asarray(position)[:2] / FOCUS_CELL))
-        self._visits[cell] = self._visits.get(cell, 0) + 1  # type: ignore[index]
         if not info.rejected:
             for m in self.members[1:]:
                 m.update(position, reading)

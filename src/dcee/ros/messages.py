@@ -143,8 +143,8 @@ def particle_markers(
     belief: Any, rng: np.random.Generator, count: int, frame_id: str, stamp: Any
 ) -> MarkerArray:
     """``count`` source hypotheses drawn from the filter ``belief`` by weight, as points."""
-    weights = belief.weights  # a count bank's target: perhaps fewer than belief.n particles
-    idx = rng.choice(len(weights), size=min(int(count), len(weights)), p=weights)
+    n = min(int(count), belief.n)
+    idx = rng.choice(belief.n, size=n, p=belief.weights)
     marker = _stamped(Marker(), frame_id, stamp)
     marker.ns, marker.id = "dcee_particles", 0
     marker.type, marker.action = Marker.POINTS, Marker.ADD

@@ -83,6 +83,5 @@ def run_episode(
 
 
 def _subsample(pf: Estimator, n: int, rng: np.random.Generator) -> np.ndarray:
-    weights = pf.weights  # a count bank's target release: perhaps a focus window's particles
-    idx = rng.choice(len(weights), size=min(n, len(weights)), replace=True, p=weights)
+    idx = rng.choice(pf.n, size=min(n, pf.n), replace=True, p=pf.weights)
     return pf.source_locations[idx].copy()
