@@ -563,18 +563,19 @@ case "${1:---list}" in
       $D bench --suite "$N-source-held-out-100" --repeats 1 --strategies dcee-cl \
         --workers "${WORKERS:-2}" --out "results/$N-source-held-out-100"
     done
-    # the same searches with the code before a change, where kept (folders named X-before), are
-    # stored beside them for the paired table
+    # the same searches with the code before the last change, where kept (folders named
+    # X-before), are stored beside them for the paired table; X-d207b1e: before the hunt for
+    # one release more
     $P studies/source_count_table.py results/two-source-held-out-100 \
       results/three-source-held-out-100 $(ls -d results/*-source-held-out-100-before \
-      results/three-source-held-out-100-20k 2>/dev/null) --csv docs/results/source-count/searches.csv
+      results/*-source-held-out-100-d207b1e results/three-source-held-out-100-20k 2>/dev/null) --csv docs/results/source-count/searches.csv
     $P studies/publish_tables.py ;;
   source-count-paper-scale)  # issue 45: the three-release held-out campaign at the paper's 20,000 particles
     $D bench --suite three-source-held-out-100 --repeats 1 --strategies dcee-cl --particles 20000 \
       --workers "${WORKERS:-2}" --out results/three-source-held-out-100-20k
     $P studies/source_count_table.py results/two-source-held-out-100 \
       results/three-source-held-out-100 $(ls -d results/*-source-held-out-100-before \
-      results/three-source-held-out-100-20k 2>/dev/null) --csv docs/results/source-count/searches.csv
+      results/*-source-held-out-100-d207b1e results/three-source-held-out-100-20k 2>/dev/null) --csv docs/results/source-count/searches.csv
     $P studies/publish_tables.py ;;
   source-count-timing)  # issue 45: decision and update time with the count unknown against one release (idle machine, one pinned core)
     $P studies/source_count_timing.py --out docs/results/source-count/timing.csv
