@@ -13,7 +13,9 @@ things change:
 
 * the likelihood sums the releases' plumes (compiled kernel);
 * a sweep's global proposal redraws the location of *one* release, chosen at random (redrawing
-  all K at once would almost never be accepted once one release is found);
+  all K at once would almost never be accepted once one release is found), its (x, y) half
+  the time from the prior and half the time upwind of a detection (:func:`upwind_draw`;
+  ``BIRTH_SHARE``), the proposal's density in the acceptance ratio;
 * the labels are aligned before every sweep. The likelihood and the prior do not change when
   two releases swap labels, so a particle may hold release A as "release 1" and another
   particle as "release 2"; a random walk scaled by the particles' covariance, and any summary
