@@ -52,13 +52,18 @@ from dcee.estimation.summaries import weighted_moments, weighted_rmse
 from dcee.models.sensor import Sensor
 
 _ALIGN_ROUNDS = 3
+_ALIGN_FLOOR = 0.05
+"""m: added to each label's spread (as a variance) before its covariance is inverted, so that
+a label whose particles all sit on one spot still has a finite precision."""
 
 BIRTH_SHARE = 0.5
 """Share of a sweep's global location proposals drawn upwind of a detection
 (:func:`upwind_draw`); the rest from the prior, as before. A further release whose gas a
 few readings caught is found by a prior draw only if one lands within a metre or two of it:
 among the tuning range's three-release searches that answered two, the missing release's gas
-had reached 12 readings (random3:1) and the filter never found it."""
+had reached 12 readings (random3:1) and the filter never found it. The share and the shape
+below were set by design, not tuned (one version tried on the tuning range,
+docs/results/source-count-tune `-birth`)."""
 
 BIRTH_REACH = 30.0
 """m: the farthest upwind of a detection the proposal looks (the paper's sensor detects a
@@ -67,9 +72,6 @@ release of a few g/s a few tens of metres downwind)."""
 BIRTH_WIDTH, BIRTH_WIDENING = 1.0, 0.2
 """m and m per m upwind: the crosswind spread of the proposal, widening with the distance as
 a plume does."""
-_ALIGN_FLOOR = 0.05
-"""m: added to each label's spread (as a variance) before its covariance is inverted, so that
-a label whose particles all sit on one spot still has a finite precision."""
 
 
 class MultiSourceFilter(ParticleFilter):
