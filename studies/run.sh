@@ -8,6 +8,15 @@ D=.venv/bin/dcee
 P=.venv/bin/python
 [ -x "$D" ] || bash scripts/setup.sh
 report() { for dir in "$@"; do $D report "results/$dir"; cat "results/$dir/report/metrics.md"; done; }
+# issue 45's held-out table and searches.csv: today's campaigns and, where kept, the same searches
+# with the code before the last change (X-before, the paired table), before the hunt for one
+# release more (X-d207b1e) and at 20,000 particles
+source_count_tables() {
+  $P studies/source_count_table.py results/two-source-held-out-100 \
+    results/three-source-held-out-100 $(ls -d results/*-source-held-out-100-before \
+    results/*-source-held-out-100-d207b1e results/three-source-held-out-100-20k 2>/dev/null) \
+    --csv docs/results/source-count/searches.csv
+}
 
 # The whole dispatch is one brace group, read before any of it runs: bash otherwise reads a
 # script as it goes, and an edit to this file during a study (hours) would run the wrong lines.
@@ -563,19 +572,12 @@ case "${1:---list}" in
       $D bench --suite "$N-source-held-out-100" --repeats 1 --strategies dcee-cl \
         --workers "${WORKERS:-2}" --out "results/$N-source-held-out-100"
     done
-    # the same searches with the code before the last change, where kept (folders named
-    # X-before), are stored beside them for the paired table; X-d207b1e: before the hunt for
-    # one release more
-    $P studies/source_count_table.py results/two-source-held-out-100 \
-      results/three-source-held-out-100 $(ls -d results/*-source-held-out-100-before \
-      results/*-source-held-out-100-d207b1e results/three-source-held-out-100-20k 2>/dev/null) --csv docs/results/source-count/searches.csv
+    source_count_tables
     $P studies/publish_tables.py ;;
   source-count-paper-scale)  # issue 45: the three-release held-out campaign at the paper's 20,000 particles
     $D bench --suite three-source-held-out-100 --repeats 1 --strategies dcee-cl --particles 20000 \
       --workers "${WORKERS:-2}" --out results/three-source-held-out-100-20k
-    $P studies/source_count_table.py results/two-source-held-out-100 \
-      results/three-source-held-out-100 $(ls -d results/*-source-held-out-100-before \
-      results/*-source-held-out-100-d207b1e results/three-source-held-out-100-20k 2>/dev/null) --csv docs/results/source-count/searches.csv
+    source_count_tables
     $P studies/publish_tables.py ;;
   source-count-timing)  # issue 45: decision and update time with the count unknown against one release (idle machine, one pinned core)
     $P studies/source_count_timing.py --out docs/results/source-count/timing.csv

@@ -452,3 +452,21 @@ def test_upwind_proposal_density_matches_its_draws():
         in_grid = np.all((xy >= lo) & (xy < hi), axis=1)
         in_draws = np.all((draws >= lo) & (draws < hi), axis=1)
         assert abs(dens[in_grid].sum() - in_draws.mean()) < 0.01
+
+
+def test_upwind_proposal_points_at_the_release_the_plume_model_carries_gas_from():
+    """The proposal's 'upwind' is the plume model's: a release 10 m upwind of a reading the
+    model makes a detection has a far higher proposal density than the point 10 m downwind,
+    for any wind direction."""
+    from dcee.estimation.multi_source import upwind_log_density
+
+    plume = IsotropicPlume()
+    for phi in np.radians([0.0, 75.0, 200.0, 300.0]):
+        release = np.array([25.0, 25.0, 1.0, 5.0, 4.0, phi, 1.0, 8.0])
+        down = -np.array([math.cos(phi), math.sin(phi)])  # where the plume model carries gas
+        reading_at = np.r_[release[:2] + 10.0 * down, 1.0]
+        c = plume.concentration(release[None, :], reading_at[None, :])
+        assert float(np.ravel(c)[0]) > SENSOR.threshold  # a detection there
+        at = np.array([release[:2], release[:2] + 20.0 * down])
+        dens = upwind_log_density(at, np.full(2, phi), reading_at[None, :2])
+        assert dens[0] > -10.0 and dens[1] == -np.inf
