@@ -582,7 +582,7 @@ case "${1:---list}" in
   source-count-timing)  # issue 45: decision and update time with the count unknown against one release (idle machine, one pinned core)
     $P studies/source_count_timing.py --out docs/results/source-count/timing.csv
     $P studies/publish_tables.py ;;
-  source-count-tune)  # issue 45: the same on the tuning range random2/3:1-20 (never reported as a result)
+  source-count-tune)  # issue 45: the same on the tuning range random2/3:1-60 (never reported as a result)
     for N in two three; do
       $D bench --suite "$N-source-tune" --repeats 1 --strategies dcee-cl \
         --workers "${WORKERS:-2}" --out "results/$N-source-tune"

@@ -78,7 +78,7 @@ SUITES: dict[str, dict] = {
         "overrides": {},
     },
     # several releases, their number unknown (issue 45): the estimator over 0-3 releases at
-    # 10,000 particles, wind known; tuning (random2/3:1-20) and reporting (1000-1099) ranges
+    # 10,000 particles, wind known; tuning (random2/3:1-60; 1-20 until 2026-11-28) and reporting (1000-1099) ranges
     **{
         f"{word}-source-{use}": {
             "configs": [f"random{n}:{k}" for k in ks],
@@ -86,7 +86,7 @@ SUITES: dict[str, dict] = {
         }
         for n, word in ((2, "two"), (3, "three"))
         for use, ks in (
-            ("tune", range(1, 21)),
+            ("tune", range(1, 61)),
             ("held-out-100", range(RANDOM_REPORTING_FROM, RANDOM_REPORTING_FROM + 100)),
         )
     },
