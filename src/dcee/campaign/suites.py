@@ -78,7 +78,8 @@ SUITES: dict[str, dict] = {
         "overrides": {},
     },
     # several releases, their number unknown (issue 45): the estimator over 0-3 releases at
-    # 10,000 particles, wind known; tuning (random2/3:1-60; 1-20 until 2026-11-28) and reporting (1000-1099) ranges
+    # 10,000 particles, wind known; tuning (random2/3:1-60; 1-20 until 2026-11-28) and
+    # reporting (1000-1099) ranges
     **{
         f"{word}-source-{use}": {
             "configs": [f"random{n}:{k}" for k in ks],

@@ -158,6 +158,25 @@ class MultiSourceFilter(ParticleFilter):
                 lp[gap < self.min_separation] = -np.inf
         return lp
 
+    def _release_blocks(self) -> np.ndarray:
+        return self._blocks
+
+    def _prior_draws(self, rng: np.random.Generator, m: int) -> np.ndarray:
+        """(m, columns) draws of every release from its prior, the separation not enforced
+        (:meth:`_prior_log_pdf` is their density; :func:`dcee.estimation.evidence`)."""
+        theta = np.hstack([self.prior.sample(rng, m), np.tile(self.theta[0, 8:], (m, 1))])
+        for j in range(1, self.n_sources):
+            for c in self._per_source:
+                theta[:, self._blocks[j, c]] = self.prior.distributions[c].sample(rng, m)
+        return theta
+
+    def _prior_log_pdf(self, theta: np.ndarray) -> np.ndarray:
+        lp = self.prior.log_density(theta)
+        for j in range(1, self.n_sources):
+            for c in self._per_source:
+                lp = lp + self.prior.distributions[c].log_pdf(theta[:, self._blocks[j, c]])
+        return lp
+
     def _unknown_scales(self) -> np.ndarray:
         scales = {int(i): s for i, s in zip(self.prior.unknown, self.prior.scales, strict=True)}
         per = [scales[c] for c in self._per_source]

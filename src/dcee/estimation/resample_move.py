@@ -140,6 +140,18 @@ class ResampleMove:
                 proposal[jump, col]
             )
 
+    def _release_blocks(self) -> np.ndarray:
+        """(K, 4) the columns (x, y, z, q) of each release in a particle: one release."""
+        return np.array([[0, 1, 2, 3]])
+
+    def _prior_draws(self, rng: np.random.Generator, m: int) -> np.ndarray:
+        """(m, columns) draws from the prior (:meth:`_prior_log_pdf` is their density)."""
+        return self.prior.sample(rng, m)
+
+    def _prior_log_pdf(self, theta: np.ndarray) -> np.ndarray:
+        """(N,) normalised log density of :meth:`_prior_draws` (no wind readings)."""
+        return self.prior.log_density(theta)
+
     def _likelihood_kernel(self) -> Callable[..., None]:
         """The compiled history likelihood of this filter's particle layout (one release)."""
         return history_log_likelihood

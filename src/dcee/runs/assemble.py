@@ -69,6 +69,7 @@ def make_searcher(
         # one filter per count; K >= 2 draw from children of filter_rng (spawning does not move
         # it), so the one-release filter is the lone filter's, draw for draw
         kmax = scenario.estimator.max_sources
+        children = filter_rng.spawn(kmax)  # the last one: the bank's bridge sampling
         more = [
             MultiSourceFilter(
                 k,
@@ -79,13 +80,14 @@ def make_searcher(
                 min_separation=MIN_SOURCE_SEPARATION,
                 **settings,
             )
-            for k, rng in zip(range(2, kmax + 1), filter_rng.spawn(kmax - 1), strict=True)
+            for k, rng in zip(range(2, kmax + 1), children[:-1], strict=True)
         ]
         estimator = SourceCountBank(
             [filters[0], *more],
             scenario.estimator.count_prior,
             localised=DEFAULT_STOP_SHARE * search.acquired_rmse,
             found=FOUND_SHARE * search.acquired_rmse,
+            seed=children[-1],
         )
     else:
         estimator = filters[0]
