@@ -9,12 +9,13 @@ P=.venv/bin/python
 [ -x "$D" ] || bash scripts/setup.sh
 report() { for dir in "$@"; do $D report "results/$dir"; cat "results/$dir/report/metrics.md"; done; }
 # issue 45's held-out table and searches.csv: today's campaigns and, where kept, the same searches
-# with the code before the last change (X-before, the paired table), before the hunt for one
-# release more (X-d207b1e) and at 20,000 particles
+# with the code before the last change (X-before, the paired table), two changes before
+# (X-5d04d27), before the hunt for one release more (X-d207b1e) and at 20,000 particles
 source_count_tables() {
   $P studies/source_count_table.py results/two-source-held-out-100 \
     results/three-source-held-out-100 $(ls -d results/*-source-held-out-100-before \
-    results/*-source-held-out-100-d207b1e results/three-source-held-out-100-20k 2>/dev/null) \
+    results/*-source-held-out-100-5d04d27 results/*-source-held-out-100-d207b1e \
+    results/three-source-held-out-100-20k 2>/dev/null) \
     --csv docs/results/source-count/searches.csv
 }
 
