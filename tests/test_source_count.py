@@ -455,50 +455,25 @@ def test_target_localises_the_likeliest_count_first_then_the_plausible_rest():
     assert bank.source_mean() == pytest.approx(f.weights @ rows[:, :3])
 
 
-@pytest.mark.parametrize("pick", [None, np.array([0.7, 0.1, 0.2])])
-def test_upwind_proposal_density_matches_its_draws(pick):
+def test_upwind_proposal_density_matches_its_draws():
     """The birth proposal's density integrates to one and gives a box the share of draws that
-    fall in it (200,000 draws: a 0.3 % binomial sd at most), detections chosen equally or
-    with unequal probabilities."""
+    fall in it (200,000 draws: a 0.3 % binomial sd at most)."""
     from dcee.estimation.multi_source import upwind_draw, upwind_log_density
 
     rng = np.random.default_rng(4)
     detections = np.array([[0.0, 0.0], [5.0, 3.0], [-2.0, 8.0]])
     phi = 0.7
-    draws = upwind_draw(rng, detections, np.full(200_000, phi), pick)
+    draws = upwind_draw(rng, detections, np.full(200_000, phi))
     step = 0.25
     g = np.arange(-45.0, 45.0, step) + step / 2
     gx, gy = np.meshgrid(g, g, indexing="ij")
     xy = np.column_stack([gx.ravel(), gy.ravel()])
-    dens = np.exp(upwind_log_density(xy, np.full(len(xy), phi), detections, pick)) * step**2
+    dens = np.exp(upwind_log_density(xy, np.full(len(xy), phi), detections)) * step**2
     assert abs(dens.sum() - 1.0) < 0.01
     for lo, hi in (((5.0, 5.0), (15.0, 15.0)), ((-5.0, 0.0), (5.0, 10.0))):
         in_grid = np.all((xy >= lo) & (xy < hi), axis=1)
         in_draws = np.all((draws >= lo) & (draws < hi), axis=1)
         assert abs(dens[in_grid].sum() - in_draws.mean()) < 0.01
-
-
-def test_detections_unexplained_by_the_belief_are_picked_more_often():
-    """A two-release filter whose particles all hold release A (and a second release far
-    away): detections of A's gas are explained, a detection of gas from elsewhere is not. The
-    unexplained one is picked 1 + gain times as often (its share of the reading unexplained is
-    1, the others' 0); with every detection explained the choice is uniform."""
-    from dcee.estimation.multi_source import UNEXPLAINED_GAIN
-
-    f = MultiSourceFilter(2, PRIOR, SENSOR, n_particles=200, seed=0)
-    a = PAPER1.truth_theta()
-    f.theta[:, :8] = a
-    f.theta[:, 8:12] = [1.0, 49.0, 1.0, 0.5]  # upwind corner: no gas where the readings are
-    plume = IsotropicPlume()
-    down = -np.array([math.cos(a[5]), math.sin(a[5])])
-    explained = np.array([np.r_[a[:2] + d * down, 4.0] for d in (3.0, 6.0, 9.0)])
-    z = plume.concentration(a[None, :], explained)[0]
-    assert (z > SENSOR.threshold).all()
-    elsewhere = np.array([[45.0, 45.0, 4.0]])
-    positions = np.vstack([explained, elsewhere])
-    w = f._detection_weights(positions, np.r_[z, 0.01])
-    np.testing.assert_allclose(w, np.r_[1, 1, 1, 1 + UNEXPLAINED_GAIN] / (4 + UNEXPLAINED_GAIN))
-    np.testing.assert_allclose(f._detection_weights(explained, z), np.full(3, 1 / 3), atol=1e-3)
 
 
 def test_upwind_proposal_points_at_the_release_the_plume_model_carries_gas_from():

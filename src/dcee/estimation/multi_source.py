@@ -45,11 +45,7 @@ import numpy as np
 from scipy.special import logsumexp
 
 from dcee.errors import DceeInputError
-from dcee.estimation.multi_source_kernels import (
-    EXTRA_COLUMNS,
-    multi_history_log_likelihood,
-    source_rows,
-)
+from dcee.estimation.multi_source_kernels import EXTRA_COLUMNS, multi_history_log_likelihood
 from dcee.estimation.particle_filter import ParticleFilter
 from dcee.estimation.priors import PHYSICAL_LOWER, SourcePrior
 from dcee.estimation.summaries import weighted_moments, weighted_rmse
@@ -68,19 +64,6 @@ among the tuning range's three-release searches that answered two, the missing r
 had reached 12 readings (random3:1) and the filter never found it. The share and the shape
 below were set by design, not tuned (one version tried on the tuning range,
 docs/results/source-count-tune `-birth`)."""
-
-UNEXPLAINED_GAIN = 20.0
-"""The upwind proposal picks a detection with probability ∝ 1 + gain × the share of its
-reading that the filter's present belief does not explain (:meth:`MultiSourceFilter.
-_detection_weights`): a detection no release of the belief explains is picked 21 times as
-often as one it explains. A further release whose gas lies inside a found release's plume
-adds to readings the found releases explain in part; drawn uniformly, its few detections are
-a few per cent of the choices (tuning search random3:1: 12 of ~250 readings, and the
-three-release filter's spare release never found it). Set by design (one version tried on
-the tuning range)."""
-
-UNEXPLAINED_PARTICLES = 1000
-"""Particles (every n-th) whose weighted mean concentration the unexplained share reads."""
 
 BIRTH_REACH = 30.0
 """m: the farthest upwind of a detection the proposal looks (the paper's sensor detects a
@@ -212,8 +195,7 @@ class MultiSourceFilter(ParticleFilter):
         which = self.rng.integers(self.n_sources, size=len(rows))
         dists = self.prior.distributions
         positions, readings, _ = self.history()
-        found = readings >= self.sensor.threshold
-        detections = positions[found, :2]
+        detections = positions[readings >= self.sensor.threshold, :2]
         planar = {0, 1} <= set(self._loc_block) and len(detections) > 0 and len(rows) > 0
         for c in self._loc_block:
             if planar and c < 2:
@@ -228,33 +210,16 @@ class MultiSourceFilter(ParticleFilter):
         phi = self.theta[rows, 5]
         draw = np.column_stack([dists[c].sample(self.rng, len(rows)) for c in (0, 1)])
         birth = self.rng.random(len(rows)) < BIRTH_SHARE
-        pick = self._detection_weights(positions[found], readings[found])
-        draw[birth] = upwind_draw(self.rng, detections, phi[birth], pick)
+        draw[birth] = upwind_draw(self.rng, detections, phi[birth])
         current = np.column_stack([self.theta[rows, xcols], self.theta[rows, ycols]])
 
         def log_q(xy: np.ndarray) -> np.ndarray:
             prior = dists[0].log_pdf(xy[:, 0]) + dists[1].log_pdf(xy[:, 1])
-            upwind = upwind_log_density(xy, phi, detections, pick)
+            upwind = upwind_log_density(xy, phi, detections)
             return np.logaddexp(np.log1p(-BIRTH_SHARE) + prior, np.log(BIRTH_SHARE) + upwind)
 
         log_q_ratio[rows] += log_q(current) - log_q(draw)
         proposal[rows, xcols], proposal[rows, ycols] = draw[:, 0], draw[:, 1]
-
-    def _detection_weights(self, positions: np.ndarray, readings: np.ndarray) -> np.ndarray:
-        """(M,) the probability that the upwind proposal starts from each detection (positions
-        (M, 3) m, readings (M,) g/m³), ∝ 1 + ``UNEXPLAINED_GAIN`` × the share of its reading,
-        1 − C̄/z clipped to [0, 1], that the particles' weighted mean concentration C̄ (every
-        release's gas, every n-th particle) leaves unexplained. A function of the population
-        before the sweep, the same for the forward and the reverse move of every particle, so
-        the proposal's density stays exact."""
-        step = max(1, self.n // UNEXPLAINED_PARTICLES)
-        theta, w = self.theta[::step], self.weights[::step]
-        share = np.zeros(len(readings))
-        if w.sum() > 0.0:
-            conc = sum(self.plume.concentration(rows, positions) for rows in source_rows(theta))
-            share = np.clip(1.0 - (w @ conc) / w.sum() / readings, 0.0, 1.0)
-        pick = 1.0 + UNEXPLAINED_GAIN * share
-        return pick / pick.sum()
 
     def _likelihood_kernel(self) -> Callable[..., None]:
         """The K-release history likelihood (:mod:`dcee.estimation.multi_source_kernels`)."""
@@ -337,36 +302,22 @@ def _upwind_frame(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.column_stack([c, s]), np.column_stack([-s, c])
 
 
-def upwind_draw(
-    rng: np.random.Generator,
-    detections: np.ndarray,
-    phi: np.ndarray,
-    pick: np.ndarray | None = None,
-) -> np.ndarray:
+def upwind_draw(rng: np.random.Generator, detections: np.ndarray, phi: np.ndarray) -> np.ndarray:
     """(R, 2) m: for each of R wind directions ``phi`` (rad, where the wind comes from, as the
-    plume model's), a location upwind of a detection drawn from ``detections`` (M, 2) m with
-    probabilities ``pick`` (M,) (uniformly without): a distance d ~ U(0, ``BIRTH_REACH``)
-    upwind and a crosswind offset ~ N(0, (``BIRTH_WIDTH`` + ``BIRTH_WIDENING`` d)²)."""
-    if pick is None:
-        pick = detections[rng.integers(len(detections), size=len(phi))]
-    else:
-        pick = detections[rng.choice(len(detections), size=len(phi), p=pick)]
+    plume model's), a location upwind of a detection drawn uniformly from ``detections``
+    (M, 2) m: a distance d ~ U(0, ``BIRTH_REACH``) upwind and a crosswind offset
+    ~ N(0, (``BIRTH_WIDTH`` + ``BIRTH_WIDENING`` d)²)."""
+    pick = detections[rng.integers(len(detections), size=len(phi))]
     d = rng.uniform(0.0, BIRTH_REACH, len(phi))
     cross = rng.normal(0.0, 1.0, len(phi)) * (BIRTH_WIDTH + BIRTH_WIDENING * d)
     up, side = _upwind_frame(phi)
     return pick + d[:, None] * up + cross[:, None] * side
 
 
-def upwind_log_density(
-    xy: np.ndarray,
-    phi: np.ndarray,
-    detections: np.ndarray,
-    pick: np.ndarray | None = None,
-) -> np.ndarray:
+def upwind_log_density(xy: np.ndarray, phi: np.ndarray, detections: np.ndarray) -> np.ndarray:
     """(R,) log density (m⁻²) of :func:`upwind_draw` at the locations ``xy`` (R, 2) m for
-    the wind directions ``phi`` (R,) rad: the mean over the M detections, weighted by
-    ``pick`` (M,) (equally without), of 1/``BIRTH_REACH`` · N(crosswind offset; 0, width(d)²)
-    for 0 ≤ d ≤ ``BIRTH_REACH``."""
+    the wind directions ``phi`` (R,) rad: the mean over the M detections of
+    1/``BIRTH_REACH`` · N(crosswind offset; 0, width(d)²) for 0 ≤ d ≤ ``BIRTH_REACH``."""
     up, side = _upwind_frame(phi)
     rel = xy[:, None, :] - detections[None, :, :]  # (R, M, 2)
     d = np.einsum("rmc,rc->rm", rel, up)
@@ -374,7 +325,4 @@ def upwind_log_density(
     width = BIRTH_WIDTH + BIRTH_WIDENING * np.clip(d, 0.0, None)
     log_k = -0.5 * (cross / width) ** 2 - np.log(width * math.sqrt(2 * math.pi) * BIRTH_REACH)
     log_k = np.where((d >= 0.0) & (d <= BIRTH_REACH), log_k, -np.inf)
-    if pick is None:
-        return logsumexp(log_k, axis=1) - math.log(detections.shape[0])
-    with np.errstate(divide="ignore"):
-        return logsumexp(log_k + np.log(pick)[None, :], axis=1)
+    return logsumexp(log_k, axis=1) - math.log(detections.shape[0])
