@@ -301,8 +301,8 @@ def test_detection_information_by_hand():
     )
 
 
-@pytest.mark.parametrize("k, focus", [(1, None), (2, None), (3, None), (2, 1), (3, 0)])
-def test_detection_information_kernel_matches_reference(k, focus):
+@pytest.mark.parametrize("k", [1, 2, 3])
+def test_detection_information_kernel_matches_reference(k):
     """The vectorised kernel (the paper's sensor and plume) against the scalar libm form, on
     1,500 particles of k releases with uneven weights (thinned to 1,000) and points over the
     area, inside plumes and upwind of all: equal to rounding (the guard compares informations
@@ -312,30 +312,10 @@ def test_detection_information_kernel_matches_reference(k, focus):
     weights = rng.gamma(0.5, size=1500)
     weights /= weights.sum()
     points = np.column_stack([rng.uniform(0, 50, (60, 2)), rng.uniform(0, 5, 60)])
-    fast = detection_information(theta, weights, SENSOR, IsotropicPlume(), points, focus)
-    ref = detection_information_reference(theta, weights, SENSOR, IsotropicPlume(), points, focus)
-    assert ref.max() > 1e-3  # some points are informative
+    fast = detection_information(theta, weights, SENSOR, IsotropicPlume(), points)
+    ref = detection_information_reference(theta, weights, SENSOR, IsotropicPlume(), points)
+    assert ref.max() > 0.05  # some points are informative
     np.testing.assert_allclose(fast, ref, rtol=0, atol=1e-13)
-
-
-def test_detection_information_about_one_release_ignores_the_others_spread():
-    """Two hypotheses of two releases that differ only in release 1: about release 1 the
-    information where its two places' gas differs is positive; about release 0 it is 0
-    everywhere (release 1's gas is then a background, its mean in both hypotheses), although
-    the joint information (no focus) is not."""
-    a = PAPER1.truth_theta()
-    theta = np.tile(np.r_[a, 40.0, 40.0, 1.0, 5.0], (2, 1))
-    theta[1, 8:10] = [40.0, 28.0]  # release 1 elsewhere (crosswind) in the second hypothesis
-    down = -np.array([math.cos(a[5]), math.sin(a[5])])
-    points = np.array(
-        [np.r_[[40.0, 40.0] + 5.0 * down, 4.0], np.r_[[10.0, 40.0] + 5.0 * down, 4.0]]
-    )
-    w = np.array([0.5, 0.5])
-    joint = detection_information(theta, w, SENSOR, IsotropicPlume(), points)
-    about_1 = detection_information(theta, w, SENSOR, IsotropicPlume(), points, focus=1)
-    about_0 = detection_information(theta, w, SENSOR, IsotropicPlume(), points, focus=0)
-    assert (joint > 0.01).all() and (about_1 > 0.01).all()
-    np.testing.assert_allclose(about_0, 0.0, atol=1e-12)
 
 
 def test_exploration_goal_heads_for_informative_ground():

@@ -54,7 +54,6 @@ def detection_information(
     sensor: Sensor,
     plume: IsotropicPlume,
     points: np.ndarray,
-    focus: int | None = None,
 ) -> np.ndarray:
     """(M,) mutual information (nats) between "a detection or not" at points (M, 3) and the
     hypothesis, for particles ``theta`` (N, 8 + 4 (K − 1)) with normalised ``weights`` (N,):
@@ -62,9 +61,6 @@ def detection_information(
     probability hypothesis i predicts (Cᵢ the sum of its releases' plumes; false alarms and
     outliers alike in every hypothesis). Zero where every hypothesis predicts the same, however
     noisy the sensor (a bare outcome entropy is not: with Pd = 0.7 a plume's core is a coin).
-    With ``focus`` = j, the information about release j alone: every other release's gas is
-    its weighted mean over the particles at each point (a background the same in every
-    hypothesis), so only release j's hypotheses tell readings apart.
 
     The paper's sensor and plume (Gaussian family, constant Pd < 1; no meander, backflow or
     area release; decay 1) take one vectorised kernel (:func:`_information_rows`); every other
@@ -83,7 +79,7 @@ def detection_information(
         and sp.sigma_min >= 2.0**-60  # σ within the range of the vectorised log
     )
     if not fast:
-        return _information(theta, weights, sensor, plume, points, focus, thin=False)
+        return _information(theta, weights, sensor, plume, points, thin=False)
     points = np.ascontiguousarray(points, dtype=np.float64)
     blocks = source_rows(theta)
     constants = np.empty((len(blocks), N_PLUME_CONSTANTS, len(theta)))
@@ -91,10 +87,7 @@ def detection_information(
         plume_constants(np.ascontiguousarray(rows), constants[k])
     p_each = np.empty((len(points), len(theta)))
     h_each = np.empty_like(p_each)
-    focus_block = -1 if focus is None else focus
-    _information_rows(
-        constants, weights, focus_block, points, plume.min_distance, sp, p_each, h_each
-    )
+    _information_rows(constants, points, plume.min_distance, sp, p_each, h_each)
     p_mean = np.clip(p_each @ weights, 1e-12, 1.0 - 1e-12)
     return _entropy(p_mean) - h_each @ weights
 
@@ -105,11 +98,10 @@ def detection_information_reference(
     sensor: Sensor,
     plume: IsotropicPlume,
     points: np.ndarray,
-    focus: int | None = None,
 ) -> np.ndarray:
     """:func:`detection_information` with the general scalar formulas (libm, any sensor or
     plume): each release's plume on the grid, summed, then the relative miss and entropies."""
-    return _information(theta, weights, sensor, plume, points, focus, thin=True)
+    return _information(theta, weights, sensor, plume, points, thin=True)
 
 
 def _information(
@@ -118,7 +110,6 @@ def _information(
     sensor: Sensor,
     plume: IsotropicPlume,
     points: np.ndarray,
-    focus: int | None,
     thin: bool,
 ) -> np.ndarray:
     if thin:
@@ -127,14 +118,11 @@ def _information(
     conc = np.zeros((len(points), len(theta)))  # (M, n): summed over the releases
     near = np.full_like(conc, np.inf)  # the nearest release's clamped distance
     c, r = np.empty_like(conc), np.empty_like(conc)
-    for k, rows in enumerate(source_rows(theta)):
+    for rows in source_rows(theta):
         grid = np.ascontiguousarray(rows)
         concentration_distance_grid(grid, points, plume.min_distance, *plume.shape, c, r)
-        if focus is None or k == focus:
-            conc += c
-            np.minimum(near, r, out=near)
-        else:  # another release's gas: its mean, the same in every hypothesis
-            conc += (c @ weights)[:, None]
+        conc += c
+        np.minimum(near, r, out=near)
     miss = np.empty_like(conc)
     _relative_miss(conc, near, sensor.params, miss)
     p_each = np.clip(1.0 - miss, 1e-12, 1.0 - 1e-12)
@@ -145,8 +133,6 @@ def _information(
 @njit(cache=True, fastmath={"contract"}, error_model="numpy")
 def _information_rows(
     constants: np.ndarray,
-    weights: np.ndarray,
-    focus: int,
     points: np.ndarray,
     rmin: float,
     sp: SensorParams,
@@ -156,10 +142,8 @@ def _information_rows(
     """p_each[m, i] = hypothesis i's detection probability at points[m] relative to none
     (clipped to [1e-12, 1 − 1e-12]) and h_each[m, i] its outcome entropy (nats), for the
     paper's sensor and plume: constants (K, 10, n) the :func:`plume_constants` of each
-    release, weights (n,); with ``focus`` ≥ 0 every other release's gas enters as its
-    weighted mean at the point (:func:`detection_information`). Loops without branches
-    (selects only) over particles, so that LLVM vectorises them with the ``exp``, ``log`` and
-    ``erfc`` of :mod:`dcee.numeric` (the scalar libm form,
+    release. Loops without branches (selects only) over particles, so that LLVM vectorises
+    them with the ``exp``, ``log`` and ``erfc`` of :mod:`dcee.numeric` (the scalar libm form,
     :func:`detection_information_reference`, took two thirds of a count-unknown decision)."""
     n = constants.shape[2]
     conc = np.empty(n)
@@ -167,26 +151,7 @@ def _information_rows(
     for m in range(points.shape[0]):
         px, py, pz = points[m, 0], points[m, 1], points[m, 2]
         conc[:] = 0.0
-        background = 0.0
         for k in range(constants.shape[0]):
-            if focus >= 0 and k != focus:
-                for j in range(n):
-                    i = np.uint64(j)
-                    c, _ = plume_from_terms(
-                        constants[k, 0, i],
-                        constants[k, 1, i],
-                        constants[k, 2, i],
-                        constants[k, 3, i],
-                        constants[k, 4, i],
-                        constants[k, 5, i],
-                        constants[k, 6, i],
-                        px,
-                        py,
-                        pz,
-                        rmin,
-                    )
-                    background += weights[i] * c
-                continue
             for j in range(n):
                 i = np.uint64(j)  # unsigned: no wraparound check to keep LLVM from vectorising
                 c, _ = plume_from_terms(
@@ -205,7 +170,7 @@ def _information_rows(
                 conc[i] += c
         for j in range(n):
             i = np.uint64(j)
-            c = conc[i] + background
+            c = conc[i]
             missed = vlog1m(
                 sp.pd * vndtr_upper((sp.v_threshold - c) / (sp.sigma_frac * c + sp.sigma_min))
             )
@@ -258,24 +223,16 @@ def exploration_goal(
     share: float = DEFAULT_EXPLORE_SHARE,
 ) -> np.ndarray | None:
     """The grid point (3,) m to head for, or None when a move within reach is informative
-    enough (see the module doc). The information is about the release the planners go after
-    (:func:`detection_information`; a count bank's target release, the other releases of its
-    count as their mean gas)."""
+    enough (see the module doc). The information is the estimator's joint belief's
+    (:func:`detection_information`; a count bank's target count, every release's gas)."""
     cands, _ = agent.candidates(position)
     if len(cands) == 0:
         return None
     joint = getattr(estimator, "joint_particles", None)
-    focus = None
-    if joint is not None:
-        theta, weights = joint()
-        focus = estimator.target()[1]
-    else:
-        theta, weights = estimator.theta, estimator.weights
+    theta, weights = joint() if joint is not None else (estimator.theta, estimator.weights)
 
     def info(points: np.ndarray) -> np.ndarray:
-        return detection_information(
-            theta, weights, estimator.sensor, estimator.plume, points, focus
-        )
+        return detection_information(theta, weights, estimator.sensor, estimator.plume, points)
 
     local = float(info(cands).max())
     if local >= share * math.log(2.0):  # no grid point can beat ln 2: the move is informative
