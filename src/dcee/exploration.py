@@ -33,7 +33,7 @@ from dcee.models.plume_kernels import concentration_distance_grid, plume_from_te
 from dcee.models.sensor import Sensor
 from dcee.models.sensor_kernels import SensorParams, log_likelihood, log_missed
 from dcee.numeric import exp_scalar, log_scalar, vlog1m, vndtr_upper
-from dcee.planning.position_kernels import N_PLUME_CONSTANTS, plume_constants
+from dcee.planning.position_kernels import N_PLUME_CONSTANTS, plume_constants, vectorised_case
 
 DEFAULT_EXPLORE_SHARE = 0.5
 """The guard acts when the best move's information is below this share of the area's best,
@@ -67,18 +67,7 @@ def detection_information(
     case, and the tests' reference, :func:`detection_information_reference`."""
     theta, weights = _thinned(theta, weights)
     sp = sensor.params
-    meander, decay, backflow, radius = plume.shape
-    fast = (
-        sp.lognormal == 0.0
-        and 0.0 < sp.pd < 1.0
-        and sp.near_length == 0.0
-        and meander == 0.0
-        and decay == 1.0
-        and backflow == 0.0
-        and radius == 0.0
-        and sp.sigma_min >= 2.0**-60  # σ within the range of the vectorised log
-    )
-    if not fast:
+    if not vectorised_case(sp, *plume.shape):
         return _information(theta, weights, sensor, plume, points, thin=False)
     points = np.ascontiguousarray(points, dtype=np.float64)
     blocks = source_rows(theta)
