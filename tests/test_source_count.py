@@ -476,29 +476,6 @@ def test_upwind_proposal_density_matches_its_draws():
         assert abs(dens[in_grid].sum() - in_draws.mean()) < 0.01
 
 
-def test_downwind_proposal_density_matches_its_draws():
-    """The split proposal (downwind of another release of the particle) integrates to one
-    and gives a box the share of its draws (200,000 draws, two anchors per row)."""
-    from dcee.estimation.multi_source import downwind_draw, downwind_log_density
-
-    rng = np.random.default_rng(5)
-    n, phi = 200_000, 2.0
-    anchors = np.broadcast_to(np.array([[0.0, 0.0], [6.0, -4.0]]), (n, 2, 2))
-    draws = downwind_draw(rng, anchors, np.full(n, phi))
-    step = 0.25
-    g = np.arange(-45.0, 45.0, step) + step / 2
-    gx, gy = np.meshgrid(g, g, indexing="ij")
-    xy = np.column_stack([gx.ravel(), gy.ravel()])
-    a = np.broadcast_to(anchors[:1], (len(xy), 2, 2))
-    dens = np.exp(downwind_log_density(xy, np.full(len(xy), phi), a)) * step**2
-    assert abs(dens.sum() - 1.0) < 0.01
-    for lo, hi in (((5.0, -15.0), (20.0, 0.0)), ((0.0, -5.0), (10.0, 5.0))):
-        in_grid = np.all((xy >= lo) & (xy < hi), axis=1)
-        in_draws = np.all((draws >= lo) & (draws < hi), axis=1)
-        assert in_draws.mean() > 0.02
-        assert abs(dens[in_grid].sum() - in_draws.mean()) < 0.01
-
-
 def test_upwind_proposal_points_at_the_release_the_plume_model_carries_gas_from():
     """The proposal's 'upwind' is the plume model's: a release 10 m upwind of a reading the
     model makes a detection has a far higher proposal density than the point 10 m downwind,

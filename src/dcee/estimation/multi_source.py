@@ -65,13 +65,6 @@ had reached 12 readings (random3:1) and the filter never found it. The share and
 below were set by design, not tuned (one version tried on the tuning range,
 docs/results/source-count-tune `-birth`)."""
 
-SPLIT_SHARE = 0.2
-"""Share of a sweep's global location proposals drawn downwind of another release of the same
-particle, inside its plume (:func:`downwind_draw`), taken from the prior's share: the
-reversible-jump "split" in this fixed-count filter. A further release standing in a found
-release's plume adds to readings the found release already explains (tuning search
-random3:1: 15 m downwind of one, the three-release filter's spare release never found it)."""
-
 BIRTH_REACH = 30.0
 """m: the farthest upwind of a detection the proposal looks (the paper's sensor detects a
 release of a few g/s a few tens of metres downwind)."""
@@ -216,33 +209,14 @@ class MultiSourceFilter(ParticleFilter):
         xcols, ycols = self._blocks[which, 0], self._blocks[which, 1]
         phi = self.theta[rows, 5]
         draw = np.column_stack([dists[c].sample(self.rng, len(rows)) for c in (0, 1)])
-        kind = self.rng.random(len(rows))
-        birth = kind < BIRTH_SHARE
-        split = (kind >= BIRTH_SHARE) & (kind < BIRTH_SHARE + SPLIT_SHARE)
+        birth = self.rng.random(len(rows)) < BIRTH_SHARE
         draw[birth] = upwind_draw(self.rng, detections, phi[birth])
-        # the other releases of each particle (they stay where they are in this move)
-        others = np.array(
-            [[j for j in range(self.n_sources) if j != w] for w in range(self.n_sources)]
-        )
-        idx = others[which]  # (R, K − 1)
-        anchors = np.stack(
-            [self.theta[rows[:, None], self._blocks[idx, c]] for c in (0, 1)], axis=-1
-        )  # (R, K − 1, 2)
-        draw[split] = downwind_draw(self.rng, anchors[split], phi[split])
         current = np.column_stack([self.theta[rows, xcols], self.theta[rows, ycols]])
-        prior_share = 1.0 - BIRTH_SHARE - SPLIT_SHARE
 
         def log_q(xy: np.ndarray) -> np.ndarray:
             prior = dists[0].log_pdf(xy[:, 0]) + dists[1].log_pdf(xy[:, 1])
             upwind = upwind_log_density(xy, phi, detections)
-            downwind = downwind_log_density(xy, phi, anchors)
-            return np.logaddexp.reduce(
-                [
-                    math.log(prior_share) + prior,
-                    math.log(BIRTH_SHARE) + upwind,
-                    math.log(SPLIT_SHARE) + downwind,
-                ]
-            )
+            return np.logaddexp(np.log1p(-BIRTH_SHARE) + prior, np.log(BIRTH_SHARE) + upwind)
 
         log_q_ratio[rows] += log_q(current) - log_q(draw)
         proposal[rows, xcols], proposal[rows, ycols] = draw[:, 0], draw[:, 1]
@@ -352,27 +326,3 @@ def upwind_log_density(xy: np.ndarray, phi: np.ndarray, detections: np.ndarray) 
     log_k = -0.5 * (cross / width) ** 2 - np.log(width * math.sqrt(2 * math.pi) * BIRTH_REACH)
     log_k = np.where((d >= 0.0) & (d <= BIRTH_REACH), log_k, -np.inf)
     return logsumexp(log_k, axis=1) - math.log(detections.shape[0])
-
-
-def downwind_draw(rng: np.random.Generator, anchors: np.ndarray, phi: np.ndarray) -> np.ndarray:
-    """(R, 2) m: for each row, a location downwind of one of its ``anchors`` (R, A, 2) m (drawn
-    uniformly): a distance d ~ U(0, ``BIRTH_REACH``) downwind in the wind ``phi`` (R,) rad and
-    a crosswind offset ~ N(0, (``BIRTH_WIDTH`` + ``BIRTH_WIDENING`` d)²)."""
-    r = len(phi)
-    pick = anchors[np.arange(r), rng.integers(anchors.shape[1], size=r)]
-    d = rng.uniform(0.0, BIRTH_REACH, r)
-    cross = rng.normal(0.0, 1.0, r) * (BIRTH_WIDTH + BIRTH_WIDENING * d)
-    up, side = _upwind_frame(phi)
-    return pick - d[:, None] * up + cross[:, None] * side
-
-
-def downwind_log_density(xy: np.ndarray, phi: np.ndarray, anchors: np.ndarray) -> np.ndarray:
-    """(R,) log density (m⁻²) of :func:`downwind_draw` at ``xy`` (R, 2) m."""
-    up, side = _upwind_frame(phi)
-    rel = xy[:, None, :] - anchors  # (R, A, 2)
-    d = -np.einsum("rac,rc->ra", rel, up)
-    cross = np.einsum("rac,rc->ra", rel, side)
-    width = BIRTH_WIDTH + BIRTH_WIDENING * np.clip(d, 0.0, None)
-    log_k = -0.5 * (cross / width) ** 2 - np.log(width * math.sqrt(2 * math.pi) * BIRTH_REACH)
-    log_k = np.where((d >= 0.0) & (d <= BIRTH_REACH), log_k, -np.inf)
-    return logsumexp(log_k, axis=1) - math.log(anchors.shape[1])
