@@ -132,3 +132,25 @@ def test_collect_metrics_keeps_a_stored_generation(tmp_path: Path, capsys) -> No
     assert collect.main(["--out", str(out), "--keep", "truth_model:c"]) == 2
     assert collect.main(["--out", str(out), "--keep", "planner:a"]) == 2
     assert capsys.readouterr().err.count("\n") == 2
+
+
+def test_count_prior_sweep_by_hand(tmp_path: Path, capsys) -> None:
+    """Two stored searches, true counts 2 and 3, each answering two under the equal prior:
+    P(K) ∝ r^K with r = 1 gets one right, r = 30 turns both to three (one right), r = 2 only
+    the search whose P(K = 3) was 0.4 (two right); a folder without searches is refused."""
+    import json
+
+    sweep = _script("count_prior_sweep")
+    folder = tmp_path / "camp"
+    for name, probs, true in (("a", [0.0, 0.0, 0.6, 0.4], 3), ("b", [0.0, 0.05, 0.9, 0.05], 2)):
+        run = folder / "runs" / f"config={name}" / "strategy=dcee-cl" / "seed=0"
+        run.mkdir(parents=True)
+        summary = {"count_probabilities": probs, "true_sources": true}
+        (run / "summary.json").write_text(json.dumps(summary))
+    assert sweep.right_counts(folder, 1.0) == (1, 2)
+    assert sweep.right_counts(folder, 2.0) == (2, 2)
+    assert sweep.right_counts(folder, 30.0) == (1, 2)
+    assert sweep.main([str(folder)]) == 0
+    assert "| r = 2 | 2/2 |" in capsys.readouterr().out
+    assert sweep.main([str(tmp_path / "empty")]) == 2
+    assert "no finished searches" in capsys.readouterr().err

@@ -68,7 +68,7 @@ def detection_information(
     theta, weights = _thinned(theta, weights)
     sp = sensor.params
     if not vectorised_case(sp, *plume.shape):
-        return _information(theta, weights, sensor, plume, points, thin=False)
+        return detection_information_reference(theta, weights, sensor, plume, points)
     points = np.ascontiguousarray(points, dtype=np.float64)
     blocks = source_rows(theta)
     constants = np.empty((len(blocks), N_PLUME_CONSTANTS, len(theta)))
@@ -89,20 +89,9 @@ def detection_information_reference(
     points: np.ndarray,
 ) -> np.ndarray:
     """:func:`detection_information` with the general scalar formulas (libm, any sensor or
-    plume): each release's plume on the grid, summed, then the relative miss and entropies."""
-    return _information(theta, weights, sensor, plume, points, thin=True)
-
-
-def _information(
-    theta: np.ndarray,
-    weights: np.ndarray,
-    sensor: Sensor,
-    plume: IsotropicPlume,
-    points: np.ndarray,
-    thin: bool,
-) -> np.ndarray:
-    if thin:
-        theta, weights = _thinned(theta, weights)
+    plume): each release's plume on the grid, summed, then the relative miss and entropies.
+    (Thinning particles already thinned leaves them as they are.)"""
+    theta, weights = _thinned(theta, weights)
     points = np.ascontiguousarray(points, dtype=np.float64)
     conc = np.zeros((len(points), len(theta)))  # (M, n): summed over the releases
     near = np.full_like(conc, np.inf)  # the nearest release's clamped distance
