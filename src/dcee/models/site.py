@@ -14,8 +14,9 @@ the segment between them is clear, else the length of the shortest 8-connected g
 around the blocked cells (Dijkstra, :func:`scipy.sparse.csgraph.dijkstra`, one field per start
 cell computed once and cached), so in open space every cost is exactly what it is without a
 map. A point inside a blocked region (a source in a no-go zone) is reached through the nearest
-reachable cell. The gas ignores the site: the isotropic truth is the paper's plume in open
-terrain, and the filament truth's filaments pass through walls (documented in
+reachable cell. The gas flows round the site's obstacles on the fluid solver's truth
+(``truth.model = "lbm"``) and ignores them on the others: the isotropic truth is the paper's
+plume in open terrain, and the filament truth's filaments pass through walls (documented in
 docs/scenarios.md).
 """
 

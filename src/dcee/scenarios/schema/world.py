@@ -71,9 +71,12 @@ class WorldSpec(BaseModel):
     chooses among the moves that stay clear; distance costs are travel distances around
     them); the difference is only what they mean to a user: an obstacle is a wall or a tank,
     a no-go zone a place the robot must keep out of, and the source may lie inside a no-go
-    zone (the robot then localises it from outside) but not inside an obstacle. The gas
-    ignores both: the isotropic truth is the paper's plume in open terrain, and the filament
-    and puff truths' filaments pass through walls."""
+    zone (the robot then localises it from outside) but not inside an obstacle. To the gas
+    an obstacle (and an occupied cell of the map) is a wall on the fluid solver's truth
+    (``truth.model = "lbm"``: the flow and the gas go round it,
+    :func:`dcee.simulation.lbm.site_frame`) and nothing on the others (the isotropic truth
+    is the paper's plume in open terrain, and the filament and puff truths' filaments pass
+    through walls); a no-go zone is nothing to the gas on any truth."""
 
     model_config = FROZEN
     obstacles: tuple[ShapeSpec, ...] = ()
