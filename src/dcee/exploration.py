@@ -67,7 +67,7 @@ def detection_information(
     case, and the tests' reference, :func:`detection_information_reference`."""
     theta, weights = _thinned(theta, weights)
     sp = sensor.params
-    if not vectorised_case(sp, *plume.shape):
+    if not isinstance(plume, IsotropicPlume) or not vectorised_case(sp, *plume.shape):
         return detection_information_reference(theta, weights, sensor, plume, points)
     points = np.ascontiguousarray(points, dtype=np.float64)
     blocks = source_rows(theta)
@@ -98,7 +98,11 @@ def detection_information_reference(
     c, r = np.empty_like(conc), np.empty_like(conc)
     for rows in source_rows(theta):
         grid = np.ascontiguousarray(rows)
-        concentration_distance_grid(grid, points, plume.min_distance, *plume.shape, c, r)
+        if isinstance(plume, IsotropicPlume):
+            concentration_distance_grid(grid, points, plume.min_distance, *plume.shape, c, r)
+        else:  # a plume that predicts with its own method (the wall-aware one)
+            conc_t, dist_t = plume.concentration_distance(grid, points)
+            c[:], r[:] = conc_t.T, dist_t.T
         conc += c
         np.minimum(near, r, out=near)
     miss = np.empty_like(conc)

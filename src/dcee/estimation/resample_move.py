@@ -27,12 +27,17 @@ from collections.abc import Callable
 import numpy as np
 
 from dcee.estimation.base import UpdateInfo
-from dcee.estimation.filter_kernels import history_log_likelihood, reading_upper_bounds
+from dcee.estimation.filter_kernels import (
+    history_log_likelihood,
+    history_log_likelihood_generic,
+    reading_upper_bounds,
+)
 from dcee.estimation.resampling import (
     effective_sample_size,
     normalised_weights,
     systematic_resample,
 )
+from dcee.models.plume import IsotropicPlume
 
 
 class ResampleMove:
@@ -169,7 +174,13 @@ class ResampleMove:
     ) -> None:
         """out (N,) = the history log-likelihood of particles ``theta`` (see
         :func:`~dcee.estimation.filter_kernels.history_log_likelihood`; the kernel is
-        :meth:`_likelihood_kernel`'s)."""
+        :meth:`_likelihood_kernel`'s; a plume without compiled constants, the wall-aware one,
+        :func:`~dcee.estimation.filter_kernels.history_log_likelihood_generic`)."""
+        if not isinstance(self.plume, IsotropicPlume):
+            history_log_likelihood_generic(
+                self.plume, theta, active, positions, readings, multiplicity, self._sp, out
+            )
+            return
         self._likelihood_kernel()(
             theta,
             active,

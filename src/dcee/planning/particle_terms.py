@@ -31,6 +31,7 @@ from dcee.planning.position_kernels import (
     plume_constants,
     position_rows,
     probe_sums,
+    rows_from_concentration,
 )
 
 
@@ -89,7 +90,8 @@ class ParticleTerms:
         self._stamp = np.zeros(0, dtype=np.int64)
         self._clock = 0
         self._terms: PositionTerms | None = None
-        self._plume: tuple[float, float] | None = None
+        self._plume: tuple | None = None
+        self._generic: object | None = None  # a plume that predicts with its own method
         self._sensor_params: tuple | None = None
 
     # --- binding ----------------------------------------------------------------------------
@@ -100,26 +102,34 @@ class ParticleTerms:
             self._probe = np.random.default_rng(20261122).standard_normal(2 * flat.size)
         return (id(theta), theta.shape, *probe_sums(flat, self._probe))
 
-    def sync(self, theta: np.ndarray, sensor: Sensor, plume: IsotropicPlume) -> None:
+    def sync(self, theta: np.ndarray, sensor: Sensor, plume: object) -> None:
         """Bind to the particles theta (N, 8) and the models; keeps the cached rows only if
         nothing changed."""
         theta = np.asarray(theta, dtype=np.float64)
         key = self._fingerprint(theta)
-        models = (plume.min_distance, *plume.shape), tuple(sensor.params)
+        # a plume without compiled constants (the wall-aware one) predicts with its own method
+        generic = None if isinstance(plume, IsotropicPlume) else plume
+        shape = (
+            ("generic", id(plume)) if generic is not None else (plume.min_distance, *plume.shape)
+        )
+        models = shape, tuple(sensor.params)
         if key == self._key and models == (self._plume, self._sensor_params):
             return
         self._key = key
         self._plume, self._sensor_params = models
         self.sp = sensor.params
-        self.min_distance, self.shape = plume.min_distance, plume.shape
+        self._generic = generic
+        if generic is None:
+            self.min_distance, self.shape = plume.min_distance, plume.shape
         if self.merge:
             self.starts = merge_runs(theta)
             self.theta = np.ascontiguousarray(theta[self.starts])
         else:
             self.starts = np.arange(len(theta), dtype=np.int64)
             self.theta = np.ascontiguousarray(theta)
-        self._plume_constants = np.empty((N_PLUME_CONSTANTS, self.n))
-        plume_constants(self.theta, self._plume_constants)
+        if generic is None:
+            self._plume_constants = np.empty((N_PLUME_CONSTANTS, self.n))
+            plume_constants(self.theta, self._plume_constants)
         self._index.clear()
         self._terms = None  # the buffers stay; their (capacity, M) views follow M
         self._stamp = np.zeros(self.capacity, dtype=np.int64)
@@ -219,15 +229,25 @@ class ParticleTerms:
             free = self._free_rows(len(missing))
             new_rows = np.array(free, dtype=np.int64)
             pts = np.ascontiguousarray(positions[missing])
-            position_rows(
-                self._plume_constants,
-                pts,
-                new_rows,
-                self.min_distance,
-                *self.shape,
-                self.sp,
-                *self.terms,
-            )
+            if self._generic is not None:
+                conc, dist = self._generic.concentration_distance(self.theta, pts)
+                rows_from_concentration(
+                    np.ascontiguousarray(conc.T),
+                    np.ascontiguousarray(dist.T),
+                    new_rows,
+                    self.sp,
+                    *self.terms,
+                )
+            else:
+                position_rows(
+                    self._plume_constants,
+                    pts,
+                    new_rows,
+                    self.min_distance,
+                    *self.shape,
+                    self.sp,
+                    *self.terms,
+                )
             for key, j in pending.items():
                 self._index[key] = int(new_rows[j])
             for k, key in enumerate(keys):
@@ -240,10 +260,12 @@ class ParticleTerms:
         """A new :class:`ParticleTerms` of the particles where ``keep`` (M,) is True, with the
         rows cached so far (copied, same row numbers)."""
         other = ParticleTerms(merge=False, max_bytes=self.max_bytes)
-        other.sp, other.min_distance, other.shape = self.sp, self.min_distance, self.shape
+        other.sp, other._generic = self.sp, self._generic
+        if self._generic is None:
+            other.min_distance, other.shape = self.min_distance, self.shape
+            other._plume_constants = np.ascontiguousarray(self._plume_constants[:, keep])
         other._plume, other._sensor_params = self._plume, self._sensor_params
         other.theta = np.ascontiguousarray(self.theta[keep])
-        other._plume_constants = np.ascontiguousarray(self._plume_constants[:, keep])
         other.starts = np.arange(other.n, dtype=np.int64)
         other._key = ("subset", id(other))
         other._grow(max(self.capacity, 8))

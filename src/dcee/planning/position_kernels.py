@@ -206,3 +206,34 @@ def position_rows(
                 inv_sigma[row, i] = 1.0 / sigma
                 log_nd[row, i] = log_likelihood(0.0, c, r, sp)
                 det_offset[row, i] = log_detection_probability(r, sp) - math.log(sigma)
+
+
+@njit(cache=True, parallel=True)
+def rows_from_concentration(
+    conc_in: np.ndarray,
+    dist_in: np.ndarray,
+    rows: np.ndarray,
+    sp: SensorParams,
+    conc: np.ndarray,
+    dist: np.ndarray,
+    loc: np.ndarray,
+    log_nd: np.ndarray,
+    inv_sigma: np.ndarray,
+    det_offset: np.ndarray,
+) -> None:
+    """:func:`position_rows` for a plume that predicts with its own method (the wall-aware
+    one): conc_in, dist_in (K, N) its concentrations and clamped source distances at K
+    positions; row rows[k] of each output gets the terms of position k (the scalar formulas of
+    :func:`position_rows`' general path)."""
+    for k in range(conc_in.shape[0]):
+        row = rows[k]
+        for i in prange(conc_in.shape[1]):
+            c = conc_in[k, i]
+            r = dist_in[k, i]
+            m, sigma = transform(c, r, sp)
+            conc[row, i] = c
+            dist[row, i] = r
+            loc[row, i] = m
+            inv_sigma[row, i] = 1.0 / sigma
+            log_nd[row, i] = log_likelihood(0.0, c, r, sp)
+            det_offset[row, i] = log_detection_probability(r, sp) - math.log(sigma)

@@ -21,6 +21,7 @@ from dcee.models.plume import PARAMETER_NAMES, IsotropicPlume
 from dcee.models.ros_map import load_ros_map
 from dcee.models.sensor import Sensor
 from dcee.models.site import SiteMap, compose_site
+from dcee.models.site_plume import SitePlume, site_grid
 from dcee.scenarios.schema.agent import team_starts
 from dcee.scenarios.schema.estimator import PHYSICAL_TRUNCATION, PriorSpec
 from dcee.stopping import StopRule
@@ -48,6 +49,34 @@ def _site(
 @functools.lru_cache(maxsize=4)
 def _raw_map(path: str) -> SiteMap:
     return load_ros_map(path)
+
+
+@functools.lru_cache(maxsize=4)
+def _wall_plume(
+    low: tuple[float, float],
+    high: tuple[float, float],
+    world_json: str,
+    mtime: float,
+    resolution: float,
+    environment: tuple[float, float, float, float],
+) -> SitePlume:
+    """The wall-aware plume of one site and one (u, φ, ζ1, ζ2), built once per process and
+    shared by the filter's members and the planners (its receptor fields are cached in it)."""
+    from dcee.scenarios.schema.world import WorldSpec, shapes_of
+
+    world = WorldSpec.model_validate_json(world_json)
+    shapes = shapes_of(world.obstacles)
+
+    def solid(xy: np.ndarray) -> np.ndarray:
+        out = np.zeros(len(xy), bool)
+        for shape in shapes:
+            out |= shape.contains(xy)
+        if world.map is not None:
+            out |= _raw_map(world.map).is_blocked(xy)
+        return out
+
+    fluid, origin = site_grid(low, high, resolution, solid)
+    return SitePlume(fluid, origin, resolution, *environment)
 
 
 class ScenarioBuilders:
@@ -91,10 +120,22 @@ class ScenarioBuilders:
             max_reading=s.max_reading,
         )
 
-    def make_plume(self, model: str | None = None) -> IsotropicPlume:
+    def make_plume(self, model: str | None = None) -> IsotropicPlume | SitePlume:
         """The dispersion model of the filter and the planners under reading model ``model``
-        (None: the first of :attr:`reading_models`)."""
+        (None: the first of :attr:`reading_models`): with ``estimator.plume = "walls"`` the one
+        wall-aware plume of the site (every member's: it has no shape setting to learn)."""
         model = self._reading_model(model)
+        if self.estimator.plume == "walls":
+            truth = self.truth_theta()
+            mtime = Path(self.world.map).stat().st_mtime if self.world.map is not None else 0.0
+            return _wall_plume(
+                tuple(self.volume.low[:2]),
+                tuple(self.volume.high[:2]),
+                self.world.model_dump_json(),
+                mtime,
+                float(self.site_resolution),
+                tuple(float(v) for v in truth[4:8]),
+            )
         if self.estimator.likelihood == "paper":
             return IsotropicPlume(meander=self.meander)
         if model == "paper":

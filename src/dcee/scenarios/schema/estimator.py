@@ -174,6 +174,9 @@ LearnedName = Literal[
     "source_radius",
 ]
 """The reading model's nuisance parameters ``estimator.learn`` may weigh."""
+PLUME_SHAPE_SETTINGS = ("meander", "decay", "backflow", "source_radius")
+"""The open plume's shape settings (:class:`~dcee.models.plume.IsotropicPlume`): the wall-aware
+plume has none of them, so ``estimator.plume = "walls"`` learns none."""
 LEARN_RANGES: dict[str, tuple[float, float]] = {
     "meander": (0.0, 2.0),
     "log_sd": (1e-3, 5.0),
@@ -215,10 +218,16 @@ def default_learn(likelihood: str, fixed: Mapping[str, float]) -> dict[str, list
     """What an unset ``estimator.learn`` weighs: :data:`LEARN_DEFAULT` for the likelihood,
     without the settings fixed by hand (``fixed``: the estimator's settings by name; one of the
     grid's whose value is not its grid's first, the plain model's, is not learned; one absent
-    counts as the plain model's)."""
+    counts as the plain model's), and without the open plume's shape settings under the
+    wall-aware plume (``fixed["plume"] == "walls"``)."""
     grid = LEARN_DEFAULT[likelihood]
+    walls = fixed.get("plume") == "walls"
     # a copy: callers may edit it
-    return {key: list(v) for key, v in grid.items() if fixed.get(key, v[0]) == v[0]}
+    return {
+        key: list(v)
+        for key, v in grid.items()
+        if fixed.get(key, v[0]) == v[0] and not (walls and key in PLUME_SHAPE_SETTINGS)
+    }
 
 
 def default_learn_prior(
@@ -393,6 +402,14 @@ class EstimatorSpec(BaseModel):
     count_prior: Annotated[list[Annotated[float, Field(gt=0)]], Field(min_length=2)] | None = None
     """with ``max_sources`` K > 1: the prior probability of 0, 1, …, K releases (K + 1 positive
     numbers, normalised); None: every count equally likely"""
+    plume: Literal["open", "walls"] = "open"
+    """the dispersion model of the filter and the planners: ``open``, the paper's plume in open
+    terrain (:mod:`dcee.models.plume`); ``walls``, the wall-aware planar plume that flows round
+    the ``[world]``'s obstacles and the map's occupied cells (:mod:`dcee.models.site_plume`: a
+    mass-consistent wind and the advection-diffusion equation solved between the walls,
+    source-receptor fields per sensor position). ``walls`` needs a ``[world]`` with obstacles or
+    a map, the wind and ζ known (``unknown = "source"``: one flow), one release, and none of
+    the open plume's shape settings learned (:data:`PLUME_SHAPE_SETTINGS`)"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the

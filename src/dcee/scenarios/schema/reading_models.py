@@ -14,6 +14,7 @@ from dcee.scenarios.schema.common import FIELD_MARK
 from dcee.scenarios.schema.estimator import (
     LEARN_MEMBERS_MAX,
     LEARN_RANGES,
+    PLUME_SHAPE_SETTINGS,
     default_learn,
     default_learn_prior,
     learn_member_weight,
@@ -40,6 +41,32 @@ class ReadingModelSettings:
                 f"model, got {len(self.reading_models)} ({', '.join(self.reading_models)}); use "
                 'likelihood = "paper", or the fluctuation likelihood with calm_prior = 0 and '
                 "learn = {}"
+            )
+
+    def _checked_walls(self) -> None:
+        """``estimator.plume = "walls"``: buildings to flow round, one known flow, one release,
+        no open-plume shape learned."""
+        e = self.estimator
+        if e.plume != "walls":
+            return
+        what = f'{FIELD_MARK}estimator.plume: "walls" '
+        if not self.world.obstacles and self.world.map is None:
+            raise ValueError(
+                f"{what}needs buildings or walls to flow round: [world] obstacles or a map "
+                '(no-go zones are nothing to the gas); use plume = "open"'
+            )
+        if self.unknown != "source":
+            raise ValueError(
+                f"{what}solves one flow, for a known wind and ζ: needs unknown = "
+                f'"source" (got "{self.unknown}")'
+            )
+        if e.max_sources > 1:
+            raise ValueError(f"{what}models one release: needs estimator.max_sources = 1")
+        shaped = sorted(set(e.learn or {}) & set(PLUME_SHAPE_SETTINGS))
+        if shaped:
+            raise ValueError(
+                f"{FIELD_MARK}estimator.learn: {', '.join(shaped)} shape the open plume; the "
+                'wall-aware plume (estimator.plume = "walls") has no such setting'
             )
 
     def _checked_learn(self) -> None:

@@ -114,6 +114,7 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
             raise ValueError(f"prior: unknown parameter name(s) {extra}; allowed {PARAMETER_NAMES}")
         self._checked_learn()
         self._checked_source_count()
+        self._checked_walls()
         self._checked_planar(start)
         site = self._checked_site(start, src)
         agent = GridAgent(

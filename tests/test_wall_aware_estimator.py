@@ -1,0 +1,132 @@
+"""The wall-aware estimator (``estimator.plume = "walls"``): every consumer of a plume without
+compiled constants (the filter's history likelihood, the planners' position terms, the
+exploration guard) against its compiled open-plume path, through a plume that predicts the open
+plume by its own method; the scenario checks; a search round a wall."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from dcee.estimation import ParticleFilter
+from dcee.estimation.filter_kernels import history_log_likelihood_generic
+from dcee.exploration import detection_information
+from dcee.models.plume import IsotropicPlume, isotropic_concentration_reference
+from dcee.models.site_plume import SitePlume
+from dcee.planning.particle_terms import ParticleTerms
+from dcee.runs import run_episode
+from dcee.scenarios import load_scenario
+
+
+class OwnMethodPlume:
+    """The open plume predicting by its own (NumPy) method, as the wall-aware plume does: what
+    the generic paths see, with the compiled paths as the reference."""
+
+    def __init__(self, plume: IsotropicPlume) -> None:
+        self.plume = plume
+
+    def concentration_distance(self, theta: np.ndarray, positions: np.ndarray) -> tuple:
+        p = self.plume
+        conc = isotropic_concentration_reference(theta, positions, p.min_distance, *p.shape)
+        d = positions[None, :, :] - theta[:, None, :3]
+        return conc, np.maximum(np.sqrt(np.einsum("nki,nki->nk", d, d)), p.min_distance)
+
+
+@pytest.fixture(scope="module")
+def belief() -> tuple:
+    sc = load_scenario("paper:2").with_overrides(**{"estimator.likelihood": "fluctuation"})
+    sensor = sc.make_sensor()
+    pf = ParticleFilter(sc.make_prior(), sensor, IsotropicPlume(), n_particles=3000, seed=4)
+    for p, z in (((10.0, 10.0, 2.0), 0.0), ((20.0, 15.0, 2.0), 0.02), ((22.0, 15.0, 2.0), 0.0)):
+        pf.update(np.array(p), z)
+    return pf, sensor
+
+
+def test_history_likelihood_of_a_plume_by_its_own_method_is_the_compiled_one(belief) -> None:
+    pf, _ = belief
+    positions = np.array([[10.0, 10.0, 2.0], [20.0, 15.0, 2.0], [30.0, 40.0, 4.0]])
+    readings = np.array([0.0, 0.03, 1.5])
+    mult = np.array([1.0, 0.5, 2.0])
+    active = np.ones(len(pf.theta), bool)
+    active[::7] = False
+    compiled = np.empty(len(pf.theta))
+    pf._history_ll(pf.theta, active, positions, readings, mult, compiled)
+    generic = np.empty(len(pf.theta))
+    history_log_likelihood_generic(
+        OwnMethodPlume(pf.plume), pf.theta, active, positions, readings, mult, pf._sp, generic
+    )
+    assert np.all(generic[~active] == -np.inf)
+    np.testing.assert_allclose(generic[active], compiled[active], rtol=1e-10, atol=1e-9)
+
+
+def test_position_terms_of_a_plume_by_its_own_method_are_the_compiled_ones(belief) -> None:
+    pf, sensor = belief
+    positions = np.array([[12.0, 30.0, 2.0], [40.0, 5.0, 3.0], [25.0, 25.0, 1.0]])
+    compiled, generic = ParticleTerms(), ParticleTerms()
+    compiled.sync(pf.theta, sensor, pf.plume)
+    generic.sync(pf.theta, sensor, OwnMethodPlume(pf.plume))
+    rows_c, rows_g = compiled.rows(positions), generic.rows(positions)
+    for a, b in zip(compiled.terms, generic.terms, strict=True):
+        np.testing.assert_allclose(b[rows_g], a[rows_c], rtol=1e-9, atol=1e-12)
+    # a subset keeps the plume's own method
+    keep = np.arange(generic.n) % 3 == 0
+    sub = generic.subset(keep)
+    more = np.array([[5.0, 45.0, 2.0]])
+    np.testing.assert_allclose(
+        sub.terms.conc[sub.rows(more)][0],
+        compiled.terms.conc[compiled.rows(more)][0][keep],
+        rtol=1e-9,
+    )
+
+
+def test_exploration_information_of_a_plume_by_its_own_method_is_the_compiled_one(belief):
+    pf, sensor = belief
+    points = np.array([[5.0, 5.0, 2.0], [25.0, 20.0, 2.0], [45.0, 45.0, 2.0], [20.0, 15.0, 2.0]])
+    a = detection_information(pf.theta, pf.weights, sensor, pf.plume, points)
+    b = detection_information(pf.theta, pf.weights, sensor, OwnMethodPlume(pf.plume), points)
+    np.testing.assert_allclose(b, a, rtol=1e-6, atol=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"scenario": "paper:1"}, "needs buildings or walls"),
+        ({"unknown": "full"}, 'needs unknown = "source"'),
+        ({"estimator.max_sources": 2}, "max_sources = 1"),
+        (
+            {"estimator.likelihood": "fluctuation", "estimator.learn": {"decay": [1.0, 0.5]}},
+            "shape the open plume",
+        ),
+    ],
+)
+def test_combinations_that_cannot_work_get_one_line(changes, message) -> None:
+    from dcee.errors import DceeInputError
+
+    changes = dict(changes)
+    name = changes.pop("scenario", "site:wall")
+    with pytest.raises(DceeInputError, match=message):
+        load_scenario(name).with_overrides(**{"estimator.plume": "walls", **changes})
+
+
+def test_the_fluctuation_likelihood_learns_no_open_plume_shape_round_walls() -> None:
+    sc = load_scenario("site:wall").with_overrides(
+        **{"estimator.plume": "walls", "estimator.likelihood": "fluctuation"}
+    )
+    assert sc.reading_models == ("fluctuation", "paper")  # the calm member only
+    plumes = {id(sc.make_plume(m)) for m in sc.reading_models}
+    assert len(plumes) == 1 and isinstance(sc.make_plume(), SitePlume)
+
+
+def test_a_search_round_a_wall_with_the_wall_aware_estimator() -> None:
+    sc = load_scenario("site:wall").with_overrides(
+        **{
+            "estimator.plume": "walls",
+            "search.particles": 600,
+            "search.hypotheses": 8,
+            "search.budget": 200.0,
+        }
+    )
+    res = run_episode(sc, "dcee-cl", seed=0)
+    xy = np.array([[r["x"], r["y"]] for r in res.records])
+    assert not sc.make_site().is_blocked(xy).any()
+    assert np.isfinite(res.summary["final_rmse"])
