@@ -103,7 +103,7 @@ def test_a_wall_shelters_what_lies_behind_it() -> None:
         > 3 * open_.concentration(theta, round_end)[0, 0]
     )
     # a source inside a wall releases nothing; distances are clamped
-    conc, dist = walled.concentration_distance(_theta(20.5, 10.0, 5.0), ahead)
+    conc, _ = walled.concentration_distance(_theta(20.5, 10.0, 5.0), ahead)
     assert conc[0, 0] == 0.0
     _, d = walled.concentration_distance(_theta(25.0, 12.5, 5.0), np.array([[25.0, 12.5, 1.0]]))
     assert d[0, 0] == pytest.approx(0.1)

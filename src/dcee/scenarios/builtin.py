@@ -267,8 +267,10 @@ def random_family_name(name: str) -> tuple[str, int] | None:
 
 # --- sites with obstacles ---------------------------------------------------------------------
 # The paper's area, sensor, start and budget with a [world]: a wall between the start and the
-# source, a narrow passage, and a no-go zone around the source itself (the robot must localise
-# it from outside). The gas ignores the walls (the isotropic truth is an open-terrain plume).
+# source, a narrow passage, a street canyon between two rows of buildings, and a no-go zone
+# around the source itself (the robot must localise it from outside). The isotropic truth's gas
+# ignores the walls (an open-terrain plume); the fluid solver's (truth.model = "lbm") flows round
+# them.
 SITES: dict[str, dict[str, Any]] = {
     "wall": {
         "description": "a 35 m wall between the start and the source: the way round is over its "
@@ -284,6 +286,18 @@ SITES: dict[str, dict[str, Any]] = {
             "obstacles": [
                 {"kind": "rectangle", "low": [24.0, 0.0], "high": [25.0, 21.0]},
                 {"kind": "rectangle", "low": [24.0, 25.0], "high": [25.0, 50.0]},
+            ]
+        },
+    },
+    "canyon": {
+        "description": "a street canyon: two rows of three buildings with an 8 m street between "
+        "them (y 20-28 m) and 6 m cross streets; the source in the street, the wind along it",
+        "source": (30.0, 24.0, 20.0),
+        "world": {
+            "obstacles": [
+                {"kind": "rectangle", "low": [x0, y0], "high": [x1, y1]}
+                for x0, x1 in ((6.0, 18.0), (24.0, 36.0), (42.0, 50.0))
+                for y0, y1 in ((10.0, 20.0), (28.0, 38.0))
             ]
         },
     },
