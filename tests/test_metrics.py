@@ -45,3 +45,35 @@ def test_stall_start_is_the_first_of_the_latest_run_within_one_step():
     assert stall_start(np.array([[9, 9], [0, 0], [2, 0], [0, 0]]), 2.0) == 1
     assert stall_start(np.array([[0, 0], [2, 0], [4, 0]]), 2.0) == 1  # moved on: its last move
     assert stall_start(np.array([[5, 5]]), 2.0) == 0
+
+
+def test_circling_in_one_region_is_a_wander_but_not_a_stall():
+    from dcee.runs.metrics import WANDER_RADIUS, search_wander
+
+    # 2 m steps round a square of side 8 m (every corner within 7.5 m of the first), 5 s apart,
+    # for 200 s; then straight away east; then the source acquired in one region
+    square = [(10, 10), (12, 10), (14, 10), (16, 10), (16, 12), (16, 14), (16, 16), (14, 16),
+              (12, 16), (10, 16), (10, 14), (10, 12)]  # fmt: skip
+    xy = [square[k % len(square)] for k in range(41)]
+    xy += [(16 + 2 * k, 10) for k in range(1, 11)]
+    rows = [{"time": 5.0 * k, "x": x, "y": y, "rmse": 5.0} for k, (x, y) in enumerate(xy)]
+    assert search_wander(rows, 3.0) == 200.0
+    assert search_stall(rows, 2.0, 3.0) <= 10.0  # never more than a corner within one step
+    # staying there once the source is acquired is not wandering
+    done = [dict(r, rmse=1.0) for r in rows]
+    assert search_wander(done, 3.0) == 0.0
+    assert WANDER_RADIUS == 7.5
+
+
+def test_the_exploration_guard_is_on_at_a_site_and_off_in_open_terrain():
+    from dcee.scenarios import load_scenario
+
+    assert not load_scenario("paper:1").explore_guard
+    assert load_scenario("paper:1").with_overrides(**{"search.explore_guard": True}).explore_guard
+    assert load_scenario("site:wall").explore_guard and load_scenario("site:nogo").explore_guard
+    assert (
+        not load_scenario("site:wall")
+        .with_overrides(**{"search.explore_guard": False})
+        .explore_guard
+    )
+    assert load_scenario("random2:1").with_overrides(**{"estimator.max_sources": 2}).explore_guard

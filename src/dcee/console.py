@@ -183,6 +183,11 @@ def print_summary(summary: dict[str, Any], out_dir: Path | None, where: str = "r
             if "longest_stall" in summary  # searches saved before the metric lack it
             else []
         ),
+        *(
+            [("longest wander in 15 m before acquired (s)", f"{summary['longest_wander']:.0f}")]
+            if "longest_wander" in summary
+            else []
+        ),
         ("steps", str(summary["steps"])),
         *(
             [

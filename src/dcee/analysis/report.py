@@ -22,6 +22,7 @@ from dcee.analysis.report_figures import (
 from dcee.analysis.results import describe_folder, load_summaries
 from dcee.analysis.statistics import (
     STALL_SECONDS,
+    WANDER_SECONDS,
     metrics_table,
     pairwise_table,
     per_configuration_table,
@@ -93,20 +94,22 @@ def _fmt(v: float, lo: float, hi: float, digits: int = 2, pct: bool = False) -> 
     return body + ("%" if pct else "")
 
 
-def _fmt_stall(longest: float, stalled: int) -> str:
-    """The longest stall of any search, s, and how many searches stalled > STALL_SECONDS."""
+def _fmt_stall(longest: float, stalled: int, limit: float = STALL_SECONDS) -> str:
+    """The longest stall (or wander) of any search, s, and how many were longer than
+    ``limit`` s."""
     if not math.isfinite(longest):
         return "n/a"
-    return f"{longest:.0f} ({stalled} > {STALL_SECONDS:.0f} s)"
+    return f"{longest:.0f} ({stalled} > {limit:.0f} s)"
 
 
 def markdown_table(table: pd.DataFrame) -> str:
     head = (
         "| strategy | n | source acquired | plume acquired | mean final RMSE (m) | "
         "median final RMSE (m) | median time to RMSE < 1 m (s) | to < 0.5 m (s) | "
-        "path (m) | decision (ms) | truth in 95% region | longest stall (s) |"
+        "path (m) | decision (ms) | truth in 95% region | longest stall (s) | "
+        "longest wander in 15 m (s) |"
     )
-    lines = [head, "|" + "---|" * 12]
+    lines = [head, "|" + "---|" * 13]
     for _, r in table.iterrows():
         src = _fmt(r.source_acquired_rate, r.source_acquired_lo, r.source_acquired_hi, pct=True)
         plume = _fmt(r.plume_acquired_rate, r.plume_acquired_lo, r.plume_acquired_hi, pct=True)
@@ -121,7 +124,8 @@ def markdown_table(table: pd.DataFrame) -> str:
             f"| {_fmt(r.path_length, r.path_length_lo, r.path_length_hi, 0)} "
             f"| {_fmt(r.decision_ms, r.decision_ms_lo, r.decision_ms_hi, 1)} "
             f"| {_fmt(r.truth_in_95_rate, r.truth_in_95_lo, r.truth_in_95_hi, pct=True)} "
-            f"| {_fmt_stall(r.longest_stall, r.stalled)} |"
+            f"| {_fmt_stall(r.longest_stall, r.stalled)} "
+            f"| {_fmt_stall(r.longest_wander, r.wandered, WANDER_SECONDS)} |"
         )
     if "count_correct_rate" in table and table["count_correct_rate"].notna().any():
         # the count of releases was unknown: its own table, the set's error beside it

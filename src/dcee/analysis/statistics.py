@@ -30,6 +30,8 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
+from dcee.runs.metrics import WANDER_SECONDS
+
 Z95 = 1.959963984540054
 
 
@@ -140,6 +142,10 @@ def metrics_table(runs: pd.DataFrame) -> pd.DataFrame:
         stall = pd.to_numeric(g.get("longest_stall", pd.Series(np.nan, g.index)), errors="coerce")
         row["longest_stall"] = float(stall.max()) if stall.notna().all() else math.nan
         row["stalled"] = int((stall > STALL_SECONDS).sum()) if stall.notna().all() else -1
+        # and the longest wander in one 15 m region (issue 44), how many wandered > 120 s
+        wander = pd.to_numeric(g.get("longest_wander", pd.Series(np.nan, g.index)), errors="coerce")
+        row["longest_wander"] = float(wander.max()) if wander.notna().all() else math.nan
+        row["wandered"] = int((wander > WANDER_SECONDS).sum()) if wander.notna().all() else -1
         # the count of releases unknown (issue 45): how often it came out right, and the OSPA
         # distance between the estimated and the true set; NaN for other campaigns
         if "count_correct" in g and g["count_correct"].notna().all():

@@ -99,8 +99,7 @@ def make_searcher(
         stall_guard=search.stall_guard,
         guard_spread=search.guard_share * search.acquired_rmse,
         stop_rule=scenario.stop_rule(on_robot),
-        # several releases: a further one may be anywhere, far from every move (dcee.exploration)
-        explore_guard=scenario.estimator.max_sources > 1,
+        explore_guard=scenario.explore_guard,
     )
 
 

@@ -54,6 +54,23 @@ def longest_stall(
     return best
 
 
+WANDER_RADIUS = 7.5
+"""m: a search *wanders* while every position of a run of readings lies within this distance of
+the run's first (a 15 m region, the scale issue 44 measured: 800 s inside 15 m with a 13 m wide
+belief) and the source is not yet acquired (:func:`search_wander`)."""
+
+WANDER_SECONDS = 120.0
+"""s: a wander longer than this is counted in a campaign's report (issue 44's bar)."""
+
+
+def search_wander(records: list[dict[str, Any]], acquired_rmse: float) -> float:
+    """The longest time, s, a robot of the search stayed within :data:`WANDER_RADIUS` m of one
+    position before the source was acquired: :func:`longest_stall` at that reach. Closing in on
+    a source it has not yet localised takes a robot a while in one region; hovering there for
+    minutes while the belief stays wide is wandering."""
+    return search_stall(records, WANDER_RADIUS, acquired_rmse)
+
+
 def search_stall(records: list[dict[str, Any]], step: float, acquired_rmse: float) -> float:
     """:func:`longest_stall` of a search's records, s: the longest over its robots."""
     robots = np.array([r.get("robot", 0) for r in records])
@@ -118,6 +135,7 @@ def summarise(
     below ``search.acquired_rmse`` (3 m in the paper); time_to_rmse_*: first time the RMSE of
     the particles about the true source falls below 1 m / 0.5 m (null if never);
     longest_stall: :func:`search_stall`, s (a robot pacing on one spot before it has the source);
+    longest_wander: :func:`search_wander`, s (one staying in a 15 m region before it has it);
     true_sources: how many releases the truth holds; final_ospa: :func:`ospa` (3 m cut-off,
     order 1) between the estimated set (one source, at the posterior mean) and the true
     releases, m (one release: the final mean's error, capped at 3 m; each release the search
@@ -154,6 +172,7 @@ def summarise(
         "time_to_rmse_1m": first_time_below(times, rmse, 1.0),
         "time_to_rmse_0_5m": first_time_below(times, rmse, 0.5),
         "longest_stall": search_stall(records, scenario.agent.step, scenario.search.acquired_rmse),
+        "longest_wander": search_wander(records, scenario.search.acquired_rmse),
         "steps": steps,
         "readings": len(records),
         "agents": int(scenario.agent.count),
@@ -188,10 +207,10 @@ def search_summary(
     out.update(scenario.resolved_settings())
     out["resamples"] = pf.n_resamples
     out["stall_guard_fired"] = searcher.guard_fired  # decisions the stall guard restricted
+    out["explore_guard_fired"] = searcher.explore_fired  # and the exploration guard
     if isinstance(pf, SourceCountBank):  # the count was unknown: what the search made of it
         out.update(pf.count_summary())
         out["count_correct"] = out["estimated_count"] == out["true_sources"]
-        out["explore_guard_fired"] = searcher.explore_fired
         out["final_ospa"] = ospa(pf.estimated_sources(), scenario.truth.source_locations())
     choice = pf.reading_model()
     if choice is not None:  # which reading model the readings chose, and how firmly

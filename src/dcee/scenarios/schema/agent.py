@@ -138,6 +138,13 @@ class SearchSpec(BaseModel):
     before, let dcee-cl hover > 60 s at a narrow but wrong belief in 19 of 56 searches and 0.15 in
     1, acquisition and final error unchanged; isotropic random-tune searches unchanged
     (docs/turbulent.md)"""
+    explore_guard: bool | None = None
+    """before each decision, compare how much the best move's next reading would tell (the
+    mutual information of detection or not with the hypotheses) with a coarse grid over the
+    area, and head for the grid's informative points when every move within reach is
+    uninformative (:mod:`dcee.exploration`): the search does not wander where nothing can be
+    learnt. None: on with several releases (``estimator.max_sources`` > 1) and on a site
+    (a ``[world]`` that is not empty), off in open terrain (open-terrain searches unchanged)"""
     resample_threshold: Annotated[float, Field(gt=0, le=1)] = 0.5
     """resample when the effective sample size falls below this share of the particles"""
     mcmc_steps: Annotated[int, Field(ge=0, le=100)] = 1

@@ -188,6 +188,15 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
             )
 
     @property
+    def explore_guard(self) -> bool:
+        """``search.explore_guard`` resolved: as given, or on with several releases (a further
+        one may be anywhere, far from every move) and on a site (walls and zones make regions
+        where no move within reach is informative; issue 44), off in open terrain."""
+        if self.search.explore_guard is not None:
+            return self.search.explore_guard
+        return self.estimator.max_sources > 1 or not self.world.empty
+
+    @property
     def planar_truth(self) -> bool:
         """The truth holds one horizontal plane (a 2-D recording or the solver plume): the
         agent stays at its altitude (an unset climb is 0) and the source height is not
@@ -313,6 +322,8 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
             "repeat_radius": self.repeat_radius,
             "repeat_power": self.repeat_power,
             "climb": self.climb,
+            "explore_guard": self.explore_guard,
+            "estimator_plume": self.estimator.plume,
         }
 
     @property
