@@ -130,3 +130,66 @@ def test_a_search_round_a_wall_with_the_wall_aware_estimator() -> None:
     xy = np.array([[r["x"], r["y"]] for r in res.records])
     assert not sc.make_site().is_blocked(xy).any()
     assert np.isfinite(res.summary["final_rmse"])
+
+
+def _map(tmp_path, resolution: float, edit) -> str:
+    """A 50 m × 50 m free map at ``resolution`` with ``edit(pixels, cell)`` applied (pixels
+    row 0 at the top: the largest y; ``cell(x, y)`` gives a pixel's (row, column))."""
+    from PIL import Image
+
+    n = round(50 / resolution)
+    pixels = np.full((n, n), 254, np.uint8)
+
+    def cell(x: float, y: float) -> tuple[int, int]:
+        return n - 1 - int(y / resolution), int(x / resolution)
+
+    edit(pixels, cell)
+    Image.fromarray(pixels, mode="L").save(tmp_path / "m.png")
+    (tmp_path / "m.yaml").write_text(
+        f"image: m.png\nresolution: {resolution}\norigin: [0.0, 0.0, 0.0]\n"
+    )
+    return str(tmp_path / "m.yaml")
+
+
+def _box(pixels, cell, x0, y0, x1, y1, value=0):
+    r1, c0 = cell(x0, y0)
+    r0, c1 = cell(x1, y1)
+    pixels[r0 : r1 + 1, c0 : c1 + 1] = value
+
+
+ENCLOSURE = (
+    (0.5, 0.5, 46.0, 1.0),
+    (0.5, 20.0, 46.0, 21.0),
+    (0.5, 0.5, 1.0, 21.0),
+    (45.0, 0.5, 46.0, 21.0),
+)
+"""Walls round the start (2, 2) and the source (37.5, 12.5) of paper:1: the robot reaches the
+source, the gas cannot leave."""
+
+
+@pytest.mark.parametrize(
+    ("resolution", "edit", "message"),
+    [
+        (2.0, lambda p, c: _box(p, c, 10, 10, 12, 30), "2 m cells"),
+        (0.5, lambda p, c: _box(p, c, 38.6, 12.0, 39.6, 13.0, 205), "unknown"),
+        (0.5, lambda p, c: [_box(p, c, *b) for b in ENCLOSURE], "no free path out"),
+    ],
+)
+def test_a_map_the_gas_cannot_use_is_one_line_exit_2_before_any_work(
+    tmp_path, capsys, resolution, edit, message
+) -> None:
+    """Too coarse, unknown round the source, the source's gas enclosed with the robot."""
+    from tests.helpers import run_cli
+
+    path = _map(tmp_path, resolution, edit)
+    out = tmp_path / "run"
+    code, _, err = run_cli(
+        [
+            "run", "--scenario", "paper:1", "--truth", "lbm", "--set", "truth.z=4",
+            "--set", f'world.map="{path}"', "--out", str(out),
+        ],
+        capsys,
+    )  # fmt: skip
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1 and message in lines[0], lines
+    assert not out.exists()

@@ -116,6 +116,8 @@ class SiteMap:
     origin: tuple[float, float]
     resolution: float
     name: str = "site"
+    unknown: np.ndarray | None = None
+    """(ny, nx) bool: the cells a map leaves unknown (None: every cell known), as given"""
     _fields: OrderedDict[int, np.ndarray] = field(default_factory=OrderedDict, repr=False)
     _graph: Any = field(default=None, repr=False)
 
@@ -172,7 +174,9 @@ class SiteMap:
         planners assume), then inflated by ``clearance`` m."""
         occ = np.asarray(occupancy, dtype=float)
         blocked = np.where(np.isnan(occ), unknown_blocked, occ > occupied)
-        site = cls(blocked, (float(origin[0]), float(origin[1])), float(resolution), name)
+        site = cls(
+            blocked, (float(origin[0]), float(origin[1])), float(resolution), name, np.isnan(occ)
+        )
         return site.inflated(clearance)
 
     def inflated(self, clearance: float) -> SiteMap:
@@ -182,7 +186,7 @@ class SiteMap:
         from scipy import ndimage
 
         dist = ndimage.distance_transform_edt(~self.blocked) * self.resolution
-        return SiteMap(dist <= clearance, self.origin, self.resolution, self.name)
+        return SiteMap(dist <= clearance, self.origin, self.resolution, self.name, self.unknown)
 
     # -- queries --------------------------------------------------------------------------
 
@@ -207,6 +211,13 @@ class SiteMap:
         ny, nx = self.shape
         inside = (i >= 0) & (i < ny) & (j >= 0) & (j < nx)
         return np.clip(i, 0, ny - 1), np.clip(j, 0, nx - 1), inside
+
+    def is_unknown(self, xy: np.ndarray) -> np.ndarray:
+        """(K,) bool: the (K, 2) points lie in a cell the map leaves unknown."""
+        if self.unknown is None:
+            return np.zeros(len(np.atleast_2d(xy)), dtype=bool)
+        i, j, inside = self.cells(np.atleast_2d(np.asarray(xy, dtype=float))[:, :2])
+        return inside & self.unknown[np.where(inside, i, 0), np.where(inside, j, 0)]
 
     def is_blocked(self, xy: np.ndarray) -> np.ndarray:
         """(K,) bool: the (K, 2) (or (K, 3)) points lie in a blocked cell."""

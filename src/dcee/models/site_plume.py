@@ -312,12 +312,28 @@ def site_grid(
     return ~walls.reshape(ny, nx), (x0, y0)
 
 
+def open_to_edge(fluid: np.ndarray, origin: tuple[float, float], resolution: float, xy) -> bool:
+    """True when the air cell holding the point ``xy`` (2,) m connects (through air cells,
+    4-connected) to the grid's edge: gas released there has a free path out of the site."""
+    from scipy import ndimage
+
+    labels, _ = ndimage.label(fluid)
+    j = int((xy[0] - origin[0]) // resolution)
+    i = int((xy[1] - origin[1]) // resolution)
+    ny, nx = fluid.shape
+    if not (0 <= i < ny and 0 <= j < nx) or not fluid[i, j]:
+        return False
+    edge = np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]])
+    return bool(np.any(edge == labels[i, j]))
+
+
 __all__ = [
     "LAYER_DEPTH",
     "MARGIN",
     "SitePlume",
     "bernoulli",
     "mass_consistent_wind",
+    "open_to_edge",
     "site_grid",
     "transport_matrix",
 ]

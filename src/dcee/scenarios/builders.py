@@ -47,7 +47,8 @@ def _site(
 
 
 @functools.lru_cache(maxsize=4)
-def _raw_map(path: str) -> SiteMap:
+def raw_map(path: str) -> SiteMap:
+    """The map file as given (no clearance), read once per process."""
     return load_ros_map(path)
 
 
@@ -72,7 +73,7 @@ def _wall_plume(
         for shape in shapes:
             out |= shape.contains(xy)
         if world.map is not None:
-            out |= _raw_map(world.map).is_blocked(xy)
+            out |= raw_map(world.map).is_blocked(xy)
         return out
 
     fluid, origin = site_grid(low, high, resolution, solid)
@@ -253,7 +254,7 @@ class ScenarioBuilders:
         for shape in shapes_of(self.world.obstacles) + zones:
             out |= shape.contains(xy)
         if self.world.map is not None:
-            out |= _raw_map(self.world.map).is_blocked(xy)
+            out |= raw_map(self.world.map).is_blocked(xy)
         return out
 
     def stop_rule(self, on_robot: bool) -> StopRule | None:

@@ -30,6 +30,14 @@ from dcee.scenarios.schema.reading_models import ReadingModelSettings
 from dcee.scenarios.schema.truth import TURBULENT_HOLD, Truth, Volume
 from dcee.scenarios.schema.world import WorldSpec
 
+GAS_MAP_MAX_CELL = 1.0
+"""m: the coarsest map cell the gas round buildings is computed on (the lbm truth, the
+wall-aware estimator): a 2 m street is then two cells wide at least."""
+
+GAS_SOURCE_CLEARANCE = 2.0
+"""m round the source within which a map may leave no cell unknown where the gas flows round
+walls (what the gas meets first must be known)."""
+
 
 class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
     """A validated, immutable scenario."""
@@ -233,7 +241,45 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
                 f"{FIELD_MARK}world: the source area around ({src[0]:g}, {src[1]:g}) cannot be "
                 f"reached from agent.start {tuple(self.agent.start)}: obstacles enclose it"
             )
+        if self.truth.model_name == "lbm" or self.estimator.plume == "walls":
+            self._checked_gas_walls(src)
         return site
+
+    def _checked_gas_walls(self, src: np.ndarray) -> None:
+        """Where the gas flows round the site's walls (the lbm truth, ``estimator.plume =
+        "walls"``): a map fine enough to hold a street, the walls round the source known, and a
+        free path for the gas from the source out of the site."""
+        from dcee.models.site_plume import open_to_edge, site_grid
+        from dcee.scenarios.builders import raw_map
+
+        if self.world.map is not None:
+            raw = raw_map(self.world.map)
+            if raw.resolution > GAS_MAP_MAX_CELL:
+                raise ValueError(
+                    f"{FIELD_MARK}world.map: {raw.name} has {raw.resolution:g} m cells; the gas "
+                    f"round buildings needs at most {GAS_MAP_MAX_CELL:g} m (a street two cells "
+                    "wide at least)"
+                )
+            ring = src[None, :2] + GAS_SOURCE_CLEARANCE * np.array(
+                [[0, 0]] + [[np.cos(a), np.sin(a)] for a in np.linspace(0, 2 * np.pi, 16)]
+            )
+            if raw.is_unknown(ring).any():
+                raise ValueError(
+                    f"{FIELD_MARK}world.map: {raw.name} leaves cells within "
+                    f"{GAS_SOURCE_CLEARANCE:g} m of the source ({src[0]:g}, {src[1]:g}) unknown; "
+                    "the walls the gas meets there must be known"
+                )
+        fluid, origin = site_grid(
+            tuple(self.volume.low[:2]),
+            tuple(self.volume.high[:2]),
+            float(self.site_resolution),
+            lambda xy: self.in_obstacle(xy, no_go=False),
+        )
+        if not open_to_edge(fluid, origin, float(self.site_resolution), src[:2]):
+            raise ValueError(
+                f"{FIELD_MARK}world: the gas from the source ({src[0]:g}, {src[1]:g}) has no "
+                "free path out of the site: obstacles enclose it"
+            )
 
     # --- settings that depend on the truth ----------------------------------------------------
 
