@@ -123,3 +123,52 @@ def test_a_cornered_climbing_robot_must_still_leave_its_spot():
     # where some move does leave the anchor, only those are offered, as before
     away, _ = LeavingAgent(agent, here, here).candidates(here)
     assert np.all(np.hypot(*(away[:, :2] - here[:2]).T) > 1.0)
+
+
+def test_the_wander_guard_sends_a_robot_out_of_a_region_it_keeps_to():
+    """Positions round a 3 m circle for 70 s with nothing detected and a belief 16 m wide: the
+    guard names a goal outside the 7.5 m region, holds it until the robot is a step from it,
+    and the search that kept to one region no longer does."""
+    from dcee.searcher import WANDER_GUARD, WANDER_RADIUS
+
+    pf = ParticleFilter(
+        planar_prior(x=(0.0, 40.0), y=(0.0, 40.0)), Sensor.paper_exact(), IsotropicPlume(), 800, 0
+    )
+    s = Searcher(pf, _Homing(), AGENT, np.random.default_rng(0), stall_guard=0.0)
+    s.explore_guard = True
+    centre = np.array([20.0, 20.0, 0.0])
+    for k in range(15):
+        a = 2 * np.pi * k / 6
+        s.tell(centre + 3.0 * np.array([np.cos(a), np.sin(a), 0.0]), 0.0, 5.0 * k)
+    assert s.estimate().spread > WANDER_RADIUS and 5.0 * 14 >= WANDER_GUARD
+    goal = s.wander_goal()
+    assert goal is not None and s.wander_fired == 1
+    assert np.hypot(*(goal[:2] - s.recent[0][1][:2])) > WANDER_RADIUS
+    assert np.array_equal(s.wander_goal(), goal)  # held
+    s.tell(goal + np.array([1.0, 0.0, 0.0]), 0.0, 200.0)
+    assert s.wander_goal() is None or not np.array_equal(s.wander_goal(), goal)
+    # a whole search: the homing planner paces round (10, 10) to the end without the guard
+    # (the stall guard off), and leaves that region within the guard's time with it
+    for guarded in (False, True):
+        pf = ParticleFilter(
+            planar_prior(x=(0.0, 40.0), y=(0.0, 40.0)),
+            Sensor.paper_exact(),
+            IsotropicPlume(),
+            500,
+            seed=0,
+        )
+        s = Searcher(pf, _Homing(), AGENT, np.random.default_rng(0), stall_guard=0.0)
+        s.explore_guard = guarded
+        position, times, path = np.array([2.0, 2.0, 0.0]), [], []
+        for k in range(120):
+            s.tell(position, 0.0, 2.0 * k)
+            times.append(2.0 * k)
+            path.append(position)
+            position = s.ask()
+        wander = longest_stall(
+            np.array(times), np.array(path), np.zeros(len(path), bool), WANDER_RADIUS
+        )
+        if guarded:
+            assert wander <= WANDER_GUARD + 10.0 and s.explore_fired > 0, wander
+        else:
+            assert wander > 150.0 and s.explore_fired == 0

@@ -259,9 +259,36 @@ class RestrictedAgent:
 
 
 class ApproachingAgent(RestrictedAgent):
-    """The moves that bring the agent closer (horizontally) to ``target`` (3,) m by at least
-    half a step: what the exploration guard hands a planner."""
+    """The moves that bring the agent closer to ``target`` (3,) m by at least half a step, by
+    travel distance round the site's obstacles (straight without a site): what the exploration
+    guard hands a planner."""
 
     def allowed(self, cands: np.ndarray) -> np.ndarray:
-        now = math.hypot(*(self.start[:2] - self.target[:2]))
-        return np.hypot(*(cands[:, :2] - self.target[:2]).T) < now - 0.5 * self.agent.step
+        site = self.agent.site
+        now = float(travel_xy(site, self.target, self.start[None])[0])
+        return travel_xy(site, self.target, cands) < now - 0.5 * self.agent.step
+
+
+def wander_goal(
+    estimator: Estimator, anchor: np.ndarray, agent: GridAgent, radius: float
+) -> np.ndarray | None:
+    """Where to go when the robot has kept to one region (within ``radius`` m of ``anchor``
+    (3,) m) while the belief stays wider than it: the grid point outside the region (beyond
+    ``radius`` + one step of the anchor, reachable) whose next reading tells the most
+    (:func:`detection_information`), or None when no such point tells anything."""
+    joint = getattr(estimator, "joint_particles", None)
+    theta, weights = joint() if joint is not None else (estimator.theta, estimator.weights)
+    grid = area_grid(agent, float(anchor[2]))
+    outside = np.hypot(*(grid[:, :2] - anchor[:2]).T) > radius + agent.step
+    grid = grid[outside]
+    if agent.site is not None and len(grid):
+        grid = grid[agent.site.reachable(anchor, grid)]
+    if len(grid) == 0:
+        return None
+    info = detection_information(theta, weights, estimator.sensor, estimator.plume, grid)
+    best = int(np.argmax(info))
+    return grid[best] if info[best] > WANDER_LEAST_INFORMATION else None
+
+
+WANDER_LEAST_INFORMATION = 1e-3
+"""nats: a grid point telling less than this is no reason to leave a region."""

@@ -14,7 +14,7 @@ import numpy as np
 from dcee.blas import one_blas_thread
 from dcee.errors import DceeInputError
 from dcee.estimation.base import Estimator, UpdateInfo
-from dcee.exploration import ApproachingAgent, RestrictedAgent, exploration_goal
+from dcee.exploration import ApproachingAgent, RestrictedAgent, exploration_goal, wander_goal
 from dcee.io import write_atomic
 from dcee.models.agent import GridAgent, stall_start
 from dcee.planning.base import Belief, Decision, Planner
@@ -45,6 +45,14 @@ DEFAULT_GUARD_SPREAD = DEFAULT_STOP_SHARE * 3.0
 """m (0.45): the guard acts while the belief's spread √tr P exceeds this: the default stop rule's
 threshold at the paper's 3 m acquisition bar, so a robot may hover only where it could also stop
 (``search.guard_share``, docs/turbulent.md)."""
+
+WANDER_RADIUS = 7.5
+"""m: the region the wander guard watches (the radius of :data:`dcee.runs.metrics.WANDER_RADIUS`,
+which the summaries count)."""
+
+WANDER_GUARD = 60.0
+"""s in one region with a belief wider than it before the wander guard sends the robot out
+(half the 120 s a study may allow, issue 44)."""
 
 STALL_HISTORY = 64
 """Told positions the stall guard looks back over (more than 30 s of readings at 1 s)."""
@@ -128,6 +136,10 @@ class Searcher:
         self.explore_guard = bool(explore_guard)
         self.explore_fired = 0
         """how many decisions the exploration guard restricted (:mod:`dcee.exploration`)"""
+        self.wander_fired = 0
+        """how many of them because the robot kept to one region (:meth:`wander_anchor`)"""
+        self.wander_target: np.ndarray | None = None
+        """where the wander guard sends the robot, held until it is within a step of it"""
         self.filter = particle_filter
         self.planner = planner
         self.agent = agent
@@ -209,11 +221,42 @@ class Searcher:
         if anchor is not None:
             return LeavingAgent(self.agent, anchor, self.position)
         if self.explore_guard:
-            goal = exploration_goal(self.filter, self.position, self.agent)
+            goal = self.wander_goal()
+            if goal is None:
+                goal = exploration_goal(self.filter, self.position, self.agent)
             if goal is not None:
                 self.explore_fired += 1
                 return ApproachingAgent(self.agent, goal, self.position)
         return self.agent
+
+    def wander_goal(self) -> np.ndarray | None:
+        """The exploration guard's region-wide part: once the told positions of the last
+        :data:`WANDER_GUARD` s or more all lie within :data:`WANDER_RADIUS` m of the first of
+        them while the belief is wider than that region (its spread √tr P above the radius:
+        readings in the region cannot resolve it), head for the grid point outside the region
+        that tells the most (:func:`~dcee.exploration.wander_goal`), and keep heading there
+        until within one step of it. None when the guard does not fire."""
+        if self.wander_target is not None:
+            reached = math.dist(self.wander_target[:2], self.position[:2]) <= self.agent.step
+            if reached or self.estimate().spread <= self.guard_spread:
+                self.wander_target = None
+            else:
+                self.wander_fired += 1
+                return self.wander_target
+        if len(self.recent) < 2:
+            return None
+        first = stall_start(np.array([p for _, p in self.recent]), WANDER_RADIUS)
+        if self.recent[-1][0] - self.recent[first][0] < WANDER_GUARD:
+            return None
+        if self.estimate().spread <= WANDER_RADIUS:
+            return None
+        self.wander_target = wander_goal(
+            self.filter, self.recent[first][1], self.agent, WANDER_RADIUS
+        )
+        if self.wander_target is not None:
+            self.wander_fired += 1
+            self.recent = self.recent[-1:]  # a new region starts once it has left this one
+        return self.wander_target
 
     def stall_anchor(self) -> np.ndarray | None:
         """The position (3,) m the robot has stayed within one step of for at least

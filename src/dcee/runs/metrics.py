@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from dcee.estimation.source_count import SourceCountBank
+from dcee.searcher import WANDER_RADIUS as WANDER_GUARD_RADIUS
 
 if TYPE_CHECKING:
     from dcee.scenarios import Scenario
@@ -54,7 +55,7 @@ def longest_stall(
     return best
 
 
-WANDER_RADIUS = 7.5
+WANDER_RADIUS = WANDER_GUARD_RADIUS
 """m: a search *wanders* while every position of a run of readings lies within this distance of
 the run's first (a 15 m region, the scale issue 44 measured: 800 s inside 15 m with a 13 m wide
 belief) and the source is not yet acquired (:func:`search_wander`)."""
@@ -207,7 +208,8 @@ def search_summary(
     out.update(scenario.resolved_settings())
     out["resamples"] = pf.n_resamples
     out["stall_guard_fired"] = searcher.guard_fired  # decisions the stall guard restricted
-    out["explore_guard_fired"] = searcher.explore_fired  # and the exploration guard
+    out["explore_guard_fired"] = searcher.explore_fired  # and the exploration guard,
+    out["wander_guard_fired"] = searcher.wander_fired  # of them for keeping to one region
     if isinstance(pf, SourceCountBank):  # the count was unknown: what the search made of it
         out.update(pf.count_summary())
         out["count_correct"] = out["estimated_count"] == out["true_sources"]
