@@ -65,6 +65,15 @@ SUITES: dict[str, dict] = {
             "estimator.likelihood": "fluctuation",
         },
     },
+    # random sites for choosing the wall-aware estimator's settings (never report them)
+    "sites-tune": {
+        "configs": [f"random-site:{k}" for k in range(1, 21)],
+        "overrides": {
+            "truth.model": "lbm",
+            "truth.z": 4.0,
+            "estimator.likelihood": "fluctuation",
+        },
+    },
     "random-tune": {"configs": [f"random:{k}" for k in range(1, 41)], "overrides": {}},
     "held-out": {
         "configs": [

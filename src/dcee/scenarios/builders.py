@@ -52,7 +52,7 @@ def raw_map(path: str) -> SiteMap:
     return load_ros_map(path)
 
 
-@functools.lru_cache(maxsize=4)
+@functools.lru_cache(maxsize=8)
 def _wall_plume(
     low: tuple[float, float],
     high: tuple[float, float],
@@ -61,8 +61,9 @@ def _wall_plume(
     resolution: float,
     environment: tuple[float, float, float, float],
 ) -> SitePlume:
-    """The wall-aware plume of one site and one (u, φ, ζ1, ζ2), built once per process and
-    shared by the filter's members and the planners (its receptor fields are cached in it)."""
+    """The wall-aware plume of one site and one (u, φ, K, ζ2), built once per process and
+    shared by the filter's members of that K and the planners (its receptor fields are cached
+    in it)."""
     from dcee.scenarios.schema.world import WorldSpec, shapes_of
 
     world = WorldSpec.model_validate_json(world_json)
@@ -127,7 +128,9 @@ class ScenarioBuilders:
         wall-aware plume of the site (every member's: it has no shape setting to learn)."""
         model = self._reading_model(model)
         if self.estimator.plume == "walls":
-            truth = self.truth_theta()
+            u, phi, _, zeta2 = (float(v) for v in self.truth_theta()[4:8])
+            learned = dict(self.reading_model_variants).get(model, {})
+            k = float(learned.get("wall_diffusivity", self.wall_diffusivity))
             mtime = Path(self.world.map).stat().st_mtime if self.world.map is not None else 0.0
             return _wall_plume(
                 tuple(self.volume.low[:2]),
@@ -135,7 +138,7 @@ class ScenarioBuilders:
                 self.world.model_dump_json(),
                 mtime,
                 float(self.site_resolution),
-                tuple(float(v) for v in truth[4:8]),
+                (u, phi, k, zeta2),
             )
         if self.estimator.likelihood == "paper":
             return IsotropicPlume(meander=self.meander)

@@ -160,7 +160,7 @@ RANDOM_REPORTING_FROM = 1000
 """K ≥ 1000 is the reporting range (the ``held-out`` suite: K = 1000-1199): no default is ever
 chosen on it, so what the studies report there was measured on configurations nothing was
 tuned on."""
-RANDOM_FAMILIES = ("random", "random-start", "random2", "random3")
+RANDOM_FAMILIES = ("random", "random-start", "random2", "random3", "random-site")
 """``random2:K`` and ``random3:K``: two and three releases
 (:func:`random_sources_configuration`)."""
 MULTI_SOURCE_SEPARATION = 5.0
@@ -247,8 +247,65 @@ def random_sources_configuration(k: int, n_sources: int) -> dict[str, Any]:
     return scenario
 
 
+SITE_BUILDINGS = (3, 6)
+"""``random-site:K``: how many buildings (inclusive range)."""
+
+
+def random_site_configuration(k: int) -> dict[str, Any]:
+    """The raw scenario ``random-site:K``: 3-6 rectangular buildings (sides 4-14 m, at least
+    3 m apart, so every street is open and every building can be flown round), a release at
+    least 3 m from each and the wind from anywhere at the paper's 4 m/s, the paper's area,
+    start, sensor and budget. Its own stream (RANDOM_STREAM, "site", K); the sites for
+    tuning the gas round buildings (issue 44: the built-in sites are reported on)."""
+    if isinstance(k, bool) or not isinstance(k, int) or k < 1:
+        raise ValueError(f"K must be an integer >= 1, got {k!r}")
+    rng = np.random.Generator(np.random.PCG64([RANDOM_STREAM, 0x517E, k]))
+    x, y = (round(float(v), 2) for v in rng.uniform(10.0, 45.0, size=2))
+    phi = round(float(rng.uniform(0.0, 360.0)), 2)
+    low, high = RANDOM_RANGES["q"]
+    q = round(math.exp(rng.uniform(math.log(low), math.log(high))), 2)
+    boxes: list[tuple[float, float, float, float]] = []
+    count = int(rng.integers(SITE_BUILDINGS[0], SITE_BUILDINGS[1] + 1))
+    for _ in range(400):
+        if len(boxes) == count:
+            break
+        w, h = rng.uniform(4.0, 14.0, size=2)
+        x0, y0 = rng.uniform(0.0, 50.0 - w), rng.uniform(0.0, 50.0 - h)
+        box = (x0, y0, x0 + w, y0 + h)
+
+        def gap(a: tuple[float, ...], px: float, py: float) -> float:
+            return math.hypot(max(a[0] - px, 0.0, px - a[2]), max(a[1] - py, 0.0, py - a[3]))
+
+        def apart(a: tuple[float, ...], b: tuple[float, ...]) -> float:
+            dx = max(a[0] - b[2], b[0] - a[2], 0.0)
+            dy = max(a[1] - b[3], b[1] - a[3], 0.0)
+            return math.hypot(dx, dy)
+
+        if gap(box, x, y) >= 3.0 and gap(box, 2.0, 2.0) >= 4.0:
+            if all(apart(box, b) >= 3.0 for b in boxes):
+                boxes.append(tuple(round(float(v), 1) for v in box))
+    scenario = _paper(1)
+    scenario.update(
+        name=f"random-site:{k}",
+        description=(
+            f"Random site {k} (tuning range): {len(boxes)} buildings; source ({x}, {y}, 1) m, "
+            f"q {q} g/s, {wind_from_words(phi)} at 4 m/s; UAV at 4 m from (2, 2)."
+        ),
+        truth={**scenario["truth"], "x": x, "y": y, "q": q, "phi": phi},
+        world={
+            "obstacles": [
+                {"kind": "rectangle", "low": [b[0], b[1]], "high": [b[2], b[3]]} for b in boxes
+            ]
+        },
+    )
+    scenario["prior"] = {**scenario["prior"], "phi": {**scenario["prior"]["phi"], "mean": phi}}
+    return scenario
+
+
 def random_family_configuration(family: str, k: int) -> dict[str, Any]:
     """The raw scenario ``family:K`` of :data:`RANDOM_FAMILIES`."""
+    if family == "random-site":
+        return random_site_configuration(k)
     if family.startswith("random") and family[6:].isdigit():
         return random_sources_configuration(k, int(family[6:]))
     return random_configuration(k, random_start=family == "random-start")

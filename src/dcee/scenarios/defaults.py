@@ -85,6 +85,16 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
     ("estimator", "count_prior"): Provenance(
         (), "unset: every count 0 … max_sources equally likely (no count is preferred)"
     ),
+    ("estimator", "plume"): Provenance(
+        (),
+        '"open": the paper\'s plume; the wall-aware plume ("walls") is opt-in until its study '
+        "chooses a default (issue 44, docs/scenarios.md)",
+    ),
+    ("search", "explore_guard"): Provenance(
+        (),
+        "unset: on with several releases or on a site ([world] not empty), off in open terrain "
+        "(open-terrain searches unchanged; measured on the sites, docs/scenarios.md)",
+    ),
     ("search", "stall_guard"): Provenance(("isotropic",), "held-out tuning, docs/held-out.md"),
     ("search", "guard_share"): Provenance(("filament", "puffs"), "random:13-40, dcee-cl"),
     ("search", "stop_hold"): Provenance(("isotropic",), "random-tune, 40 configurations"),

@@ -136,6 +136,7 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
         ("agent", "dwell"): scenario.dwell,
         ("agent", "climb"): scenario.climb,
         ("world", "resolution"): scenario.site_resolution,
+        ("search", "explore_guard"): scenario.explore_guard,
     }
     # unset with no single resolved value: what unset means, in words
     unset = {

@@ -172,6 +172,7 @@ LearnedName = Literal[
     "decay",
     "backflow",
     "source_radius",
+    "wall_diffusivity",
 ]
 """The reading model's nuisance parameters ``estimator.learn`` may weigh."""
 PLUME_SHAPE_SETTINGS = ("meander", "decay", "backflow", "source_radius")
@@ -186,6 +187,7 @@ LEARN_RANGES: dict[str, tuple[float, float]] = {
     "decay": (0.25, 2.0),
     "backflow": (0.0, 0.5),
     "source_radius": (0.0, 10.0),
+    "wall_diffusivity": (1e-3, 1000.0),
 }
 """Allowed values of each learned setting (as for the fixed setting)."""
 LEARN_DEFAULT: dict[str, dict[str, list[float]]] = {
@@ -214,6 +216,14 @@ Jeffreys' scale calls evidence strong (the value from that convention, not from 
 equal prior let the disc lead on point releases: docs/results/tuning-source-radius-13-40)."""
 
 
+WALL_DIFFUSIVITY_FACTORS = (1.0, 3.0, 10.0)
+"""The wall-aware plume's diffusivity K the fluctuation likelihood weighs by default, as
+multiples of the fixed one (the scenario's ζ1 unless ``estimator.wall_diffusivity`` is set): a
+decade in steps of about √10. Not chosen by measurement: the spread of a plume among buildings
+(wakes, channelling; the fluid solver's eddies) is not known before the search, and each
+member is a filter updated at every reading, so three members."""
+
+
 def default_learn(likelihood: str, fixed: Mapping[str, float]) -> dict[str, list[float]]:
     """What an unset ``estimator.learn`` weighs: :data:`LEARN_DEFAULT` for the likelihood,
     without the settings fixed by hand (``fixed``: the estimator's settings by name; one of the
@@ -223,11 +233,15 @@ def default_learn(likelihood: str, fixed: Mapping[str, float]) -> dict[str, list
     grid = LEARN_DEFAULT[likelihood]
     walls = fixed.get("plume") == "walls"
     # a copy: callers may edit it
-    return {
+    out = {
         key: list(v)
         for key, v in grid.items()
         if fixed.get(key, v[0]) == v[0] and not (walls and key in PLUME_SHAPE_SETTINGS)
     }
+    if walls and likelihood == "fluctuation" and fixed.get("wall_diffusivity") is not None:
+        k0 = float(fixed["wall_diffusivity"])
+        out["wall_diffusivity"] = [k0 * f for f in WALL_DIFFUSIVITY_FACTORS]
+    return out
 
 
 def default_learn_prior(
@@ -410,6 +424,10 @@ class EstimatorSpec(BaseModel):
     source-receptor fields per sensor position). ``walls`` needs a ``[world]`` with obstacles or
     a map, the wind and ζ known (``unknown = "source"``: one flow), one release, and none of
     the open plume's shape settings learned (:data:`PLUME_SHAPE_SETTINGS`)"""
+    wall_diffusivity: Annotated[float | None, Field(gt=0, le=1000, allow_inf_nan=False)] = None
+    """m²/s: the wall-aware plume's diffusivity K (``plume = "walls"``); None: the scenario's
+    ζ1. The fluctuation likelihood weighs it and 3 and 10 times it
+    (:data:`WALL_DIFFUSIVITY_FACTORS`) unless ``learn`` says otherwise"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the

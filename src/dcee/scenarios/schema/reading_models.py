@@ -48,6 +48,11 @@ class ReadingModelSettings:
         no open-plume shape learned."""
         e = self.estimator
         if e.plume != "walls":
+            if e.wall_diffusivity is not None or "wall_diffusivity" in (e.learn or {}):
+                raise ValueError(
+                    f"{FIELD_MARK}estimator.wall_diffusivity: is the wall-aware plume's; needs "
+                    'estimator.plume = "walls"'
+                )
             return
         what = f'{FIELD_MARK}estimator.plume: "walls" '
         if not self.world.obstacles and self.world.map is None:
@@ -115,7 +120,7 @@ class ReadingModelSettings:
         """``estimator.learn`` resolved: as given, or the likelihood's default
         (:data:`LEARN_DEFAULT`, without a setting fixed by hand)."""
         e = self.estimator
-        return e.learn if e.learn is not None else default_learn(e.likelihood, dict(e))
+        return e.learn if e.learn is not None else default_learn(e.likelihood, self._learn_fixed())
 
     @property
     def learn_prior(self) -> dict[str, list[float]]:
@@ -124,7 +129,18 @@ class ReadingModelSettings:
         e = self.estimator
         if e.learn_prior is not None:
             return e.learn_prior
-        return default_learn_prior(e.likelihood, dict(e), e.learn)
+        return default_learn_prior(e.likelihood, self._learn_fixed(), e.learn)
+
+    def _learn_fixed(self) -> dict:
+        """The estimator's settings by name, the wall-aware plume's diffusivity resolved."""
+        return {**dict(self.estimator), "wall_diffusivity": self.wall_diffusivity}
+
+    @property
+    def wall_diffusivity(self) -> float:
+        """The wall-aware plume's fixed diffusivity K, m²/s: ``estimator.wall_diffusivity`` or
+        the scenario's ζ1."""
+        e = self.estimator
+        return float(e.wall_diffusivity if e.wall_diffusivity is not None else self.truth.zeta1)
 
     @property
     def reading_model_variants(self) -> tuple[tuple[str, dict[str, float]], ...]:
@@ -150,6 +166,8 @@ class ReadingModelSettings:
 
     def _fluctuation_value(self, key: str) -> float:
         """The fixed (resolved) value of a setting ``estimator.learn`` may weigh."""
+        if key == "wall_diffusivity":
+            return self.wall_diffusivity
         return self.meander if key == "meander" else float(getattr(self.estimator, key))
 
     @property

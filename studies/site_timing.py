@@ -1,0 +1,96 @@
+"""Decision and update time on a site against open terrain (issue 44: "a decision on a site
+costs at most 3× one on open terrain"), in one run on one pinned core.
+
+For each site with walls (``site:wall``, ``site:passage``, ``site:canyon``) the same search
+(``dcee-cl``, seed 0, 10,000 particles, 900 s, the lbm truth at the flight height, the
+fluctuation likelihood, as the ``sites-walls`` suite) three ways: in open terrain (the site's
+source, wind and start with ``world.obstacles = []``: no walls, no guard), on the site with the
+wall-blind estimator, and with the wall-aware one (``estimator.plume = "walls"``). Each in its own
+process pinned to core 0 with one thread (``taskset -c 0``, NUMBA/OMP/OPENBLAS threads 1), the
+kernels compiled by a first warm-up search; the truths' plumes must be cached (run the suite
+first). Run it with nothing else on the machine; the load is recorded beside the times.
+
+    python studies/site_timing.py --out docs/results/sites-walls/timing.csv
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parent.parent
+DCEE = ROOT / ".venv" / "bin" / "dcee"
+SITES = ("site:wall", "site:passage", "site:canyon")
+COMMON = ["--truth", "lbm", "--likelihood", "fluctuation", "--set", "truth.z=4"]
+WAYS = {
+    "open terrain": ["--set", "world.obstacles=[]"],
+    "site, wall-blind": [],
+    "site, wall-aware": ["--set", 'estimator.plume="walls"'],
+}
+
+
+def one(site: str, extra: list[str], folder: Path) -> dict:
+    env = {
+        **os.environ,
+        "NUMBA_NUM_THREADS": "1",
+        "OMP_NUM_THREADS": "1",
+        "OPENBLAS_NUM_THREADS": "1",
+    }
+    cmd = ["taskset", "-c", "0", str(DCEE), "run", "--scenario", site, *COMMON, *extra]
+    cmd += ["--strategy", "dcee-cl", "--seed", "0", "--particles", "10000", "--no-figure"]
+    cmd += ["--out", str(folder)]
+    subprocess.run(cmd, check=True, env=env, capture_output=True)
+    return json.loads((folder / "summary.json").read_text())
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, required=True)
+    args = ap.parse_args(argv)
+    try:
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        print(f"site_timing: error: --out: cannot write {args.out} ({exc})", file=sys.stderr)
+        return 2
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        one(SITES[0], WAYS["site, wall-aware"], Path(tmp) / "warm-up")  # compile the kernels
+        for site in SITES:
+            for way, extra in WAYS.items():
+                load = os.getloadavg()[0]
+                s = one(site, extra, Path(tmp) / f"{len(rows)}")
+                rows.append(
+                    {
+                        "site": site,
+                        "way": way,
+                        "decision_ms_mean": 1e3 * s["decision_seconds_mean"],
+                        "update_ms_mean": 1e3 * s["update_seconds_total"] / s["readings"],
+                        "steps": s["steps"],
+                        "final_rmse": s["final_rmse"],
+                        "load_before": round(load, 2),
+                        "commit": s["code"]["commit"],
+                    }
+                )
+                print(rows[-1], flush=True)
+    frame = pd.DataFrame(rows)
+    base = frame[frame.way == "open terrain"].set_index("site")
+    frame["decision_ratio"] = frame.apply(
+        lambda r: r.decision_ms_mean / base.loc[r.site, "decision_ms_mean"], axis=1
+    )
+    frame["update_ratio"] = frame.apply(
+        lambda r: r.update_ms_mean / base.loc[r.site, "update_ms_mean"], axis=1
+    )
+    frame.to_csv(args.out, index=False)
+    print(frame.to_string(index=False))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
