@@ -5,6 +5,8 @@ plume by its own method; the scenario checks; a search round a wall."""
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 
@@ -193,3 +195,27 @@ def test_a_map_the_gas_cannot_use_is_one_line_exit_2_before_any_work(
     lines = err.strip().splitlines()
     assert code == 2 and len(lines) == 1 and message in lines[0], lines
     assert not out.exists()
+
+
+def test_random_sites_are_reproducible_open_and_valid_for_the_gas() -> None:
+    from dcee.scenarios.builtin import random_site_configuration
+
+    for k in (1, 7, 20):
+        a, b = random_site_configuration(k), random_site_configuration(k)
+        assert a == b
+        boxes = [(o["low"], o["high"]) for o in a["world"]["obstacles"]]
+        assert 3 <= len(boxes) <= 6
+        src = np.array([a["truth"]["x"], a["truth"]["y"]])
+        for (lo, hi), (lo2, hi2) in itertools.combinations(boxes, 2):
+            gap = np.hypot(
+                max(lo[0] - hi2[0], lo2[0] - hi[0], 0), max(lo[1] - hi2[1], lo2[1] - hi[1], 0)
+            )
+            assert gap >= 2.9
+        for lo, hi in boxes:
+            assert (
+                np.hypot(*np.maximum(np.maximum(np.array(lo) - src, src - np.array(hi)), 0)) >= 2.9
+            )
+        # it validates with the gas flowing round its buildings (reachable, open to the edge)
+        load_scenario(f"random-site:{k}").with_overrides(
+            **{"truth.model": "lbm", "truth.z": 4.0, "estimator.plume": "walls"}
+        )

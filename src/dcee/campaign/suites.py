@@ -58,7 +58,7 @@ SUITES: dict[str, dict] = {
     # wall-aware estimator is --set estimator.plume=walls. Designed for the study, no default
     # chosen on them
     "sites-walls": {
-        "configs": ["site:wall", "site:passage", "site:canyon"],
+        "configs": ["site:wall", "site:passage", "site:canyon", "site:block"],
         "overrides": {
             "truth.model": "lbm",
             "truth.z": 4.0,

@@ -10,6 +10,7 @@ lab plume's parameters; every value chosen here is listed in docs/scenarios.md w
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -160,6 +161,9 @@ RANDOM_REPORTING_FROM = 1000
 """K ≥ 1000 is the reporting range (the ``held-out`` suite: K = 1000-1199): no default is ever
 chosen on it, so what the studies report there was measured on configurations nothing was
 tuned on."""
+MAPS = Path(__file__).resolve().parent / "maps"
+"""The built-in sites' map files (``site:block``)."""
+
 RANDOM_FAMILIES = ("random", "random-start", "random2", "random3", "random-site")
 """``random2:K`` and ``random3:K``: two and three releases
 (:func:`random_sources_configuration`)."""
@@ -357,6 +361,13 @@ SITES: dict[str, dict[str, Any]] = {
                 for y0, y1 in ((10.0, 20.0), (28.0, 38.0))
             ]
         },
+    },
+    "block": {
+        "description": "a city block from a map file (maps/block.yaml, a ROS map-server grid "
+        "at 0.25 m): an L-shaped building, a courtyard block, two smaller buildings and a strip "
+        "the map leaves unknown",
+        "source": (24.0, 27.0, 30.0),
+        "world": {"map": str(MAPS / "block.yaml")},
     },
     "nogo": {
         "description": "a no-go zone of radius 5 m around the source: the robot localises it from "
