@@ -56,12 +56,16 @@ def test_circling_in_one_region_is_a_wander_but_not_a_stall():
               (12, 16), (10, 16), (10, 14), (10, 12)]  # fmt: skip
     xy = [square[k % len(square)] for k in range(41)]
     xy += [(16 + 2 * k, 10) for k in range(1, 11)]
-    rows = [{"time": 5.0 * k, "x": x, "y": y, "rmse": 5.0} for k, (x, y) in enumerate(xy)]
+    rows = [
+        {"time": 5.0 * k, "x": x, "y": y, "rmse": 5.0, "spread": 12.0}
+        for k, (x, y) in enumerate(xy)
+    ]
     assert search_wander(rows, 3.0) == 200.0
     assert search_stall(rows, 2.0, 3.0) <= 10.0  # never more than a corner within one step
-    # staying there once the source is acquired is not wandering
-    done = [dict(r, rmse=1.0) for r in rows]
-    assert search_wander(done, 3.0) == 0.0
+    # staying there once the source is acquired is not wandering, nor with a belief narrower
+    # than the region (closing in, or stuck on a wrong estimate: the final error counts that)
+    assert search_wander([dict(r, rmse=1.0) for r in rows], 3.0) == 0.0
+    assert search_wander([dict(r, spread=WANDER_RADIUS) for r in rows], 3.0) == 0.0
     assert WANDER_RADIUS == 7.5
 
 

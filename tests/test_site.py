@@ -204,7 +204,10 @@ def test_open_terrain_searches_are_unchanged_by_an_empty_world():
     assert [r["x"] for r in a.records] == [r["x"] for r in b.records]
 
 
-@pytest.mark.parametrize("name", ["site:wall", "site:passage", "site:canyon", "site:block", "site:nogo"])
+SITE_NAMES = ["site:wall", "site:passage", "site:canyon", "site:block", "site:nogo"]
+
+
+@pytest.mark.parametrize("name", SITE_NAMES)
 @pytest.mark.parametrize("strategy", ["dcee-cl", "infotaxis", "mpc", "dcee", "entrotaxis"])
 def test_no_search_enters_or_crosses_a_blocked_cell(name, strategy):
     sc = load_scenario(name).with_overrides(

@@ -96,6 +96,10 @@ def test_exploration_information_of_a_plume_by_its_own_method_is_the_compiled_on
         ({"unknown": "full"}, 'needs unknown = "source"'),
         ({"estimator.max_sources": 2}, "max_sources = 1"),
         (
+            {"scenario": "site:wall", "estimator.plume": "open", "estimator.wall_lifetime": 8.0},
+            "wall_lifetime",
+        ),
+        (
             {"estimator.likelihood": "fluctuation", "estimator.learn": {"decay": [1.0, 0.5]}},
             "shape the open plume",
         ),
@@ -114,9 +118,20 @@ def test_the_fluctuation_likelihood_learns_no_open_plume_shape_round_walls() -> 
     sc = load_scenario("site:wall").with_overrides(
         **{"estimator.plume": "walls", "estimator.likelihood": "fluctuation"}
     )
-    assert sc.reading_models == ("fluctuation", "paper")  # the calm member only
-    plumes = {id(sc.make_plume(m)) for m in sc.reading_models}
-    assert len(plumes) == 1 and isinstance(sc.make_plume(), SitePlume)
+    # the diffusivity weighed at 1, 3 and 10 times ζ1 (no backflow or disc member), and the calm
+    # member with the first; no decay (a conserved gas)
+    assert sc.reading_models == (
+        "fluctuation",
+        "fluctuation[wall_diffusivity=3]",
+        "fluctuation[wall_diffusivity=10]",
+        "paper",
+    )
+    plumes = [sc.make_plume(m) for m in sc.reading_models]
+    assert all(isinstance(p, SitePlume) for p in plumes)
+    assert [p.zeta1 for p in plumes] == [1.0, 3.0, 10.0, 1.0]
+    assert plumes[0] is plumes[3] and all(p.zeta2 == float("inf") for p in plumes)
+    fixed = sc.with_overrides(**{"estimator.learn": {}, "estimator.wall_lifetime": 8.0})
+    assert fixed.reading_models == ("fluctuation", "paper") and fixed.make_plume().zeta2 == 8.0
 
 
 def test_a_search_round_a_wall_with_the_wall_aware_estimator() -> None:

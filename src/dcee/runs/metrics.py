@@ -66,10 +66,28 @@ WANDER_SECONDS = 120.0
 
 def search_wander(records: list[dict[str, Any]], acquired_rmse: float) -> float:
     """The longest time, s, a robot of the search stayed within :data:`WANDER_RADIUS` m of one
-    position before the source was acquired: :func:`longest_stall` at that reach. Closing in on
-    a source it has not yet localised takes a robot a while in one region; hovering there for
-    minutes while the belief stays wide is wandering."""
-    return search_stall(records, WANDER_RADIUS, acquired_rmse)
+    position while the source was not acquired and its belief was wider than that region (the
+    spread √tr P above the radius: readings in the region could not resolve it): issue 44's
+    wandering, what the wander guard (:meth:`dcee.searcher.Searcher.wander_goal`) acts on. A
+    robot closing in on a source with a belief narrower than the region is not wandering, nor is
+    one stuck on a narrow, wrong belief (a failure the final error counts)."""
+    robots = np.array([r.get("robot", 0) for r in records])
+    best = 0.0
+    for robot in np.unique(robots):
+        rows = [r for r, k in zip(records, robots, strict=True) if k == robot]
+        settled = np.array(
+            [r["rmse"] < acquired_rmse or r["spread"] <= WANDER_RADIUS for r in rows]
+        )
+        best = max(
+            best,
+            longest_stall(
+                np.array([r["time"] for r in rows]),
+                np.array([[r["x"], r["y"]] for r in rows]),
+                settled,
+                WANDER_RADIUS,
+            ),
+        )
+    return best
 
 
 def search_stall(records: list[dict[str, Any]], step: float, acquired_rmse: float) -> float:
@@ -136,7 +154,8 @@ def summarise(
     below ``search.acquired_rmse`` (3 m in the paper); time_to_rmse_*: first time the RMSE of
     the particles about the true source falls below 1 m / 0.5 m (null if never);
     longest_stall: :func:`search_stall`, s (a robot pacing on one spot before it has the source);
-    longest_wander: :func:`search_wander`, s (one staying in a 15 m region before it has it);
+    longest_wander: :func:`search_wander`, s (one staying in a 15 m region with a belief wider
+    than it before it has the source);
     true_sources: how many releases the truth holds; final_ospa: :func:`ospa` (3 m cut-off,
     order 1) between the estimated set (one source, at the posterior mean) and the true
     releases, m (one release: the final mean's error, capped at 3 m; each release the search

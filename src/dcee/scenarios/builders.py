@@ -128,7 +128,9 @@ class ScenarioBuilders:
         wall-aware plume of the site (every member's: it has no shape setting to learn)."""
         model = self._reading_model(model)
         if self.estimator.plume == "walls":
-            u, phi, _, zeta2 = (float(v) for v in self.truth_theta()[4:8])
+            u, phi = (float(v) for v in self.truth_theta()[4:6])
+            lifetime = self.estimator.wall_lifetime
+            zeta2 = math.inf if lifetime is None else float(lifetime)
             learned = dict(self.reading_model_variants).get(model, {})
             k = float(learned.get("wall_diffusivity", self.wall_diffusivity))
             mtime = Path(self.world.map).stat().st_mtime if self.world.map is not None else 0.0

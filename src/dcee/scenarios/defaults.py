@@ -90,6 +90,12 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
         '"open": the paper\'s plume; the wall-aware plume ("walls") is opt-in until its study '
         "chooses a default (issue 44, docs/scenarios.md)",
     ),
+    ("estimator", "wall_lifetime"): Provenance(
+        ("lbm",), "random-site:1-20 (the tuning sites), dcee-cl, docs/results/sites-walls-tune"
+    ),
+    ("estimator", "wall_diffusivity"): Provenance(
+        (), "unset: the scenario's ζ1, weighed with 3 and 10 times it (not chosen by measurement)"
+    ),
     ("search", "explore_guard"): Provenance(
         (),
         "unset: on with several releases or on a site ([world] not empty), off in open terrain "

@@ -48,10 +48,11 @@ class ReadingModelSettings:
         no open-plume shape learned."""
         e = self.estimator
         if e.plume != "walls":
-            if e.wall_diffusivity is not None or "wall_diffusivity" in (e.learn or {}):
+            walls_only = e.wall_diffusivity is not None or e.wall_lifetime is not None
+            if walls_only or "wall_diffusivity" in (e.learn or {}):
                 raise ValueError(
-                    f"{FIELD_MARK}estimator.wall_diffusivity: is the wall-aware plume's; needs "
-                    'estimator.plume = "walls"'
+                    f"{FIELD_MARK}estimator.wall_diffusivity, wall_lifetime: are the wall-aware "
+                    'plume\'s; need estimator.plume = "walls"'
                 )
             return
         what = f'{FIELD_MARK}estimator.plume: "walls" '
