@@ -528,6 +528,81 @@ def sites_table() -> str:
     )
 
 
+def sites_walls_table(name: str, all_only: bool = False) -> Callable[[], str]:
+    """Issue 44's tables (studies/sites_walls_table.py): per site and estimator, then the
+    estimators paired search by search."""
+
+    def make() -> str:
+        frame = pd.read_csv(RESULTS / name / "summary.csv")
+        if all_only:  # one search per configuration: only the pooled rows say anything
+            frame = frame[frame["scenario"] == "all sites"]
+        rows = []
+        for _, r in frame.iterrows():
+            n = int(r["searches"])
+            lo, hi = 100 * r["acquired_lo"], 100 * r["acquired_hi"]
+            t1 = r["median_time_to_1m"]
+            rows.append(
+                [
+                    f"`{r['scenario']}`" if ":" in r["scenario"] else r["scenario"],
+                    str(r["estimator"]),
+                    f"{int(r['acquired'])}/{n}, "
+                    f"{100 * r['acquired_rate']:.0f} % [{lo:.0f}, {hi:.0f}]",
+                    interval(r, "median_final_rmse", ".2f"),
+                    "never"
+                    if math.isnan(t1)
+                    else f"{t1:.0f} ({100 * r['reached_1m']:.0f} % got there)",
+                    f"{100 * r['truth_in_95']:.0f} %",
+                    f"{r['longest_wander']:.0f} ({int(r['wandered'])} > 120 s)",
+                    f"{r['decision_ms']:.0f}",
+                ]
+            )
+        head = table(
+            [
+                "site",
+                "estimator",
+                "source acquired",
+                "median final RMSE (m)",
+                "median time to RMSE < 1 m (s)",
+                "truth in 95 % region",
+                "longest wander (s)",
+                "decision (ms, 2 workers)",
+            ],
+            rows,
+        )
+        pairs = pd.read_csv(RESULTS / name / "paired.csv")
+        prow = [
+            [
+                f"`{r['scenario']}`" if ":" in r["scenario"] else r["scenario"],
+                f"{r['a']} − {r['b']}",
+                str(int(r["pairs"])),
+                f"{int(r['acquired_a_only'])} / {int(r['acquired_b_only'])}",
+                f"{r['mcnemar_p']:.2g}",
+                f"{r['median_rmse_difference']:+.2f}",
+                f"{r['wilcoxon_p']:.2g}",
+            ]
+            for _, r in pairs.iterrows()
+            if r["pairs"] >= 5 and not (all_only and r["scenario"] != "all sites")
+        ]
+        return (
+            head
+            + "\n"
+            + table(
+                [
+                    "site",
+                    "paired",
+                    "searches",
+                    "acquired by the first only / the second only",
+                    "McNemar p",
+                    "median final RMSE difference (m)",
+                    "Wilcoxon p",
+                ],
+                prow,
+            )
+        )
+
+    return make
+
+
 def anemometer_table() -> str:
     frame = pd.read_csv(RESULTS / "anemometer" / "anemometer.csv")
     pairs = pd.read_csv(RESULTS / "anemometer" / "paired.csv").set_index("prior")
@@ -1396,6 +1471,8 @@ TABLES: dict[str, Callable[[], str]] = {
     "stop-rule": stop_rule_table,
     "anemometer": anemometer_table,
     "sites": sites_table,
+    "sites-walls": sites_walls_table("sites-walls"),
+    "sites-walls-tune": sites_walls_table("sites-walls-tune", all_only=True),
     "speed": speed_table,
     "search-speed": search_speed_table,
     "kernel-speedup": kernel_speedup_table,

@@ -404,6 +404,25 @@ case "${1:---list}" in
     $P studies/sites_table.py results/sites results/sites-mcts results/sites-robot \
       --csv docs/results/sites/sites.csv
     $P studies/publish_tables.py ;;
+  sites-walls-tune)  # issue 44: the wall-aware estimator's variants on the tuning sites random-site:1-20 (never reported as a result)
+    B="$D bench --suite sites-tune --strategies dcee-cl --repeats 1 --particles 10000 --workers ${WORKERS:-2}"
+    $B --set estimator.plume=walls --set truth.zeta2=1000 --out results/sites-tune-C
+    $B --set estimator.plume=walls --out results/sites-tune-B
+    $B --set estimator.plume=walls --set 'estimator.learn={}' --out results/sites-tune-A
+    $B --out results/sites-tune-blind
+    $P studies/sites_walls_table.py "no-decay, K learned (C, chosen)=results/sites-tune-C" \
+      "decay 8 s, K learned (B)=results/sites-tune-B" "decay 8 s, K fixed (A)=results/sites-tune-A" \
+      "wall-blind=results/sites-tune-blind" --out docs/results/sites-walls-tune
+    $P studies/publish_tables.py ;;
+  sites-walls)  # issue 44: gas round buildings, the lbm truth on the four sites with walls, wall-aware against wall-blind, dcee-cl, 10 seeds
+    B="$D bench --suite sites-walls --strategies dcee-cl --repeats 10 --particles 10000 --workers ${WORKERS:-2}"
+    $B --set estimator.plume=walls --out results/sites-walls-aware
+    $B --out results/sites-walls-blind
+    $P studies/sites_walls_table.py wall-aware=results/sites-walls-aware \
+      wall-blind=results/sites-walls-blind --out docs/results/sites-walls
+    $P studies/publish_tables.py ;;
+  sites-walls-timing)  # issue 44: decision time on a site against open terrain (idle machine, one pinned core)
+    $P studies/site_timing.py --out docs/results/sites-walls/timing.csv ;;
   anemometer)  # the full-unknown study with and without a measured wind (paired)
     bash studies/study_anemometer.sh
     mkdir -p docs/results/anemometer

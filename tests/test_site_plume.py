@@ -113,3 +113,16 @@ def test_refuses_a_model_without_diffusion() -> None:
     fluid = np.ones((10, 10), bool)
     with pytest.raises(DceeInputError):
         SitePlume(fluid, (0.0, 0.0), 1.0, u=4.0, phi=0.0, zeta1=0.0, zeta2=8.0)
+
+
+def test_the_field_cache_evicts_the_least_recent_and_keeps_the_numbers(monkeypatch) -> None:
+    import dcee.models.site_plume as module
+
+    theta = np.vstack([_theta(30.0 + k, 12.0 + 2 * k, 1.0 + k) for k in range(5)])
+    positions = np.array([[10.0 + 4 * k, 10.0 + k, 4.0] for k in range(7)])
+    expected = _open().concentration(theta, positions)
+    monkeypatch.setattr(module, "FIELD_CACHE", 4)  # two positions per gather, rows reused
+    small = _open()
+    np.testing.assert_array_equal(small.concentration(theta, positions), expected)
+    assert len(small._slots) == 4  # rows reused, the bank never grown
+    np.testing.assert_array_equal(small.concentration(theta, positions[::-1]), expected[:, ::-1])

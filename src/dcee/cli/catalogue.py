@@ -20,6 +20,10 @@ def scenarios() -> None:
         "drawn from K alone; K < 1000 tuning range, K >= 1000 reporting range (docs/scenarios.md)."
     )
     click.echo(f"{'random-start:K':14s} The same as random:K with a start drawn over the area.")
+    click.echo(
+        f"{'random-site:K':14s} A random site: 3-6 buildings, a release among them, the wind "
+        "from anywhere; for tuning the gas round buildings (--truth lbm), never reported."
+    )
 
 
 @click.command(short_help="List the planners and their options.")

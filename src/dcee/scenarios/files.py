@@ -137,6 +137,7 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
         ("agent", "climb"): scenario.climb,
         ("world", "resolution"): scenario.site_resolution,
         ("search", "explore_guard"): scenario.explore_guard,
+        ("estimator", "wall_diffusivity"): scenario.wall_diffusivity,
     }
     # unset with no single resolved value: what unset means, in words
     unset = {
@@ -146,6 +147,7 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
         ),
         ("world", "map"): "unset: no occupancy-grid map",
         ("estimator", "count_prior"): "unset: every count 0 … max_sources equally likely",
+        ("estimator", "wall_lifetime"): "unset: no decay, a conserved gas (the wall-aware plume)",
     }
     lines = [f"# dcee scenario {scenario.name}"]
     tables = []
