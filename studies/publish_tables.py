@@ -603,6 +603,34 @@ def sites_walls_table(name: str, all_only: bool = False) -> Callable[[], str]:
     return make
 
 
+def sites_walls_timing_table() -> str:
+    """Issue 44: decision and update time on a site against open terrain, one pinned core, idle
+    (studies/site_timing.py)."""
+    frame = pd.read_csv(RESULTS / "sites-walls" / "timing.csv")
+    rows = [
+        [
+            f"`{r['site']}`",
+            str(r["way"]),
+            f"{r['decision_ms_mean']:.1f}",
+            f"{r['decision_ratio']:.2f}×",
+            f"{r['update_ms_mean']:.1f}",
+            f"{r['update_ratio']:.2f}×",
+        ]
+        for _, r in frame.iterrows()
+    ]
+    return table(
+        [
+            "site",
+            "search",
+            "mean decision (ms)",
+            "× open terrain",
+            "mean update per reading (ms)",
+            "× open terrain",
+        ],
+        rows,
+    )
+
+
 def anemometer_table() -> str:
     frame = pd.read_csv(RESULTS / "anemometer" / "anemometer.csv")
     pairs = pd.read_csv(RESULTS / "anemometer" / "paired.csv").set_index("prior")
@@ -1473,6 +1501,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "sites": sites_table,
     "sites-walls": sites_walls_table("sites-walls"),
     "sites-walls-tune": sites_walls_table("sites-walls-tune", all_only=True),
+    "sites-walls-timing": sites_walls_timing_table,
     "speed": speed_table,
     "search-speed": search_speed_table,
     "kernel-speedup": kernel_speedup_table,
