@@ -132,6 +132,33 @@ def _rows_gaussian(
         det_offset[i] = sp.log_pd - log_scalar(sigma)
 
 
+@njit(cache=True, inline="always")
+def _store_terms(
+    c: float,
+    r: float,
+    sp: SensorParams,
+    row: int,
+    i: int,
+    conc: np.ndarray,
+    dist: np.ndarray,
+    loc: np.ndarray,
+    log_nd: np.ndarray,
+    inv_sigma: np.ndarray,
+    det_offset: np.ndarray,
+) -> None:
+    """The terms of one particle at one position from its concentration ``c`` and clamped
+    source distance ``r``, by the scalar formulas of :mod:`dcee.models.sensor_kernels`, into
+    row ``row``, column ``i`` of each output (:func:`position_rows`' general path and
+    :func:`rows_from_concentration`)."""
+    m, sigma = transform(c, r, sp)
+    conc[row, i] = c
+    dist[row, i] = r
+    loc[row, i] = m
+    inv_sigma[row, i] = 1.0 / sigma
+    log_nd[row, i] = log_likelihood(0.0, c, r, sp)
+    det_offset[row, i] = log_detection_probability(r, sp) - math.log(sigma)
+
+
 @njit(cache=True, parallel=True)
 def position_rows(
     plume: np.ndarray,
@@ -199,13 +226,7 @@ def position_rows(
                 c, r = plume_at(
                     constants_at(plume, i), px, py, pz, rmin, meander, decay, backflow, radius
                 )
-                m, sigma = transform(c, r, sp)
-                conc[row, i] = c
-                dist[row, i] = r
-                loc[row, i] = m
-                inv_sigma[row, i] = 1.0 / sigma
-                log_nd[row, i] = log_likelihood(0.0, c, r, sp)
-                det_offset[row, i] = log_detection_probability(r, sp) - math.log(sigma)
+                _store_terms(c, r, sp, row, i, conc, dist, loc, log_nd, inv_sigma, det_offset)
 
 
 @njit(cache=True, parallel=True)
@@ -228,12 +249,7 @@ def rows_from_concentration(
     for k in range(conc_in.shape[0]):
         row = rows[k]
         for i in prange(conc_in.shape[1]):
-            c = conc_in[k, i]
-            r = dist_in[k, i]
-            m, sigma = transform(c, r, sp)
-            conc[row, i] = c
-            dist[row, i] = r
-            loc[row, i] = m
-            inv_sigma[row, i] = 1.0 / sigma
-            log_nd[row, i] = log_likelihood(0.0, c, r, sp)
-            det_offset[row, i] = log_detection_probability(r, sp) - math.log(sigma)
+            _store_terms(
+                conc_in[k, i], dist_in[k, i], sp, row, i,
+                conc, dist, loc, log_nd, inv_sigma, det_offset,
+            )  # fmt: skip
