@@ -544,7 +544,7 @@ def sites_walls_table(name: str, all_only: bool = False) -> Callable[[], str]:
             rows.append(
                 [
                     f"`{r['scenario']}`" if ":" in r["scenario"] else r["scenario"],
-                    str(r["estimator"]),
+                    f"`{r['strategy']}`, {r['estimator']}",
                     f"{int(r['acquired'])}/{n}, "
                     f"{100 * r['acquired_rate']:.0f} % [{lo:.0f}, {hi:.0f}]",
                     interval(r, "median_final_rmse", ".2f"),
@@ -559,7 +559,7 @@ def sites_walls_table(name: str, all_only: bool = False) -> Callable[[], str]:
         head = table(
             [
                 "site",
-                "estimator",
+                "planner, estimator",
                 "source acquired",
                 "median final RMSE (m)",
                 "median time to RMSE < 1 m (s)",
@@ -573,7 +573,7 @@ def sites_walls_table(name: str, all_only: bool = False) -> Callable[[], str]:
         prow = [
             [
                 f"`{r['scenario']}`" if ":" in r["scenario"] else r["scenario"],
-                f"{r['a']} − {r['b']}",
+                f"`{r.get('strategy', 'dcee-cl')}`: {r['a']} − {r['b']}",
                 str(int(r["pairs"])),
                 f"{int(r['acquired_a_only'])} / {int(r['acquired_b_only'])}",
                 f"{r['mcnemar_p']:.2g}",

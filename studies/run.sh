@@ -414,12 +414,15 @@ case "${1:---list}" in
       "decay 8 s, K learned (B)=results/sites-tune-B" "decay 8 s, K fixed (A)=results/sites-tune-A" \
       "wall-blind=results/sites-tune-blind" --out docs/results/sites-walls-tune
     $P studies/publish_tables.py ;;
-  sites-walls)  # issue 44: gas round buildings, the lbm truth on the four sites with walls, wall-aware against wall-blind, dcee-cl, 10 seeds
-    B="$D bench --suite sites-walls --strategies dcee-cl --repeats 10 --particles 10000 --workers ${WORKERS:-2}"
-    $B --set estimator.plume=walls --out results/sites-walls-aware
-    $B --out results/sites-walls-blind
+  sites-walls)  # issue 44: gas round buildings, the lbm truth on the four sites with walls, wall-aware against wall-blind, dcee-cl and infotaxis, 10 seeds
+    B="$D bench --suite sites-walls --repeats 10 --particles 10000 --workers ${WORKERS:-2}"
+    $B --strategies dcee-cl --set estimator.plume=walls --out results/sites-walls-aware
+    $B --strategies dcee-cl --out results/sites-walls-blind
+    $B --strategies infotaxis --set estimator.plume=walls --out results/sites-walls-aware-infotaxis
+    $B --strategies infotaxis --out results/sites-walls-blind-infotaxis
     $P studies/sites_walls_table.py wall-aware=results/sites-walls-aware \
-      wall-blind=results/sites-walls-blind --out docs/results/sites-walls
+      wall-blind=results/sites-walls-blind wall-aware=results/sites-walls-aware-infotaxis \
+      wall-blind=results/sites-walls-blind-infotaxis --out docs/results/sites-walls
     $P studies/publish_tables.py ;;
   sites-walls-timing)  # issue 44: decision time on a site against open terrain (idle machine, one pinned core)
     $P studies/site_timing.py --out docs/results/sites-walls/timing.csv ;;

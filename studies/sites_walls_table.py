@@ -97,8 +97,13 @@ def summary(frame: pd.DataFrame) -> pd.DataFrame:
 def paired(frame: pd.DataFrame, a: str, b: str) -> pd.DataFrame:
     out = []
     keys = ["scenario", "strategy", "seed"]
-    for site in [None, *sorted(frame.scenario.unique())]:
-        sub = frame if site is None else frame[frame.scenario == site]
+    for strategy, site in (
+        (st, si)
+        for st in sorted(frame.strategy.unique())
+        for si in [None, *sorted(frame.scenario.unique())]
+    ):
+        sub = frame[frame.strategy == strategy]
+        sub = sub if site is None else sub[sub.scenario == site]
         m = sub[sub.estimator == a].merge(sub[sub.estimator == b], on=keys, suffixes=("_a", "_b"))
         if m.empty:
             continue
@@ -110,6 +115,7 @@ def paired(frame: pd.DataFrame, a: str, b: str) -> pd.DataFrame:
         out.append(
             {
                 "scenario": site or "all sites",
+                "strategy": strategy,
                 "a": a,
                 "b": b,
                 "pairs": len(m),
