@@ -16,17 +16,14 @@ first). Run it with nothing else on the machine; the load is recorded beside the
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
 import pandas as pd
+from source_count_timing import pinned_search
 
-ROOT = Path(__file__).resolve().parent.parent
-DCEE = ROOT / ".venv" / "bin" / "dcee"
 SITES = ("site:wall", "site:passage", "site:canyon")
 COMMON = ["--truth", "lbm", "--likelihood", "fluctuation", "--set", "truth.z=4"]
 WAYS = {
@@ -37,17 +34,7 @@ WAYS = {
 
 
 def one(site: str, extra: list[str], folder: Path) -> dict:
-    env = {
-        **os.environ,
-        "NUMBA_NUM_THREADS": "1",
-        "OMP_NUM_THREADS": "1",
-        "OPENBLAS_NUM_THREADS": "1",
-    }
-    cmd = ["taskset", "-c", "0", str(DCEE), "run", "--scenario", site, *COMMON, *extra]
-    cmd += ["--strategy", "dcee-cl", "--seed", "0", "--particles", "10000", "--no-figure"]
-    cmd += ["--out", str(folder)]
-    subprocess.run(cmd, check=True, env=env, capture_output=True)
-    return json.loads((folder / "summary.json").read_text())
+    return pinned_search(["--scenario", site, *COMMON, *extra, "--particles", "10000"], folder)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -31,7 +31,9 @@ TRUTHS = {
 COUNTS = (1, 2, 3)
 
 
-def one(args: list[str], count: int, folder: Path) -> dict:
+def pinned_search(args: list[str], folder: Path) -> dict:
+    """The summary of ``dcee run ARGS --strategy dcee-cl --seed 0 --no-figure --out FOLDER``
+    run on core 0 with one thread (taskset, NUMBA/OMP/OPENBLAS threads 1)."""
     env = {
         **os.environ,
         "NUMBA_NUM_THREADS": "1",
@@ -39,10 +41,14 @@ def one(args: list[str], count: int, folder: Path) -> dict:
         "OPENBLAS_NUM_THREADS": "1",
     }
     cmd = ["taskset", "-c", "0", str(DCEE), "run", *args, "--strategy", "dcee-cl"]
-    cmd += ["--seed", "0", "--set", "search.particles=10000", "--no-figure", "--out", str(folder)]
-    cmd += ["--set", f"estimator.max_sources={count}"]
+    cmd += ["--seed", "0", "--no-figure", "--out", str(folder)]
     subprocess.run(cmd, check=True, env=env, capture_output=True)
     return json.loads((folder / "summary.json").read_text())
+
+
+def one(args: list[str], count: int, folder: Path) -> dict:
+    extra = ["--set", "search.particles=10000", "--set", f"estimator.max_sources={count}"]
+    return pinned_search([*args, *extra], folder)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -83,6 +83,21 @@ def test_the_guard_is_off_in_old_checkpoints_and_checked():
     old = Searcher.__new__(Searcher)
     old.__setstate__(state)  # a checkpoint written before the guard existed
     assert old.stall_guard == 0.0 and old.recent == []
+    # one written with the exploration guard on (several releases) before the wander guard
+    # existed: it resumes with the wander guard not holding a goal
+    pf = ParticleFilter(
+        planar_prior(x=(0.0, 40.0), y=(0.0, 40.0)), Sensor.paper_exact(), IsotropicPlume(), 300, 0
+    )
+    live = Searcher(pf, _Homing(), AGENT, np.random.default_rng(0))
+    live.explore_guard = True
+    live.tell(np.array([2.0, 2.0, 0.0]), 0.0, 0.0)
+    state = live.__getstate__()
+    for key in ("wander_fired", "wander_target"):
+        state.pop(key)
+    resumed = Searcher.__new__(Searcher)
+    resumed.__setstate__(state)
+    assert resumed.wander_fired == 0 and resumed.wander_target is None
+    assert resumed.ask().shape == (3,)
 
 
 def test_a_search_that_never_paces_is_unchanged_by_the_guard():

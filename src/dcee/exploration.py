@@ -198,6 +198,13 @@ def area_grid(agent: GridAgent, altitude: float, cells: int = GRID_CELLS) -> np.
     return np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, altitude)])
 
 
+def joint_belief(estimator: Estimator) -> tuple[np.ndarray, np.ndarray]:
+    """The particles and weights the guards' information is about: the estimator's joint belief
+    (a count bank's target count, every release's gas) or its particles."""
+    joint = getattr(estimator, "joint_particles", None)
+    return joint() if joint is not None else (estimator.theta, estimator.weights)
+
+
 def exploration_goal(
     estimator: Estimator,
     position: np.ndarray,
@@ -210,8 +217,7 @@ def exploration_goal(
     cands, _ = agent.candidates(position)
     if len(cands) == 0:
         return None
-    joint = getattr(estimator, "joint_particles", None)
-    theta, weights = joint() if joint is not None else (estimator.theta, estimator.weights)
+    theta, weights = joint_belief(estimator)
 
     def info(points: np.ndarray) -> np.ndarray:
         return detection_information(theta, weights, estimator.sensor, estimator.plume, points)
@@ -276,8 +282,7 @@ def wander_goal(
     (3,) m) while the belief stays wider than it: the grid point outside the region (beyond
     ``radius`` + one step of the anchor, reachable) whose next reading tells the most
     (:func:`detection_information`), or None when no such point tells anything."""
-    joint = getattr(estimator, "joint_particles", None)
-    theta, weights = joint() if joint is not None else (estimator.theta, estimator.weights)
+    theta, weights = joint_belief(estimator)
     grid = area_grid(agent, float(anchor[2]))
     outside = np.hypot(*(grid[:, :2] - anchor[:2]).T) > radius + agent.step
     grid = grid[outside]

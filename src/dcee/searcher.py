@@ -137,7 +137,7 @@ class Searcher:
         self.explore_fired = 0
         """how many decisions the exploration guard restricted (:mod:`dcee.exploration`)"""
         self.wander_fired = 0
-        """how many of them because the robot kept to one region (:meth:`wander_anchor`)"""
+        """how many of them because the robot kept to one region (:meth:`wander_goal`)"""
         self.wander_target: np.ndarray | None = None
         """where the wander guard sends the robot, held until it is within a step of it"""
         self.filter = particle_filter
@@ -305,8 +305,7 @@ class Searcher:
         return state
 
     def __setstate__(self, state: dict[str, Any]) -> None:
-        # checkpoints written before the stall guard: it was off
-        # and before the stop rule: none
+        # checkpoints written before the stall guard: it was off; before the stop rule: none
         state = {
             "stall_guard": 0.0,
             "guard_spread": 3.0,
@@ -316,6 +315,9 @@ class Searcher:
             "below_since": math.nan,
             "explore_guard": False,
             "explore_fired": 0,
+            # and before the wander guard: it had not fired
+            "wander_fired": 0,
+            "wander_target": None,
             **state,
         }
         self.__dict__.update(state)

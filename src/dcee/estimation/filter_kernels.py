@@ -310,20 +310,17 @@ def history_log_likelihood_reference(
 def _history_from_concentration_kernel(
     conc: np.ndarray,
     dist: np.ndarray,
-    active: np.ndarray,
     readings: np.ndarray,
     multiplicity: np.ndarray,
     sp: SensorParams,
     out: np.ndarray,
 ) -> None:
+    """out[i] += Σ_k multiplicity[k] · log p(readings[k] | conc[i, k], dist[i, k])."""
     for i in prange(conc.shape[0]):
-        if not active[i]:
-            out[i] = -np.inf
-            continue
         total = 0.0
         for k in range(conc.shape[1]):
             total += multiplicity[k] * log_likelihood(readings[k], conc[i, k], dist[i, k], sp)
-        out[i] = total
+        out[i] += total
 
 
 HISTORY_CHUNK = 64
@@ -344,28 +341,22 @@ def history_log_likelihood_generic(
     ``plume.concentration_distance(theta, positions)`` → ((N, K) g/m³, (N, K) m) (the
     wall-aware plume, :class:`~dcee.models.site_plume.SitePlume`): the same sum of the same
     scalar log-likelihood, without the early rejection (an exact value in its place)."""
-    theta = np.ascontiguousarray(theta, dtype=np.float64)
-    active = np.ascontiguousarray(active, dtype=np.bool_)
+    live = np.flatnonzero(np.asarray(active, dtype=np.bool_))
+    theta = np.ascontiguousarray(np.asarray(theta, dtype=np.float64)[live])
     positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     readings = np.ascontiguousarray(readings, dtype=np.float64)
     multiplicity = np.ascontiguousarray(multiplicity, dtype=np.float64)
-    out[:] = 0.0
-    part = np.empty(len(theta))
-    live = np.flatnonzero(active)
+    total = np.zeros(len(live))
     for start in range(0, len(positions), HISTORY_CHUNK):
         rows = slice(start, start + HISTORY_CHUNK)
-        conc, dist = plume.concentration_distance(theta[live], positions[rows])  # type: ignore[attr-defined]
-        sub = np.empty(len(live))
+        conc, dist = plume.concentration_distance(theta, positions[rows])  # type: ignore[attr-defined]
         _history_from_concentration_kernel(
             np.ascontiguousarray(conc),
             np.ascontiguousarray(dist),
-            np.ones(len(live), dtype=np.bool_),
             readings[rows],
             multiplicity[rows],
             sp,
-            sub,
+            total,
         )
-        part[:] = 0.0
-        part[live] = sub
-        out += part
-    out[~active] = -np.inf
+    out[:] = -np.inf
+    out[live] = total

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from dcee.estimation.source_count import SourceCountBank
-from dcee.searcher import WANDER_RADIUS as WANDER_GUARD_RADIUS
+from dcee.searcher import WANDER_RADIUS
 
 if TYPE_CHECKING:
     from dcee.scenarios import Scenario
@@ -55,28 +55,38 @@ def longest_stall(
     return best
 
 
-WANDER_RADIUS = WANDER_GUARD_RADIUS
-"""m: a search *wanders* while every position of a run of readings lies within this distance of
-the run's first (a 15 m region, the scale issue 44 measured: 800 s inside 15 m with a 13 m wide
-belief) and the source is not yet acquired (:func:`search_wander`)."""
-
 WANDER_SECONDS = 120.0
 """s: a wander longer than this is counted in a campaign's report (issue 44's bar)."""
 
 
 def search_wander(records: list[dict[str, Any]], acquired_rmse: float) -> float:
-    """The longest time, s, a robot of the search stayed within :data:`WANDER_RADIUS` m of one
-    position while the source was not acquired and its belief was wider than that region (the
-    spread √tr P above the radius: readings in the region could not resolve it): issue 44's
-    wandering, what the wander guard (:meth:`dcee.searcher.Searcher.wander_goal`) acts on. A
-    robot closing in on a source with a belief narrower than the region is not wandering, nor is
-    one stuck on a narrow, wrong belief (a failure the final error counts)."""
+    """The longest time, s, a robot of the search stayed within :data:`WANDER_RADIUS` m (the
+    wander guard's region, :mod:`dcee.searcher`: a 15 m region, the scale issue 44 measured) of
+    one position while the source was not acquired and its belief was wider than that region
+    (the spread √tr P above the radius: readings in the region could not resolve it): what
+    the wander guard (:meth:`dcee.searcher.Searcher.wander_goal`) acts on. A robot closing in
+    on a source with a belief narrower than the region is not wandering, nor is one stuck on a
+    narrow, wrong belief (a failure the final error counts)."""
+    return search_stall(records, WANDER_RADIUS, acquired_rmse, wider_than=WANDER_RADIUS)
+
+
+def search_stall(
+    records: list[dict[str, Any]],
+    step: float,
+    acquired_rmse: float,
+    wider_than: float | None = None,
+) -> float:
+    """:func:`longest_stall` of a search's records, s: the longest over its robots; with
+    ``wider_than`` (m), a reading whose belief spread is at most that counts as settled too."""
     robots = np.array([r.get("robot", 0) for r in records])
     best = 0.0
     for robot in np.unique(robots):
         rows = [r for r, k in zip(records, robots, strict=True) if k == robot]
         settled = np.array(
-            [r["rmse"] < acquired_rmse or r["spread"] <= WANDER_RADIUS for r in rows]
+            [
+                r["rmse"] < acquired_rmse or (wider_than is not None and r["spread"] <= wider_than)
+                for r in rows
+            ]
         )
         best = max(
             best,
@@ -84,24 +94,6 @@ def search_wander(records: list[dict[str, Any]], acquired_rmse: float) -> float:
                 np.array([r["time"] for r in rows]),
                 np.array([[r["x"], r["y"]] for r in rows]),
                 settled,
-                WANDER_RADIUS,
-            ),
-        )
-    return best
-
-
-def search_stall(records: list[dict[str, Any]], step: float, acquired_rmse: float) -> float:
-    """:func:`longest_stall` of a search's records, s: the longest over its robots."""
-    robots = np.array([r.get("robot", 0) for r in records])
-    best = 0.0
-    for robot in np.unique(robots):
-        rows = [r for r, k in zip(records, robots, strict=True) if k == robot]
-        best = max(
-            best,
-            longest_stall(
-                np.array([r["time"] for r in rows]),
-                np.array([[r["x"], r["y"]] for r in rows]),
-                np.array([r["rmse"] < acquired_rmse for r in rows]),
                 step,
             ),
         )

@@ -9,6 +9,7 @@ import dataclasses
 import functools
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -25,6 +26,9 @@ from dcee.models.site_plume import SitePlume, site_grid
 from dcee.scenarios.schema.agent import team_starts
 from dcee.scenarios.schema.estimator import PHYSICAL_TRUNCATION, PriorSpec
 from dcee.stopping import StopRule
+
+if TYPE_CHECKING:
+    from dcee.scenarios.schema.world import WorldSpec
 
 
 @functools.lru_cache(maxsize=16)
@@ -64,21 +68,29 @@ def _wall_plume(
     """The wall-aware plume of one site and one (u, φ, K, ζ2), built once per process and
     shared by the filter's members of that K and the planners (its receptor fields are cached
     in it)."""
-    from dcee.scenarios.schema.world import WorldSpec, shapes_of
+    from dcee.scenarios.schema.world import WorldSpec
 
     world = WorldSpec.model_validate_json(world_json)
-    shapes = shapes_of(world.obstacles)
-
-    def solid(xy: np.ndarray) -> np.ndarray:
-        out = np.zeros(len(xy), bool)
-        for shape in shapes:
-            out |= shape.contains(xy)
-        if world.map is not None:
-            out |= raw_map(world.map).is_blocked(xy)
-        return out
-
-    fluid, origin = site_grid(low, high, resolution, solid)
+    fluid, origin = site_grid(
+        low, high, resolution, lambda xy: inside_world(world, xy, no_go=False)
+    )
     return SitePlume(fluid, origin, resolution, *environment)
+
+
+def inside_world(world: WorldSpec, xy: np.ndarray, no_go: bool = True) -> np.ndarray:
+    """(K,) bool: the (K, 2) points lie inside an obstacle of ``world`` (a
+    :class:`~dcee.scenarios.schema.world.WorldSpec`; with ``no_go``, or a no-go zone) itself
+    (the shapes as given) or in an occupied or unknown cell of its map file."""
+    from dcee.scenarios.schema.world import shapes_of
+
+    xy = np.atleast_2d(np.asarray(xy, dtype=float))[:, :2]
+    out = np.zeros(len(xy), bool)
+    zones = shapes_of(world.no_go) if no_go else []
+    for shape in shapes_of(world.obstacles) + zones:
+        out |= shape.contains(xy)
+    if world.map is not None:
+        out |= raw_map(world.map).is_blocked(xy)
+    return out
 
 
 class ScenarioBuilders:
@@ -124,8 +136,9 @@ class ScenarioBuilders:
 
     def make_plume(self, model: str | None = None) -> IsotropicPlume | SitePlume:
         """The dispersion model of the filter and the planners under reading model ``model``
-        (None: the first of :attr:`reading_models`): with ``estimator.plume = "walls"`` the one
-        wall-aware plume of the site (every member's: it has no shape setting to learn)."""
+        (None: the first of :attr:`reading_models`): with ``estimator.plume = "walls"`` the
+        site's wall-aware plume at the member's diffusivity (members of one diffusivity share
+        it: it has no open-plume shape setting to learn)."""
         model = self._reading_model(model)
         if self.estimator.plume == "walls":
             u, phi = (float(v) for v in self.truth_theta()[4:6])
@@ -251,16 +264,7 @@ class ScenarioBuilders:
         zone) itself (the shapes as given, not grown to the grid's cells or by
         ``clearance``) or in an occupied or unknown cell of the map file: what a robot's drive
         must never touch."""
-        from dcee.scenarios.schema.world import shapes_of
-
-        xy = np.atleast_2d(np.asarray(xy, dtype=float))[:, :2]
-        out = np.zeros(len(xy), bool)
-        zones = shapes_of(self.world.no_go) if no_go else []
-        for shape in shapes_of(self.world.obstacles) + zones:
-            out |= shape.contains(xy)
-        if self.world.map is not None:
-            out |= raw_map(self.world.map).is_blocked(xy)
-        return out
+        return inside_world(self.world, xy, no_go)
 
     def stop_rule(self, on_robot: bool) -> StopRule | None:
         """When this search ends early (:class:`~dcee.stopping.StopRule`): ``search.stop_spread``
