@@ -7,11 +7,10 @@ the search area, in the plane of the flight (planar, as the fluid solver's truth
 
     u(x) · ∇C − K ∇²C + C / τ = (q / h) δ(x − s),  no flux through a wall,
 
-* **Wind round the walls.** ``u = U + ∇φ`` is the free wind U made mass-consistent: the least
-  change to U that has no divergence in the air and no flow into a wall (a Poisson equation
-  for φ, zero at the grid's edge). It is the diagnostic wind model of urban dispersion codes
-  (Sherman's MATHEW, Röckle's and QUIC-URB's initial field): it turns the wind along a wall and
-  through a gap, and has no wake (that is the truth's job: the lattice Boltzmann solver).
+* **Wind round the walls** (:mod:`dcee.models.site_flow`): ``wind = "wake"``, the time-mean
+  flow of a constant-eddy-viscosity Navier–Stokes model (a recirculating wake in a building's
+  lee, a vortex in a street across the wind); ``wind = "potential"``, the free wind U made
+  mass-consistent (u = U + ∇φ: turned along a wall and through a gap, no wake).
 * **Transport.** Finite volumes on the grid's cells, each face's flux by the exponentially
   fitted (Scharfetter-Gummel) scheme, exact for 1-D advection-diffusion between two cell
   centres at any cell Péclet number (no numerical diffusion from upwinding, no oscillation):
@@ -42,6 +41,7 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.models.plume import MIN_DISTANCE
+from dcee.models.site_flow import WAKE_VISCOSITY, mass_consistent_wind, wake_wind
 
 LAYER_DEPTH = 2.0
 """m: the depth the release is spread over (the fluid solver's truth's default): the plane
@@ -75,6 +75,8 @@ class SitePlume:
     u, phi : the free wind, m/s, and the direction it comes from, rad (the paper's convention).
     zeta1 : diffusivity K, m²/s; zeta2 : the gas's lifetime τ, s (inf: none).
     layer_depth : m, see :data:`LAYER_DEPTH`.
+    wind : ``"wake"`` or ``"potential"`` (module doc); or a precomputed pair of face velocity
+        arrays (shared by the models of one site and wind that differ only in K).
     """
 
     def __init__(
@@ -88,6 +90,7 @@ class SitePlume:
         zeta2: float,
         layer_depth: float = LAYER_DEPTH,
         min_distance: float = MIN_DISTANCE,
+        wind: str | tuple[np.ndarray, np.ndarray] = "potential",
     ) -> None:
         self.fluid = np.asarray(fluid, dtype=bool)
         if self.fluid.ndim != 2 or min(self.fluid.shape) < 3:
@@ -106,7 +109,14 @@ class SitePlume:
         self.index[self.fluid] = np.arange(int(self.fluid.sum()))
         # the free wind blows towards −(cos φ, sin φ) (dcee.models.plume)
         free = -u * np.array([math.cos(phi), math.sin(phi)])
-        self.face_u, self.face_v = mass_consistent_wind(self.fluid, self.resolution, free)
+        if isinstance(wind, tuple):
+            self.face_u, self.face_v = wind
+        elif wind == "wake":
+            self.face_u, self.face_v = wake_wind(self.fluid, self.resolution, free, WAKE_VISCOSITY)
+        elif wind == "potential":
+            self.face_u, self.face_v = mass_consistent_wind(self.fluid, self.resolution, free)
+        else:
+            raise DceeInputError("estimator.wall_wind", "must be 'wake' or 'potential'")
         matrix = transport_matrix(
             self.fluid, self.index, self.resolution, self.face_u, self.face_v, zeta1, zeta2
         )
@@ -223,54 +233,6 @@ class SitePlume:
         return out
 
 
-def mass_consistent_wind(
-    fluid: np.ndarray, h: float, free: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Face velocities (m/s) of the free wind ``free`` (2,) made divergence-free in the air
-    with no flow through walls: u = free + ∇φ, Σ_faces u · n = 0 per air cell, φ = 0 beyond the
-    grid. Returns (ny, nx + 1) x-velocities on the cells' west/east faces and (ny + 1, nx)
-    y-velocities on their south/north faces (0 on every face that touches a wall)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.linalg import spsolve
-
-    ny, nx = fluid.shape
-    index = np.full(fluid.shape, -1, dtype=np.int64)
-    index[fluid] = np.arange(int(fluid.sum()))
-    n = int(fluid.sum())
-    rows: list[np.ndarray] = []
-    cols: list[np.ndarray] = []
-    vals: list[np.ndarray] = []
-    rhs = np.zeros(n)
-    ii, jj = np.nonzero(fluid)
-    me = index[ii, jj]
-    for di, dj, normal in ((0, 1, free[0]), (0, -1, -free[0]), (1, 0, free[1]), (-1, 0, -free[1])):
-        i, j = ii + di, jj + dj
-        inside = (i >= 0) & (i < ny) & (j >= 0) & (j < nx)
-        nb = np.where(inside, index[np.clip(i, 0, ny - 1), np.clip(j, 0, nx - 1)], -1)
-        open_face = ~inside | (nb >= 0)  # the grid's edge is open air (φ = 0 beyond it)
-        rows.append(me[open_face])
-        cols.append(me[open_face])
-        vals.append(np.full(int(open_face.sum()), -1.0))
-        inner = inside & (nb >= 0)
-        rows.append(me[inner])
-        cols.append(nb[inner])
-        vals.append(np.ones(int(inner.sum())))
-        np.add.at(rhs, me[open_face], -h * normal)
-    lap = coo_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), (n, n))
-    phi = np.zeros(fluid.shape)
-    phi[fluid] = spsolve(lap.tocsc(), rhs)
-    # faces: φ beyond the grid is 0; a face touching a wall carries nothing
-    padded = np.zeros((ny + 2, nx + 2))
-    padded[1:-1, 1:-1] = phi
-    air = np.ones((ny + 2, nx + 2), dtype=bool)
-    air[1:-1, 1:-1] = fluid
-    fu = free[0] + (padded[1:-1, 1:] - padded[1:-1, :-1]) / h
-    fu[~(air[1:-1, 1:] & air[1:-1, :-1])] = 0.0
-    fv = free[1] + (padded[1:, 1:-1] - padded[:-1, 1:-1]) / h
-    fv[~(air[1:, 1:-1] & air[:-1, 1:-1])] = 0.0
-    return fu, fv
-
-
 def transport_matrix(
     fluid: np.ndarray,
     index: np.ndarray,
@@ -359,7 +321,6 @@ __all__ = [
     "MARGIN",
     "SitePlume",
     "bernoulli",
-    "mass_consistent_wind",
     "open_to_edge",
     "site_grid",
     "transport_matrix",

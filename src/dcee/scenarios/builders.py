@@ -22,6 +22,7 @@ from dcee.models.plume import PARAMETER_NAMES, IsotropicPlume
 from dcee.models.ros_map import load_ros_map
 from dcee.models.sensor import Sensor
 from dcee.models.site import SiteMap, compose_site
+from dcee.models.site_flow import mass_consistent_wind, wake_wind
 from dcee.models.site_plume import SitePlume, site_grid
 from dcee.scenarios.schema.agent import team_starts
 from dcee.scenarios.schema.estimator import PHYSICAL_TRUNCATION, PriorSpec
@@ -56,25 +57,42 @@ def raw_map(path: str) -> SiteMap:
     return load_ros_map(path)
 
 
-@functools.lru_cache(maxsize=8)
-def _wall_plume(
+@functools.lru_cache(maxsize=4)
+def _site_fluid(
     low: tuple[float, float],
     high: tuple[float, float],
     world_json: str,
     mtime: float,
     resolution: float,
-    environment: tuple[float, float, float, float],
-) -> SitePlume:
-    """The wall-aware plume of one site and one (u, φ, K, ζ2), built once per process and
-    shared by the filter's members of that K and the planners (its receptor fields are cached
-    in it)."""
+) -> tuple[np.ndarray, tuple[float, float]]:
+    """The site's air mask and its grid's origin (:func:`~dcee.models.site_plume.site_grid`)."""
     from dcee.scenarios.schema.world import WorldSpec
 
     world = WorldSpec.model_validate_json(world_json)
-    fluid, origin = site_grid(
-        low, high, resolution, lambda xy: inside_world(world, xy, no_go=False)
-    )
-    return SitePlume(fluid, origin, resolution, *environment)
+    return site_grid(low, high, resolution, lambda xy: inside_world(world, xy, no_go=False))
+
+
+@functools.lru_cache(maxsize=4)
+def _site_wind(site: tuple, u: float, phi: float, model: str) -> tuple[np.ndarray, np.ndarray]:
+    """The wind round the site's walls (:mod:`dcee.models.site_flow`), computed once per
+    process and shared by the models that differ only in K."""
+    fluid, _ = _site_fluid(*site)
+    free = -u * np.array([math.cos(phi), math.sin(phi)])
+    if model == "wake":
+        return wake_wind(fluid, site[-1], free)
+    return mass_consistent_wind(fluid, site[-1], free)
+
+
+@functools.lru_cache(maxsize=8)
+def _wall_plume(
+    site: tuple, environment: tuple[float, float, float, float], wind: str
+) -> SitePlume:
+    """The wall-aware plume of one site (``(low, high, world_json, mtime, resolution)``), one
+    (u, φ, K, ζ2) and one wind model, built once per process and shared by the filter's
+    members of that K and the planners (its receptor fields are cached in it)."""
+    fluid, origin = _site_fluid(*site)
+    u, phi = environment[:2]
+    return SitePlume(fluid, origin, site[-1], *environment, wind=_site_wind(site, u, phi, wind))
 
 
 def inside_world(world: WorldSpec, xy: np.ndarray, no_go: bool = True) -> np.ndarray:
@@ -147,14 +165,14 @@ class ScenarioBuilders:
             learned = dict(self.reading_model_variants).get(model, {})
             k = float(learned.get("wall_diffusivity", self.wall_diffusivity))
             mtime = Path(self.world.map).stat().st_mtime if self.world.map is not None else 0.0
-            return _wall_plume(
+            site = (
                 tuple(self.volume.low[:2]),
                 tuple(self.volume.high[:2]),
                 self.world.model_dump_json(),
                 mtime,
                 float(self.site_resolution),
-                (u, phi, k, zeta2),
             )
+            return _wall_plume(site, (u, phi, k, zeta2), self.wall_wind)
         if self.estimator.likelihood == "paper":
             return IsotropicPlume(meander=self.meander)
         if model == "paper":

@@ -93,6 +93,9 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
     ("estimator", "wall_lifetime"): Provenance(
         ("lbm",), "random-site:1-20 (the tuning sites), dcee-cl, docs/results/sites-walls-tune"
     ),
+    ("estimator", "wall_wind"): Provenance(
+        ("lbm",), "random-site:1-20 (the tuning sites), dcee-cl, docs/results/sites-walls-tune"
+    ),
     ("estimator", "wall_diffusivity"): Provenance(
         (), "unset: the scenario's ζ1, weighed with 3 and 10 times it (not chosen by measurement)"
     ),

@@ -216,6 +216,11 @@ Jeffreys' scale calls evidence strong (the value from that convention, not from 
 equal prior let the disc lead on point releases: docs/results/tuning-source-radius-13-40)."""
 
 
+WALL_WIND_DEFAULT = "wake"
+"""The wall-aware plume's wind when ``estimator.wall_wind`` is unset (see the field): chosen on
+the tuning sites ``random-site:1-20`` (lbm truth, ``dcee-cl``, rule written before the run,
+docs/results/sites-walls-tune)."""
+
 WALL_DIFFUSIVITY_FACTORS = (1.0, 3.0, 10.0)
 """The wall-aware plume's diffusivity K the fluctuation likelihood weighs by default, as
 multiples of the fixed one (the scenario's ζ1 unless ``estimator.wall_diffusivity`` is set): a
@@ -434,6 +439,11 @@ class EstimatorSpec(BaseModel):
     ``random-site:1-20`` (lbm truth, ``dcee-cl``, rule written before the run,
     docs/results/sites-walls-tune): without decay 11/20 acquired against 9/20 with ζ2 = 8 s
     (+3 / −1, McNemar p = 0.63; median final error 1.03 m against 4.32 m)"""
+    wall_wind: Literal["wake", "potential"] | None = None
+    """the wall-aware plume's wind round the buildings (``plume = "walls"``,
+    :mod:`dcee.models.site_flow`): ``wake``, the time-mean flow of a constant-eddy-viscosity
+    Navier–Stokes model (a recirculating wake in a building's lee); ``potential``, the free wind
+    made mass-consistent (turned along walls, no wake). None: :data:`WALL_WIND_DEFAULT`"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the

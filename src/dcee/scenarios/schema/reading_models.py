@@ -15,6 +15,7 @@ from dcee.scenarios.schema.estimator import (
     LEARN_MEMBERS_MAX,
     LEARN_RANGES,
     PLUME_SHAPE_SETTINGS,
+    WALL_WIND_DEFAULT,
     default_learn,
     default_learn_prior,
     learn_member_weight,
@@ -48,10 +49,11 @@ class ReadingModelSettings:
         no open-plume shape learned."""
         e = self.estimator
         if e.plume != "walls":
-            walls_only = e.wall_diffusivity is not None or e.wall_lifetime is not None
+            walls_only = (e.wall_diffusivity, e.wall_lifetime, e.wall_wind) != (None,) * 3
             if walls_only or "wall_diffusivity" in (e.learn or {}):
                 raise ValueError(
-                    f"{FIELD_MARK}estimator.wall_diffusivity, wall_lifetime: are the wall-aware "
+                    f"{FIELD_MARK}estimator.wall_diffusivity, wall_lifetime, wall_wind: are the "
+                    "wall-aware "
                     'plume\'s; need estimator.plume = "walls"'
                 )
             return
@@ -135,6 +137,11 @@ class ReadingModelSettings:
     def _learn_fixed(self) -> dict:
         """The estimator's settings by name, the wall-aware plume's diffusivity resolved."""
         return {**dict(self.estimator), "wall_diffusivity": self.wall_diffusivity}
+
+    @property
+    def wall_wind(self) -> str:
+        """The wall-aware plume's wind model: ``estimator.wall_wind`` or its default."""
+        return self.estimator.wall_wind or WALL_WIND_DEFAULT
 
     @property
     def wall_diffusivity(self) -> float:
