@@ -406,12 +406,20 @@ case "${1:---list}" in
     $P studies/publish_tables.py ;;
   sites-walls-tune)  # issue 44: the wall-aware estimator's variants on the tuning sites random-site:1-20 (never reported as a result)
     B="$D bench --suite sites-tune --strategies dcee-cl --repeats 1 --particles 10000 --workers ${WORKERS:-2}"
-    $B --set estimator.plume=walls --set truth.zeta2=1000 --out results/sites-tune-C
-    $B --set estimator.plume=walls --out results/sites-tune-B
-    $B --set estimator.plume=walls --set 'estimator.learn={}' --out results/sites-tune-A
+    # round 2: the wind round the buildings (wake: constant-eddy-viscosity Navier-Stokes; potential: mass-consistent)
+    $B --set estimator.plume=walls --set estimator.wall_wind=wake --out results/sites-tune-wake
+    $B --set estimator.plume=walls --set estimator.wall_wind=potential --out results/sites-tune-potential
+    # round 1 (the mass-consistent wind): decay and K
+    W="--set estimator.plume=walls --set estimator.wall_wind=potential"
+    $B $W --set truth.zeta2=1000 --out results/sites-tune-C
+    $B $W --out results/sites-tune-B
+    $B $W --set 'estimator.learn={}' --out results/sites-tune-A
     $B --out results/sites-tune-blind
-    $P studies/sites_walls_table.py "no-decay, K learned (C, chosen)=results/sites-tune-C" \
-      "decay 8 s, K learned (B)=results/sites-tune-B" "decay 8 s, K fixed (A)=results/sites-tune-A" \
+    $P studies/sites_walls_table.py "wake wind (chosen)=results/sites-tune-wake" \
+      "potential wind=results/sites-tune-potential" \
+      "potential, no decay, K learned (C)=results/sites-tune-C" \
+      "potential, decay 8 s, K learned (B)=results/sites-tune-B" \
+      "potential, decay 8 s, K fixed (A)=results/sites-tune-A" \
       "wall-blind=results/sites-tune-blind" --out docs/results/sites-walls-tune
     $P studies/publish_tables.py ;;
   sites-walls)  # issue 44: gas round buildings, the lbm truth on the four sites with walls, wall-aware against wall-blind, dcee-cl and infotaxis, 10 seeds

@@ -234,3 +234,34 @@ def test_random_sites_are_reproducible_open_and_valid_for_the_gas() -> None:
         load_scenario(f"random-site:{k}").with_overrides(
             **{"truth.model": "lbm", "truth.z": 4.0, "estimator.plume": "walls"}
         )
+
+
+def test_a_robot_map_makes_the_gas_flow_round_its_walls() -> None:
+    """The ROS node's switch (dcee.robot.map_gas): a map received becomes the scenario's map
+    under the wall-aware plume, whose grid has the map's wall as walls; where the scenario
+    cannot take the wall-aware plume (the wind to estimate) it stays as it was, with the
+    reason."""
+    from dcee.models.site import Rectangle, SiteMap
+    from dcee.robot.map_gas import MapGas
+
+    site = load_scenario("paper:1").with_overrides(
+        **{"unknown": "source", "estimator.likelihood": "fluctuation"}
+    )
+    wall = Rectangle((20.0, 30.0), (40.0, 31.0))  # a wall north of the source, across the area
+    grid = SiteMap.from_shapes((0.0, 0.0), (50.0, 50.0), [wall], resolution=0.5, name="robot")
+    gas = MapGas()
+    assert gas.scenario(site, True) == (site, None)  # no map yet
+    gas.update(grid)
+    assert gas.scenario(site, False) == (site, None)  # parameter gas_walls off
+    walled, line = gas.scenario(site, True)
+    assert walled.estimator.plume == "walls" and "flows round the map's walls" in line
+    assert walled.world.map.endswith("map-1.yaml")
+    plume = walled.make_plume()
+    assert isinstance(plume, SitePlume)
+    cells = np.array([[30.0, 30.5], [30.0, 25.0]])
+    _, w = plume.weights(cells)
+    assert w[0].sum() == 0 and w[1].sum() == pytest.approx(1.0)  # the wall is a wall for the gas
+    # the wind unknown: one flow cannot be solved, the gas stays open, the reason is one line
+    full = site.with_overrides(**{"unknown": "full"})
+    same, line = gas.scenario(full, True)
+    assert same is full and "open terrain" in line and "unknown" in line and "\n" not in line

@@ -29,7 +29,7 @@ PARAMS = PACKAGE / "config" / "dcee_search.yaml"
 
 
 def _domain() -> int:
-    return 150 + os.getpid() % 50
+    return 150 + os.getpid() % 50  # 150-199; tests/ros/test_ros_node.py: 100-149
 
 
 def test_the_manifests_parse_as_colcon_reads_them():
@@ -178,3 +178,69 @@ def test_demo_runs_the_managed_node_through_its_contract_with_a_map_and_wind(tmp
     xy = np.array([[r["x"], r["y"]] for r in summary["records"]])
     assert not sc.in_obstacle(xy).any()
     assert summary["records"][-1]["rmse"] < sc.search.acquired_rmse
+
+
+def test_a_map_on_the_map_topic_makes_the_next_search_s_gas_flow_round_its_walls():
+    """A managed node whose scenario can take the wall-aware plume (wind known): a map received
+    before dcee/start makes the search's gas flow round the map's walls (``gas_walls``, on by
+    default); with ``gas_walls`` false it stays in open terrain."""
+    import rclpy
+    from nav_msgs.msg import OccupancyGrid
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    from std_srvs.srv import Trigger
+
+    from dcee.models.site import Rectangle, SiteMap
+    from dcee.models.site_plume import SitePlume
+    from dcee.ros.node import LATCHED, SearchNode
+    from dcee.scenarios import load_scenario
+
+    scenario = load_scenario("paper:1").with_overrides(
+        **{"unknown": "source", "estimator.likelihood": "fluctuation", "search.particles": 300}
+    )
+    wall = Rectangle((20.0, 30.0), (40.0, 31.0))
+    site = SiteMap.from_shapes((0.0, 0.0), (50.0, 50.0), [wall], resolution=0.5)
+    msg = OccupancyGrid()
+    msg.header.frame_id = "map"
+    msg.info.resolution = 0.5
+    msg.info.width, msg.info.height = site.shape[1], site.shape[0]
+    msg.info.origin.orientation.w = 1.0
+    msg.data = [100 if b else 0 for b in site.blocked.ravel()]
+    for enabled, expected in ((True, "walls"), (False, "open")):
+        context = rclpy.Context()
+        rclpy.init(context=context, args=[], domain_id=_domain())
+        try:
+            node = SearchNode(
+                context=context,
+                scenario=scenario,
+                parameter_overrides=[
+                    Parameter("autostart", value=False),
+                    Parameter("strategy", value="infotaxis"),
+                    Parameter("gas_walls", value=enabled),
+                ],
+            )
+            robot = rclpy.create_node("robot", context=context)
+            map_pub = robot.create_publisher(OccupancyGrid, "map", LATCHED)
+            start = robot.create_client(Trigger, "dcee/start")
+            executor = SingleThreadedExecutor(context=context)
+            executor.add_node(node)
+            executor.add_node(robot)
+            node.trigger_configure()
+            node.trigger_activate()
+            map_pub.publish(msg)
+            deadline = time.monotonic() + 30
+            while node.maps_received == 0 and time.monotonic() < deadline:
+                executor.spin_once(timeout_sec=0.02)
+            assert start.wait_for_service(timeout_sec=10)
+            future = start.call_async(Trigger.Request())
+            executor.spin_until_future_complete(future, timeout_sec=60)
+            assert future.result().success
+            assert node.gas_model == expected
+            plume = node.searcher.filter.plume
+            assert isinstance(plume, SitePlume) == (expected == "walls")
+            if expected == "walls":  # the map's wall is a wall for the gas
+                assert plume.weights(np.array([[30.0, 30.5]]))[1].sum() == 0
+            for n in (node, robot):  # no latched map left for a later test
+                n.destroy_node()
+        finally:
+            rclpy.try_shutdown(context=context)

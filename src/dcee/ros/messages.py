@@ -63,11 +63,9 @@ def pose_from_pose_cov(msg: PoseWithCovarianceStamped, now: float, last: Pose | 
     return Pose(t, x, y, yaw, v, w)
 
 
-def site_from_map(msg: OccupancyGrid, scenario: Scenario) -> SiteMap:
-    """The site an occupancy grid makes over ``scenario``'s search area: its occupied and unknown
-    cells blocked, on top of the scenario's own obstacles, zones and map file. A grid that
-    cannot be used (malformed, rotated, not covering the area) raises
-    :class:`DceeInputError`."""
+def grid_from_map(msg: OccupancyGrid) -> SiteMap:
+    """The occupancy grid as it is (occupied and unknown cells blocked); a grid that cannot be
+    used (malformed, rotated) raises :class:`DceeInputError`."""
     info = msg.info
     if info.width == 0 or info.height == 0 or len(msg.data) != info.width * info.height:
         raise DceeInputError("map", f"{len(msg.data)} cells for {info.width} x {info.height}")
@@ -75,9 +73,17 @@ def site_from_map(msg: OccupancyGrid, scenario: Scenario) -> SiteMap:
         raise DceeInputError("map", "a rotated map (origin yaw != 0) is not supported")
     occ = np.asarray(msg.data, dtype=float).reshape(info.height, info.width)
     occ = np.where(occ < 0, np.nan, occ / 100.0)
-    grid = SiteMap.from_occupancy(
+    return SiteMap.from_occupancy(
         occ, (info.origin.position.x, info.origin.position.y), info.resolution, name="map topic"
     )
+
+
+def site_from_map(msg: OccupancyGrid | SiteMap, scenario: Scenario) -> SiteMap:
+    """The site an occupancy grid (a message, or :func:`grid_from_map`'s grid) makes over
+    ``scenario``'s search area: its occupied and unknown cells blocked, on top of the
+    scenario's own obstacles, zones and map file. A grid that cannot be used (malformed,
+    rotated, not covering the area) raises :class:`DceeInputError`."""
+    grid = msg if isinstance(msg, SiteMap) else grid_from_map(msg)
     site = compose_site(
         tuple(scenario.volume.low[:2]),
         tuple(scenario.volume.high[:2]),

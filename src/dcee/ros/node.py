@@ -45,7 +45,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import (
     PointStamped,
     PoseStamped,
@@ -62,18 +62,15 @@ from visualization_msgs.msg import MarkerArray
 
 from dcee.errors import DceeInputError
 from dcee.robot.cycle import Pose, SearchCycle
+from dcee.robot.map_gas import MapGas
 from dcee.ros.messages import (
-    diagnostic_status,
-    estimate_messages,
-    goal_message,
-    particle_markers,
-    path_pose,
+    grid_from_map,
     pose_from_odometry,
     pose_from_pose_cov,
-    search_result,
     seconds,
     site_from_map,
 )
+from dcee.ros.outputs import NodeOutputs
 from dcee.ros.parameters import (
     LATCHED,
     MAX_CONSECUTIVE_ERRORS,
@@ -87,7 +84,7 @@ from dcee.scenarios import Scenario
 from dcee.searcher import Searcher
 
 
-class SearchNode(LifecycleNode):
+class SearchNode(NodeOutputs, LifecycleNode):
     """The search cycle as a managed (lifecycle) ROS 2 node.
 
     Lifecycle: *configure* reads the parameters and the scenario (a bad value fails the
@@ -149,6 +146,10 @@ class SearchNode(LifecycleNode):
         self._lock = threading.Lock()
         self._last_pose: Pose | None = None
         self._map_site: Any = None
+        self.map_gas = MapGas()
+        self.gas_model = "open"
+        """the current search's ``estimator.plume``: "walls" once a map made the gas flow
+        round its walls (parameter ``gas_walls``)"""
         self.create_service(Trigger, "dcee/start", self._on_start)
         self.create_service(Trigger, "dcee/cancel", self._on_cancel)
         self._autostarting = bool(self.get_parameter("autostart").value)
@@ -238,7 +239,12 @@ class SearchNode(LifecycleNode):
             searcher = Searcher.load(self.checkpoint)
             self.get_logger().info(f"resumed the search from {self.checkpoint}")
         else:
+            scenario, line = self.map_gas.scenario(scenario, bool(p["gas_walls"]))
+            if line is not None:
+                walls = scenario.estimator.plume == "walls"
+                (self.get_logger().info if walls else self.get_logger().warning)(line)
             searcher = new_searcher(p, scenario, self.searches_started)
+        self.gas_model = scenario.estimator.plume
         if self._map_site is not None:  # the map topic's obstacles outlive a search
             searcher.agent = dataclasses.replace(searcher.agent, site=self._map_site)
         with self._lock:
@@ -330,16 +336,20 @@ class SearchNode(LifecycleNode):
     def _map(self, msg: OccupancyGrid) -> None:
         """Apply an occupancy grid: a map that cannot be used (rotated, not covering the
         search area, malformed) is logged and ignored; the search goes on with the last map."""
-        site = site_from_map(msg, self.scenario)
+        grid = grid_from_map(msg)
+        site = site_from_map(grid, self.scenario)
         with self._lock:
             self._map_site = site
-            if self.searcher is not None:
+            self.map_gas.update(grid)
+            searching = self.searcher is not None
+            if searching:
                 self.searcher.agent = dataclasses.replace(self.searcher.agent, site=site)
         self.maps_received += 1
         info = msg.info
+        later = " (the gas model follows it from the next search)" if searching else ""
         self.get_logger().info(
             f"map applied: {info.width} x {info.height} cells of {info.resolution:g} m, "
-            f"{int(site.blocked.sum())} of {site.blocked.size} planning cells blocked"
+            f"{int(site.blocked.sum())} of {site.blocked.size} planning cells blocked{later}"
         )
 
     def _odometry(self, msg: Odometry) -> None:
@@ -391,59 +401,6 @@ class SearchNode(LifecycleNode):
         self.result_pub.publish(String(data=json.dumps(self.result())))
         self.done.set()
         self._publish_diagnostics()
-
-    def result(self) -> dict[str, Any]:
-        """The search's result (the ``dcee/result`` message, :func:`search_result`)."""
-        return search_result(self.searcher, len(self.cycle.records), self.finish_reason)
-
-    def _publish_feedback(self, record: dict[str, Any]) -> None:
-        est = self.searcher.estimate()
-        feedback = {
-            "state": self.cycle.state,
-            "readings": len(self.cycle.records),
-            "mean": [float(v) for v in est.mean],
-            "spread": float(est.spread),
-            "elapsed": float(record["time"]),
-        }
-        self.feedback_pub.publish(String(data=json.dumps(feedback)))
-
-    def diagnostics(self) -> DiagnosticStatus:
-        """The search's state and its input health (:func:`diagnostic_status`)."""
-        return diagnostic_status(
-            f"{self.get_name()}: source search",
-            self.cycle,
-            self.active,
-            self.callback_errors,
-            self.finish_reason,
-        )
-
-    def _publish_diagnostics(self) -> None:
-        msg = DiagnosticArray()
-        msg.header.stamp = self._stamp()
-        msg.status = [self.diagnostics()]
-        self.diagnostics_pub.publish(msg)
-
-    # --- outputs ------------------------------------------------------------------------------
-
-    def _stamp(self) -> Any:
-        return self.get_clock().now().to_msg()
-
-    def _publish_goal(self, goal: np.ndarray, pose: Pose) -> None:
-        self.goal_pub.publish(goal_message(goal, pose, self.frame_id, self._stamp()))
-
-    def _publish_belief(self, record: dict[str, Any]) -> None:
-        est = self.searcher.estimate()
-        stamp = self._stamp()
-        point, cov = estimate_messages(est.mean, est.cov, self.frame_id, stamp)
-        self.estimate_pub.publish(point)
-        self.cov_pub.publish(cov)
-        n = int(self.params["marker_particles"])
-        self.particles_pub.publish(
-            particle_markers(self.searcher.filter, self._marker_rng, n, self.frame_id, stamp)
-        )
-        self.path_msg.header.stamp = stamp
-        self.path_msg.poses.append(path_pose(record, self.frame_id, stamp))
-        self.path_pub.publish(self.path_msg)
 
 
 __all__ = ["SearchNode"]

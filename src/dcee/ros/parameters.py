@@ -14,7 +14,9 @@ Parameters
     ``sensor.average``). The search ends when the budget is spent or, by default, once the
     source is localised (:mod:`dcee.stopping`): ``stop_spread`` m and ``stop_hold`` s (< 0:
     the scenario's ``search.stop_spread``/``stop_hold``, unset there: spread below
-    0.15 × ``search.acquired_rmse`` for 60 s; ``stop_spread`` 0: never).
+    0.15 × ``search.acquired_rmse`` for 60 s; ``stop_spread`` 0: never). ``gas_walls``
+    (true): a map on the map topic makes the estimator's gas flow round its walls
+    (:mod:`dcee.robot.map_gas`).
 """
 
 from __future__ import annotations
@@ -63,6 +65,8 @@ PARAMETERS: dict[str, Any] = {
     "stop_hold": -1.0,
     # configure and activate at start (a node without a lifecycle manager); false: wait for one
     "autostart": True,
+    # a map on the map topic makes the estimator's gas flow round its walls (next search on)
+    "gas_walls": True,
 }
 
 

@@ -1,0 +1,82 @@
+"""What the search node publishes (a mixin of :class:`dcee.ros.node.SearchNode`): the goal, the
+belief (estimate, covariance, particles, path), feedback, the result and the diagnostics. Every
+attribute it reads (publishers, ``searcher``, ``cycle``, ``params``) is the node's."""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import numpy as np
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from std_msgs.msg import String
+
+from dcee.robot.cycle import Pose
+from dcee.ros.messages import (
+    diagnostic_status,
+    estimate_messages,
+    goal_message,
+    particle_markers,
+    path_pose,
+    search_result,
+)
+
+
+class NodeOutputs:
+    """The search node's outputs (module doc)."""
+
+    def result(self) -> dict[str, Any]:
+        """The search's result (the ``dcee/result`` message, :func:`search_result`)."""
+        return search_result(self.searcher, len(self.cycle.records), self.finish_reason)
+
+    def _publish_feedback(self, record: dict[str, Any]) -> None:
+        est = self.searcher.estimate()
+        feedback = {
+            "state": self.cycle.state,
+            "readings": len(self.cycle.records),
+            "mean": [float(v) for v in est.mean],
+            "spread": float(est.spread),
+            "elapsed": float(record["time"]),
+        }
+        self.feedback_pub.publish(String(data=json.dumps(feedback)))
+
+    def diagnostics(self) -> DiagnosticStatus:
+        """The search's state and its input health (:func:`diagnostic_status`)."""
+        return diagnostic_status(
+            f"{self.get_name()}: source search",
+            self.cycle,
+            self.active,
+            self.callback_errors,
+            self.finish_reason,
+        )
+
+    def _publish_diagnostics(self) -> None:
+        msg = DiagnosticArray()
+        msg.header.stamp = self._stamp()
+        msg.status = [self.diagnostics()]
+        self.diagnostics_pub.publish(msg)
+
+    # --- outputs ------------------------------------------------------------------------------
+
+    def _stamp(self) -> Any:
+        return self.get_clock().now().to_msg()
+
+    def _publish_goal(self, goal: np.ndarray, pose: Pose) -> None:
+        self.goal_pub.publish(goal_message(goal, pose, self.frame_id, self._stamp()))
+
+    def _publish_belief(self, record: dict[str, Any]) -> None:
+        est = self.searcher.estimate()
+        stamp = self._stamp()
+        point, cov = estimate_messages(est.mean, est.cov, self.frame_id, stamp)
+        self.estimate_pub.publish(point)
+        self.cov_pub.publish(cov)
+        n = int(self.params["marker_particles"])
+        self.particles_pub.publish(
+            particle_markers(self.searcher.filter, self._marker_rng, n, self.frame_id, stamp)
+        )
+        self.path_msg.header.stamp = stamp
+        self.path_msg.poses.append(path_pose(record, self.frame_id, stamp))
+        self.path_pub.publish(self.path_msg)
+
+
+__all__ = ["NodeOutputs"]
