@@ -138,6 +138,7 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
         ("world", "resolution"): scenario.site_resolution,
         ("search", "explore_guard"): scenario.explore_guard,
         ("estimator", "wall_diffusivity"): scenario.wall_diffusivity,
+        ("estimator", "wall_wind"): scenario.wall_wind,
     }
     # unset with no single resolved value: what unset means, in words
     unset = {
