@@ -126,3 +126,29 @@ def test_the_field_cache_evicts_the_least_recent_and_keeps_the_numbers(monkeypat
     np.testing.assert_array_equal(small.concentration(theta, positions), expected)
     assert len(small._slots) == 4  # rows reused, the bank never grown
     np.testing.assert_array_equal(small.concentration(theta, positions[::-1]), expected[:, ::-1])
+
+
+def test_the_compiled_gather_is_its_numpy_reference() -> None:
+    """The kernel that reads receptor fields at the particles' cells against the NumPy
+    reference (einsum over a fancy-indexed gather), and the distances against einsum's."""
+    from dcee.models.plume_kernels import gather_receptor_fields
+    from dcee.models.site_plume import gather_receptor_fields_reference
+
+    plume = _open()
+    rng = np.random.default_rng(7)
+    theta = np.column_stack(
+        [rng.uniform(-5, 55, (700, 2)), np.ones(700), rng.uniform(0.5, 5, 700), np.zeros((700, 4))]
+    )
+    positions = np.column_stack([rng.uniform(0, 50, (9, 2)), np.full(9, 2.0)])
+    conc, dist = plume.concentration_distance(theta, positions)
+    rows = np.array([plume._slot(p[:2]) for p in positions])
+    cells, w = plume.weights(theta[:, :2])
+    reference = gather_receptor_fields_reference(plume._bank, rows, cells, w)
+    out = np.empty_like(reference)
+    gather_receptor_fields(plume._bank, rows, cells, w, out)
+    np.testing.assert_allclose(out, reference, rtol=1e-14, atol=1e-300)
+    np.testing.assert_allclose(conc, reference * theta[:, 3:4] / plume.layer_depth, rtol=1e-14)
+    assert np.all(conc[np.all(w == 0, axis=1)] == 0)  # off the grid: clean air
+    d = positions[None, :, :] - theta[:, None, :3]
+    expected = np.maximum(np.sqrt(np.einsum("nki,nki->nk", d, d)), plume.min_distance)
+    np.testing.assert_allclose(dist, expected, rtol=1e-15)

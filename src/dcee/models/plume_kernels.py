@@ -229,3 +229,23 @@ def concentration_matrix(
     dist = np.empty_like(tmp)
     concentration_distance_grid(theta, positions, rmin, meander, decay, backflow, radius, tmp, dist)
     out[...] = tmp.T
+
+
+@njit(cache=True, nogil=True)
+def gather_receptor_fields(
+    bank: np.ndarray, rows: np.ndarray, cells: np.ndarray, weights: np.ndarray, out: np.ndarray
+) -> None:
+    """The wall-aware plume's predictions (:class:`dcee.models.site_plume.SitePlume`):
+    ``out[n, k] = Σ_c weights[n, c] · bank[rows[k], cells[n, c]]`` for (N, 4) cells and bilinear
+    weights of N particles and K receptor-field rows of ``bank`` (float32). One field at a time
+    (it stays in cache while every particle reads it); the four terms summed as NumPy's einsum
+    pairs them, (0 + 2) + (1 + 3), so the kernel equals its reference
+    (:func:`dcee.models.site_plume.gather_receptor_fields_reference`) exactly."""
+    for k in range(rows.shape[0]):
+        field = bank[rows[k]]
+        for n in range(cells.shape[0]):
+            a0 = weights[n, 0] * np.float64(field[cells[n, 0]])
+            a1 = weights[n, 1] * np.float64(field[cells[n, 1]])
+            a2 = weights[n, 2] * np.float64(field[cells[n, 2]])
+            a3 = weights[n, 3] * np.float64(field[cells[n, 3]])
+            out[n, k] = (a0 + a2) + (a1 + a3)

@@ -41,6 +41,7 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.models.plume import MIN_DISTANCE
+from dcee.models.plume_kernels import gather_receptor_fields
 from dcee.models.site_flow import WAKE_VISCOSITY, mass_consistent_wind, wake_wind
 
 LAYER_DEPTH = 2.0
@@ -199,22 +200,23 @@ class SitePlume:
     ) -> tuple[np.ndarray, np.ndarray]:
         """(N, K) concentrations (g/m³) and source distances (m, clamped at ``min_distance``)
         of particles ``theta`` (N, 8) at (K, 3) positions. Only each particle's x, y and q are
-        read (the wind and ζ are the model's). The K fields are gathered at the particles'
-        four cells in one indexing (at most half the field cache at a time)."""
+        read (the wind and ζ are the model's). The K fields are read at the particles' four
+        cells by a compiled kernel (at most half the field cache at a time)."""
         theta = np.asarray(theta, dtype=np.float64).reshape(-1, theta.shape[-1])
         positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
         cells, w = self.weights(theta[:, :2])
-        scale = theta[:, 3] / self.layer_depth
         conc = np.empty((len(theta), len(positions)))
-        flat = cells.reshape(1, -1)
         step = FIELD_CACHE // 2
         for start in range(0, len(positions), step):
             chunk = positions[start : start + step]
             rows = np.array([self._slot(p[:2]) for p in chunk], dtype=np.int64)
-            vals = self._bank[rows[:, None], flat].reshape(len(chunk), *cells.shape)
-            conc[:, start : start + len(chunk)] = scale[:, None] * np.einsum("nc,knc->nk", w, vals)
-        d = positions[None, :, :] - theta[:, None, :3]
-        dist = np.maximum(np.sqrt(np.einsum("nki,nki->nk", d, d)), self.min_distance)
+            gather_receptor_fields(self._bank, rows, cells, w, conc[:, start : start + len(chunk)])
+        conc *= (theta[:, 3] / self.layer_depth)[:, None]
+        # the squared distance summed axis by axis, as einsum("nki,nki->nk") does (same bits)
+        d2 = np.square(positions[None, :, 0] - theta[:, None, 0])
+        d2 += np.square(positions[None, :, 1] - theta[:, None, 1])
+        d2 += np.square(positions[None, :, 2] - theta[:, None, 2])
+        dist = np.maximum(np.sqrt(d2, out=d2), self.min_distance)
         return conc, dist
 
     def concentration(self, theta: np.ndarray, positions: np.ndarray) -> np.ndarray:
@@ -231,6 +233,15 @@ class SitePlume:
         out = np.full(self.fluid.shape, np.nan)
         out[self.fluid] = c
         return out
+
+
+def gather_receptor_fields_reference(
+    bank: np.ndarray, rows: np.ndarray, cells: np.ndarray, weights: np.ndarray
+) -> np.ndarray:
+    """NumPy reference of :func:`dcee.models.plume_kernels.gather_receptor_fields`: (N, K)
+    Σ_c weights[n, c] · bank[rows[k], cells[n, c]]."""
+    vals = bank[rows[:, None], cells.reshape(1, -1)].reshape(len(rows), *cells.shape)
+    return np.einsum("nc,knc->nk", weights, vals)
 
 
 def transport_matrix(
@@ -321,6 +332,7 @@ __all__ = [
     "MARGIN",
     "SitePlume",
     "bernoulli",
+    "gather_receptor_fields_reference",
     "open_to_edge",
     "site_grid",
     "transport_matrix",
