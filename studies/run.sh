@@ -422,15 +422,28 @@ case "${1:---list}" in
       "potential, decay 8 s, K fixed (A)=results/sites-tune-A" \
       "wall-blind=results/sites-tune-blind" --out docs/results/sites-walls-tune
     $P studies/publish_tables.py ;;
-  sites-walls)  # issue 44: gas round buildings, the lbm truth on the four sites with walls, wall-aware against wall-blind, dcee-cl and infotaxis, 10 seeds
+  sites-walls)  # issue 44: gas round buildings, the lbm truth on the four sites with walls, wall-aware (wake and potential wind) against wall-blind, dcee-cl and infotaxis, 10 seeds
     B="$D bench --suite sites-walls --repeats 10 --particles 10000 --workers ${WORKERS:-2}"
-    $B --strategies dcee-cl --set estimator.plume=walls --out results/sites-walls-aware
-    $B --strategies dcee-cl --out results/sites-walls-blind
-    $B --strategies infotaxis --set estimator.plume=walls --out results/sites-walls-aware-infotaxis
-    $B --strategies infotaxis --out results/sites-walls-blind-infotaxis
+    W="--set estimator.plume=walls"
+    P2="--set estimator.wall_wind=potential"
+    for s in dcee-cl infotaxis; do
+      x=$([ $s = infotaxis ] && echo -infotaxis || true)
+      $B --strategies $s $W --out results/sites-walls-aware$x
+      $B --strategies $s $W $P2 --out results/sites-walls-aware-potential$x
+      $B --strategies $s --out results/sites-walls-blind$x
+    done
     $P studies/sites_walls_table.py wall-aware=results/sites-walls-aware \
+      "wall-aware, potential wind=results/sites-walls-aware-potential" \
       wall-blind=results/sites-walls-blind wall-aware=results/sites-walls-aware-infotaxis \
+      "wall-aware, potential wind=results/sites-walls-aware-potential-infotaxis" \
       wall-blind=results/sites-walls-blind-infotaxis --out docs/results/sites-walls
+    $P studies/publish_tables.py ;;
+  sites-walls-planners)  # issue 44: the other planners on the four sites with walls, wall-aware against wall-blind, 10 seeds
+    B="$D bench --suite sites-walls --repeats 10 --particles 10000 --workers ${WORKERS:-2} --strategies dcee,dcee-ms,mpc,entrotaxis,dcee-mcts"
+    $B --set estimator.plume=walls --out results/sites-walls-aware-planners
+    $B --out results/sites-walls-blind-planners
+    $P studies/sites_walls_table.py wall-aware=results/sites-walls-aware-planners \
+      wall-blind=results/sites-walls-blind-planners --out docs/results/sites-walls-planners
     $P studies/publish_tables.py ;;
   sites-walls-timing)  # issue 44: decision time on a site against open terrain (idle machine, one pinned core)
     $P studies/site_timing.py --out docs/results/sites-walls/timing.csv ;;
