@@ -9,7 +9,8 @@ air points where either is above the sensor's threshold: the correlation of log1
 concentrations and the RMS of their difference after the best common shift (the estimator
 learns q, so only the shape counts). Writes one row per site, wind and K.
 
-    python studies/site_flow_fidelity.py --sites 1-4 --out docs/results/sites-walls-tune/fidelity.csv
+    python studies/site_flow_fidelity.py --sites 1-8 \
+        --out docs/results/sites-walls-tune/fidelity.csv
 """
 
 from __future__ import annotations

@@ -216,11 +216,6 @@ Jeffreys' scale calls evidence strong (the value from that convention, not from 
 equal prior let the disc lead on point releases: docs/results/tuning-source-radius-13-40)."""
 
 
-WALL_WIND_DEFAULT = "wake"
-"""The wall-aware plume's wind when ``estimator.wall_wind`` is unset (see the field): chosen on
-the tuning sites ``random-site:1-20`` (lbm truth, ``dcee-cl``, rule written before the run,
-docs/results/sites-walls-tune)."""
-
 WALL_DIFFUSIVITY_FACTORS = (1.0, 3.0, 10.0)
 """The wall-aware plume's diffusivity K the fluctuation likelihood weighs by default, as
 multiples of the fixed one (the scenario's ζ1 unless ``estimator.wall_diffusivity`` is set): a
@@ -425,10 +420,10 @@ class EstimatorSpec(BaseModel):
     """the dispersion model of the filter and the planners: ``open``, the paper's plume in open
     terrain (:mod:`dcee.models.plume`); ``walls``, the wall-aware planar plume that flows round
     the ``[world]``'s obstacles and the map's occupied cells (:mod:`dcee.models.site_plume`: a
-    mass-consistent wind and the advection-diffusion equation solved between the walls,
-    source-receptor fields per sensor position). ``walls`` needs a ``[world]`` with obstacles or
-    a map, the wind and ζ known (``unknown = "source"``: one flow), one release, and none of
-    the open plume's shape settings learned (:data:`PLUME_SHAPE_SETTINGS`)"""
+    wind round the walls, ``wall_wind``, and the advection-diffusion equation solved between
+    them, source-receptor fields per sensor position). ``walls`` needs a ``[world]`` with
+    obstacles or a map, the wind and ζ known (``unknown = "source"``: one flow), one release,
+    and none of the open plume's shape settings learned (:data:`PLUME_SHAPE_SETTINGS`)"""
     wall_diffusivity: Annotated[float | None, Field(gt=0, le=1000, allow_inf_nan=False)] = None
     """m²/s: the wall-aware plume's diffusivity K (``plume = "walls"``); None: the scenario's
     ζ1. The fluctuation likelihood weighs it and 3 and 10 times it
@@ -443,7 +438,8 @@ class EstimatorSpec(BaseModel):
     """the wall-aware plume's wind round the buildings (``plume = "walls"``,
     :mod:`dcee.models.site_flow`): ``wake``, the time-mean flow of a constant-eddy-viscosity
     Navier–Stokes model (a recirculating wake in a building's lee); ``potential``, the free wind
-    made mass-consistent (turned along walls, no wake). None: :data:`WALL_WIND_DEFAULT`"""
+    made mass-consistent (turned along walls, no wake). None: the default,
+    :data:`dcee.models.site_flow.WALL_WIND_DEFAULT`"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the

@@ -10,12 +10,12 @@ import itertools
 
 import numpy as np
 
+from dcee.models.site_flow import WALL_WIND_DEFAULT
 from dcee.scenarios.schema.common import FIELD_MARK
 from dcee.scenarios.schema.estimator import (
     LEARN_MEMBERS_MAX,
     LEARN_RANGES,
     PLUME_SHAPE_SETTINGS,
-    WALL_WIND_DEFAULT,
     default_learn,
     default_learn_prior,
     learn_member_weight,
