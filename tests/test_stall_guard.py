@@ -187,3 +187,27 @@ def test_the_wander_guard_sends_a_robot_out_of_a_region_it_keeps_to():
             assert wander <= WANDER_GUARD + 10.0 and s.explore_fired > 0, wander
         else:
             assert wander > 150.0 and s.explore_fired == 0
+
+
+def test_a_goal_round_a_corner_no_whole_step_follows_is_still_approached():
+    """``site:block``, where entrotaxis stepped back and forth for 150 s: from (43.6, 44) the
+    travel distance to a goal round the courtyard building falls by less than half a step
+    for every move (0.93 m at most), so the guard offered every move. It now offers the moves
+    that bring the robot closer at all, and the robot walked along them reaches the goal."""
+    from dcee.exploration import ApproachingAgent, travel_xy
+
+    agent = load_scenario("site:block").make_agent()
+    goal = np.array([43.8, 10.4, 4.0])
+    here = np.array([43.556349, 44.041631, 4.0])
+    cands, _ = ApproachingAgent(agent, goal, here).candidates(here)
+    now = travel_xy(agent.site, goal, here[None])[0]
+    after = travel_xy(agent.site, goal, cands)
+    assert 0 < len(cands) < len(agent.candidates(here)[0]) and np.all(after < now)
+    for _ in range(40):  # greedy along the offered moves: never back, and there in the end
+        cands, _ = ApproachingAgent(agent, goal, here).candidates(here)
+        after = travel_xy(agent.site, goal, cands)
+        assert after.min() < travel_xy(agent.site, goal, here[None])[0]
+        here = cands[int(np.argmin(after))]
+        if np.hypot(*(here[:2] - goal[:2])) <= agent.step:
+            break
+    assert np.hypot(*(here[:2] - goal[:2])) <= agent.step
