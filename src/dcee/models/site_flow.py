@@ -147,8 +147,8 @@ def wake_wind(
     while t < total:
         umax = max(float(np.abs(fu).max()), float(np.abs(fv).max()), speed)
         dt = min(0.4 * h / umax, 0.2 * h * h / nu)
-        fu_new = fu + dt * _tendency(fu, fv, wall_u, free[0], h, nu, along_x=True)
-        fv_new = fv + dt * _tendency(fv.T, fu.T, wall_v.T, free[1], h, nu, along_x=True).T
+        fu_new = fu + dt * _tendency(fu, fv, wall_u, free[0], h, nu)
+        fv_new = fv + dt * _tendency(fv.T, fu.T, wall_v.T, free[1], h, nu).T
         fu = _held_edges(np.where(march_u, fu_new, 0.0), project.open_u, free[0])
         fv = _held_edges(np.where(march_v, fv_new, 0.0).T, project.open_v.T, free[1]).T
         fu, fv = project(fu, fv)
@@ -170,7 +170,7 @@ def _held_edges(u: np.ndarray, open_faces: np.ndarray, component: float) -> np.n
 
 
 def _tendency(
-    u: np.ndarray, v: np.ndarray, wall: np.ndarray, edge: float, h: float, nu: float, along_x: bool
+    u: np.ndarray, v: np.ndarray, wall: np.ndarray, edge: float, h: float, nu: float
 ) -> np.ndarray:
     """du/dt of the x-velocity ``u`` (ny, nx + 1) on its faces: −(u ∂x u + v̄ ∂y u) (first-order
     upwind) + ν ∇²u, with ``v`` (ny + 1, nx) the other component; ``wall`` marks faces in a
