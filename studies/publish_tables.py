@@ -615,6 +615,7 @@ def sites_walls_timing_table() -> str:
             f"{r['decision_ratio']:.2f}×",
             f"{r['update_ms_mean']:.1f}",
             f"{r['update_ratio']:.2f}×",
+            f"{r['load_before']:.2f}",
         ]
         for _, r in frame.iterrows()
     ]
@@ -626,6 +627,7 @@ def sites_walls_timing_table() -> str:
             "× open terrain",
             "mean update per reading (ms)",
             "× open terrain",
+            "load before",
         ],
         rows,
     )

@@ -25,7 +25,11 @@ terrain, a reversed flow behind a wall across the wind and none in front of it
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+
+from dcee.errors import DceeInputError
 
 WAKE_VISCOSITY = 1.0
 """m²/s: the eddy viscosity ν_t of :func:`wake_wind` by default, the order of κ u* z at a UAV's
@@ -160,6 +164,21 @@ def wake_wind(
     return project(mean_u / averaged, mean_v / averaged)
 
 
+def site_wind(
+    fluid: np.ndarray, h: float, u: float, phi: float, model: str
+) -> tuple[np.ndarray, np.ndarray]:
+    """The face velocities round the walls of ``fluid`` (ny, nx) (cells of ``h`` m) of the free
+    wind of ``u`` m/s from ``phi`` rad (the paper's convention: it blows towards
+    −(cos φ, sin φ)) by the wind model ``model``: ``"wake"`` (:func:`wake_wind`) or
+    ``"potential"`` (:func:`mass_consistent_wind`)."""
+    free = -u * np.array([math.cos(phi), math.sin(phi)])
+    if model == "wake":
+        return wake_wind(fluid, h, free)
+    if model == "potential":
+        return mass_consistent_wind(fluid, h, free)
+    raise DceeInputError("estimator.wall_wind", f"must be 'wake' or 'potential', got {model!r}")
+
+
 def _held_edges(u: np.ndarray, open_faces: np.ndarray, component: float) -> np.ndarray:
     """``u`` (ny, nx + 1) with its end faces set: the inflow end holds ``component`` (the free
     wind's), the outflow end copies the face next to it (where ``open_faces``)."""
@@ -202,5 +221,6 @@ __all__ = [
     "WALL_WIND_DEFAULT",
     "Projection",
     "mass_consistent_wind",
+    "site_wind",
     "wake_wind",
 ]

@@ -42,7 +42,7 @@ import numpy as np
 from dcee.errors import DceeInputError
 from dcee.models.plume import MIN_DISTANCE
 from dcee.models.plume_kernels import gather_receptor_fields
-from dcee.models.site_flow import WAKE_VISCOSITY, mass_consistent_wind, wake_wind
+from dcee.models.site_flow import site_wind
 
 LAYER_DEPTH = 2.0
 """m: the depth the release is spread over (the fluid solver's truth's default): the plane
@@ -108,16 +108,10 @@ class SitePlume:
         self.min_distance = float(min_distance)
         self.index = np.full(self.fluid.shape, -1, dtype=np.int64)
         self.index[self.fluid] = np.arange(int(self.fluid.sum()))
-        # the free wind blows towards −(cos φ, sin φ) (dcee.models.plume)
-        free = -u * np.array([math.cos(phi), math.sin(phi)])
         if isinstance(wind, tuple):
             self.face_u, self.face_v = wind
-        elif wind == "wake":
-            self.face_u, self.face_v = wake_wind(self.fluid, self.resolution, free, WAKE_VISCOSITY)
-        elif wind == "potential":
-            self.face_u, self.face_v = mass_consistent_wind(self.fluid, self.resolution, free)
         else:
-            raise DceeInputError("estimator.wall_wind", "must be 'wake' or 'potential'")
+            self.face_u, self.face_v = site_wind(self.fluid, self.resolution, u, phi, wind)
         matrix = transport_matrix(
             self.fluid, self.index, self.resolution, self.face_u, self.face_v, zeta1, zeta2
         )

@@ -22,7 +22,7 @@ from dcee.models.plume import PARAMETER_NAMES, IsotropicPlume
 from dcee.models.ros_map import load_ros_map
 from dcee.models.sensor import Sensor
 from dcee.models.site import SiteMap, compose_site
-from dcee.models.site_flow import mass_consistent_wind, wake_wind
+from dcee.models.site_flow import site_wind
 from dcee.models.site_plume import SitePlume, site_grid
 from dcee.scenarios.schema.agent import team_starts
 from dcee.scenarios.schema.estimator import PHYSICAL_TRUNCATION, PriorSpec
@@ -76,11 +76,7 @@ def _site_fluid(
 def _site_wind(site: tuple, u: float, phi: float, model: str) -> tuple[np.ndarray, np.ndarray]:
     """The wind round the site's walls (:mod:`dcee.models.site_flow`), computed once per
     process and shared by the models that differ only in K."""
-    fluid, _ = _site_fluid(*site)
-    free = -u * np.array([math.cos(phi), math.sin(phi)])
-    if model == "wake":
-        return wake_wind(fluid, site[-1], free)
-    return mass_consistent_wind(fluid, site[-1], free)
+    return site_wind(_site_fluid(*site)[0], site[-1], u, phi, model)
 
 
 @functools.lru_cache(maxsize=8)
