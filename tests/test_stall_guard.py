@@ -211,3 +211,26 @@ def test_a_goal_round_a_corner_no_whole_step_follows_is_still_approached():
         if np.hypot(*(here[:2] - goal[:2])) <= agent.step:
             break
     assert np.hypot(*(here[:2] - goal[:2])) <= agent.step
+
+
+def test_a_guard_never_names_a_goal_it_cannot_steer_to():
+    """``site:block``, mpc, seed 0: the exploration guard named (31.25, 39.58), a point inside a
+    building. The robot reaches it at the building's face, but the travel distance back from
+    it is infinite (a blocked cell is left only to another blocked one), so every move
+    measured infinitely far and the guard steered nowhere for 155 s. Goals are now free cells
+    reachable from the robot, and from every one of them the way back is finite."""
+    from dcee.exploration import ApproachingAgent, area_grid, reachable_points, travel_xy
+
+    agent = load_scenario("site:block").make_agent()
+    here = np.array([27.556349, 38.727922, 4.0])
+    inside = np.array([[31.25, 39.58333333, 4.0]])
+    assert agent.site.is_blocked(inside)[0] and agent.site.reachable(here, inside)[0]
+    assert not np.isfinite(travel_xy(agent.site, inside[0], here[None])[0])
+    assert len(reachable_points(agent, here, inside)) == 0
+    grid = area_grid(agent, 4.0)
+    goals = reachable_points(agent, here, grid)
+    assert 0 < len(goals) < len(grid) and not agent.site.is_blocked(goals).any()
+    for goal in goals[:: max(1, len(goals) // 40)]:  # every 40th: one Dijkstra each
+        assert np.isfinite(travel_xy(agent.site, goal, here[None])[0])
+        cands, _ = ApproachingAgent(agent, goal, here).candidates(here)
+        assert np.all(travel_xy(agent.site, goal, cands) < travel_xy(agent.site, goal, here[None]))

@@ -189,6 +189,20 @@ def _thinned(
     return theta[idx], np.full(n, 1.0 / n)
 
 
+def reachable_points(agent: GridAgent, position: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """The rows of ``points`` (K, 3) m a robot at ``position`` (3,) m can go to: on a site, free
+    cells (not blocked, not unknown) at a finite travel distance round the walls; all of them
+    without a site. A point inside a building counts as reachable to the travel distance (a
+    hypothesised source there is reached at its nearest face), but a goal there is not: the
+    way back from it is blocked, so a guard steering towards it measured every move as
+    infinitely far and steered nowhere (``site:block``, mpc, seed 0: 155 s in one region)."""
+    site = agent.site
+    if site is None or len(points) == 0:
+        return points
+    points = points[~site.is_blocked(points)]
+    return points[site.reachable(position, points)] if len(points) else points
+
+
 def area_grid(agent: GridAgent, altitude: float, cells: int = GRID_CELLS) -> np.ndarray:
     """(cells², 3) grid points over the agent's area (cell centres) at ``altitude`` m."""
     lo, hi = np.asarray(agent.volume.low), np.asarray(agent.volume.high)
@@ -225,11 +239,9 @@ def exploration_goal(
     local = float(info(cands).max())
     if local >= share * math.log(2.0):  # no grid point can beat ln 2: the move is informative
         return None
-    grid = area_grid(agent, float(position[2]))
-    if agent.site is not None:  # points the robot can reach, by travel distance round walls
-        grid = grid[agent.site.reachable(position, grid)]
-        if len(grid) == 0:
-            return None
+    grid = reachable_points(agent, position, area_grid(agent, float(position[2])))
+    if len(grid) == 0:
+        return None
     h_grid = info(grid)
     best = float(h_grid.max())
     if best <= 0.0 or local >= share * best:
@@ -280,18 +292,22 @@ class ApproachingAgent(RestrictedAgent):
 
 
 def wander_goal(
-    estimator: Estimator, anchor: np.ndarray, agent: GridAgent, radius: float
+    estimator: Estimator,
+    anchor: np.ndarray,
+    agent: GridAgent,
+    radius: float,
+    position: np.ndarray | None = None,
 ) -> np.ndarray | None:
-    """Where to go when the robot has kept to one region (within ``radius`` m of ``anchor``
-    (3,) m) while the belief stays wider than it: the grid point outside the region (beyond
-    ``radius`` + one step of the anchor, reachable) whose next reading tells the most
+    """Where to go when the robot (at ``position`` (3,) m, default the anchor) has kept to one
+    region (within ``radius`` m of ``anchor`` (3,) m) while the belief stays wider than it: the
+    grid point outside the region (beyond ``radius`` + one step of the anchor, reachable from
+    the robot, :func:`reachable_points`) whose next reading tells the most
     (:func:`detection_information`), or None when no such point tells anything."""
     theta, weights = joint_belief(estimator)
-    grid = area_grid(agent, float(anchor[2]))
+    at = anchor if position is None else np.asarray(position, dtype=np.float64)
+    grid = area_grid(agent, float(at[2]))
     outside = np.hypot(*(grid[:, :2] - anchor[:2]).T) > radius + agent.step
-    grid = grid[outside]
-    if agent.site is not None and len(grid):
-        grid = grid[agent.site.reachable(anchor, grid)]
+    grid = reachable_points(agent, at, grid[outside])
     if len(grid) == 0:
         return None
     info = detection_information(theta, weights, estimator.sensor, estimator.plume, grid)

@@ -251,7 +251,7 @@ class Searcher:
         if self.estimate().spread <= WANDER_RADIUS:
             return None
         self.wander_target = wander_goal(
-            self.filter, self.recent[first][1], self.agent, WANDER_RADIUS
+            self.filter, self.recent[first][1], self.agent, WANDER_RADIUS, self.position
         )
         if self.wander_target is not None:
             self.wander_fired += 1
