@@ -305,7 +305,7 @@ def wander_goal(
     (:func:`detection_information`), or None when no such point tells anything."""
     theta, weights = joint_belief(estimator)
     at = anchor if position is None else np.asarray(position, dtype=np.float64)
-    grid = area_grid(agent, float(at[2]))
+    grid = area_grid(agent, float(anchor[2]))
     outside = np.hypot(*(grid[:, :2] - anchor[:2]).T) > radius + agent.step
     grid = reachable_points(agent, at, grid[outside])
     if len(grid) == 0:
