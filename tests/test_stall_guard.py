@@ -230,7 +230,7 @@ def test_a_guard_never_names_a_goal_it_cannot_steer_to():
     grid = area_grid(agent, 4.0)
     goals = reachable_points(agent, here, grid)
     assert 0 < len(goals) < len(grid) and not agent.site.is_blocked(goals).any()
-    for goal in goals[:: max(1, len(goals) // 40)]:  # every 40th: one Dijkstra each
+    for goal in goals[:: max(1, len(goals) // 40)]:  # about 40, a Dijkstra each
         assert np.isfinite(travel_xy(agent.site, goal, here[None])[0])
         cands, _ = ApproachingAgent(agent, goal, here).candidates(here)
         assert np.all(travel_xy(agent.site, goal, cands) < travel_xy(agent.site, goal, here[None]))

@@ -296,18 +296,17 @@ def wander_goal(
     anchor: np.ndarray,
     agent: GridAgent,
     radius: float,
-    position: np.ndarray | None = None,
+    position: np.ndarray,
 ) -> np.ndarray | None:
-    """Where to go when the robot (at ``position`` (3,) m, default the anchor) has kept to one
-    region (within ``radius`` m of ``anchor`` (3,) m) while the belief stays wider than it: the
-    grid point outside the region (beyond ``radius`` + one step of the anchor, reachable from
-    the robot, :func:`reachable_points`) whose next reading tells the most
+    """Where to go when the robot (at ``position`` (3,) m) has kept to one region (within
+    ``radius`` m of ``anchor`` (3,) m) while the belief stays wider than it: the grid point
+    outside the region (beyond ``radius`` + one step of the anchor, reachable from the robot,
+    :func:`reachable_points`) whose next reading tells the most
     (:func:`detection_information`), or None when no such point tells anything."""
     theta, weights = joint_belief(estimator)
-    at = anchor if position is None else np.asarray(position, dtype=np.float64)
     grid = area_grid(agent, float(anchor[2]))
     outside = np.hypot(*(grid[:, :2] - anchor[:2]).T) > radius + agent.step
-    grid = reachable_points(agent, at, grid[outside])
+    grid = reachable_points(agent, position, grid[outside])
     if len(grid) == 0:
         return None
     info = detection_information(theta, weights, estimator.sensor, estimator.plume, grid)
