@@ -165,15 +165,20 @@ def wake_wind(
 
 
 def site_wind(
-    fluid: np.ndarray, h: float, u: float, phi: float, model: str
+    fluid: np.ndarray,
+    h: float,
+    u: float,
+    phi: float,
+    model: str,
+    viscosity: float = WAKE_VISCOSITY,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The face velocities round the walls of ``fluid`` (ny, nx) (cells of ``h`` m) of the free
     wind of ``u`` m/s from ``phi`` rad (the paper's convention: it blows towards
-    −(cos φ, sin φ)) by the wind model ``model``: ``"wake"`` (:func:`wake_wind`) or
-    ``"potential"`` (:func:`mass_consistent_wind`)."""
+    −(cos φ, sin φ)) by the wind model ``model``: ``"wake"`` (:func:`wake_wind`, eddy viscosity
+    ``viscosity`` m²/s) or ``"potential"`` (:func:`mass_consistent_wind`)."""
     free = -u * np.array([math.cos(phi), math.sin(phi)])
     if model == "wake":
-        return wake_wind(fluid, h, free)
+        return wake_wind(fluid, h, free, viscosity=viscosity)
     if model == "potential":
         return mass_consistent_wind(fluid, h, free)
     raise DceeInputError("estimator.wall_wind", f"must be 'wake' or 'potential', got {model!r}")

@@ -73,22 +73,24 @@ def _site_fluid(
 
 
 @functools.lru_cache(maxsize=4)
-def _site_wind(site: tuple, u: float, phi: float, model: str) -> tuple[np.ndarray, np.ndarray]:
-    """The wind round the site's walls (:mod:`dcee.models.site_flow`), computed once per
-    process and shared by the models that differ only in K."""
-    return site_wind(_site_fluid(*site)[0], site[-1], u, phi, model)
+def _site_wind(
+    site: tuple, u: float, phi: float, model: str, viscosity: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The wind round the site's walls (:mod:`dcee.models.site_flow`; ``viscosity`` m²/s, the
+    wake wind's ν_t), computed once per process and shared by the models that differ only in K."""
+    return site_wind(_site_fluid(*site)[0], site[-1], u, phi, model, viscosity)
 
 
 @functools.lru_cache(maxsize=8)
 def _wall_plume(
-    site: tuple, environment: tuple[float, float, float, float], wind: str
+    site: tuple, environment: tuple[float, float, float, float], wind: tuple[str, float]
 ) -> SitePlume:
     """The wall-aware plume of one site (``(low, high, world_json, mtime, resolution)``), one
-    (u, φ, K, ζ2) and one wind model, built once per process and shared by the filter's
-    members of that K and the planners (its receptor fields are cached in it)."""
+    (u, φ, K, ζ2) and one wind (model, eddy viscosity m²/s), built once per process and shared
+    by the filter's members of that K and the planners (its receptor fields are cached in it)."""
     fluid, origin = _site_fluid(*site)
     u, phi = environment[:2]
-    return SitePlume(fluid, origin, site[-1], *environment, wind=_site_wind(site, u, phi, wind))
+    return SitePlume(fluid, origin, site[-1], *environment, wind=_site_wind(site, u, phi, *wind))
 
 
 def inside_world(world: WorldSpec, xy: np.ndarray, no_go: bool = True) -> np.ndarray:
@@ -168,7 +170,7 @@ class ScenarioBuilders:
                 mtime,
                 float(self.site_resolution),
             )
-            return _wall_plume(site, (u, phi, k, zeta2), self.wall_wind)
+            return _wall_plume(site, (u, phi, k, zeta2), (self.wall_wind, self.wall_viscosity))
         if self.estimator.likelihood == "paper":
             return IsotropicPlume(meander=self.meander)
         if model == "paper":

@@ -139,6 +139,7 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
         ("search", "explore_guard"): scenario.explore_guard,
         ("estimator", "wall_diffusivity"): scenario.wall_diffusivity,
         ("estimator", "wall_wind"): scenario.wall_wind,
+        ("estimator", "wall_viscosity"): scenario.wall_viscosity,
     }
     # unset with no single resolved value: what unset means, in words
     unset = {

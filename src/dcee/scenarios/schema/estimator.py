@@ -440,6 +440,9 @@ class EstimatorSpec(BaseModel):
     Navier–Stokes model (a recirculating wake in a building's lee); ``potential``, the free wind
     made mass-consistent (turned along walls, no wake). None: the default,
     :data:`dcee.models.site_flow.WALL_WIND_DEFAULT`"""
+    wall_viscosity: Annotated[float | None, Field(gt=0, le=100, allow_inf_nan=False)] = None
+    """m²/s: the eddy viscosity ν_t of the wake wind (``wall_wind = "wake"``); None:
+    :data:`dcee.models.site_flow.WAKE_VISCOSITY`"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the

@@ -10,7 +10,7 @@ import itertools
 
 import numpy as np
 
-from dcee.models.site_flow import WALL_WIND_DEFAULT
+from dcee.models.site_flow import WAKE_VISCOSITY, WALL_WIND_DEFAULT
 from dcee.scenarios.schema.common import FIELD_MARK
 from dcee.scenarios.schema.estimator import (
     LEARN_MEMBERS_MAX,
@@ -49,14 +49,18 @@ class ReadingModelSettings:
         no open-plume shape learned."""
         e = self.estimator
         if e.plume != "walls":
-            walls_only = (e.wall_diffusivity, e.wall_lifetime, e.wall_wind) != (None,) * 3
-            if walls_only or "wall_diffusivity" in (e.learn or {}):
+            walls_only = (e.wall_diffusivity, e.wall_lifetime, e.wall_wind, e.wall_viscosity)
+            if walls_only != (None,) * 4 or "wall_diffusivity" in (e.learn or {}):
                 raise ValueError(
-                    f"{FIELD_MARK}estimator.wall_diffusivity, wall_lifetime, wall_wind: are the "
-                    "wall-aware "
-                    'plume\'s; need estimator.plume = "walls"'
+                    f"{FIELD_MARK}estimator.wall_diffusivity, wall_lifetime, wall_wind, "
+                    'wall_viscosity: are the wall-aware plume\'s; need estimator.plume = "walls"'
                 )
             return
+        if e.wall_viscosity is not None and self.wall_wind != "wake":
+            raise ValueError(
+                f"{FIELD_MARK}estimator.wall_viscosity: is the wake wind's eddy viscosity; the "
+                f'"{self.wall_wind}" wind has none (set wall_wind = "wake" or leave it unset)'
+            )
         what = f'{FIELD_MARK}estimator.plume: "walls" '
         if not self.world.obstacles and self.world.map is None:
             raise ValueError(
@@ -142,6 +146,13 @@ class ReadingModelSettings:
     def wall_wind(self) -> str:
         """The wall-aware plume's wind model: ``estimator.wall_wind`` or its default."""
         return self.estimator.wall_wind or WALL_WIND_DEFAULT
+
+    @property
+    def wall_viscosity(self) -> float:
+        """The wake wind's eddy viscosity ν_t, m²/s: ``estimator.wall_viscosity`` or
+        :data:`dcee.models.site_flow.WAKE_VISCOSITY` (unused by the potential wind)."""
+        v = self.estimator.wall_viscosity
+        return WAKE_VISCOSITY if v is None else float(v)
 
     @property
     def wall_diffusivity(self) -> float:
