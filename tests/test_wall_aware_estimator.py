@@ -100,6 +100,14 @@ def test_exploration_information_of_a_plume_by_its_own_method_is_the_compiled_on
             "wall_lifetime",
         ),
         (
+            {"estimator.wall_wind": "potential", "estimator.wall_viscosity": 0.5},
+            "wall_viscosity: is the wake wind's",
+        ),
+        (
+            {"scenario": "site:wall", "estimator.plume": "open", "estimator.wall_viscosity": 0.5},
+            "wall_viscosity",
+        ),
+        (
             {"estimator.likelihood": "fluctuation", "estimator.learn": {"decay": [1.0, 0.5]}},
             "shape the open plume",
         ),
