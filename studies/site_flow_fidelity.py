@@ -7,10 +7,13 @@ area, and the wall-aware plume's prediction for the true release with each wind 
 (``wake``, ``potential``) and each diffusivity of the estimator's bank (1, 3, 10 × ζ1). Over the
 air points where either is above the sensor's threshold: the correlation of log10
 concentrations and the RMS of their difference after the best common shift (the estimator
-learns q, so only the shape counts). Writes one row per site, wind and K.
+learns q, so only the shape counts). Writes one row per site, wind, eddy viscosity (the wake
+wind's ν_t, ``--viscosities``; the potential wind has none) and K.
 
     python studies/site_flow_fidelity.py --sites 1-8 \
         --out docs/results/sites-walls-tune/fidelity.csv
+    python studies/site_flow_fidelity.py --sites 1-8 --viscosities 0.25,0.5,1,2,4 \
+        --out docs/results/sites-walls-tune/viscosity/fidelity.csv
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from dcee.models.site_flow import WAKE_VISCOSITY, site_wind
 from dcee.models.site_plume import SitePlume
 from dcee.provenance import code_version, describe
 from dcee.scenarios import load_scenario
@@ -35,7 +39,7 @@ OVERRIDES = {
 }
 
 
-def site_rows(k: int) -> list[dict]:
+def site_rows(k: int, viscosities: tuple[float, ...] = (WAKE_VISCOSITY,)) -> list[dict]:
     sc = load_scenario(f"random-site:{k}").with_overrides(**OVERRIDES)
     truth = make_truth(sc, 0)
     plume = sc.make_plume()
@@ -47,7 +51,9 @@ def site_rows(k: int) -> list[dict]:
     air = ~sc.in_obstacle(pos[:, :2], no_go=False)
     threshold = sc.sensor.threshold
     rows = []
-    for wind in ("wake", "potential"):
+    winds = [("wake", nu) for nu in viscosities] + [("potential", math.nan)]
+    for wind, nu in winds:
+        faces = site_wind(plume.fluid, plume.resolution, theta[4], theta[5], wind, nu)
         for factor in (1.0, 3.0, 10.0):
             model = SitePlume(
                 plume.fluid,
@@ -57,7 +63,7 @@ def site_rows(k: int) -> list[dict]:
                 theta[5],
                 factor * theta[6],
                 math.inf,
-                wind=wind,
+                wind=faces,
             )
             c = model.concentration(theta[None], pos)[0]
             keep = air & ((mean > threshold) | (c > threshold))
@@ -68,6 +74,7 @@ def site_rows(k: int) -> list[dict]:
                 {
                     "site": f"random-site:{k}",
                     "wind": wind,
+                    "viscosity": nu,
                     "K_factor": factor,
                     "points": int(keep.sum()),
                     "log_correlation": float(np.corrcoef(a, b)[0, 1]),
@@ -80,15 +87,26 @@ def site_rows(k: int) -> list[dict]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sites", default="1-4", help="K range of random-site:K, e.g. 1-4")
+    parser.add_argument(
+        "--viscosities",
+        default=str(WAKE_VISCOSITY),
+        help="the wake wind's eddy viscosities ν_t, m²/s, comma-separated",
+    )
     parser.add_argument("--out", type=Path, required=True)
     args = parser.parse_args()
     first, last = (int(v) for v in args.sites.split("-"))
-    rows = [r for k in range(first, last + 1) for r in site_rows(k)]
+    viscosities = tuple(float(v) for v in args.viscosities.split(","))
+    rows = [r for k in range(first, last + 1) for r in site_rows(k, viscosities)]
     table = pd.DataFrame(rows).assign(code=describe(code_version()))
     args.out.parent.mkdir(parents=True, exist_ok=True)
     table.to_csv(args.out, index=False, float_format="%.4g")
-    best = table.groupby(["site", "wind"])["log_rms_error"].min().unstack()
+    table["model"] = [
+        w if w == "potential" else f"wake {v:g}"
+        for w, v in zip(table["wind"], table["viscosity"], strict=True)
+    ]
+    best = table.groupby(["site", "model"])["log_rms_error"].min().unstack()
     print(best.round(2).to_string())
+    print(best.mean().round(3).to_string())
 
 
 if __name__ == "__main__":
