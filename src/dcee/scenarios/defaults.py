@@ -97,7 +97,8 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
         ("lbm",), "random-site:1-20 (the tuning sites), dcee-cl, docs/results/sites-walls-tune"
     ),
     ("estimator", "wall_viscosity"): Provenance(
-        (), "unset: 1 m²/s, the order of κ u* z among buildings (not chosen by measurement)"
+        ("lbm",),
+        "random-site:1-20 (the tuning sites), dcee-cl, docs/results/sites-walls-tune/viscosity",
     ),
     ("estimator", "wall_diffusivity"): Provenance(
         (), "unset: the scenario's ζ1, weighed with 3 and 10 times it (not chosen by measurement)"

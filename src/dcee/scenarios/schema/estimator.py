@@ -442,7 +442,8 @@ class EstimatorSpec(BaseModel):
     :data:`dcee.models.site_flow.WALL_WIND_DEFAULT`"""
     wall_viscosity: Annotated[float | None, Field(gt=0, le=100, allow_inf_nan=False)] = None
     """m²/s: the eddy viscosity ν_t of the wake wind (``wall_wind = "wake"``); None:
-    :data:`dcee.models.site_flow.WAKE_VISCOSITY`"""
+    :data:`dcee.models.site_flow.WAKE_VISCOSITY` (1 m²/s, kept against 0.25 and 0.5 on the
+    tuning sites, docs/results/sites-walls-tune/viscosity)"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the
