@@ -1,8 +1,15 @@
 import subprocess
+from pathlib import Path
 
 import pytest
 
-from dcee.provenance import code_version, describe, version_from_describe
+from dcee.provenance import (
+    FALLBACK_VERSION,
+    code_version,
+    describe,
+    version_from_describe,
+    version_without_tag,
+)
 
 
 @pytest.mark.parametrize(
@@ -34,3 +41,14 @@ def test_code_version_names_the_commit_that_runs():
         f"+g{head[:7]}" in code["version"] or "+" not in code["version"]
     )
     assert head[:7] in describe(code)
+
+
+def test_version_without_a_tag_follows_setuptools_scm() -> None:
+    # what the editable install of commit 7e23c7d (606 commits, no version tag) was given
+    assert version_without_tag(606, "7e23c7d1e", False) == "0.1.1.dev606+g7e23c7d1e"
+    assert version_without_tag(3, "abc", True) == "0.1.1.dev3+gabc.dirty"
+
+
+def test_the_fallback_version_is_pyprojects() -> None:
+    text = (Path(__file__).parents[1] / "pyproject.toml").read_text()
+    assert f'fallback_version = "{FALLBACK_VERSION}"' in text

@@ -40,8 +40,14 @@ def code_version() -> dict[str, Any]:
     described = (
         _git("describe", "--tags", "--long", "--match", "v[0-9]*") if dirty is not None else None
     )
+    version = version_from_describe(described, bool(dirty))
+    if version is None and dirty is not None:
+        # no version tag in the history: setuptools-scm counts commits from its fallback
+        count, sha = _git("rev-list", "--count", "HEAD"), _git("rev-parse", "--short=9", "HEAD")
+        if count and count.isdigit() and sha:
+            version = version_without_tag(int(count), sha, bool(dirty))
     return {
-        "version": version_from_describe(described, bool(dirty)) or package_version(),
+        "version": version or package_version(),
         "commit": _git("rev-parse", "HEAD"),
         "dirty": dirty,
         "source_hash": source_hash(),
@@ -66,6 +72,20 @@ def version_from_describe(described: str | None, dirty: bool) -> str | None:
     parts[-1] = str(int(parts[-1]) + 1)
     local = f"g{sha}" + (".dirty" if dirty else "")
     return f"{'.'.join(parts)}.dev{distance}+{local}"
+
+
+FALLBACK_VERSION = "0.1.0"
+"""pyproject.toml's ``[tool.setuptools_scm] fallback_version``: the base of a history without a
+version tag."""
+
+
+def version_without_tag(count: int, sha: str, dirty: bool) -> str:
+    """The version setuptools-scm gives a work tree whose history has no version tag: the
+    fallback's next patch version with ``.dev<commits>+g<sha>`` (``.dirty`` for uncommitted
+    edits), e.g. ``0.1.1.dev606+g7e23c7d1e``."""
+    parts = FALLBACK_VERSION.split(".")
+    parts[-1] = str(int(parts[-1]) + 1)
+    return f"{'.'.join(parts)}.dev{count}+g{sha}" + (".dirty" if dirty else "")
 
 
 def source_hash() -> str:
