@@ -406,6 +406,9 @@ case "${1:---list}" in
     $P studies/publish_tables.py ;;
   sites-walls-tune)  # issue 44: the wall-aware estimator's variants on the tuning sites random-site:1-20 (never reported as a result)
     B="$D bench --suite sites-tune --strategies dcee-cl --repeats 1 --particles 10000 --workers ${WORKERS:-2}"
+    # round 5: the diffusivity bank with a fourth member (1, 3, 10 × ζ1 is the default; ζ1 = 1 here)
+    $B --set estimator.plume=walls --set 'estimator.learn={wall_diffusivity=[1.0,3.0,10.0,30.0]}' \
+      --out results/sites-tune-k30
     # round 4: the reading weight with the wall-aware estimator (0.5 is the default: round 3's nu1)
     $B --set estimator.plume=walls --set estimator.reading_weight=0.25 --out results/sites-tune-rw0.25
     # round 3: the wake wind's eddy viscosity ν_t (1 m²/s is the default)
@@ -417,6 +420,8 @@ case "${1:---list}" in
       --out docs/results/sites-walls-tune/viscosity
     $P studies/sites_walls_table.py "reading weight 0.5 (default)=results/sites-tune-nu1" \
       "reading weight 0.25=results/sites-tune-rw0.25" --out docs/results/sites-walls-tune/reading-weight
+    $P studies/sites_walls_table.py "K bank 1,3,10 (default)=results/sites-tune-nu1" \
+      "K bank 1,3,10,30=results/sites-tune-k30" --out docs/results/sites-walls-tune/diffusivity-bank
     $P studies/site_flow_fidelity.py --sites 1-8 --viscosities 0.25,0.5,1,2,4 \
       --out docs/results/sites-walls-tune/viscosity/fidelity.csv
     # round 2: the wind round the buildings (wake: constant-eddy-viscosity Navier-Stokes; potential: mass-consistent)

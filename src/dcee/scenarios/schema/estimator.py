@@ -219,9 +219,11 @@ equal prior let the disc lead on point releases: docs/results/tuning-source-radi
 WALL_DIFFUSIVITY_FACTORS = (1.0, 3.0, 10.0)
 """The wall-aware plume's diffusivity K the fluctuation likelihood weighs by default, as
 multiples of the fixed one (the scenario's ζ1 unless ``estimator.wall_diffusivity`` is set): a
-decade in steps of about √10. Not chosen by measurement: the spread of a plume among buildings
-(wakes, channelling; the fluid solver's eddies) is not known before the search, and each
-member is a filter updated at every reading, so three members."""
+decade in steps of about √10: the spread of a plume among buildings (wakes, channelling; the
+fluid solver's eddies) is not known before the search, and each member is a filter updated at
+every reading. A fourth member at 30 × was tried on the tuning sites and not taken (13/20
+acquired either way, median final error 0.54 against 0.52 m;
+docs/results/sites-walls-tune/diffusivity-bank)."""
 
 
 def default_learn(likelihood: str, fixed: Mapping[str, float]) -> dict[str, list[float]]:
