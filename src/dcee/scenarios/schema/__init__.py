@@ -23,10 +23,9 @@ from dcee.scenarios.schema.estimator import (
     Likelihood,
     PriorSpec,
     SensorSpec,
-    default_learn,
-    default_learn_prior,
     default_priors,
 )
+from dcee.scenarios.schema.learn import default_learn, default_learn_prior
 from dcee.scenarios.schema.scenario import FIELD_MARK, Scenario, validate_scenario
 from dcee.scenarios.schema.truth import (
     TRUTH_KINDS,

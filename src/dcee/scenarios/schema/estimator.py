@@ -4,10 +4,8 @@ the instrument, and the reading model of the filter and the planners."""
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
 from typing import Annotated, Literal, get_args
 
-import numpy as np
 from pydantic import BaseModel, Field, field_validator, model_validator
 
 from dcee.models.sensor import OUTLIER_DEFAULT
@@ -226,75 +224,6 @@ acquired either way, median final error 0.54 against 0.52 m;
 docs/results/sites-walls-tune/diffusivity-bank)."""
 
 
-def default_learn(likelihood: str, fixed: Mapping[str, float]) -> dict[str, list[float]]:
-    """What an unset ``estimator.learn`` weighs: :data:`LEARN_DEFAULT` for the likelihood,
-    without the settings fixed by hand (``fixed``: the estimator's settings by name; one of the
-    grid's whose value is not its grid's first, the plain model's, is not learned; one absent
-    counts as the plain model's), and without the open plume's shape settings under the
-    wall-aware plume (``fixed["plume"] == "walls"``)."""
-    grid = LEARN_DEFAULT[likelihood]
-    walls = fixed.get("plume") == "walls"
-    # a copy: callers may edit it
-    out = {
-        key: list(v)
-        for key, v in grid.items()
-        if fixed.get(key, v[0]) == v[0] and not (walls and key in PLUME_SHAPE_SETTINGS)
-    }
-    if walls and likelihood == "fluctuation" and fixed.get("wall_diffusivity") is not None:
-        k0 = float(fixed["wall_diffusivity"])
-        out["wall_diffusivity"] = [k0 * f for f in WALL_DIFFUSIVITY_FACTORS]
-    return out
-
-
-def default_learn_prior(
-    likelihood: str, fixed: Mapping[str, float], learn: dict[str, list[float]] | None
-) -> dict[str, list[float]]:
-    """What an unset ``estimator.learn_prior`` says: :data:`LEARN_PRIOR_DEFAULT` with the
-    default grid (``learn`` None), nothing (every value equally likely) with a grid given."""
-    if learn is not None:
-        return {}
-    grid = default_learn(likelihood, fixed)
-    prior = LEARN_PRIOR_DEFAULT[likelihood]
-    return {key: list(probs) for key, probs in prior.items() if key in grid}
-
-
-LEARN_MEMBERS_MAX = 12
-"""Most fluctuation members a learned grid may make (each costs one filter update per reading)."""
-
-
-def learn_prior_problem(
-    learn_prior: dict[str, list[float]] | None, learn: dict[str, list[float]]
-) -> str | None:
-    """Why ``estimator.learn_prior`` does not fit the resolved ``learn`` grid (a message naming
-    the field), or None."""
-    for key, probs in (learn_prior or {}).items():
-        values = learn.get(key)
-        if values is None:
-            return f"estimator.learn_prior.{key}: {key} is not learned (estimator.learn)"
-        if len(probs) != len(values) or not all(np.isfinite(p) and p > 0 for p in probs):
-            return (
-                f"estimator.learn_prior.{key}: one positive probability per value of "
-                f"estimator.learn.{key} {values} (got {probs})"
-            )
-    return None
-
-
-def learn_member_weight(
-    settings: dict[str, float],
-    learn: dict[str, list[float]],
-    learn_prior: dict[str, list[float]] | None,
-) -> float:
-    """The prior weight of the fluctuation member with these learned ``settings``: the product,
-    over the settings ``learn_prior`` names, of each value's normalised probability (a setting it
-    does not name weighs its values equally: the same factor for every member)."""
-    weight = 1.0
-    for key, probs in (learn_prior or {}).items():
-        values = learn[key]
-        index = int(np.argmin([abs(v - settings[key]) for v in values]))
-        weight *= probs[index] / sum(probs)
-    return weight
-
-
 class EstimatorSpec(BaseModel):
     """The reading model the filter and every planner use (one :class:`Sensor` for both).
 
@@ -393,7 +322,8 @@ class EstimatorSpec(BaseModel):
     )
     """fluctuation: nuisance parameters of the reading model learned during the search instead
     of fixed, each with the values to weigh, e.g. ``{meander = [0.15, 0.3, 0.5]}``: one filter
-    per combination (the grid's product, at most :data:`LEARN_MEMBERS_MAX`) on the same
+    per combination (the grid's product, at most
+    :data:`~dcee.scenarios.schema.learn.LEARN_MEMBERS_MAX`) on the same
     readings, with equal prior probability among them, selected by their evidence like the calm
     member (:mod:`dcee.estimation.model_bank`); the combination of the values above is the
     preferred (first) member and must be in the grid. Empty: every value fixed. None: the

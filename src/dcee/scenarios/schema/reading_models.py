@@ -12,10 +12,9 @@ import numpy as np
 
 from dcee.models.site_flow import WAKE_VISCOSITY, WALL_WIND_DEFAULT
 from dcee.scenarios.schema.common import FIELD_MARK
-from dcee.scenarios.schema.estimator import (
+from dcee.scenarios.schema.estimator import LEARN_RANGES, PLUME_SHAPE_SETTINGS
+from dcee.scenarios.schema.learn import (
     LEARN_MEMBERS_MAX,
-    LEARN_RANGES,
-    PLUME_SHAPE_SETTINGS,
     default_learn,
     default_learn_prior,
     learn_member_weight,
