@@ -4,6 +4,7 @@ import pytest
 from dcee import DceeInputError, IsotropicPlume, ParticleFilter, Sensor
 from dcee.estimation import Estimator, ModelBank, systematic_resample
 from dcee.estimation.filter_kernels import history_log_likelihood, history_log_likelihood_reference
+from dcee.estimation.resampling import systematic_resample_reference
 from dcee.models.plume import isotropic_concentration_reference
 from tests.helpers import planar_prior, theta_at
 
@@ -218,6 +219,18 @@ def test_systematic_resampling_counts_are_within_one_of_expectation():
     idx = systematic_resample(w, np.random.default_rng(1), 1000)
     counts = np.bincount(idx, minlength=50)
     assert np.all(np.abs(counts - 1000 * w) < 1.0 + 1e-9)
+
+
+def test_the_compiled_systematic_resampling_draws_the_numpy_references_indices():
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        n = int(rng.integers(1, 3000))
+        w = rng.random(n) ** 8  # many tiny weights, a few large: ties of the running sum
+        w /= w.sum()
+        m, seed = int(rng.integers(1, 200)), int(rng.integers(2**31))
+        fast = systematic_resample(w, np.random.default_rng(seed), m)
+        reference = systematic_resample_reference(w, np.random.default_rng(seed), m)
+        assert np.array_equal(fast, reference)
 
 
 def test_public_shapes(sensor):

@@ -6,7 +6,7 @@ import pytest
 
 from dcee.models import IsotropicPlume, Sensor
 from dcee.planning.base import Belief
-from dcee.planning.particle_terms import ParticleTerms, merge_runs
+from dcee.planning.particle_terms import ParticleTerms, merge_runs, run_sums
 from dcee.planning.predicted import PredictionContext
 from tests.helpers import random_theta
 
@@ -34,6 +34,17 @@ def test_merge_runs_keeps_one_particle_per_run_with_the_runs_weight():
     ends = np.append(starts[1:], len(theta))
     np.testing.assert_allclose(merged, [w[a:b].sum() for a, b in zip(starts, ends, strict=True)])
     assert np.all(np.any(pt.theta[1:] != pt.theta[:-1], axis=1))  # no run left
+
+
+def test_run_sums_are_numpys_reduceat_bit_for_bit():
+    # runs shorter than 8, up to 128 and longer (NumPy's pairwise summation splits those)
+    rng = np.random.default_rng(5)
+    for trial in range(150):
+        n = int(rng.integers(1, 4000))
+        w = rng.random(n) * 10.0 ** rng.uniform(-12, 0, n)
+        cuts = int(rng.integers(1, 4)) if trial % 2 else int(rng.integers(1, n + 1))
+        starts = np.unique(np.concatenate([[0], rng.integers(0, n, cuts)])).astype(np.int64)
+        assert np.array_equal(run_sums(w, starts), np.add.reduceat(w, starts))
 
 
 def test_merged_statistics_equal_the_unmerged_ones():

@@ -12,10 +12,39 @@ from dcee.numeric import exp_scalar
 
 def systematic_resample(weights: np.ndarray, rng: np.random.Generator, n: int) -> np.ndarray:
     """n indices drawn ∝ weights by systematic sampling (one uniform, O(N + n), no sorting)."""
+    return _systematic_indices(np.ascontiguousarray(weights, dtype=np.float64), rng.random(), n)
+
+
+def systematic_resample_reference(
+    weights: np.ndarray, rng: np.random.Generator, n: int
+) -> np.ndarray:
+    """NumPy reference of :func:`systematic_resample` (the same indices for the same draws)."""
     cumulative = np.cumsum(weights)
     cumulative[-1] = 1.0  # guard against round-off
     points = (rng.random() + np.arange(n)) / n
     return np.searchsorted(cumulative, points, side="right").clip(0, len(weights) - 1)
+
+
+@njit(cache=True)
+def _systematic_indices(weights: np.ndarray, u: float, n: int) -> np.ndarray:
+    """:func:`systematic_resample_reference` in one pass for the offset ``u`` in [0, 1): the
+    running sum in the order of ``np.cumsum`` (the same bits), the last one set to 1, and each
+    point (u + k)/n given the first index whose running sum exceeds it (``searchsorted``'s
+    "right"). A decision draws 4-40 indices from 10,000-20,000 weights: NumPy's cumsum, search
+    and clip took 40 µs of Stone Soup's workload's 1.3 ms decision."""
+    size = weights.shape[0]
+    out = np.full(n, max(size - 1, 0), dtype=np.int64)
+    k = 0
+    total = 0.0
+    for i in range(size):
+        total += weights[i]
+        cumulative = 1.0 if i == size - 1 else total
+        while k < n and (u + k) / n < cumulative:
+            out[k] = i
+            k += 1
+        if k == n:
+            break
+    return out
 
 
 def effective_sample_size(weights: np.ndarray) -> float:

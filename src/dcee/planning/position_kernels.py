@@ -29,11 +29,12 @@ from dcee.numeric import (
 )
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath={"reassoc", "contract"})
 def probe_sums(flat: np.ndarray, probe: np.ndarray) -> tuple[float, float]:
     """(Σ flat·probe[:n], Σ flat·probe[n:2n]) for flat (n,): a fingerprint of an array's
-    contents. Compiled and sequential, not a BLAS dot: OpenBLAS threads that spin after a call
-    take the cores from the numba threads of the kernels that follow."""
+    contents. Compiled, not a BLAS dot: OpenBLAS threads that spin after a call take the cores
+    from the numba threads of the kernels that follow. Reassociated so that LLVM vectorises the
+    sums (a fingerprint needs the same value for the same array, not a fixed order)."""
     n = flat.shape[0]
     a = 0.0
     b = 0.0

@@ -174,7 +174,7 @@ class PredictionContext:
         self._fresh = noise == "fresh"
         self._simplify = readings
         self._draw()
-        self._source = np.ascontiguousarray(belief.source)
+        self._source = self._pt.source  # belief.source, kept contiguous across decisions
         self._center = belief.source_mean()
         self._cell_cache: dict[float, tuple[np.ndarray, ...]] = {}
 
@@ -212,7 +212,7 @@ class PredictionContext:
         if keep.mean() < 0.9:
             theta, weights = theta[keep], weights[keep] / weights[keep].sum()
             other._pt = self._pt.subset(keep)
-            other._source = np.ascontiguousarray(theta[:, :3])
+            other._source = other._pt.source
         other.belief = Belief(theta, weights, self.sensor, self.belief.plume, site=self.belief.site)
         other._n, other._horizon, other._rng = int(n_hypotheses), 1, rng
         other._center = other.belief.source_mean()

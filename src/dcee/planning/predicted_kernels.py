@@ -22,8 +22,8 @@ from dcee.numeric import HALF_LOG_2PI, exp_scalar, log_scalar
 from dcee.planning.block_sums import BLOCK as _BLOCK
 from dcee.planning.block_sums import task_sums as _task_sums
 from dcee.planning.block_sums import weighted_columns
+from dcee.planning.interpolated_kernels import MIN_READINGS, interpolate_groups
 from dcee.planning.interpolated_kernels import applicable as interpolation_applies
-from dcee.planning.interpolated_kernels import interpolate_groups
 from dcee.planning.multi_stage_kernels import multi_stage_weights
 from dcee.planning.predicted_single import BOUND_SLACK_SINGLE, single_stage_sums
 from dcee.planning.reading_terms import (
@@ -313,7 +313,13 @@ def predicted_posterior_stats(
     sums = np.empty((s_count, _N_ACC))
     log_ref = bound.copy()
     exact_tasks, group_start_exact = np.arange(s_count), group_start
-    if precision == "interpolated" and one_stage and interpolation_applies(sp):
+    group_sizes = np.diff(group_start)
+    if (
+        precision == "interpolated"
+        and one_stage
+        and interpolation_applies(sp)
+        and group_sizes.max(initial=0) >= MIN_READINGS  # smaller groups are summed exactly
+    ):
         # the groups it takes are summed over nodes (loc is C itself with this sensor)
         exact_tasks, group_start_exact = interpolate_groups(
             loc, weights, weighted, group_start, task_positions, task_v, task_out, bound, sp,

@@ -97,7 +97,7 @@ def task_bound(
     return b
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def live_row_max(
     log_nd: np.ndarray,
     det_offset: np.ndarray,
@@ -107,8 +107,10 @@ def live_row_max(
     max_det_offset: np.ndarray,
 ) -> None:
     """For each row r in ``rows``: the largest log_nd[r, i] and det_offset[r, i] over the
-    particles with weight > 0 (the inputs of :func:`task_bound`)."""
-    for r in rows:
+    particles with weight > 0 (the inputs of :func:`task_bound`). Rows in parallel (a maximum
+    does not depend on the order)."""
+    for k in prange(rows.shape[0]):
+        r = rows[k]
         a = -np.inf
         b = -np.inf
         for i in range(weights.shape[0]):
