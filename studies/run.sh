@@ -14,6 +14,7 @@ report() { for dir in "$@"; do $D report "results/$dir"; cat "results/$dir/repor
 source_count_tables() {
   $P studies/source_count_table.py results/two-source-held-out-100 \
     results/three-source-held-out-100 $(ls -d results/*-source-held-out-100-before \
+    results/*-source-held-out-100-9f200ee results/one-source-*-held-out-100 \
     results/*-source-held-out-100-5d04d27 results/*-source-held-out-100-d207b1e \
     results/three-source-held-out-100-20k 2>/dev/null) \
     --csv docs/results/source-count/searches.csv
@@ -633,6 +634,13 @@ case "${1:---list}" in
     for N in two three; do
       $D bench --suite "$N-source-held-out-100" --repeats 1 --strategies dcee-cl \
         --workers "${WORKERS:-2}" --out "results/$N-source-held-out-100"
+    done
+    source_count_tables
+    $P studies/publish_tables.py ;;
+  source-count-one)  # issue 45: one release, the count unknown (0-3) against the one-release filter, 100 held-out configurations (docs/multi-source.md)
+    for ARM in unknown-count known-count; do
+      $D bench --suite "one-source-$ARM-held-out-100" --repeats 1 --strategies dcee-cl \
+        --workers "${WORKERS:-2}" --out "results/one-source-$ARM-held-out-100"
     done
     source_count_tables
     $P studies/publish_tables.py ;;

@@ -112,6 +112,18 @@ SUITES: dict[str, dict] = {
             ("held-out-100", range(RANDOM_REPORTING_FROM, RANDOM_REPORTING_FROM + 100)),
         )
     },
+    # one release with the count unknown (issue 45, K = 1): does the estimator invent a second
+    # leak? The reporting range of random:K, which no setting of the count was chosen on, the
+    # count-unknown estimator beside the one-release filter on the same configurations
+    **{
+        f"one-source-{arm}-held-out-100": {
+            "configs": [
+                f"random:{k}" for k in range(RANDOM_REPORTING_FROM, RANDOM_REPORTING_FROM + 100)
+            ],
+            "overrides": {"estimator.max_sources": k_max, "search.particles": 10_000},
+        }
+        for arm, k_max in (("unknown-count", 3), ("known-count", 1))
+    },
     # tuning configurations for slow studies (never report them)
     "random-tune-12": {"configs": [f"random:{k}" for k in range(1, 13)], "overrides": {}},
     "smoke": {
