@@ -1435,7 +1435,7 @@ def search_speed_table() -> str:
 
 def _source_count(kind: str) -> str:
     """Issue 45's unknown-count study: studies/source_count_table.py's tables of the stored
-    searches (``kind`` "table", "paired" or "worst")."""
+    searches (``kind`` "table", "table_latest", "paired" or "worst")."""
     import importlib.util
 
     spec = importlib.util.spec_from_file_location(
@@ -1474,6 +1474,7 @@ def source_count_timing_table() -> str:
 
 TABLES: dict[str, Callable[[], str]] = {
     "source-count": lambda: _source_count("table"),
+    "source-count-latest": lambda: _source_count("table_latest"),
     "source-count-worst": lambda: _source_count("worst"),
     "source-count-paired": lambda: _source_count("paired"),
     "source-count-timing": source_count_timing_table,

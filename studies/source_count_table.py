@@ -107,24 +107,36 @@ def table(df: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
+def table_latest(df: pd.DataFrame) -> str:
+    """:func:`table` of today's campaigns only (names without a code suffix: they end in
+    ``held-out-100``; the README's table)."""
+    return table(df[df["campaign"].str.endswith("held-out-100")])
+
+
 BEFORE = "-before"
 """A campaign named X-before is the same searches as X with the code before a change: the
 paired table compares them, the worst-search table leaves them out."""
 
+PAIRS = (("one-source-unknown-count-held-out-100", "one-source-known-count-held-out-100"),)
+"""Campaigns compared on the same configurations besides each X against X-before: one release
+with the count unknown against the one-release filter (issue 45, K = 1)."""
+
 
 def paired(df: pd.DataFrame) -> str:
-    """Each campaign X against X-before on the same configurations: right count by one only
-    (exact McNemar p) and the median paired OSPA difference (Wilcoxon signed-rank p)."""
+    """Each campaign X against X-before, and each pair of :data:`PAIRS`, on the same
+    configurations: right count by one only (exact McNemar p) and the median paired OSPA
+    difference (Wilcoxon signed-rank p)."""
     lines = [
-        "| campaign (after − before, same configurations) | pairs | right count: after only / "
-        "before only (McNemar p) | median OSPA difference (m) (Wilcoxon p) |",
+        "| campaign A − campaign B (same configurations) | pairs | right count: A only / "
+        "B only (McNemar p) | median OSPA difference A − B (m) (Wilcoxon p) |",
         "|---|---|---|---|",
     ]
     keyed = df.set_index(["campaign", "scenario", "strategy", "seed"])
-    for campaign in df["campaign"].unique():
-        if campaign.endswith(BEFORE) or campaign + BEFORE not in set(df["campaign"]):
-            continue
-        after, before = keyed.loc[campaign], keyed.loc[campaign + BEFORE]
+    names = list(df["campaign"].unique())
+    pairs = [(c, c + BEFORE) for c in names if not c.endswith(BEFORE) and c + BEFORE in names]
+    pairs += [(a, b) for a, b in PAIRS if a in names and b in names]
+    for first, second in pairs:
+        after, before = keyed.loc[first], keyed.loc[second]
         common = after.index.intersection(before.index)
         a = after.loc[common, "count_correct"].astype(bool).to_numpy()
         b = before.loc[common, "count_correct"].astype(bool).to_numpy()
@@ -135,7 +147,7 @@ def paired(df: pd.DataFrame) -> str:
         ].to_numpy(float)
         p_ospa = float(stats.wilcoxon(diff).pvalue) if np.any(diff != 0) else 1.0
         lines.append(
-            f"| {campaign} | {len(common)} | {only_a} / {only_b} (p = {p_count:.2g}) | "
+            f"| {first} − {second} | {len(common)} | {only_a} / {only_b} (p = {p_count:.2g}) | "
             f"{np.median(diff):+.2f} (p = {p_ospa:.2g}) |"
         )
     return "\n".join(lines)
