@@ -124,6 +124,18 @@ SUITES: dict[str, dict] = {
         }
         for arm, k_max in (("unknown-count", 3), ("known-count", 1))
     },
+    # two releases with the wind unknown too (all eight parameters of the flow and the first
+    # release, x, y, z, q of the second): the first 50 reporting configurations
+    "two-source-wind-unknown-held-out-50": {
+        "configs": [
+            f"random2:{k}" for k in range(RANDOM_REPORTING_FROM, RANDOM_REPORTING_FROM + 50)
+        ],
+        "overrides": {
+            "estimator.max_sources": 3,
+            "search.particles": 10_000,
+            "unknown": "full",
+        },
+    },
     # tuning configurations for slow studies (never report them)
     "random-tune-12": {"configs": [f"random:{k}" for k in range(1, 13)], "overrides": {}},
     "smoke": {
