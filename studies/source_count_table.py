@@ -109,8 +109,8 @@ def table(df: pd.DataFrame) -> str:
 
 def table_latest(df: pd.DataFrame) -> str:
     """:func:`table` of today's campaigns only (names without a code suffix: they end in
-    ``held-out-100``; the README's table)."""
-    return table(df[df["campaign"].str.endswith("held-out-100")])
+    ``held-out-N``; the README's table)."""
+    return table(df[df["campaign"].str.contains(r"held-out-\d+$", regex=True)])
 
 
 BEFORE = "-before"
