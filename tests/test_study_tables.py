@@ -154,3 +154,44 @@ def test_count_prior_sweep_by_hand(tmp_path: Path, capsys) -> None:
     assert "| r = 2 | 2/2 |" in capsys.readouterr().out
     assert sweep.main([str(tmp_path / "empty")]) == 2
     assert "no finished searches" in capsys.readouterr().err
+
+
+def _count_rows(campaign: str, correct: list[bool], ospa: list[float]) -> list[dict]:
+    return [
+        {
+            "campaign": campaign,
+            "scenario": f"random:{k}",
+            "strategy": "dcee-cl",
+            "seed": 0,
+            "true_count": 1,
+            "estimated_count": 1 if ok else 2,
+            "count_correct": ok,
+            "p_estimated": float("nan"),
+            "p_true": float("nan"),
+            "final_ospa": d,
+            "worst_release_error": d,
+            "mean_release_error": d,
+            "explore_guard_fired": 0,
+            "least_reached_readings": 5,
+            "decision_ms": 1.0,
+            "code": "",
+        }
+        for k, (ok, d) in enumerate(zip(correct, ospa, strict=True))
+    ]
+
+
+def test_the_source_count_tables_pair_named_campaigns_and_list_todays_only() -> None:
+    script = _script("source_count_table")
+    unknown, known = script.PAIRS[0]
+    rows = _count_rows(unknown, [True, True, False, True], [0.3, 0.2, 3.0, 0.5])
+    rows += _count_rows(known, [True, True, True, True], [0.1, 0.1, 0.2, 0.1])
+    rows += _count_rows("two-source-held-out-100-before", [True] * 4, [0.1] * 4)
+    frame = pd.DataFrame(rows)
+    latest = script.table_latest(frame)
+    assert unknown in latest and known in latest and "-before" not in latest
+    assert "| — |" in latest  # no count probabilities: no median P(K̂)
+    paired = script.paired(frame).splitlines()
+    (row,) = [line for line in paired if line.startswith(f"| {unknown} − {known} ")]
+    # one search right only with the count known; OSPA differences 0.2, 0.1, 2.8, 0.4
+    assert "| 4 | 0 / 1 (p = 1) |" in row
+    assert "+0.30" in row
