@@ -85,6 +85,16 @@ def rows_of(folder: Path) -> list[dict]:
     return out
 
 
+def merged_rows(stored: pd.DataFrame | None, new: pd.DataFrame) -> pd.DataFrame:
+    """The stored rows with those of every campaign in ``new`` replaced by ``new``'s: a study
+    that flies some campaigns keeps the stored rows of the others (a fresh machine holds only
+    the campaigns it flew)."""
+    if stored is None:
+        return new
+    kept = stored[~stored["campaign"].isin(set(new["campaign"]))]
+    return pd.concat([new, kept], ignore_index=True)
+
+
 def table(df: pd.DataFrame) -> str:
     lines = [
         "| campaign | planner | searches | right count | confusion (K̂: searches) | median OSPA "
@@ -144,13 +154,13 @@ def paired(df: pd.DataFrame) -> str:
     pairs = [(c, c + BEFORE) for c in names if not c.endswith(BEFORE) and c + BEFORE in names]
     pairs += [(a, b) for a, b in PAIRS if a in names and b in names]
     for first, second in pairs:
-        after, before = keyed.loc[first], keyed.loc[second]
-        common = after.index.intersection(before.index)
-        a = after.loc[common, "count_correct"].astype(bool).to_numpy()
-        b = before.loc[common, "count_correct"].astype(bool).to_numpy()
+        rows_a, rows_b = keyed.loc[first], keyed.loc[second]
+        common = rows_a.index.intersection(rows_b.index)
+        a = rows_a.loc[common, "count_correct"].astype(bool).to_numpy()
+        b = rows_b.loc[common, "count_correct"].astype(bool).to_numpy()
         only_a, only_b = int((a & ~b).sum()), int((~a & b).sum())
         p_count = stats.binomtest(only_a, only_a + only_b, 0.5).pvalue if only_a + only_b else 1.0
-        diff = after.loc[common, "final_ospa"].to_numpy(float) - before.loc[
+        diff = rows_a.loc[common, "final_ospa"].to_numpy(float) - rows_b.loc[
             common, "final_ospa"
         ].to_numpy(float)
         p_ospa = float(stats.wilcoxon(diff).pvalue) if np.any(diff != 0) else 1.0
@@ -195,7 +205,8 @@ def main(argv: list[str] | None = None) -> int:
     df = pd.DataFrame(rows)
     if args.csv:
         args.csv.parent.mkdir(parents=True, exist_ok=True)
-        df.to_csv(args.csv, index=False)
+        stored = pd.read_csv(args.csv) if args.csv.exists() else None
+        merged_rows(stored, df).to_csv(args.csv, index=False)
     print(table(df))
     print()
     print(paired(df))

@@ -195,3 +195,13 @@ def test_the_source_count_tables_pair_named_campaigns_and_list_todays_only() -> 
     # one search right only with the count known; OSPA differences 0.2, 0.1, 2.8, 0.4
     assert "| 4 | 0 / 1 (p = 1) |" in row
     assert "+0.30" in row
+
+
+def test_the_source_count_csv_keeps_the_campaigns_a_study_did_not_fly() -> None:
+    script = _script("source_count_table")
+    stored = pd.DataFrame(_count_rows("a", [True], [0.1]) + _count_rows("b", [True], [0.2]))
+    new = pd.DataFrame(_count_rows("b", [False, True], [1.0, 0.3]))
+    merged = script.merged_rows(stored, new)
+    assert sorted(merged["campaign"]) == ["a", "b", "b"]
+    assert list(merged.loc[merged["campaign"] == "b", "final_ospa"]) == [1.0, 0.3]
+    assert script.merged_rows(None, new) is new
