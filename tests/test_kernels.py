@@ -315,3 +315,26 @@ def test_location_kl_matches_reference_and_its_limits(sensor):
             assert np.all(fast <= joint * (1 + 1e-9) + 1e-12) and np.all(fast >= 0)
         np.testing.assert_allclose(compiled_location_kl(*args, 1e-6, dist), joint, rtol=1e-9)
         np.testing.assert_allclose(compiled_location_kl(*args, 1e3, dist), 0.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("stages", [1, 2, 3])
+def test_compiled_task_list_equals_the_numpy_reference(stages):
+    from dcee.planning.predicted import unique_per_sequence_reference
+    from dcee.planning.reading_terms import task_layout, unique_tasks
+
+    rng = np.random.default_rng(stages)
+    for j_count in (1, 4, 40):
+        # few distinct values: many equal hypotheses (the non-detections) and equal prefixes
+        readings = rng.choice([0.0, 0.0, 0.0, 1e-3, 2.5e-3, 7.0], size=(9, j_count, stages))
+        got = unique_tasks(readings)
+        want = unique_per_sequence_reference(readings)
+        for a, b in zip(got, want, strict=True):
+            np.testing.assert_array_equal(a, b)
+        # every hypothesis maps back to its own readings
+        np.testing.assert_array_equal(got[0][got[2]], readings)
+        positions = np.repeat(np.arange(9), [len(np.unique(r, axis=0)) for r in readings])
+        starts, used = task_layout(np.tile(positions[:, None], (1, stages)), 12)
+        np.testing.assert_array_equal(
+            starts, np.append(np.flatnonzero(np.diff(positions, prepend=-1)), len(positions))
+        )
+        np.testing.assert_array_equal(used, np.arange(9))

@@ -7,6 +7,7 @@ import pytest
 from dcee.models import IsotropicPlume, Sensor
 from dcee.planning.base import Belief
 from dcee.planning.particle_terms import ParticleTerms, merge_runs, run_sums
+from dcee.planning.position_kernels import content_hash
 from dcee.planning.predicted import PredictionContext
 from tests.helpers import random_theta
 
@@ -45,6 +46,34 @@ def test_run_sums_are_numpys_reduceat_bit_for_bit():
         cuts = int(rng.integers(1, 4)) if trial % 2 else int(rng.integers(1, n + 1))
         starts = np.unique(np.concatenate([[0], rng.integers(0, n, cuts)])).astype(np.int64)
         assert np.array_equal(run_sums(w, starts), np.add.reduceat(w, starts))
+
+
+def _content_hash_reference(values: np.ndarray) -> tuple[int, int]:
+    """The content hash in Python integers (splitmix64's mix of k + 1, made odd)."""
+    mask = 2**64 - 1
+    a = b = 0
+    for k, bits in enumerate(values.view(np.uint64).tolist()):
+        h = ((k + 1) * 0x9E3779B97F4A7C15) & mask
+        h = ((h ^ (h >> 29)) * 0xBF58476D1CE4E5B9) & mask
+        h = (h ^ (h >> 32)) | 1
+        a = (a + bits * h) & mask
+        b = (b + bits * ((h * 0x94D049BB133111EB) & mask)) & mask
+    return a, b
+
+
+def test_the_content_hash_matches_its_reference_and_sees_any_one_changed_value():
+    rng = np.random.default_rng(11)
+    x = rng.standard_normal(500)
+    assert tuple(int(v) for v in content_hash(x.view(np.uint64))) == _content_hash_reference(x)
+    base = content_hash(x.view(np.uint64))
+    for k in rng.integers(0, len(x), 50):
+        y = x.copy()
+        y[k] = np.nextafter(y[k], np.inf)  # the smallest change a float allows
+        changed = content_hash(y.view(np.uint64))
+        assert changed[0] != base[0] and changed[1] != base[1]
+    swapped = x.copy()
+    swapped[[3, 7]] = swapped[[7, 3]]  # the same values elsewhere: a different set of particles
+    assert content_hash(swapped.view(np.uint64)) != base
 
 
 def test_merged_statistics_equal_the_unmerged_ones():

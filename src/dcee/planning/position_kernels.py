@@ -1,7 +1,7 @@
 """Compiled (numba) per-position likelihood terms of a particle set: the plume constants of each
 particle (:func:`plume_constants`), the terms at a batch of positions (:func:`position_rows`,
-cached across decisions by :class:`~dcee.planning.particle_terms.ParticleTerms`) and the probe
-sums that detect a changed particle set. Tested against the NumPy plume and sensor models."""
+cached across decisions by :class:`~dcee.planning.particle_terms.ParticleTerms`) and the content
+hash that detects a changed particle set. Tested against the NumPy plume and sensor models."""
 
 from __future__ import annotations
 
@@ -28,19 +28,29 @@ from dcee.numeric import (
     vndtr_upper,
 )
 
+_HASH_MUL1 = np.uint64(0x9E3779B97F4A7C15)
+_HASH_MUL2 = np.uint64(0xBF58476D1CE4E5B9)
+_HASH_MUL3 = np.uint64(0x94D049BB133111EB)
 
-@njit(cache=True, fastmath={"reassoc", "contract"})
-def probe_sums(flat: np.ndarray, probe: np.ndarray) -> tuple[float, float]:
-    """(Σ flat·probe[:n], Σ flat·probe[n:2n]) for flat (n,): a fingerprint of an array's
-    contents. Compiled, not a BLAS dot: OpenBLAS threads that spin after a call take the cores
-    from the numba threads of the kernels that follow. Reassociated so that LLVM vectorises the
-    sums (a fingerprint needs the same value for the same array, not a fixed order)."""
-    n = flat.shape[0]
-    a = 0.0
-    b = 0.0
-    for i in range(n):
-        a += flat[i] * probe[i]
-        b += flat[i] * probe[n + i]
+
+@njit(cache=True)
+def content_hash(bits: np.ndarray) -> tuple[int, int]:
+    """(Σ bits[k]·h(k), Σ bits[k]·h'(k)) modulo 2^64 for bits (n,) uint64 (a float array's
+    IEEE-754 bits, viewed): a fingerprint of an array's contents. h(k) is an odd 64-bit mix of
+    k (splitmix64's), h'(k) = h(k)·another odd constant; so a change of any one element always
+    changes both sums (an odd factor is invertible modulo 2^64), and integer sums do not depend
+    on their order. Computed from the index, not read from a stored probe: no megabyte of
+    random numbers to fetch at every decision (measured, 80,000 values: 18 µs against 47 µs
+    for two dot products with a stored probe, hot; the probe came from memory in a decision)."""
+    a = np.uint64(0)
+    b = np.uint64(0)
+    one = np.uint64(1)
+    for k in range(bits.shape[0]):
+        h = (np.uint64(k) + one) * _HASH_MUL1
+        h = (h ^ (h >> np.uint64(29))) * _HASH_MUL2
+        h = (h ^ (h >> np.uint64(32))) | one
+        a += bits[k] * h
+        b += bits[k] * (h * _HASH_MUL3)
     return a, b
 
 

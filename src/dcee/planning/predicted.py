@@ -30,6 +30,7 @@ from dcee.planning.base import Belief
 from dcee.planning.location_kl import location_cells, location_kl
 from dcee.planning.particle_terms import ParticleTerms, PositionTerms
 from dcee.planning.predicted_kernels import predicted_posterior_stats
+from dcee.planning.reading_terms import unique_tasks
 
 
 @dataclass(frozen=True)
@@ -53,12 +54,15 @@ class SequenceStats:
         return np.einsum("sj,sj->s", self.probability, values)
 
 
-def unique_per_sequence(readings: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def unique_per_sequence_reference(
+    readings: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The distinct reading sequences of each candidate: readings (S, J, T) →
     (task readings (Q, T), the candidate of each task (Q,), inverse (S, J) task of each
     hypothesis). Tasks are ordered by candidate, then lexicographically by reading (the order
     ``np.unique(readings[s], axis=0)`` gives), so identical hypotheses of one candidate
-    (in practice every non-detection) are evaluated once."""
+    (in practice every non-detection) are evaluated once. The NumPy reference of the compiled
+    :func:`~dcee.planning.reading_terms.unique_tasks` the planners call."""
     s_count, j_count, t_count = readings.shape
     flat = readings.reshape(s_count * j_count, t_count)
     seq = np.repeat(np.arange(s_count), j_count)
@@ -71,6 +75,8 @@ def unique_per_sequence(readings: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
     inverse[order] = task
     return np.ascontiguousarray(fs[new]), ss[new], inverse.reshape(s_count, j_count)
 
+
+_NO_CENTER = np.zeros(3)  # passed where no statistic reads the reference point
 
 EXPECTATIONS = ("sampled", "stratified")
 """How a planner estimates an expectation over the next readings:
@@ -175,8 +181,16 @@ class PredictionContext:
         self._simplify = readings
         self._draw()
         self._source = self._pt.source  # belief.source, kept contiguous across decisions
-        self._center = belief.source_mean()
+        self._center_value: np.ndarray | None = None
         self._cell_cache: dict[float, tuple[np.ndarray, ...]] = {}
+
+    @property
+    def _center(self) -> np.ndarray:
+        """(3,) the belief's mean source location: the reference the second moments are taken
+        about (computed once, when a statistic first needs it)."""
+        if self._center_value is None:
+            self._center_value = self.belief.source_mean()
+        return self._center_value
 
     def _draw(self) -> None:
         """Every random number one set of hypotheses needs (see the class docstring)."""
@@ -215,7 +229,7 @@ class PredictionContext:
             other._source = other._pt.source
         other.belief = Belief(theta, weights, self.sensor, self.belief.plume, site=self.belief.site)
         other._n, other._horizon, other._rng = int(n_hypotheses), 1, rng
-        other._center = other.belief.source_mean()
+        other._center_value = None
         other._cell_cache = {}
         other._draw()
         return other
@@ -350,7 +364,7 @@ class PredictionContext:
             probability = np.empty((s_count, j_count))
             for s in range(s_count):
                 readings[s], probability[s] = self.readings(pos_idx[s])
-        tz, seq_of_task, inverse = unique_per_sequence(readings)
+        tz, seq_of_task, inverse = unique_tasks(np.ascontiguousarray(readings))
         n_tasks = len(tz)
         tp = np.ascontiguousarray(pos_idx[seq_of_task])
         log_ev = np.empty(n_tasks)
@@ -361,7 +375,8 @@ class PredictionContext:
             *self.terms[2:],
             self._source,
             self.belief.weights,
-            self._center,
+            # the moments' reference point; the other statistics do not read it
+            self._center if moments else _NO_CENTER,
             tp,
             *self.sensor.transformed_readings(tz),
             self._sp,

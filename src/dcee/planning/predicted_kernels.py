@@ -31,6 +31,7 @@ from dcee.planning.reading_terms import (
     exact_task_stats,
     live_row_max,
     task_bounds,
+    task_layout,
 )
 from dcee.planning.stage_products import applies as stage_products_apply
 from dcee.planning.stage_products import key_bounds, product_stats, redo_below, stage_keys
@@ -289,10 +290,7 @@ def predicted_posterior_stats(
         np.ascontiguousarray(a, dtype=np.float64) for a in (task_v, task_fa, task_out)
     )
     s_count = task_positions.shape[0]
-    new_group = np.ones(s_count, dtype=bool)
-    new_group[1:] = np.any(task_positions[1:] != task_positions[:-1], axis=1)
-    group_start = np.append(np.flatnonzero(new_group), s_count).astype(np.int64)
-    used = np.unique(task_positions)  # rows of the position terms the tasks read
+    group_start, used = task_layout(task_positions, log_nd.shape[0])
     max_log_nd = np.full(log_nd.shape[0], -np.inf)
     max_det_offset = np.full(log_nd.shape[0], -np.inf)
     live_row_max(log_nd, det_offset, used, weights, max_log_nd, max_det_offset)
@@ -301,11 +299,20 @@ def predicted_posterior_stats(
     n_blocks = (source.shape[0] + _BLOCK - 1) // _BLOCK
     common = (loc, log_nd, inv_sigma, det_offset, source, weights, center)
     one_stage = task_positions.shape[1] == 1 and sp.false_alarm == 0.0
-    # the vectorised kernels' sums read w, w·dx, w·dy, w·dz, w·|d|² per particle, the scalar
-    # kernel of false alarms the offsets: each only what it reads (memory at 100,000 particles)
     vector_path = sp.false_alarm == 0.0
+    interpolate = (
+        precision == "interpolated"
+        and one_stage
+        and interpolation_applies(sp)
+        and np.diff(group_start).max(initial=0) >= MIN_READINGS  # smaller groups: exact sums
+    )
+    # the vectorised kernels' sums read w, w·dx, w·dy, w·dz, w·|d|² per particle (only the
+    # moments and the interpolation read more than the weights themselves), the scalar kernel
+    # of false alarms the offsets: each only what it reads (memory at 100,000 particles)
     weighted = (
-        weighted_columns(weights, source, center, want_moments) if vector_path else np.zeros((0, 5))
+        weighted_columns(weights, source, center, want_moments)
+        if vector_path and (want_moments or interpolate)
+        else np.zeros((0, 5))
     )
     scalar_moments = want_moments and not vector_path
     offsets = _centred_offsets(source, center) if scalar_moments else np.zeros((4, 0))
@@ -313,22 +320,19 @@ def predicted_posterior_stats(
     sums = np.empty((s_count, _N_ACC))
     log_ref = bound.copy()
     exact_tasks, group_start_exact = np.arange(s_count), group_start
-    group_sizes = np.diff(group_start)
-    if (
-        precision == "interpolated"
-        and one_stage
-        and interpolation_applies(sp)
-        and group_sizes.max(initial=0) >= MIN_READINGS  # smaller groups are summed exactly
-    ):
+    exact_positions, exact_v, exact_fa, exact_out = task_positions, task_v, task_fa, task_out
+    exact_bound = bound
+    if interpolate:
         # the groups it takes are summed over nodes (loc is C itself with this sensor)
         exact_tasks, group_start_exact = interpolate_groups(
             loc, weights, weighted, group_start, task_positions, task_v, task_out, bound, sp,
             want_kl, sums, log_ref,
         )  # fmt: skip
-    exact_positions = np.ascontiguousarray(task_positions[exact_tasks])
-    exact_v, exact_fa, exact_out = (
-        np.ascontiguousarray(a[exact_tasks]) for a in (task_v, task_fa, task_out)
-    )
+        exact_positions = np.ascontiguousarray(task_positions[exact_tasks])
+        exact_v, exact_fa, exact_out = (
+            np.ascontiguousarray(a[exact_tasks]) for a in (task_v, task_fa, task_out)
+        )
+        exact_bound = bound[exact_tasks]
     partial = np.empty((n_blocks, len(exact_tasks), _N_ACC))
     products = stage_products_apply(task_positions.shape[1], sp)
     if len(exact_tasks) == 0:
@@ -338,7 +342,7 @@ def predicted_posterior_stats(
         key_bound = key_bounds(key_p, key_v, key_out, max_log_nd, max_det_offset, sp)
         product_stats(
             loc, log_nd, inv_sigma, det_offset, weights, weighted, key_p, key_v, key_out,
-            key_bound, key_of, bound[exact_tasks], sp, want_moments, want_kl,
+            key_bound, key_of, exact_bound, sp, want_moments, want_kl,
             partial,
         )  # fmt: skip
     elif single:
@@ -350,7 +354,7 @@ def predicted_posterior_stats(
             exact_positions,
             exact_v,
             exact_out,
-            bound[exact_tasks],
+            exact_bound,
             sp,
             want_moments,
             want_kl,
@@ -370,13 +374,16 @@ def predicted_posterior_stats(
             exact_v,
             exact_fa,
             exact_out,
-            bound[exact_tasks],
+            exact_bound,
             sp,
             want_moments,
             want_kl,
             partial,
         )
-    sums[exact_tasks] = partial.sum(axis=0)  # fixed order over blocks: thread count free
+    if len(exact_tasks) == s_count:
+        sums = partial.sum(axis=0)  # fixed order over blocks: thread count free
+    else:
+        sums[exact_tasks] = partial.sum(axis=0)
     # Σ e_i ll_i was accumulated with e relative to the bound; a task is redone exactly when its
     # largest weight e^(ll_max − bound) is too small for the one-pass sums to be accurate.
     slack = _BOUND_SLACK
@@ -402,10 +409,13 @@ def predicted_posterior_stats(
         sums[redo] = redo_sums
         log_ref[redo] = redo_max
     s0 = sums[:, 0]
-    offset = sums[:, 1:4] / s0[:, None]
     log_ev = log_ref + np.log(s0)
     kl[:] = sums[:, 5] / s0 - log_ev if want_kl else np.nan
     log_evidence[:] = log_ev + np.asarray(task_jac, dtype=np.float64).sum(axis=1)
-    mean[:] = center + offset if want_moments else np.nan
-    trace = np.maximum(sums[:, 4] / s0 - np.einsum("ij,ij->i", offset, offset), 0.0)
-    trace_cov[:] = trace if want_moments else np.nan
+    if not want_moments:
+        mean[:] = np.nan
+        trace_cov[:] = np.nan
+        return
+    offset = sums[:, 1:4] / s0[:, None]
+    mean[:] = center + offset
+    trace_cov[:] = np.maximum(sums[:, 4] / s0 - np.einsum("ij,ij->i", offset, offset), 0.0)

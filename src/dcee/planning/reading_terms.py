@@ -97,6 +97,74 @@ def task_bound(
     return b
 
 
+@njit(cache=True, inline="always")
+def _row_less(flat: np.ndarray, a: int, b: int) -> bool:
+    """Row a of flat (Q, T) lexicographically before row b."""
+    for t in range(flat.shape[1]):
+        if flat[a, t] != flat[b, t]:
+            return flat[a, t] < flat[b, t]
+    return False
+
+
+@njit(cache=True)
+def unique_tasks(readings: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Compiled :func:`~dcee.planning.predicted.unique_per_sequence_reference`, the same
+    output: readings (S, J, T) → (task readings (Q, T), the candidate of each task (Q,),
+    inverse (S, J)); each candidate's J rows sorted by a stable insertion sort (J is 4-40),
+    equal rows one task. Its dozen NumPy calls took 70 µs of a 1.3 ms infotaxis decision."""
+    s_count, j_count, t_count = readings.shape
+    flat = readings.reshape(s_count * j_count, t_count)
+    order = np.empty(j_count, dtype=np.int64)
+    tz = np.empty((s_count * j_count, t_count))
+    seq = np.empty(s_count * j_count, dtype=np.int64)
+    inverse = np.empty((s_count, j_count), dtype=np.int64)
+    q = 0
+    for s in range(s_count):
+        base = s * j_count
+        for j in range(j_count):
+            k = j
+            while k > 0 and _row_less(flat, base + j, base + order[k - 1]):
+                order[k] = order[k - 1]
+                k -= 1
+            order[k] = j
+        for k in range(j_count):
+            row = base + order[k]
+            if k == 0 or _row_less(flat, base + order[k - 1], row):
+                for t in range(t_count):
+                    tz[q, t] = flat[row, t]
+                seq[q] = s
+                q += 1
+            inverse[s, order[k]] = q - 1
+    return tz[:q].copy(), seq[:q].copy(), inverse
+
+
+@njit(cache=True)
+def task_layout(task_positions: np.ndarray, n_rows: int) -> tuple[np.ndarray, np.ndarray]:
+    """(group_start (G + 1,), used rows (U,)) of tasks with position rows task_positions (S, T)
+    into n_rows position rows: a group is a run of consecutive tasks with the same rows (its
+    start indices, then S), ``used`` the distinct rows any task reads, increasing (what
+    ``np.unique(task_positions)`` gives)."""
+    s_count, t_count = task_positions.shape
+    starts = np.empty(s_count + 1, dtype=np.int64)
+    g = 0
+    for s in range(s_count):
+        new = s == 0
+        if not new:
+            for t in range(t_count):
+                if task_positions[s, t] != task_positions[s - 1, t]:
+                    new = True
+                    break
+        if new:
+            starts[g] = s
+            g += 1
+    starts[g] = s_count
+    seen = np.zeros(n_rows, dtype=np.bool_)
+    for s in range(s_count):
+        for t in range(t_count):
+            seen[task_positions[s, t]] = True
+    return starts[: g + 1].copy(), np.flatnonzero(seen).astype(np.int64)
+
+
 @njit(cache=True, parallel=True)
 def live_row_max(
     log_nd: np.ndarray,
