@@ -338,3 +338,33 @@ def test_compiled_task_list_equals_the_numpy_reference(stages):
             starts, np.append(np.flatnonzero(np.diff(positions, prepend=-1)), len(positions))
         )
         np.testing.assert_array_equal(used, np.arange(9))
+
+
+@pytest.mark.parametrize(
+    "sensor",
+    [
+        Sensor.paper_exact(),
+        Sensor(outlier=0.01),
+        Sensor(family="lognormal", pd=0.6, outlier=0.01),
+        Sensor.paper_exact(near_length=3.0),
+    ],
+    ids=["exact", "gauss+out", "ln+out", "exact+near"],
+)
+def test_one_pass_sums_without_moments_match_the_matrix_product_path(sensor):
+    """Without the moments (infotaxis, entrotaxis) one-stage tasks are summed while their
+    weights are computed (dcee.planning.one_stage_sums): the evidence and KL divergence of the
+    general path (moments on) and of the NumPy reference, to rounding."""
+    source, weights, conc = _stats_case(n=2100, seed=4)  # four blocks and a partial one
+    rng = np.random.default_rng(6)
+    task_pos = np.repeat(np.array([[0], [1], [2]]), 6, axis=0)
+    task_z = np.where(rng.random(task_pos.shape) < 0.4, 0.0, rng.lognormal(-6, 1.5, task_pos.shape))
+    task_z[1, 0] = 500.0  # a spike: with outliers only their component explains it
+    one_pass = _run(conc, source, weights, task_pos, task_z, sensor, want_moments=False)
+    general = _run(conc, source, weights, task_pos, task_z, sensor)
+    ref = predicted_posterior_stats_reference(conc, source, weights, task_pos, task_z, sensor)
+    for k in (0, 3):  # log evidence, KL divergence
+        # (KL = Σwe·ll/Σwe − log evidence cancels: its rounding is absolute, ~1e-15 · |ll|)
+        np.testing.assert_allclose(one_pass[k], general[k], rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(one_pass[k], ref[k], rtol=1e-8, atol=1e-10)
+    assert np.isnan(one_pass[1]).all() and np.isnan(one_pass[2]).all()
+    assert np.ptp(one_pass[3]) > 0.01  # the readings teach different amounts: not a vacuous check

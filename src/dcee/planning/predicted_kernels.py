@@ -25,6 +25,7 @@ from dcee.planning.block_sums import weighted_columns
 from dcee.planning.interpolated_kernels import MIN_READINGS, interpolate_groups
 from dcee.planning.interpolated_kernels import applicable as interpolation_applies
 from dcee.planning.multi_stage_kernels import multi_stage_weights
+from dcee.planning.one_stage_sums import one_stage_sums
 from dcee.planning.predicted_single import BOUND_SLACK_SINGLE, single_stage_sums
 from dcee.planning.reading_terms import (
     cached_log_likelihood,
@@ -360,6 +361,11 @@ def predicted_posterior_stats(
             want_kl,
             partial,
         )
+    elif one_stage and not want_moments:  # the evidence and KL alone: sums in one pass
+        one_stage_sums(
+            loc, log_nd, inv_sigma, det_offset, weights, group_start_exact, exact_positions,
+            exact_v, exact_out, exact_bound, sp, want_kl, partial,
+        )  # fmt: skip
     else:
         _grouped_stats(
             loc,

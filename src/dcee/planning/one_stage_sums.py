@@ -1,0 +1,100 @@
+"""The sums of one-stage tasks that need neither the location moments nor more than the
+evidence and the KL divergence (infotaxis, entrotaxis): weights and sums in one pass (issue 46).
+
+The general kernel (:func:`dcee.planning.predicted_kernels._grouped_stats`) stores each
+reading's relative weights e_i = exp(ll_i − bound) for a block of particles and forms the sums
+as matrix products with the five weighted columns, which pays when the moments are wanted. A
+planner that reads only Σ w e and Σ w e ll gets them here while the weights are computed:
+nothing stored, no BLAS call per block and reading. The sums are reassociated (eight SIMD
+partial sums, LLVM's order), so they differ from the general kernel's in the last bits (about
+1e-15 relative); measured on Stone Soup's STE workload (10,000 particles, 9 moves × 4
+readings): 0.08 against 0.17 ms per decision's sums, hot.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from dcee.models.sensor_kernels import SensorParams
+from dcee.numeric import HALF_LOG_2PI, exp_scalar, log_scalar
+from dcee.planning.block_sums import BLOCK
+
+EXP_FLOOR = -680.0
+"""As :data:`dcee.planning.predicted_kernels._EXP_FLOOR`: weights stay normal floats."""
+
+
+@njit(cache=True, parallel=True, fastmath={"contract", "reassoc"}, error_model="numpy")
+def one_stage_sums(
+    loc: np.ndarray,
+    log_nd: np.ndarray,
+    inv_sigma: np.ndarray,
+    det_offset: np.ndarray,
+    weights: np.ndarray,
+    group_start: np.ndarray,
+    task_positions: np.ndarray,
+    task_v: np.ndarray,
+    task_out: np.ndarray,
+    bound: np.ndarray,
+    sp: SensorParams,
+    want_kl: bool,
+    partial: np.ndarray,
+) -> None:
+    """partial[b, s] = (Σ w e, 0, 0, 0, 0, Σ w e ll) of one-stage task s over particle block b
+    (:data:`~dcee.planning.block_sums.BLOCK` particles), e = exp(ll − bound[s]) with ll the
+    log-likelihood of the task's reading less the Jacobian; the last sum is 0 without
+    ``want_kl``. Inputs as :func:`dcee.planning.predicted_kernels._grouped_stats` takes them
+    (a vector-path sensor: no false alarms): the position terms (P, N), weights (N,), tasks
+    grouped by position (group_start (G + 1,)), task_positions (S, 1), the transformed reading
+    v and outlier term of each task (S, 1), bound (S,); partial (n_blocks, S, 6)."""
+    n = weights.shape[0]
+    n_groups = group_start.shape[0] - 1
+    n_blocks = (n + BLOCK - 1) // BLOCK
+    det_add = sp.log_keep - HALF_LOG_2PI
+    with_outlier = sp.log_outlier > -np.inf
+    for item in prange(n_groups * n_blocks):
+        g = item // n_blocks
+        b = item % n_blocks
+        s0 = group_start[g]
+        i0 = b * BLOCK
+        m = min(n, i0 + BLOCK) - i0
+        p = task_positions[s0, 0]
+        lo, lnd, isg, dof = loc[p], log_nd[p], inv_sigma[p], det_offset[p]
+        for s in range(s0, group_start[g + 1]):
+            v = task_v[s, 0]
+            bnd = bound[s]
+            total = 0.0
+            weighted_ll = 0.0
+            # one branch-free loop per case (a test inside the loop would stop LLVM vectorising)
+            if v < sp.v_threshold:
+                for q in range(m):
+                    i = np.uint64(i0 + q)
+                    lq = lnd[i] - bnd
+                    we = weights[i] * exp_scalar(min(max(lq, EXP_FLOOR), 0.0))
+                    total += we
+                    weighted_ll += we * lq
+            elif with_outlier:
+                # p(z | C) = e^a + e^out: e = e^(a − bnd) + e^(out − bnd), ll − bnd = log e
+                out_term = exp_scalar(min(task_out[s, 0] - bnd, 0.0))
+                for q in range(m):
+                    i = np.uint64(i0 + q)
+                    r = (v - lo[i]) * isg[i]
+                    a = max(dof[i] + det_add - 0.5 * r * r - bnd, EXP_FLOOR)
+                    e = exp_scalar(min(a, 0.0)) + out_term
+                    we = weights[i] * e
+                    total += we
+                    if want_kl:
+                        weighted_ll += we * log_scalar(e)
+            else:
+                for q in range(m):
+                    i = np.uint64(i0 + q)
+                    r = (v - lo[i]) * isg[i]
+                    lq = dof[i] + det_add - 0.5 * r * r - bnd
+                    we = weights[i] * exp_scalar(min(max(lq, EXP_FLOOR), 0.0))
+                    total += we
+                    weighted_ll += we * lq
+            partial[b, s, 0] = total
+            for c in range(1, 5):
+                partial[b, s, c] = 0.0
+            # Σ w e ll = Σ w e (ll − bound) + bound Σ w e
+            partial[b, s, 5] = weighted_ll + bnd * total if want_kl else 0.0
