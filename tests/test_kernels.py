@@ -368,3 +368,25 @@ def test_one_pass_sums_without_moments_match_the_matrix_product_path(sensor):
         np.testing.assert_allclose(one_pass[k], ref[k], rtol=1e-8, atol=1e-10)
     assert np.isnan(one_pass[1]).all() and np.isnan(one_pass[2]).all()
     assert np.ptp(one_pass[3]) > 0.01  # the readings teach different amounts: not a vacuous check
+
+
+@pytest.mark.parametrize(
+    "sensor", [Sensor.paper_exact(), Sensor.paper_exact(false_alarm=0.1)], ids=["exact", "fa"]
+)
+def test_compiled_sampled_readings_are_the_sensors_bit_for_bit(sensor):
+    from dcee.planning.reading_terms import gaussian_sampled_readings
+
+    rng = np.random.default_rng(9)
+    conc = rng.lognormal(-8, 2, (7, 300))
+    indices = rng.integers(0, 300, 40)
+    pos_idx = rng.integers(0, 7, (9, 2))
+    noise = sensor.draw_noise(rng, (40, 3))
+    got = gaussian_sampled_readings(
+        conc, indices, pos_idx, noise, sensor.sigma_frac, sensor.sigma_min, sensor.pd,
+        sensor.threshold, sensor.false_alarm, sensor.false_alarm_scale,
+    )  # fmt: skip
+    want = sensor.simulate_from(
+        conc[:, indices][pos_idx].transpose(0, 2, 1), noise[None, :, :2], np.inf
+    )
+    assert np.array_equal(got, want)
+    assert 0 < np.mean(got > 0) < 1  # detections and non-detections both present

@@ -30,7 +30,7 @@ from dcee.planning.base import Belief
 from dcee.planning.location_kl import location_cells, location_kl
 from dcee.planning.particle_terms import ParticleTerms, PositionTerms
 from dcee.planning.predicted_kernels import predicted_posterior_stats
-from dcee.planning.reading_terms import unique_tasks
+from dcee.planning.reading_terms import gaussian_sampled_readings, unique_tasks
 
 
 @dataclass(frozen=True)
@@ -275,6 +275,13 @@ class PredictionContext:
         """(S, J, T) sampled hypothesised readings along (S, T) sequences of cached positions;
         the same as :meth:`readings` for each sequence (shared noise), in one NumPy pass."""
         t_count = pos_idx.shape[1]
+        sensor = self.sensor
+        if not sensor.lognormal and sensor.near_length == 0 and sensor.outlier == 0:
+            return gaussian_sampled_readings(
+                self.conc, self.indices, pos_idx, self.noise, sensor.sigma_frac,
+                sensor.sigma_min, sensor.pd, sensor.threshold, sensor.false_alarm,
+                sensor.false_alarm_scale,
+            )  # fmt: skip
         c = self.conc[:, self.indices][pos_idx].transpose(0, 2, 1)  # (S, J, T)
         r = self.terms.dist[:, self.indices][pos_idx].transpose(0, 2, 1)
         return self.sensor.simulate_from(c, self.noise[None, :, :t_count], r)

@@ -30,9 +30,7 @@ from dcee.planning.predicted_single import BOUND_SLACK_SINGLE, single_stage_sums
 from dcee.planning.reading_terms import (
     cached_log_likelihood,
     exact_task_stats,
-    live_row_max,
-    task_bounds,
-    task_layout,
+    task_setup,
 )
 from dcee.planning.stage_products import applies as stage_products_apply
 from dcee.planning.stage_products import key_bounds, product_stats, redo_below, stage_keys
@@ -291,12 +289,9 @@ def predicted_posterior_stats(
         np.ascontiguousarray(a, dtype=np.float64) for a in (task_v, task_fa, task_out)
     )
     s_count = task_positions.shape[0]
-    group_start, used = task_layout(task_positions, log_nd.shape[0])
-    max_log_nd = np.full(log_nd.shape[0], -np.inf)
-    max_det_offset = np.full(log_nd.shape[0], -np.inf)
-    live_row_max(log_nd, det_offset, used, weights, max_log_nd, max_det_offset)
-    bound = np.empty(s_count)
-    task_bounds(task_positions, task_v, task_fa, task_out, max_log_nd, max_det_offset, sp, bound)
+    group_start, bound, largest_group, max_log_nd, max_det_offset = task_setup(
+        task_positions, task_v, task_fa, task_out, log_nd, det_offset, weights, sp
+    )
     n_blocks = (source.shape[0] + _BLOCK - 1) // _BLOCK
     common = (loc, log_nd, inv_sigma, det_offset, source, weights, center)
     one_stage = task_positions.shape[1] == 1 and sp.false_alarm == 0.0
@@ -305,7 +300,7 @@ def predicted_posterior_stats(
         precision == "interpolated"
         and one_stage
         and interpolation_applies(sp)
-        and np.diff(group_start).max(initial=0) >= MIN_READINGS  # smaller groups: exact sums
+        and largest_group >= MIN_READINGS  # smaller groups are summed exactly
     )
     # the vectorised kernels' sums read w, w·dx, w·dy, w·dz, w·|d|² per particle (only the
     # moments and the interpolation read more than the weights themselves), the scalar kernel

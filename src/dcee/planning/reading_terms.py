@@ -97,6 +97,41 @@ def task_bound(
     return b
 
 
+@njit(cache=True)
+def gaussian_sampled_readings(
+    conc: np.ndarray,
+    indices: np.ndarray,
+    pos_idx: np.ndarray,
+    noise: np.ndarray,
+    sigma_frac: float,
+    sigma_min: float,
+    pd: float,
+    threshold: float,
+    false_alarm: float,
+    false_alarm_scale: float,
+) -> np.ndarray:
+    """(S, J, T) hypothesised readings of the J particles ``indices`` (J,) along (S, T)
+    sequences of position rows ``pos_idx`` of ``conc`` (R, N), from standard noise (J, T', 4),
+    T' ≥ T: :meth:`dcee.models.sensor.Sensor.simulate_from` for a Gaussian-family sensor with
+    a constant Pd and no outliers, the same arithmetic in the same order (the same bits, tested),
+    without its dozen NumPy calls and the gathers before them."""
+    s_count, t_count = pos_idx.shape
+    j_count = indices.shape[0]
+    z = np.empty((s_count, j_count, t_count))
+    for s in range(s_count):
+        for j in range(j_count):
+            for t in range(t_count):
+                c = conc[pos_idx[s, t], indices[j]]
+                y = c + (sigma_frac * c + sigma_min) * noise[j, t, 1]
+                if noise[j, t, 0] < pd and y >= threshold:
+                    z[s, j, t] = y
+                elif noise[j, t, 2] < false_alarm:
+                    z[s, j, t] = threshold + false_alarm_scale * noise[j, t, 3]
+                else:
+                    z[s, j, t] = 0.0
+    return z
+
+
 @njit(cache=True, inline="always")
 def _row_less(flat: np.ndarray, a: int, b: int) -> bool:
     """Row a of flat (Q, T) lexicographically before row b."""
@@ -299,3 +334,30 @@ def exact_task_stats(
             sums[q, 3] += e * dz
             sums[q, 4] += e * (dx * dx + dy * dy + dz * dz)
             sums[q, 5] += e * ll[i]
+
+
+@njit(cache=True)
+def task_setup(
+    task_positions: np.ndarray,
+    task_v: np.ndarray,
+    task_fa: np.ndarray,
+    task_out: np.ndarray,
+    log_nd: np.ndarray,
+    det_offset: np.ndarray,
+    weights: np.ndarray,
+    sp: SensorParams,
+) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray]:
+    """What the statistics kernels need of a task list, in one call: (group_start
+    (:func:`task_layout`), each task's bound (S,) (:func:`task_bound` from the largest live
+    terms of the rows the tasks read, :func:`live_row_max`), the largest group's size, and
+    those largest terms per row (R,) (−inf for rows no task reads))."""
+    group_start, used = task_layout(task_positions, log_nd.shape[0])
+    max_log_nd = np.full(log_nd.shape[0], -np.inf)
+    max_det_offset = np.full(log_nd.shape[0], -np.inf)
+    live_row_max(log_nd, det_offset, used, weights, max_log_nd, max_det_offset)
+    bound = np.empty(task_positions.shape[0])
+    task_bounds(task_positions, task_v, task_fa, task_out, max_log_nd, max_det_offset, sp, bound)
+    largest = 0
+    for g in range(group_start.shape[0] - 1):
+        largest = max(largest, group_start[g + 1] - group_start[g])
+    return group_start, bound, largest, max_log_nd, max_det_offset
