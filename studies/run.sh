@@ -709,6 +709,8 @@ case "${1:---list}" in
     # every decision of the demo's whole search (and of paper:5 and paper:12), not only the first 40
     $P studies/decision_agreement.py --precision interpolated --strategies dcee-cl --seeds 1 \
       --steps 450 --json docs/results/perf/agreement-interpolated-full.json
+    # infotaxis and entrotaxis: the one-pass sums against the matrix-product path, every decision
+    $P studies/one_pass_agreement.py --json docs/results/perf/one-pass-agreement.json
     $P studies/publish_tables.py ;;
   precision-interpolated)  # dcee-cl with interpolated sums beside exact double: the public study's 120 searches, paired
     $D bench --suite paper --repeats 10 \
