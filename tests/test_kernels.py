@@ -319,7 +319,7 @@ def test_location_kl_matches_reference_and_its_limits(sensor):
 
 @pytest.mark.parametrize("stages", [1, 2, 3])
 def test_compiled_task_list_equals_the_numpy_reference(stages):
-    from dcee.planning.predicted import unique_per_sequence_reference
+    from dcee.planning.predicted_reference import unique_per_sequence_reference
     from dcee.planning.reading_terms import task_layout, unique_tasks
 
     rng = np.random.default_rng(stages)
@@ -390,3 +390,12 @@ def test_compiled_sampled_readings_are_the_sensors_bit_for_bit(sensor):
     )
     assert np.array_equal(got, want)
     assert 0 < np.mean(got > 0) < 1  # detections and non-detections both present
+    from dcee.planning.reading_terms import gaussian_transformed
+
+    tz = got.reshape(-1, 2)
+    assert np.array_equal(
+        gaussian_transformed(tz, sensor.threshold), sensor.transformed_readings(tz)[0]
+    )
+    if sensor.false_alarm == 0:  # the other terms the planners then pass: −inf, −inf and 0
+        _, fa, out, jac = sensor.transformed_readings(tz)
+        assert np.all(fa == -np.inf) and np.all(out == -np.inf) and np.all(jac == 0)

@@ -26,11 +26,16 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.estimation.resampling import systematic_resample
+from dcee.models.sensor import Sensor
 from dcee.planning.base import Belief
 from dcee.planning.location_kl import location_cells, location_kl
 from dcee.planning.particle_terms import ParticleTerms, PositionTerms
 from dcee.planning.predicted_kernels import predicted_posterior_stats
-from dcee.planning.reading_terms import gaussian_sampled_readings, unique_tasks
+from dcee.planning.reading_terms import (
+    gaussian_sampled_readings,
+    gaussian_transformed,
+    unique_tasks,
+)
 
 
 @dataclass(frozen=True)
@@ -54,29 +59,14 @@ class SequenceStats:
         return np.einsum("sj,sj->s", self.probability, values)
 
 
-def unique_per_sequence_reference(
-    readings: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The distinct reading sequences of each candidate: readings (S, J, T) →
-    (task readings (Q, T), the candidate of each task (Q,), inverse (S, J) task of each
-    hypothesis). Tasks are ordered by candidate, then lexicographically by reading (the order
-    ``np.unique(readings[s], axis=0)`` gives), so identical hypotheses of one candidate
-    (in practice every non-detection) are evaluated once. The NumPy reference of the compiled
-    :func:`~dcee.planning.reading_terms.unique_tasks` the planners call."""
-    s_count, j_count, t_count = readings.shape
-    flat = readings.reshape(s_count * j_count, t_count)
-    seq = np.repeat(np.arange(s_count), j_count)
-    order = np.lexsort((*flat.T[::-1], seq))  # the last key is the primary one
-    fs, ss = flat[order], seq[order]
-    new = np.ones(len(order), dtype=bool)
-    new[1:] = (ss[1:] != ss[:-1]) | np.any(fs[1:] != fs[:-1], axis=1)
-    task = np.cumsum(new) - 1
-    inverse = np.empty(len(order), dtype=np.int64)
-    inverse[order] = task
-    return np.ascontiguousarray(fs[new]), ss[new], inverse.reshape(s_count, j_count)
-
-
 _NO_CENTER = np.zeros(3)  # passed where no statistic reads the reference point
+
+
+def _plain_gaussian(sensor: Sensor) -> bool:
+    """A Gaussian-family sensor with a constant Pd and no outliers: its readings and their
+    transformed terms have compiled forms (:mod:`dcee.planning.reading_terms`)."""
+    return not sensor.lognormal and sensor.near_length == 0 and sensor.outlier == 0
+
 
 EXPECTATIONS = ("sampled", "stratified")
 """How a planner estimates an expectation over the next readings:
@@ -276,7 +266,7 @@ class PredictionContext:
         the same as :meth:`readings` for each sequence (shared noise), in one NumPy pass."""
         t_count = pos_idx.shape[1]
         sensor = self.sensor
-        if not sensor.lognormal and sensor.near_length == 0 and sensor.outlier == 0:
+        if _plain_gaussian(sensor):
             return gaussian_sampled_readings(
                 self.conc, self.indices, pos_idx, self.noise, sensor.sigma_frac,
                 sensor.sigma_min, sensor.pd, sensor.threshold, sensor.false_alarm,
@@ -385,7 +375,7 @@ class PredictionContext:
             # the moments' reference point; the other statistics do not read it
             self._center if moments else _NO_CENTER,
             tp,
-            *self.sensor.transformed_readings(tz),
+            *self._transformed(tz),
             self._sp,
             log_ev,
             mean,
@@ -397,7 +387,7 @@ class PredictionContext:
         )
         loc_kl = np.full(n_tasks, np.nan)
         if location_cell is not None:
-            tv, tfa, tout, _ = self.sensor.transformed_readings(tz)
+            tv, tfa, tout, _ = self._transformed(tz)
             location_kl(
                 *self.terms[2:],
                 self.belief.weights,
@@ -418,6 +408,17 @@ class PredictionContext:
             kl_div[inverse],
             loc_kl[inverse],
         )
+
+    def _transformed(self, tz: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """:meth:`~dcee.models.sensor.Sensor.transformed_readings` of task readings tz (Q, T);
+        for a Gaussian sensor without false alarms or outliers compiled (the same values: v the
+        reading or half the threshold, the other terms −inf and 0), without its dozen NumPy
+        calls."""
+        sensor = self.sensor
+        if _plain_gaussian(sensor) and sensor.false_alarm == 0:
+            never = np.full_like(tz, -np.inf)
+            return gaussian_transformed(tz, sensor.threshold), never, never, np.zeros_like(tz)
+        return sensor.transformed_readings(tz)
 
     def _cells(self, cell: float) -> tuple[np.ndarray, ...]:
         """:func:`~dcee.planning.location_kl.location_cells` of this context's belief,

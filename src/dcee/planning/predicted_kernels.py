@@ -392,7 +392,7 @@ def predicted_posterior_stats(
         slack = BOUND_SLACK_SINGLE if single else -redo_below(task_positions.shape[1])
     with np.errstate(divide="ignore"):
         too_small = ~(np.log(sums[:, 0]) > -slack)
-    if np.any(too_small):
+    if too_small.any():
         redo = np.flatnonzero(too_small).astype(np.int64)
         redo_sums = np.empty((len(redo), _N_ACC))
         redo_max = np.empty(len(redo))

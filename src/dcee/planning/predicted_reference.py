@@ -86,3 +86,25 @@ def location_kl_reference(
         pos = post > 0
         out[s] = np.sum(post[pos] * np.log(post[pos] / prior[pos]))
     return out
+
+
+def unique_per_sequence_reference(
+    readings: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The distinct reading sequences of each candidate: readings (S, J, T) →
+    (task readings (Q, T), the candidate of each task (Q,), inverse (S, J) task of each
+    hypothesis). Tasks are ordered by candidate, then lexicographically by reading (the order
+    ``np.unique(readings[s], axis=0)`` gives), so identical hypotheses of one candidate
+    (in practice every non-detection) are evaluated once. The NumPy reference of the compiled
+    :func:`~dcee.planning.reading_terms.unique_tasks` the planners call."""
+    s_count, j_count, t_count = readings.shape
+    flat = readings.reshape(s_count * j_count, t_count)
+    seq = np.repeat(np.arange(s_count), j_count)
+    order = np.lexsort((*flat.T[::-1], seq))  # the last key is the primary one
+    fs, ss = flat[order], seq[order]
+    new = np.ones(len(order), dtype=bool)
+    new[1:] = (ss[1:] != ss[:-1]) | np.any(fs[1:] != fs[:-1], axis=1)
+    task = np.cumsum(new) - 1
+    inverse = np.empty(len(order), dtype=np.int64)
+    inverse[order] = task
+    return np.ascontiguousarray(fs[new]), ss[new], inverse.reshape(s_count, j_count)
