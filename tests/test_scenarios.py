@@ -58,6 +58,30 @@ def test_overrides_are_revalidated():
         s.with_overrides(**{"search.particles": -1})
 
 
+def test_only_the_final_combination_of_overrides_must_hold():
+    # the order the refusal's advice gives: more releases, then one reading model
+    changes = {
+        "estimator.likelihood": "fluctuation",
+        "estimator.max_sources": 3,
+        "estimator.calm_prior": 0.0,
+        "estimator.learn": {},
+    }
+    s = load_scenario("random2:1").with_overrides(**changes)
+    assert s.estimator.max_sources == 3 and s.reading_models == ("fluctuation",)
+    # a final combination that does not hold is still refused, with its own reason
+    with pytest.raises(DceeInputError, match="need one reading model"):
+        load_scenario("random2:1").with_overrides(**{**changes, "estimator.calm_prior": 0.5})
+    # a later path into a section the invalid halfway state never made: the real reason
+    with pytest.raises(DceeInputError, match=r"search\.particles"):
+        load_scenario("paper:1").with_overrides(
+            **{
+                "search.particles": -1,
+                "truth.model": "filament",
+                "truth.model.meander_intensity": 1,
+            }
+        )
+
+
 def test_toml_file_errors(tmp_path):
     good = tmp_path / "site.toml"
     good.write_text(

@@ -379,24 +379,39 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
         return loc + env
 
     def with_overrides(self, **changes: Any) -> Scenario:
-        """A re-validated copy; keys are dotted paths, e.g. ``{"search.particles": 2000}``."""
+        """A re-validated copy; keys are dotted paths, e.g. ``{"search.particles": 2000}``.
+
+        Applied in order, each on the validated result of the ones before (so that a later path
+        may go into what an earlier one set: ``truth.model = "filament"``, then
+        ``truth.model.meander_intensity``); a combination that is only invalid halfway (the
+        count of releases raised before the reading models are cut to one) is carried on
+        unvalidated, and only the final one must hold."""
         scenario = self
+        data = scenario.model_dump()
+        pending: DceeInputError | None = None  # why the changes so far do not validate
         for path, value in changes.items():
             if value is None:
                 continue
-            # one at a time, so that a later path may go into what an earlier one set
-            # (e.g. truth.model = "filament", then truth.model.meander_intensity)
-            data = scenario.model_dump()
             node = data
             *parents, leaf = path.split(".")
             for p in parents:
                 if not isinstance(node.get(p), dict):
+                    if pending is not None:
+                        raise pending  # the section would exist once the earlier change held
                     raise DceeInputError(path, f"no such setting ({p!r} is not a section)")
                 node = node[p]
             node[leaf] = value
             if leaf == "wind_from" and parents in (["truth"], ["prior"]):
                 node.pop("phi", None)  # the bearing replaces the angle it was given as
-            scenario = validate_scenario(data)
+            try:
+                scenario = validate_scenario(data)
+            except DceeInputError as exc:
+                pending = exc
+                continue
+            pending = None
+            data = scenario.model_dump()
+        if pending is not None:
+            raise pending
         return scenario
 
 
