@@ -15,7 +15,8 @@ source_count_tables() {
   $P studies/source_count_table.py results/two-source-held-out-100 \
     results/three-source-held-out-100 $(ls -d results/*-source-held-out-100-before \
     results/*-source-held-out-100-9f200ee results/one-source-*-held-out-100 \
-    results/two-source-wind-unknown-held-out-50 \
+    results/two-source-wind-unknown-held-out-50 results/two-source-filament-held-out-100 \
+    results/two-source-puffs-held-out-100 \
     results/*-source-held-out-100-5d04d27 results/*-source-held-out-100-d207b1e \
     results/three-source-held-out-100-20k 2>/dev/null) \
     --csv docs/results/source-count/searches.csv
@@ -648,6 +649,14 @@ case "${1:---list}" in
   source-count-wind-unknown)  # issue 45: two releases with the wind unknown too, the first 50 held-out configurations (docs/multi-source.md)
     $D bench --suite two-source-wind-unknown-held-out-50 --repeats 1 --strategies dcee-cl \
       --workers "${WORKERS:-2}" --out results/two-source-wind-unknown-held-out-50
+    source_count_tables
+    $P studies/publish_tables.py ;;
+  source-count-turbulent)  # issue 45: two releases in the filament and the puff truths, the fluctuation likelihood with one reading model (docs/multi-source.md)
+    for T in filament puffs; do
+      $D bench --suite two-source-held-out-100 --repeats 1 --strategies dcee-cl --truth $T \
+        --likelihood fluctuation --set estimator.calm_prior=0 --set 'estimator.learn={}' \
+        --workers "${WORKERS:-2}" --out results/two-source-$T-held-out-100
+    done
     source_count_tables
     $P studies/publish_tables.py ;;
   source-count-paper-scale)  # issue 45: the three-release held-out campaign at the paper's 20,000 particles

@@ -134,10 +134,13 @@ paired table compares them, the worst-search table leaves them out."""
 PAIRS = (
     ("one-source-unknown-count-held-out-100", "one-source-known-count-held-out-100"),
     ("two-source-wind-unknown-held-out-50", "two-source-held-out-100"),
+    ("two-source-filament-held-out-100", "two-source-held-out-100"),
+    ("two-source-puffs-held-out-100", "two-source-held-out-100"),
 )
 """Campaigns compared on the same configurations besides each X against X-before: one release
 with the count unknown against the one-release filter (issue 45, K = 1); two releases with the
-wind unknown against the wind known (the 50 configurations both flew)."""
+wind unknown against the wind known (the 50 configurations both flew); two releases in a
+turbulent truth (filament, puffs; the fluctuation likelihood) against the isotropic truth."""
 
 
 def paired(df: pd.DataFrame) -> str:
