@@ -91,8 +91,11 @@ def merged_rows(stored: pd.DataFrame | None, new: pd.DataFrame) -> pd.DataFrame:
     the campaigns it flew)."""
     if stored is None:
         return new
-    kept = stored[~stored["campaign"].isin(set(new["campaign"]))]
-    return pd.concat([new, kept], ignore_index=True)
+    # each campaign where it stood (a replaced one in its stored place), new ones at the end
+    order = list(dict.fromkeys([*stored["campaign"], *new["campaign"]]))
+    fresh = set(new["campaign"])
+    parts = [(new if c in fresh else stored)[lambda d, c=c: d["campaign"] == c] for c in order]
+    return pd.concat(parts, ignore_index=True)
 
 
 def table(df: pd.DataFrame) -> str:

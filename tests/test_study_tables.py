@@ -205,3 +205,6 @@ def test_the_source_count_csv_keeps_the_campaigns_a_study_did_not_fly() -> None:
     assert sorted(merged["campaign"]) == ["a", "b", "b"]
     assert list(merged.loc[merged["campaign"] == "b", "final_ospa"]) == [1.0, 0.3]
     assert script.merged_rows(None, new) is new
+    # a replaced campaign keeps its place in the tables, a new one comes after the stored ones
+    first = pd.DataFrame(_count_rows("a", [False], [2.0]) + _count_rows("c", [True], [0.5]))
+    assert list(dict.fromkeys(script.merged_rows(stored, first)["campaign"])) == ["a", "b", "c"]

@@ -282,7 +282,9 @@ def predicted_posterior_stats(
     paper's sensor family are summed over nodes of the predicted concentration
     (:mod:`dcee.planning.interpolated_kernels`, an approximation within about 1e-8); any
     other task is computed in double precision, tasks of two or three stages as products of
-    their distinct stage factors (:mod:`dcee.planning.stage_products`).
+    their distinct stage factors (:mod:`dcee.planning.stage_products`). One-stage tasks without
+    the moments (the evidence and KL alone) are summed in one pass
+    (:mod:`dcee.planning.one_stage_sums`, equal to about 1e-15).
     """
     task_positions = np.ascontiguousarray(task_positions, dtype=np.int64)
     task_v, task_fa, task_out = (
