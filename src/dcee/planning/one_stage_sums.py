@@ -19,9 +19,7 @@ from numba import njit, prange
 from dcee.models.sensor_kernels import SensorParams
 from dcee.numeric import HALF_LOG_2PI, exp_scalar, log_scalar
 from dcee.planning.block_sums import BLOCK
-
-EXP_FLOOR = -680.0
-"""As :data:`dcee.planning.predicted_kernels._EXP_FLOOR`: weights stay normal floats."""
+from dcee.planning.multi_stage_kernels import EXP_FLOOR  # weights stay normal floats
 
 
 @njit(cache=True, parallel=True, fastmath={"contract", "reassoc"}, error_model="numpy")
