@@ -63,12 +63,23 @@ DEFAULT_MAX_BYTES = 32 * 2**20
 """Rows kept across decisions are capped at this many bytes (a decision's own rows always fit)."""
 
 
+@njit(cache=True)
 def merge_runs(theta: np.ndarray) -> np.ndarray:
-    """(M,) start index of each run of identical consecutive rows of theta (N, 8)."""
-    if len(theta) == 0:
-        return np.zeros(0, dtype=np.int64)
-    differs = np.any(theta[1:] != theta[:-1], axis=1)
-    return np.concatenate([[0], np.flatnonzero(differs) + 1]).astype(np.int64)
+    """(M,) start index of each run of identical consecutive rows of theta (N, 8): row i
+    starts a run when any value differs from row i − 1 (``!=``, so a NaN always does). A
+    loop, not ``np.any(theta[1:] != theta[:-1], axis=1)``: that builds an (N, 8) mask and
+    reduces its short rows, 176 µs at 10,000 particles against a few here."""
+    n, d = theta.shape
+    starts = np.empty(n, dtype=np.int64)
+    m = 0
+    for i in range(n):
+        differs = i == 0
+        if i > 0:
+            for k in range(d):  # no early exit: a branch per value cost more than the compares
+                differs |= theta[i, k] != theta[i - 1, k]
+        starts[m] = i
+        m += differs
+    return starts[:m].copy()
 
 
 @njit(cache=True)

@@ -77,7 +77,7 @@ def vectorised_case(
 ) -> bool:
     """True for the paper's sensor and plume (Gaussian family, constant Pd < 1; no meander,
     backflow or area release; decay 1), which the branch-free loops with the vectorisable
-    ``exp``, ``log`` and ``erfc`` of :mod:`dcee.numeric` handle (:func:`_rows_gaussian`, the
+    ``exp``, ``log`` and ``erfc`` of :mod:`dcee.numeric` handle (:func:`position_rows`, the
     exploration guard's information); every other case takes the scalar libm formulas."""
     return (
         sp.lognormal == 0.0
@@ -91,11 +91,20 @@ def vectorised_case(
     )
 
 
-_ROW_BLOCK = 256  # particles per work item of position_rows
+_ROW_BLOCK = 512  # particles per work item of position_rows (4 KB per row: within L1)
+
+
+# The common case in four loops over a block of particles, not one. Each particle's arithmetic
+# is the same, in the same order (bit for bit the one fused loop it replaces), but a fused loop
+# body of ~200 vector instructions holds three long dependency chains (the plume's exp, the
+# erfc's 25-term Clenshaw recurrence, two logs), longer than the out-of-order window: the core
+# waited on each chain's latency. In short loops the next iterations' chains overlap:
+# 557 → 345 µs on one thread for 6 positions × 7,703 particles (lab measurement, 2026-11-29,
+# Stone Soup's workload; docs/performance.md "Issue 46 (2026-11-29, later)").
 
 
 @njit(cache=True, fastmath={"contract"}, error_model="numpy")
-def _rows_gaussian(
+def _rows_plume(
     plume: np.ndarray,
     i0: int,
     i1: int,
@@ -103,18 +112,12 @@ def _rows_gaussian(
     py: float,
     pz: float,
     rmin: float,
-    sp: SensorParams,
     conc: np.ndarray,
     dist: np.ndarray,
     loc: np.ndarray,
-    log_nd: np.ndarray,
-    inv_sigma: np.ndarray,
-    det_offset: np.ndarray,
 ) -> None:
-    """:func:`position_rows` for particles i0..i1−1 at one position, into 1-D rows, in the
-    common case (Gaussian family, constant Pd < 1, no meander): one loop without branches
-    (selects only), so that LLVM vectorises it, exp, log and erfc included."""
-    missed_offset = sp.log_not_false_alarm + sp.log_keep
+    """Phase 1 of the common case: C and the clamped distance r of particles i0..i1−1 at one
+    position (the transformed location of the Gaussian family is C itself)."""
     for j in range(i1 - i0):
         # an unsigned index: numba then emits no negative-index wraparound, which would keep
         # LLVM from vectorising the loop
@@ -132,16 +135,49 @@ def _rows_gaussian(
             pz,
             rmin,
         )
-        sigma = sp.sigma_frac * c + sp.sigma_min
-        inv_s = 1.0 / sigma
-        missed = vlog1m(sp.pd * vndtr_upper((sp.v_threshold - c) * inv_s))  # log(1 − Pd Φ(−x))
-        lin = sp.lin0 + sp.lin1 * c
         conc[i] = c
         dist[i] = r
         loc[i] = c
-        inv_sigma[i] = inv_s
-        log_nd[i] = (lin if c < sp.c_lin else missed) + missed_offset
+
+
+@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+def _rows_sigma(
+    i0: int,
+    i1: int,
+    sp: SensorParams,
+    conc: np.ndarray,
+    inv_sigma: np.ndarray,
+    det_offset: np.ndarray,
+) -> None:
+    """Phase 2: 1/σ and log Pd − log σ, σ = σ_frac C + σ_min."""
+    for j in range(i1 - i0):
+        i = np.uint64(i0 + j)
+        sigma = sp.sigma_frac * conc[i] + sp.sigma_min
+        inv_sigma[i] = 1.0 / sigma
         det_offset[i] = sp.log_pd - log_scalar(sigma)
+
+
+@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+def _rows_detect(
+    i0: int, i1: int, sp: SensorParams, conc: np.ndarray, inv_sigma: np.ndarray, log_nd: np.ndarray
+) -> None:
+    """Phase 3: Pd Φ(−(threshold − C)/σ), the probability of a detection, into log_nd."""
+    for j in range(i1 - i0):
+        i = np.uint64(i0 + j)
+        log_nd[i] = sp.pd * vndtr_upper((sp.v_threshold - conc[i]) * inv_sigma[i])
+
+
+@njit(cache=True, fastmath={"contract"}, error_model="numpy")
+def _rows_missed(i0: int, i1: int, sp: SensorParams, conc: np.ndarray, log_nd: np.ndarray) -> None:
+    """Phase 4: log_nd = log(1 − Pd Φ(·)) (linearised below c_lin) + the false-alarm and
+    keep terms: log p(non-detection | C)."""
+    missed_offset = sp.log_not_false_alarm + sp.log_keep
+    for j in range(i1 - i0):
+        i = np.uint64(i0 + j)
+        c = conc[i]
+        missed = vlog1m(log_nd[i])
+        lin = sp.lin0 + sp.lin1 * c
+        log_nd[i] = (lin if c < sp.c_lin else missed) + missed_offset
 
 
 @njit(cache=True, inline="always")
@@ -200,7 +236,8 @@ def position_rows(
     :meth:`~dcee.models.sensor.Sensor.log_likelihood`.
 
     Blocks of particles run in parallel. The paper's sensor (Gaussian family, constant Pd < 1)
-    without meander or backflow and with decay 1 takes :func:`_rows_gaussian`, vectorised with
+    without meander or backflow and with decay 1 takes four short loops (:func:`_rows_plume`
+    to :func:`_rows_missed`), vectorised with
     the ``exp``, ``log`` and ``erfc`` of :mod:`dcee.numeric`; every other case the scalar
     formulas with libm
     (with Pd = 1, log Φ needs relative accuracy far in the tail).
@@ -217,22 +254,10 @@ def position_rows(
             pz = positions[k, 2]
             row = rows[k]
             if fast:
-                _rows_gaussian(
-                    plume,
-                    i0,
-                    i1,
-                    px,
-                    py,
-                    pz,
-                    rmin,
-                    sp,
-                    conc[row],
-                    dist[row],
-                    loc[row],
-                    log_nd[row],
-                    inv_sigma[row],
-                    det_offset[row],
-                )
+                _rows_plume(plume, i0, i1, px, py, pz, rmin, conc[row], dist[row], loc[row])
+                _rows_sigma(i0, i1, sp, conc[row], inv_sigma[row], det_offset[row])
+                _rows_detect(i0, i1, sp, conc[row], inv_sigma[row], log_nd[row])
+                _rows_missed(i0, i1, sp, conc[row], log_nd[row])
                 continue
             for i in range(i0, i1):
                 c, r = plume_at(
