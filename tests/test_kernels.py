@@ -13,7 +13,7 @@ from dcee.planning.predicted_reference import (
     location_kl_reference,
     predicted_posterior_stats_reference,
 )
-from tests.helpers import compiled_location_kl, compiled_predicted_stats
+from tests.helpers import _terms_from_concentrations, compiled_location_kl, compiled_predicted_stats
 
 
 def test_vectorised_exp_matches_math_exp():
@@ -399,3 +399,67 @@ def test_compiled_sampled_readings_are_the_sensors_bit_for_bit(sensor):
     if sensor.false_alarm == 0:  # the other terms the planners then pass: −inf, −inf and 0
         _, fa, out, jac = sensor.transformed_readings(tz)
         assert np.all(fa == -np.inf) and np.all(out == -np.inf) and np.all(jac == 0)
+
+
+def test_one_stage_task_sums_in_one_call_equal_the_kernels_it_replaces():
+    """predicted_posterior_stats without moments sends one-stage tasks to one compiled call
+    (bounds, one-pass sums, their totals): its sums equal task_setup + one_stage_sums +
+    partial.sum(axis=0) bit for bit; an unreachable reading is still redone exactly; the
+    interpolated precision still interpolates a group of 16 readings or more and takes the
+    one call (the same numbers as double precision) below that."""
+    from dcee.planning.block_sums import BLOCK
+    from dcee.planning.one_stage_sums import one_stage_sums, one_stage_task_sums
+    from dcee.planning.reading_terms import task_setup
+
+    source, weights, conc = _stats_case(n=2100, seed=4)
+    conc[1] = np.random.default_rng(0).uniform(1e-6, 2e-5, conc.shape[1])
+    sensor = Sensor.paper_exact()
+    task_pos = np.array([[0], [0], [1], [1], [2]])
+    task_z = np.array([[0.0], [2e-3], [0.0], [1e-2], [1e-3]])  # task 3: unreachable
+    loc, log_nd, inv_sigma, det_offset = _terms_from_concentrations(conc, None, sensor)
+    v, fa, out, _ = sensor.transformed_readings(task_z)
+    args = (loc, log_nd, inv_sigma, det_offset, weights, task_pos, v, fa, out, sensor.params)
+    done, setup, sums = one_stage_task_sums(*args, True, len(task_pos) + 1)
+    assert done
+    group_start, bound, *_ = task_setup(
+        task_pos, v, fa, out, log_nd, det_offset, weights, sensor.params
+    )
+    partial = np.empty(((len(weights) + BLOCK - 1) // BLOCK, len(task_pos), 6))
+    one_stage_sums(
+        loc, log_nd, inv_sigma, det_offset, weights, group_start, task_pos, v, out, bound,
+        sensor.params, True, partial,
+    )  # fmt: skip
+    assert np.array_equal(sums, partial.sum(axis=0))
+    assert np.array_equal(setup[1], bound)
+    assert not one_stage_task_sums(*args, True, 2)[0]  # a group of two: "interpolate it"
+
+    ref = predicted_posterior_stats_reference(conc, source, weights, task_pos, task_z, sensor)
+    fast = _run(conc, source, weights, task_pos, task_z, sensor, want_moments=False)
+    assert fast[0][3] < -3000  # redone exactly, not lost to underflow
+    for k in (0, 3):
+        np.testing.assert_allclose(fast[k], ref[k], rtol=1e-8, atol=1e-10)
+    small = _run(
+        conc,
+        source,
+        weights,
+        task_pos,
+        task_z,
+        sensor,
+        want_moments=False,
+        precision="interpolated",
+    )
+    for a, b in zip(small, fast, strict=True):
+        assert np.array_equal(a, b, equal_nan=True)
+    # late in a search (concentrations within a factor of a few): 20 readings at one position
+    # (4,000 particles: with fewer the nodes would not be fewer than the particles)
+    rng = np.random.default_rng(3)
+    n = 4000
+    narrow = np.exp(rng.normal(-6.0, 0.5, size=(1, n)))
+    many_pos = np.zeros((20, 1), dtype=np.int64)
+    many_z = narrow[0, rng.integers(0, n, 20)][:, None]
+    late = (narrow, rng.uniform(0, 50, (n, 3)), np.full(n, 1.0 / n), many_pos, many_z, sensor)
+    interp, exact = (
+        _run(*late, want_moments=False, precision=p) for p in ("interpolated", "double")
+    )
+    assert not np.array_equal(interp[0], exact[0])  # interpolated: within 1e-8, not equal
+    np.testing.assert_allclose(interp[0], exact[0], rtol=1e-7)

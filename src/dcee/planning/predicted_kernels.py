@@ -25,7 +25,7 @@ from dcee.planning.block_sums import weighted_columns
 from dcee.planning.interpolated_kernels import MIN_READINGS, interpolate_groups
 from dcee.planning.interpolated_kernels import applicable as interpolation_applies
 from dcee.planning.multi_stage_kernels import multi_stage_weights
-from dcee.planning.one_stage_sums import one_stage_sums
+from dcee.planning.one_stage_sums import one_stage_sums, one_stage_task_sums
 from dcee.planning.predicted_single import BOUND_SLACK_SINGLE, single_stage_sums
 from dcee.planning.reading_terms import (
     cached_log_likelihood,
@@ -291,102 +291,122 @@ def predicted_posterior_stats(
         np.ascontiguousarray(a, dtype=np.float64) for a in (task_v, task_fa, task_out)
     )
     s_count = task_positions.shape[0]
-    group_start, bound, largest_group, max_log_nd, max_det_offset = task_setup(
-        task_positions, task_v, task_fa, task_out, log_nd, det_offset, weights, sp
+    setup, done = None, False
+    if (
+        task_positions.shape[1] == 1
+        and sp.false_alarm == 0.0
+        and not want_moments
+        and precision in ("double", "interpolated")
+        and s_count
+    ):  # the evidence and KL alone of one-stage tasks: bounds and one-pass sums in one call
+        interpolate_from = (
+            MIN_READINGS
+            if precision == "interpolated" and interpolation_applies(sp)
+            else s_count + 1
+        )
+        done, setup, sums = one_stage_task_sums(
+            loc, log_nd, inv_sigma, det_offset, weights, task_positions, task_v, task_fa,
+            task_out, sp, want_kl, interpolate_from,
+        )  # fmt: skip
+    group_start, bound, largest_group, max_log_nd, max_det_offset = (
+        task_setup(task_positions, task_v, task_fa, task_out, log_nd, det_offset, weights, sp)
+        if setup is None
+        else setup
     )
-    n_blocks = (source.shape[0] + _BLOCK - 1) // _BLOCK
+    log_ref = bound.copy()
     common = (loc, log_nd, inv_sigma, det_offset, source, weights, center)
     one_stage = task_positions.shape[1] == 1 and sp.false_alarm == 0.0
-    vector_path = sp.false_alarm == 0.0
-    interpolate = (
-        precision == "interpolated"
-        and one_stage
-        and interpolation_applies(sp)
-        and largest_group >= MIN_READINGS  # smaller groups are summed exactly
-    )
-    # the vectorised kernels' sums read w, w·dx, w·dy, w·dz, w·|d|² per particle (only the
-    # moments and the interpolation read more than the weights themselves), the scalar kernel
-    # of false alarms the offsets: each only what it reads (memory at 100,000 particles)
-    weighted = (
-        weighted_columns(weights, source, center, want_moments)
-        if vector_path and (want_moments or interpolate)
-        else np.zeros((0, 5))
-    )
-    scalar_moments = want_moments and not vector_path
-    offsets = _centred_offsets(source, center) if scalar_moments else np.zeros((4, 0))
     single = precision == "single" and one_stage
-    sums = np.empty((s_count, _N_ACC))
-    log_ref = bound.copy()
-    exact_tasks, group_start_exact = np.arange(s_count), group_start
-    exact_positions, exact_v, exact_fa, exact_out = task_positions, task_v, task_fa, task_out
-    exact_bound = bound
-    if interpolate:
-        # the groups it takes are summed over nodes (loc is C itself with this sensor)
-        exact_tasks, group_start_exact = interpolate_groups(
-            loc, weights, weighted, group_start, task_positions, task_v, task_out, bound, sp,
-            want_kl, sums, log_ref,
-        )  # fmt: skip
-        exact_positions = np.ascontiguousarray(task_positions[exact_tasks])
-        exact_v, exact_fa, exact_out = (
-            np.ascontiguousarray(a[exact_tasks]) for a in (task_v, task_fa, task_out)
-        )
-        exact_bound = bound[exact_tasks]
-    partial = np.empty((n_blocks, len(exact_tasks), _N_ACC))
     products = stage_products_apply(task_positions.shape[1], sp)
-    if len(exact_tasks) == 0:
-        pass  # every task interpolated
-    elif products:  # two or three stages: products of the distinct stage factors
-        key_of, key_p, key_v, key_out = stage_keys(exact_positions, exact_v, exact_out, sp)
-        key_bound = key_bounds(key_p, key_v, key_out, max_log_nd, max_det_offset, sp)
-        product_stats(
-            loc, log_nd, inv_sigma, det_offset, weights, weighted, key_p, key_v, key_out,
-            key_bound, key_of, exact_bound, sp, want_moments, want_kl,
-            partial,
-        )  # fmt: skip
-    elif single:
-        single_stage_sums(
-            (loc, log_nd, inv_sigma, det_offset),
-            weights,
-            weighted,
-            group_start_exact,
-            exact_positions,
-            exact_v,
-            exact_out,
-            exact_bound,
-            sp,
-            want_moments,
-            want_kl,
-            partial,
+    if not done:  # the general kernels
+        n_blocks = (source.shape[0] + _BLOCK - 1) // _BLOCK
+        vector_path = sp.false_alarm == 0.0
+        interpolate = (
+            precision == "interpolated"
+            and one_stage
+            and interpolation_applies(sp)
+            and largest_group >= MIN_READINGS  # smaller groups are summed exactly
         )
-    elif one_stage and not want_moments:  # the evidence and KL alone: sums in one pass
-        one_stage_sums(
-            loc, log_nd, inv_sigma, det_offset, weights, group_start_exact, exact_positions,
-            exact_v, exact_out, exact_bound, sp, want_kl, partial,
-        )  # fmt: skip
-    else:
-        _grouped_stats(
-            loc,
-            log_nd,
-            inv_sigma,
-            det_offset,
-            offsets,
-            weights,
-            weighted,
-            group_start_exact,
-            exact_positions,
-            exact_v,
-            exact_fa,
-            exact_out,
-            exact_bound,
-            sp,
-            want_moments,
-            want_kl,
-            partial,
+        # the vectorised kernels' sums read w, w·dx, w·dy, w·dz, w·|d|² per particle (only the
+        # moments and the interpolation read more than the weights themselves), the scalar kernel
+        # of false alarms the offsets: each only what it reads (memory at 100,000 particles)
+        weighted = (
+            weighted_columns(weights, source, center, want_moments)
+            if vector_path and (want_moments or interpolate)
+            else np.zeros((0, 5))
         )
-    if len(exact_tasks) == s_count:
-        sums = partial.sum(axis=0)  # fixed order over blocks: thread count free
-    else:
-        sums[exact_tasks] = partial.sum(axis=0)
+        scalar_moments = want_moments and not vector_path
+        offsets = _centred_offsets(source, center) if scalar_moments else np.zeros((4, 0))
+        sums = np.empty((s_count, _N_ACC))
+        exact_tasks, group_start_exact = np.arange(s_count), group_start
+        exact_positions, exact_v, exact_fa, exact_out = task_positions, task_v, task_fa, task_out
+        exact_bound = bound
+        if interpolate:
+            # the groups it takes are summed over nodes (loc is C itself with this sensor)
+            exact_tasks, group_start_exact = interpolate_groups(
+                loc, weights, weighted, group_start, task_positions, task_v, task_out, bound, sp,
+                want_kl, sums, log_ref,
+            )  # fmt: skip
+            exact_positions = np.ascontiguousarray(task_positions[exact_tasks])
+            exact_v, exact_fa, exact_out = (
+                np.ascontiguousarray(a[exact_tasks]) for a in (task_v, task_fa, task_out)
+            )
+            exact_bound = bound[exact_tasks]
+        partial = np.empty((n_blocks, len(exact_tasks), _N_ACC))
+        if len(exact_tasks) == 0:
+            pass  # every task interpolated
+        elif products:  # two or three stages: products of the distinct stage factors
+            key_of, key_p, key_v, key_out = stage_keys(exact_positions, exact_v, exact_out, sp)
+            key_bound = key_bounds(key_p, key_v, key_out, max_log_nd, max_det_offset, sp)
+            product_stats(
+                loc, log_nd, inv_sigma, det_offset, weights, weighted, key_p, key_v, key_out,
+                key_bound, key_of, exact_bound, sp, want_moments, want_kl,
+                partial,
+            )  # fmt: skip
+        elif single:
+            single_stage_sums(
+                (loc, log_nd, inv_sigma, det_offset),
+                weights,
+                weighted,
+                group_start_exact,
+                exact_positions,
+                exact_v,
+                exact_out,
+                exact_bound,
+                sp,
+                want_moments,
+                want_kl,
+                partial,
+            )
+        elif one_stage and not want_moments:  # the evidence and KL alone: sums in one pass
+            one_stage_sums(
+                loc, log_nd, inv_sigma, det_offset, weights, group_start_exact, exact_positions,
+                exact_v, exact_out, exact_bound, sp, want_kl, partial,
+            )  # fmt: skip
+        else:
+            _grouped_stats(
+                loc,
+                log_nd,
+                inv_sigma,
+                det_offset,
+                offsets,
+                weights,
+                weighted,
+                group_start_exact,
+                exact_positions,
+                exact_v,
+                exact_fa,
+                exact_out,
+                exact_bound,
+                sp,
+                want_moments,
+                want_kl,
+                partial,
+            )
+        if len(exact_tasks) == s_count:
+            sums = partial.sum(axis=0)  # fixed order over blocks: thread count free
+        else:
+            sums[exact_tasks] = partial.sum(axis=0)
     # Σ e_i ll_i was accumulated with e relative to the bound; a task is redone exactly when its
     # largest weight e^(ll_max − bound) is too small for the one-pass sums to be accurate.
     slack = _BOUND_SLACK
