@@ -1118,6 +1118,12 @@ def _timed(record: dict) -> str:
     return f"{when}, {machine['cpus']} CPUs, {state}, `{commit}`"
 
 
+def _repeats_text(result: dict) -> str:
+    """How many runs of the alternation a comparison's figures are the median of."""
+    n = result.get("repeats", 1)
+    return f"; the median of {n} such runs in one process" if n > 1 else ""
+
+
 def speed_table() -> str:
     """Speed, from the stored `dcee perf` outputs of docs/results/perf/ (bash studies/run.sh
     perf): every ratio's two sides timed in the same run."""
@@ -1126,8 +1132,14 @@ def speed_table() -> str:
     rows = [
         [
             "our `infotaxis` decision vs Stone Soup's KL planner on Stone Soup's own STE "
-            f"workload, {ste['stonesoup']['decisions']} decisions each, in alternation",
-            f"{ste['stonesoup']['speedup']:.1f}× faster",
+            f"workload, {ste['stonesoup']['decisions']} decisions each, in alternation"
+            + _repeats_text(ste["stonesoup"]),
+            f"{ste['stonesoup']['speedup']:.1f}× faster"
+            + (
+                " (runs {:.1f}-{:.1f}×)".format(*ste["stonesoup"]["speedup_range"])
+                if ste["stonesoup"].get("repeats", 1) > 1
+                else ""
+            ),
             f"{ste['stonesoup']['dcee_infotaxis_median_ms']:.2f} ms vs "
             f"{ste['stonesoup']['stonesoup_median_ms']:.1f} ms",
             "≥ 50×",  # TARGET_SPEEDUP of dcee.perf.stonesoup_compare (older runs stored 20)

@@ -681,7 +681,7 @@ case "${1:---list}" in
     # else on the machine (each output records the load beside it and is marked shared if not)
     mkdir -p docs/results/perf
     $D perf --json docs/results/perf/workloads.json
-    $D perf --compare-stonesoup --decisions 20 --json docs/results/perf/stonesoup-ste.json
+    $D perf --compare-stonesoup --decisions 20 --repeats 5 --json docs/results/perf/stonesoup-ste.json
     $P studies/kernel_speedup.py --before f52a5b6 --json docs/results/perf/kernel-speedup.json
     $P studies/kernel_speedup.py --before cae7e4f --json docs/results/perf/kernel-speedup-blas.json
     $P studies/demo_decision.py --before cae7e4f --json docs/results/perf/demo-decision.json

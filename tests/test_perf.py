@@ -78,3 +78,26 @@ def test_compare_stonesoup_without_the_extra_is_a_clear_error(monkeypatch, capsy
     assert code == 2
     assert err.strip().count("\n") == 0
     assert "stonesoup" in err.lower() and "dcee[bench]" in err
+
+
+def test_compare_stonesoup_refuses_a_repeat_count_below_one(capsys):
+    code, _, err = run_cli(["perf", "--compare-stonesoup", "--repeats", "0"], capsys)
+    assert code == 2
+    assert err.strip().count("\n") == 0 and "repeats" in err and ">= 1" in err
+
+
+def test_compare_reports_the_median_run_of_several(monkeypatch):
+    """--repeats: each run alternates fresh generators; the summary is the median over runs
+    (the ratio the median of the runs' ratios), every run kept."""
+    import itertools
+
+    from dcee.perf import stonesoup_compare as sc
+
+    ours = itertools.cycle([[1.0, 1.0, 9.0], [2.0, 2.0, 2.0], [0.5, 0.5, 0.5]])
+    monkeypatch.setattr(sc, "stonesoup_decisions", lambda n: iter([50.0, 40.0, 60.0]))
+    monkeypatch.setattr(sc, "dcee_decisions", lambda n: iter(next(ours)))
+    result = sc.compare(3, repeats=3)
+    assert [r["speedup"] for r in result["runs"]] == [50.0, 25.0, 100.0]
+    assert result["speedup"] == 50.0 and result["speedup_range"] == [25.0, 100.0]
+    assert result["stonesoup_median_ms"] == 50.0 and result["dcee_infotaxis_median_ms"] == 1.0
+    assert result["repeats"] == 3 and result["decisions"] == 3

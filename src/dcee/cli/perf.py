@@ -20,7 +20,15 @@ from dcee.io import check_writable_file, write_json
     help="Time Stone Soup's STE example side by side (needs the 'bench' extra).",
 )
 @click.option("--decisions", default=10, show_default=True, help="Decisions per side to time.")
-def perf(json_path: str | None, quick: bool, compare_stonesoup: bool, decisions: int) -> None:
+@click.option(
+    "--repeats",
+    default=1,
+    show_default=True,
+    help="With --compare-stonesoup: runs of the alternation; the median run's ratio is reported.",
+)
+def perf(
+    json_path: str | None, quick: bool, compare_stonesoup: bool, decisions: int, repeats: int
+) -> None:
     """Time the standard workloads against their targets (see docs/performance.md). The JSON
     records the machine, the versions and the load beside the run (dcee.perf.machine): a run
     with other processes busy is marked shared."""
@@ -33,19 +41,30 @@ def perf(json_path: str | None, quick: bool, compare_stonesoup: bool, decisions:
         check_writable_file(Path(json_path), "json")  # before minutes of timing, not after
     if decisions < 1:
         raise DceeInputError("decisions", f"must be >= 1, got {decisions}")
+    if repeats < 1:
+        raise DceeInputError("repeats", f"must be >= 1, got {repeats}")
     console = Console(width=None if sys.stdout.isatty() else 120)
     machine = machine_record()
     if compare_stonesoup:
         from dcee.perf.stonesoup_compare import compare
 
         with LoadMonitor() as load:
-            result = compare(decisions)
+            result = compare(decisions, repeats)
         warning = load_warning(load.record())
+        console.print(f"{result['workload']}, {decisions} decisions each (medians, same process):")
+        for run in result["runs"] if repeats > 1 else []:
+            console.print(
+                f"  run: Stone Soup {run['stonesoup_median_ms']:.2f} ms · dcee infotaxis "
+                f"{run['dcee_infotaxis_median_ms']:.2f} ms · ratio {run['speedup']:.1f}x"
+            )
+        low, high = result["speedup_range"]
         console.print(
-            f"{result['workload']}, {decisions} decisions each (medians, same process):\n"
-            f"  Stone Soup {result['stonesoup_median_ms']:.2f} ms · "
+            f"  {'median of ' + str(repeats) + ' runs: ' if repeats > 1 else ''}"
+            f"Stone Soup {result['stonesoup_median_ms']:.2f} ms · "
             f"dcee infotaxis {result['dcee_infotaxis_median_ms']:.2f} ms · "
-            f"ratio {result['speedup']:.1f}x (target >= {result['target_speedup']:.0f}x)"
+            f"ratio {result['speedup']:.1f}x"
+            f"{f' (runs {low:.1f}-{high:.1f}x)' if repeats > 1 else ''}"
+            f" (target >= {result['target_speedup']:.0f}x)"
         )
         if warning:
             console.print(f"[yellow]{warning}")
