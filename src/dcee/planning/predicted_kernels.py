@@ -385,24 +385,10 @@ def predicted_posterior_stats(
             )  # fmt: skip
         else:
             _grouped_stats(
-                loc,
-                log_nd,
-                inv_sigma,
-                det_offset,
-                offsets,
-                weights,
-                weighted,
-                group_start_exact,
-                exact_positions,
-                exact_v,
-                exact_fa,
-                exact_out,
-                exact_bound,
-                sp,
-                want_moments,
-                want_kl,
-                partial,
-            )
+                loc, log_nd, inv_sigma, det_offset, offsets, weights, weighted, group_start_exact,
+                exact_positions, exact_v, exact_fa, exact_out, exact_bound, sp, want_moments,
+                want_kl, partial,
+            )  # fmt: skip
         if len(exact_tasks) == s_count:
             sums = partial.sum(axis=0)  # fixed order over blocks: thread count free
         else:
