@@ -16,7 +16,7 @@ source_count_tables() {
     results/three-source-held-out-100 $(ls -d results/*-source-held-out-100-before \
     results/*-source-held-out-100-9f200ee results/one-source-*-held-out-100 \
     results/two-source-wind-unknown-held-out-50 results/two-source-filament-held-out-100 \
-    results/two-source-puffs-held-out-100 \
+    results/two-source-puffs-held-out-100 results/two-source-held-out-100-infotaxis \
     results/*-source-held-out-100-5d04d27 results/*-source-held-out-100-d207b1e \
     results/three-source-held-out-100-20k 2>/dev/null) \
     --csv docs/results/source-count/searches.csv
@@ -657,6 +657,11 @@ case "${1:---list}" in
         --likelihood fluctuation --set estimator.calm_prior=0 --set 'estimator.learn={}' \
         --workers "${WORKERS:-2}" --out results/two-source-$T-held-out-100
     done
+    source_count_tables
+    $P studies/publish_tables.py ;;
+  source-count-infotaxis)  # issue 45: infotaxis on the joint belief, the same 100 two-release held-out configurations (docs/multi-source.md)
+    $D bench --suite two-source-held-out-100 --repeats 1 --strategies infotaxis \
+      --workers "${WORKERS:-2}" --out results/two-source-held-out-100-infotaxis
     source_count_tables
     $P studies/publish_tables.py ;;
   source-count-paper-scale)  # issue 45: the three-release held-out campaign at the paper's 20,000 particles

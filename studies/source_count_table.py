@@ -126,8 +126,8 @@ def table(df: pd.DataFrame) -> str:
 
 def table_latest(df: pd.DataFrame) -> str:
     """:func:`table` of today's campaigns only (names without a code suffix: they end in
-    ``held-out-N``; the README's table)."""
-    return table(df[df["campaign"].str.contains(r"held-out-\d+$", regex=True)])
+    ``held-out-N``, or ``held-out-N-infotaxis`` for another planner's; the README's table)."""
+    return table(df[df["campaign"].str.contains(r"held-out-\d+(?:-infotaxis)?$", regex=True)])
 
 
 BEFORE = "-before"
@@ -139,11 +139,13 @@ PAIRS = (
     ("two-source-wind-unknown-held-out-50", "two-source-held-out-100"),
     ("two-source-filament-held-out-100", "two-source-held-out-100"),
     ("two-source-puffs-held-out-100", "two-source-held-out-100"),
+    ("two-source-held-out-100-infotaxis", "two-source-held-out-100"),
 )
 """Campaigns compared on the same configurations besides each X against X-before: one release
 with the count unknown against the one-release filter (issue 45, K = 1); two releases with the
 wind unknown against the wind known (the 50 configurations both flew); two releases in a
-turbulent truth (filament, puffs; the fluctuation likelihood) against the isotropic truth."""
+turbulent truth (filament, puffs; the fluctuation likelihood) against the isotropic truth;
+infotaxis against dcee-cl (campaigns of one planner each are paired across planners)."""
 
 
 def paired(df: pd.DataFrame) -> str:
@@ -161,6 +163,12 @@ def paired(df: pd.DataFrame) -> str:
     pairs += [(a, b) for a, b in PAIRS if a in names and b in names]
     for first, second in pairs:
         rows_a, rows_b = keyed.loc[first], keyed.loc[second]
+        one_planner = (
+            rows_a.index.get_level_values("strategy").nunique() == 1
+            and rows_b.index.get_level_values("strategy").nunique() == 1
+        )
+        if one_planner:  # two planners on the same configurations: pair by scenario and seed
+            rows_a, rows_b = rows_a.droplevel("strategy"), rows_b.droplevel("strategy")
         common = rows_a.index.intersection(rows_b.index)
         a = rows_a.loc[common, "count_correct"].astype(bool).to_numpy()
         b = rows_b.loc[common, "count_correct"].astype(bool).to_numpy()

@@ -208,3 +208,17 @@ def test_the_source_count_csv_keeps_the_campaigns_a_study_did_not_fly() -> None:
     # a replaced campaign keeps its place in the tables, a new one comes after the stored ones
     first = pd.DataFrame(_count_rows("a", [False], [2.0]) + _count_rows("c", [True], [0.5]))
     assert list(dict.fromkeys(script.merged_rows(stored, first)["campaign"])) == ["a", "b", "c"]
+
+
+def test_the_source_count_tables_pair_two_planners_on_the_same_configurations() -> None:
+    script = _script("source_count_table")
+    rows = _count_rows("two-source-held-out-100", [True, False, True], [0.3, 2.0, 0.4])
+    other = _count_rows("two-source-held-out-100-infotaxis", [True, True, True], [0.2, 0.5, 0.4])
+    for row in other:
+        row["strategy"] = "infotaxis"
+    frame = pd.DataFrame(rows + other)
+    assert "two-source-held-out-100-infotaxis | infotaxis" in script.table_latest(frame)
+    paired = script.paired(frame).splitlines()
+    (row,) = [line for line in paired if "-infotaxis − two-source-held-out-100 " in line]
+    # paired by scenario and seed across planners: one search right only with infotaxis
+    assert "| 3 | 1 / 0 (p = 1) |" in row and "-0.10" in row
