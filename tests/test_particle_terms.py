@@ -187,3 +187,16 @@ def test_a_cached_row_asked_for_again_is_not_evicted_for_the_new_ones_of_the_sam
     fresh_rows = fresh.rows(mixed)
     for a, b in zip(cache.terms, fresh.terms, strict=True):
         np.testing.assert_array_equal(a[rows], b[fresh_rows])
+
+
+def test_merge_runs_is_the_numpy_comparison_nan_and_signed_zero_included():
+    theta, _ = _resampled(n=900, seed=3)
+    theta[10:12, 2] = np.nan  # two equal rows with a NaN: still two runs (NaN != NaN)
+    theta[20, 1], theta[21, 1] = 0.0, -0.0  # equal values: one run where the rest agrees
+    theta[21] = theta[20]
+    theta[21, 1] = -0.0
+    differs = np.any(theta[1:] != theta[:-1], axis=1)
+    expected = np.concatenate([[0], np.flatnonzero(differs) + 1])
+    np.testing.assert_array_equal(merge_runs(theta), expected)
+    assert 11 in merge_runs(theta) and 21 not in merge_runs(theta)
+    assert merge_runs(np.zeros((0, 8))).shape == (0,)

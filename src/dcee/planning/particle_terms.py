@@ -68,7 +68,7 @@ def merge_runs(theta: np.ndarray) -> np.ndarray:
     """(M,) start index of each run of identical consecutive rows of theta (N, 8): row i
     starts a run when any value differs from row i − 1 (``!=``, so a NaN always does). A
     loop, not ``np.any(theta[1:] != theta[:-1], axis=1)``: that builds an (N, 8) mask and
-    reduces its short rows, 176 µs at 10,000 particles against a few here."""
+    reduces its short rows: 200 µs at 10,000 particles against 40 µs here (lab, 2026-11-29)."""
     n, d = theta.shape
     starts = np.empty(n, dtype=np.int64)
     m = 0

@@ -291,13 +291,10 @@ def predicted_posterior_stats(
         np.ascontiguousarray(a, dtype=np.float64) for a in (task_v, task_fa, task_out)
     )
     s_count = task_positions.shape[0]
+    one_stage = task_positions.shape[1] == 1 and sp.false_alarm == 0.0
     setup, done = None, False
     if (
-        task_positions.shape[1] == 1
-        and sp.false_alarm == 0.0
-        and not want_moments
-        and precision in ("double", "interpolated")
-        and s_count
+        one_stage and not want_moments and precision in ("double", "interpolated") and s_count
     ):  # the evidence and KL alone of one-stage tasks: bounds and one-pass sums in one call
         interpolate_from = (
             MIN_READINGS
@@ -315,7 +312,6 @@ def predicted_posterior_stats(
     )
     log_ref = bound.copy()
     common = (loc, log_nd, inv_sigma, det_offset, source, weights, center)
-    one_stage = task_positions.shape[1] == 1 and sp.false_alarm == 0.0
     single = precision == "single" and one_stage
     products = stage_products_apply(task_positions.shape[1], sp)
     if not done:  # the general kernels
