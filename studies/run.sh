@@ -12,11 +12,13 @@ report() { for dir in "$@"; do $D report "results/$dir"; cat "results/$dir/repor
 # with the code before the last change (X-before, the paired table), two changes before
 # (X-5d04d27), before the hunt for one release more (X-d207b1e) and at 20,000 particles
 source_count_tables() {
-  $P studies/source_count_table.py results/two-source-held-out-100 \
-    results/three-source-held-out-100 $(ls -d results/*-source-held-out-100-before \
+  # the campaigns this machine holds (a fresh one only those it flew; the CSV keeps the rest)
+  $P studies/source_count_table.py $(ls -d results/two-source-held-out-100 \
+    results/three-source-held-out-100 results/*-source-held-out-100-before \
     results/*-source-held-out-100-9f200ee results/one-source-*-held-out-100 \
     results/two-source-wind-unknown-held-out-50 results/two-source-filament-held-out-100 \
     results/two-source-puffs-held-out-100 results/two-source-held-out-100-infotaxis \
+    results/*-source-held-out-100-mcts \
     results/*-source-held-out-100-5d04d27 results/*-source-held-out-100-d207b1e \
     results/three-source-held-out-100-20k 2>/dev/null) \
     --csv docs/results/source-count/searches.csv
@@ -662,6 +664,13 @@ case "${1:---list}" in
   source-count-infotaxis)  # issue 45: infotaxis on the joint belief, the same 100 two-release held-out configurations (docs/multi-source.md)
     $D bench --suite two-source-held-out-100 --repeats 1 --strategies infotaxis \
       --workers "${WORKERS:-2}" --out results/two-source-held-out-100-infotaxis
+    source_count_tables
+    $P studies/publish_tables.py ;;
+  source-count-mcts)  # issue 45: the tree search on the joint belief, the same 100 held-out configurations of two and of three releases (docs/multi-source.md)
+    for N in two three; do
+      $D bench --suite "$N-source-held-out-100" --repeats 1 --strategies dcee-mcts \
+        --workers "${WORKERS:-2}" --out "results/$N-source-held-out-100-mcts"
+    done
     source_count_tables
     $P studies/publish_tables.py ;;
   source-count-paper-scale)  # issue 45: the three-release held-out campaign at the paper's 20,000 particles

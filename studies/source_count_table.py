@@ -27,7 +27,7 @@ from dcee.analysis.results import find_runs
 from dcee.analysis.statistics import median_ci, wilson
 from dcee.errors import DceeInputError
 from dcee.models import IsotropicPlume
-from dcee.scenarios import Scenario
+from dcee.scenarios import Scenario, load_scenario
 from dcee.scenarios.schema.scenario import validate_scenario
 
 
@@ -40,6 +40,26 @@ def release_readings(scenario: Scenario, run: Path) -> np.ndarray:
     positions = steps[["x", "y", "z"]].to_numpy()
     conc = IsotropicPlume().concentration(scenario.truth_thetas(), positions)  # (K, steps)
     return (conc > scenario.sensor.threshold).sum(axis=1)
+
+
+FOOTPRINT_CELL = 0.5
+"""m: the side of the cells a release's footprint is counted in."""
+
+
+def release_footprints(scenario: Scenario) -> np.ndarray:
+    """(K,) m²: each true release's footprint, the part of the area at the robot's flight
+    height where its mean (isotropic) gas is above the sensor's threshold, counted on a
+    0.5 m grid. A property of the configuration, not of a search: a release of footprint 0
+    (its gas leaves the area below or beside the flight plane) reaches no reading anywhere a
+    robot may go, and no estimator can count it."""
+    lo, hi = np.asarray(scenario.volume.low), np.asarray(scenario.volume.high)
+    xs = np.arange(lo[0] + FOOTPRINT_CELL / 2, hi[0], FOOTPRINT_CELL)
+    ys = np.arange(lo[1] + FOOTPRINT_CELL / 2, hi[1], FOOTPRINT_CELL)
+    gx, gy = np.meshgrid(xs, ys, indexing="ij")
+    height = np.full(gx.size, float(scenario.agent.start[2]))
+    points = np.column_stack([gx.ravel(), gy.ravel(), height])
+    conc = IsotropicPlume().concentration(scenario.truth_thetas(), points)  # (K, cells)
+    return (conc > scenario.sensor.threshold).sum(axis=1) * FOOTPRINT_CELL**2
 
 
 def rows_of(folder: Path) -> list[dict]:
@@ -76,6 +96,7 @@ def rows_of(folder: Path) -> list[dict]:
                 "mean_release_error": float(near.mean()),
                 "explore_guard_fired": int(summary.get("explore_guard_fired", 0)),
                 "least_reached_readings": int(reached.min()),
+                "least_footprint_m2": float(release_footprints(scenario).min()),
                 "decision_ms": 1e3 * float(summary["decision_seconds_mean"]),
                 "code": summary.get("code", {}).get("commit", "")
                 if isinstance(summary.get("code"), dict)
@@ -126,8 +147,10 @@ def table(df: pd.DataFrame) -> str:
 
 def table_latest(df: pd.DataFrame) -> str:
     """:func:`table` of today's campaigns only (names without a code suffix: they end in
-    ``held-out-N``, or ``held-out-N-infotaxis`` for another planner's; the README's table)."""
-    return table(df[df["campaign"].str.contains(r"held-out-\d+(?:-infotaxis)?$", regex=True)])
+    ``held-out-N``, or ``held-out-N-infotaxis`` / ``-mcts`` for another planner's; the README's
+    table)."""
+    latest = r"held-out-\d+(?:-infotaxis|-mcts)?$"
+    return table(df[df["campaign"].str.contains(latest, regex=True)])
 
 
 BEFORE = "-before"
@@ -140,12 +163,15 @@ PAIRS = (
     ("two-source-filament-held-out-100", "two-source-held-out-100"),
     ("two-source-puffs-held-out-100", "two-source-held-out-100"),
     ("two-source-held-out-100-infotaxis", "two-source-held-out-100"),
+    ("two-source-held-out-100-mcts", "two-source-held-out-100"),
+    ("three-source-held-out-100-mcts", "three-source-held-out-100"),
 )
 """Campaigns compared on the same configurations besides each X against X-before: one release
 with the count unknown against the one-release filter (issue 45, K = 1); two releases with the
 wind unknown against the wind known (the 50 configurations both flew); two releases in a
 turbulent truth (filament, puffs; the fluctuation likelihood) against the isotropic truth;
-infotaxis against dcee-cl (campaigns of one planner each are paired across planners)."""
+infotaxis and the tree search ``dcee-mcts`` against dcee-cl (campaigns of one planner each are
+paired across planners)."""
 
 
 def paired(df: pd.DataFrame) -> str:
@@ -185,6 +211,28 @@ def paired(df: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
+def observable(df: pd.DataFrame) -> str:
+    """:func:`table` of the searches whose every release has a footprint
+    (:func:`release_footprints` > 0): what an estimator could count at all."""
+    seen = df[df["least_footprint_m2"] > 0]
+    return table(seen.assign(campaign=seen["campaign"] + " (every release observable)"))
+
+
+def with_footprints(df: pd.DataFrame) -> pd.DataFrame:
+    """``df`` with ``least_footprint_m2`` filled from the scenarios where missing (rows stored
+    before the column existed)."""
+    if "least_footprint_m2" not in df:
+        df = df.assign(least_footprint_m2=np.nan)
+    missing = df["least_footprint_m2"].isna()
+    cache: dict[str, float] = {}
+    for i in df.index[missing]:
+        name = df.at[i, "scenario"]
+        if name not in cache:
+            cache[name] = float(release_footprints(load_scenario(name)).min())
+        df.at[i, "least_footprint_m2"] = cache[name]
+    return df
+
+
 def worst(df: pd.DataFrame, k: int = 5) -> str:
     lines = [
         "| campaign | scenario | true K | K̂ | P(true K) | OSPA (m) | worst release error (m) "
@@ -220,8 +268,10 @@ def main(argv: list[str] | None = None) -> int:
     if args.csv:
         args.csv.parent.mkdir(parents=True, exist_ok=True)
         stored = pd.read_csv(args.csv) if args.csv.exists() else None
-        merged_rows(stored, df).to_csv(args.csv, index=False)
+        with_footprints(merged_rows(stored, df)).to_csv(args.csv, index=False)
     print(table(df))
+    print()
+    print(observable(df))
     print()
     print(paired(df))
     print()
