@@ -1447,7 +1447,7 @@ def search_speed_table() -> str:
 
 def _source_count(kind: str) -> str:
     """Issue 45's unknown-count study: studies/source_count_table.py's tables of the stored
-    searches (``kind`` "table", "table_latest", "paired" or "worst")."""
+    searches (``kind`` "table", "table_latest", "paired", "observable" or "worst")."""
     import importlib.util
 
     spec = importlib.util.spec_from_file_location(
@@ -1489,6 +1489,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "source-count-latest": lambda: _source_count("table_latest"),
     "source-count-worst": lambda: _source_count("worst"),
     "source-count-paired": lambda: _source_count("paired"),
+    "source-count-observable": lambda: _source_count("observable"),
     "source-count-timing": source_count_timing_table,
     "learn-tuning": learn_tuning_table,
     "backflow-tuning": backflow_tuning_table,

@@ -45,13 +45,18 @@ def release_readings(scenario: Scenario, run: Path) -> np.ndarray:
 FOOTPRINT_CELL = 0.5
 """m: the side of the cells a release's footprint is counted in."""
 
+FOOTPRINT_DETECTION = 0.1
+"""The least probability that one reading detects a release's gas for its cell to count in the
+release's footprint: one reading in ten."""
+
 
 def release_footprints(scenario: Scenario) -> np.ndarray:
     """(K,) m²: each true release's footprint, the part of the area at the robot's flight
-    height where its mean (isotropic) gas is above the sensor's threshold, counted on a
-    0.5 m grid. A property of the configuration, not of a search: a release of footprint 0
-    (its gas leaves the area below or beside the flight plane) reaches no reading anywhere a
-    robot may go, and no estimator can count it."""
+    height where one reading of the scenario's sensor detects its mean (isotropic) gas with
+    probability at least :data:`FOOTPRINT_DETECTION` (P(detection | C) − P(detection | 0)),
+    counted on a 0.5 m grid. A property of the configuration, not of a search: a release of
+    footprint 0 (its gas leaves the area below or beside the flight plane) is detected at best
+    by chance anywhere a robot may go."""
     lo, hi = np.asarray(scenario.volume.low), np.asarray(scenario.volume.high)
     xs = np.arange(lo[0] + FOOTPRINT_CELL / 2, hi[0], FOOTPRINT_CELL)
     ys = np.arange(lo[1] + FOOTPRINT_CELL / 2, hi[1], FOOTPRINT_CELL)
@@ -59,7 +64,9 @@ def release_footprints(scenario: Scenario) -> np.ndarray:
     height = np.full(gx.size, float(scenario.agent.start[2]))
     points = np.column_stack([gx.ravel(), gy.ravel(), height])
     conc = IsotropicPlume().concentration(scenario.truth_thetas(), points)  # (K, cells)
-    return (conc > scenario.sensor.threshold).sum(axis=1) * FOOTPRINT_CELL**2
+    sensor = scenario.make_sensor()  # the truth's sensor
+    missed = np.exp(sensor.log_likelihood(0.0, conc) - sensor.log_likelihood(0.0, 0.0))
+    return (1.0 - missed >= FOOTPRINT_DETECTION).sum(axis=1) * FOOTPRINT_CELL**2
 
 
 def rows_of(folder: Path) -> list[dict]:
@@ -211,11 +218,17 @@ def paired(df: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
+OBSERVABLE_M2 = 4.0
+"""m²: the least footprint (:func:`release_footprints`) of a release a search can be expected
+to find: one cell of the robot's 2 m step. A smaller one a robot on its 2 m lattice of moves
+may never stand in."""
+
+
 def observable(df: pd.DataFrame) -> str:
-    """:func:`table` of the searches whose every release has a footprint
-    (:func:`release_footprints` > 0): what an estimator could count at all."""
-    seen = df[df["least_footprint_m2"] > 0]
-    return table(seen.assign(campaign=seen["campaign"] + " (every release observable)"))
+    """:func:`table_latest` of the searches whose every release's footprint is at least
+    :data:`OBSERVABLE_M2`: what a search could be expected to count."""
+    seen = df[df["least_footprint_m2"] >= OBSERVABLE_M2]
+    return table_latest(seen)
 
 
 def with_footprints(df: pd.DataFrame) -> pd.DataFrame:

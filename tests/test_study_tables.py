@@ -8,8 +8,10 @@ import importlib.util
 import math
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
+from scipy import stats
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -222,3 +224,44 @@ def test_the_source_count_tables_pair_two_planners_on_the_same_configurations() 
     (row,) = [line for line in paired if "-infotaxis − two-source-held-out-100 " in line]
     # paired by scenario and seed across planners: one search right only with infotaxis
     assert "| 3 | 1 / 0 (p = 1) |" in row and "-0.10" in row
+
+
+def test_a_releases_footprint_is_where_one_reading_detects_its_gas() -> None:
+    """The footprint counts the 0.5 m cells of the flight plane where one reading detects the
+    release's mean gas with probability ≥ 0.1: by hand from the sensor's Pd and noise on
+    paper:1; a release made ten times weaker covers less ground; one at the ground at the
+    downwind edge whose gas leaves the area (random2:1073's first) covers none."""
+    script = _script("source_count_table")
+    from dcee.models import IsotropicPlume
+    from dcee.scenarios import load_scenario
+
+    paper = load_scenario("paper:1")
+    sensor = paper.make_sensor()
+    cells = np.arange(0.25, 50.0, 0.5)
+    gx, gy = np.meshgrid(cells, cells, indexing="ij")
+    points = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, 4.0)])
+    conc = IsotropicPlume().concentration(paper.truth_thetas(), points)[0]
+    # P(detection | C) = Pd Φ((C − threshold) / σ(C)), σ = σ_frac C + σ_min (no false alarms)
+    sigma = sensor.sigma_frac * conc + sensor.sigma_min
+    p_detect = sensor.pd * stats.norm.cdf((conc - sensor.threshold) / sigma)
+    assert sensor.false_alarm == 0.0 and sensor.outlier == 0.0
+    by_hand = (p_detect >= 0.1).sum() * 0.25
+    (footprint,) = script.release_footprints(paper)
+    assert footprint == pytest.approx(by_hand) and footprint > 100.0
+    weak = paper.model_copy(
+        update={"truth": paper.truth.model_copy(update={"q": paper.truth.q / 10})}
+    )
+    assert 0 < script.release_footprints(weak)[0] < footprint
+    assert script.release_footprints(load_scenario("random2:1073"))[0] == 0.0
+
+
+def test_the_observable_table_keeps_searches_whose_every_release_has_a_footprint() -> None:
+    script = _script("source_count_table")
+    rows = _count_rows("two-source-held-out-100", [False, True, True], [2.0, 0.3, 0.4])
+    frame = pd.DataFrame(rows).drop(columns=["least_footprint_m2"], errors="ignore")
+    frame["scenario"] = ["random2:1073", "random2:1000", "random2:1001"]
+    filled = script.with_footprints(frame)
+    assert filled.loc[0, "least_footprint_m2"] == 0.0  # computed from the scenario
+    assert (filled.loc[1:, "least_footprint_m2"] >= script.OBSERVABLE_M2).all()
+    table = script.observable(filled)
+    assert "| 2 | 2/2 (100 %)" in table  # the unobservable search is left out
