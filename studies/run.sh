@@ -8,6 +8,13 @@ D=.venv/bin/dcee
 P=.venv/bin/python
 [ -x "$D" ] || bash scripts/setup.sh
 report() { for dir in "$@"; do $D report "results/$dir"; cat "results/$dir/report/metrics.md"; done; }
+count_campaigns() {  # PLANNER SUFFIX: its two- and three-release held-out campaigns (issue 45)
+  for N in two three; do
+    $D bench --suite "$N-source-held-out-100" --repeats 1 --strategies "$1" \
+      --workers "${WORKERS:-2}" --out "results/$N-source-held-out-100$2"
+  done
+}
+
 # issue 45's held-out table and searches.csv: today's campaigns and, where kept, the same searches
 # with the code before the last change (X-before, the paired table), two changes before
 # (X-5d04d27), before the hunt for one release more (X-d207b1e) and at 20,000 particles
@@ -635,10 +642,7 @@ case "${1:---list}" in
       "$r-nsl25=infotaxis" "$r-decay=dcee-cl" "$r-mcts=dcee-mcts" "$r-nsl=dcee-cl"
     $P studies/publish_tables.py ;;
   source-count)  # issue 45: an unknown number of releases, dcee-cl, 100 held-out configurations of two and of three releases (docs/multi-source.md)
-    for N in two three; do
-      $D bench --suite "$N-source-held-out-100" --repeats 1 --strategies dcee-cl \
-        --workers "${WORKERS:-2}" --out "results/$N-source-held-out-100"
-    done
+    count_campaigns dcee-cl ""
     source_count_tables
     $P studies/publish_tables.py ;;
   source-count-one)  # issue 45: one release, the count unknown (0-3) against the one-release filter, 100 held-out configurations (docs/multi-source.md)
@@ -667,10 +671,7 @@ case "${1:---list}" in
     source_count_tables
     $P studies/publish_tables.py ;;
   source-count-mcts)  # issue 45: the tree search on the joint belief, the same 100 held-out configurations of two and of three releases (docs/multi-source.md)
-    for N in two three; do
-      $D bench --suite "$N-source-held-out-100" --repeats 1 --strategies dcee-mcts \
-        --workers "${WORKERS:-2}" --out "results/$N-source-held-out-100-mcts"
-    done
+    count_campaigns dcee-mcts -mcts
     source_count_tables
     $P studies/publish_tables.py ;;
   source-count-paper-scale)  # issue 45: the three-release held-out campaign at the paper's 20,000 particles
