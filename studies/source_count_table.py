@@ -53,10 +53,10 @@ release's footprint: one reading in ten."""
 def release_footprints(scenario: Scenario) -> np.ndarray:
     """(K,) m²: each true release's footprint, the part of the area at the robot's flight
     height where one reading of the scenario's sensor detects its mean (isotropic) gas with
-    probability at least :data:`FOOTPRINT_DETECTION` (P(detection | C) − P(detection | 0)),
-    counted on a 0.5 m grid. A property of the configuration, not of a search: a release of
-    footprint 0 (its gas leaves the area below or beside the flight plane) is detected at best
-    by chance anywhere a robot may go."""
+    probability at least :data:`FOOTPRINT_DETECTION` (1 − P(miss | C) / P(miss | 0), as the
+    exploration guard measures a detection), counted on a 0.5 m grid. A property of the
+    configuration, not of a search: a release of footprint 0 (its gas leaves the area below or
+    beside the flight plane) is detected at best by chance anywhere a robot may go."""
     lo, hi = np.asarray(scenario.volume.low), np.asarray(scenario.volume.high)
     xs = np.arange(lo[0] + FOOTPRINT_CELL / 2, hi[0], FOOTPRINT_CELL)
     ys = np.arange(lo[1] + FOOTPRINT_CELL / 2, hi[1], FOOTPRINT_CELL)
