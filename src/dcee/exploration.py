@@ -14,8 +14,7 @@ hypothesis predicts the same. It compares the best candidate move with a coarse 
 area at the robot's altitude. When the best move's information is below ``share`` of the
 grid's best, the robot is offered only the moves that bring it closer to the nearest grid point
 with at least ``share`` of the best (:class:`ApproachingAgent`); the planner chooses among them
-as usual. The searcher holds that goal until the robot is within a step of it (while it stays
-informative and no move within reach is as informative as the grid's best).
+as usual.
 """
 
 from __future__ import annotations
@@ -225,19 +224,10 @@ def exploration_goal(
     position: np.ndarray,
     agent: GridAgent,
     share: float = DEFAULT_EXPLORE_SHARE,
-    keep: np.ndarray | None = None,
 ) -> np.ndarray | None:
     """The grid point (3,) m to head for, or None when a move within reach is informative
     enough (see the module doc). The information is the estimator's joint belief's
-    (:func:`detection_information`; a count bank's target count, every release's gas).
-
-    ``keep`` (3,) m: the goal returned before, held until the robot is within a step of it,
-    while its information stays at least ``share`` of the grid's best and no move within
-    reach is as informative as the grid's best. Chosen afresh each decision, the nearest
-    informative point changed as the robot moved (the belief changes with every reading) and
-    the robot turned back and forth between a found release's cell and a far corner: 400 s
-    within 10 m of a release localised to 0.5 m while a further one was hunted
-    (``random3:27``, tuning range)."""
+    (:func:`detection_information`; a count bank's target count, every release's gas)."""
     cands, _ = agent.candidates(position)
     if len(cands) == 0:
         return None
@@ -252,16 +242,9 @@ def exploration_goal(
     grid = reachable_points(agent, position, area_grid(agent, float(position[2])))
     if len(grid) == 0:
         return None
-    if keep is not None and math.dist(keep[:2], position[:2]) <= agent.step:
-        keep = None  # reached
-    h_all = info(grid if keep is None else np.vstack([grid, keep]))
-    h_grid = h_all[: len(grid)]
+    h_grid = info(grid)
     best = float(h_grid.max())
-    if best <= 0.0:
-        return None
-    if keep is not None and local < best and h_all[-1] >= share * best:
-        return np.asarray(keep, dtype=np.float64)
-    if local >= share * best:
+    if best <= 0.0 or local >= share * best:
         return None
     good = grid[h_grid >= share * best]
     d = travel_xy(agent.site, position, good)

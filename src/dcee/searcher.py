@@ -140,9 +140,6 @@ class Searcher:
         """how many of them because the robot kept to one region (:meth:`wander_goal`)"""
         self.wander_target: np.ndarray | None = None
         """where the wander guard sends the robot, held until it is within a step of it"""
-        self.explore_target: np.ndarray | None = None
-        """where the exploration guard sends the robot, held until it is within a step of it
-        (:func:`~dcee.exploration.exploration_goal`'s ``keep``)"""
         self.filter = particle_filter
         self.planner = planner
         self.agent = agent
@@ -226,12 +223,7 @@ class Searcher:
         if self.explore_guard:
             goal = self.wander_goal()
             if goal is None:
-                goal = exploration_goal(
-                    self.filter, self.position, self.agent, keep=self.explore_target
-                )
-                self.explore_target = goal
-            else:
-                self.explore_target = None
+                goal = exploration_goal(self.filter, self.position, self.agent)
             if goal is not None:
                 self.explore_fired += 1
                 return ApproachingAgent(self.agent, goal, self.position)
@@ -326,8 +318,6 @@ class Searcher:
             # and before the wander guard: it had not fired
             "wander_fired": 0,
             "wander_target": None,
-            # and before the exploration guard held its goal: none held
-            "explore_target": None,
             **state,
         }
         self.__dict__.update(state)
