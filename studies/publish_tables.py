@@ -1177,6 +1177,22 @@ def speed_table() -> str:
         w = by_name[name]
         ratio = w["ratio_to"][reference]
         rows.append([label, f"{ratio:.2f}×", f"{w['median']:.3g} ms", target, _timed(work)])
+    move_path = RESULTS / "perf" / "move-speedup.json"
+    if move_path.exists():  # studies/move_speedup.py: what moved the move / update ratio
+        move = _perf("move-speedup")
+        rows.append(
+            [
+                "the same move and one filter update vs commit "
+                f"`{move['before']}` (the move / update ratio "
+                f"{move['before_ratio']:.0f}× there), each side in a fresh process, in "
+                "alternation",
+                f"move {move['move_speedup']:.2f}× faster, update "
+                f"{move['update_speedup']:.2f}× faster (ratio {move['after_ratio']:.0f}× today)",
+                f"{move['after_move_ms']:.3g} ms vs {move['before_move_ms']:.3g} ms",
+                "the move no slower",
+                _timed(move),
+            ]
+        )
     # issue 46: the default (interpolated sums) and precision=single against the exact decision
     for name, label in (
         ("dcee-cl-decision-20k", "the default (`precision=interpolated`)"),

@@ -699,6 +699,7 @@ case "${1:---list}" in
     $D perf --compare-stonesoup --decisions 20 --repeats 5 --json docs/results/perf/stonesoup-ste.json
     $P studies/kernel_speedup.py --before f52a5b6 --json docs/results/perf/kernel-speedup.json
     $P studies/kernel_speedup.py --before cae7e4f --json docs/results/perf/kernel-speedup-blas.json
+    $P studies/move_speedup.py --before 825da4d --rounds 5 --json docs/results/perf/move-speedup.json
     $P studies/demo_decision.py --before cae7e4f --json docs/results/perf/demo-decision.json
     $P studies/search_speed.py --before 31f49fd --json docs/results/perf/search-speed.json
     rm -rf results/perf-stonesoup-mcts  # every seed timed in this run

@@ -103,7 +103,11 @@ def rows_of(folder: Path) -> list[dict]:
                 "mean_release_error": float(near.mean()),
                 "explore_guard_fired": int(summary.get("explore_guard_fired", 0)),
                 "least_reached_readings": int(reached.min()),
-                "least_footprint_m2": float(release_footprints(scenario).min()),
+                # the configuration's (its built-in scenario's sensor), as with_footprints
+                # fills stored rows: the same number whichever campaign folders a machine holds
+                "least_footprint_m2": float(
+                    release_footprints(load_scenario(summary["scenario"])).min()
+                ),
                 "decision_ms": 1e3 * float(summary["decision_seconds_mean"]),
                 "code": summary.get("code", {}).get("commit", "")
                 if isinstance(summary.get("code"), dict)

@@ -1,0 +1,123 @@
+"""The resample-move step and the filter update, two code versions in alternation (issue 17).
+
+`dcee perf` judges the resample + MCMC move over 500 readings (20,000 particles) by its ratio to
+one filter update in the same run (target ≤ 76×, a third of the 227× of when issue 17 was
+filed). A ratio moves when either side does: a faster update raises it with the move unchanged.
+This study times both workloads of :mod:`dcee.perf.workloads` (``_filter_update``,
+``_resample_move``) with the code of ``--before`` (a git worktree made for it) and with this
+checkout's, each side in a fresh process, ``--rounds`` times in alternation so that both see the
+same machine; the kernels are compiled by a first run of each side that is not counted. Writes
+JSON with each run's medians, the machine and the load beside the run (docs/results/perf/; the
+speed table on docs/performance.md is generated from it).
+
+    .venv/bin/python studies/move_speedup.py --before 825da4d \\
+        [--json docs/results/perf/move-speedup.json] [--rounds 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from dcee.io import write_json
+from dcee.perf.machine import LoadMonitor, load_warning, machine_record
+
+ROOT = Path(__file__).resolve().parent.parent
+TIMED = (
+    "import json; from dcee.perf import workloads as w; "
+    "u = w._filter_update(15); m = w._resample_move(5); "
+    "print(json.dumps({'update_ms': u.median, 'move_ms': m.median}))"
+)
+
+
+def _timed(src: Path) -> dict[str, float]:
+    """Median ms of one filter update and of one resample + move, the package under ``src``."""
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    done = subprocess.run(
+        [sys.executable, "-c", TIMED], env=env, check=True, capture_output=True, text=True
+    )
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--before", required=True, help="the commit to compare with")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--json", type=Path)
+    args = ap.parse_args(argv)
+    if args.json is not None and not args.json.parent.is_dir():
+        print(f"move_speedup: error: --json: no folder {args.json.parent}", file=sys.stderr)
+        return 2
+    if args.rounds < 1:
+        print(f"move_speedup: error: --rounds must be ≥ 1, got {args.rounds}", file=sys.stderr)
+        return 2
+    work = Path(tempfile.mkdtemp())
+    tree = work / "before"
+    made = subprocess.run(
+        ["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), args.before],
+        capture_output=True,
+        text=True,
+    )
+    if made.returncode != 0:
+        first = (made.stderr.strip().splitlines() or ["git worktree add failed"])[0]
+        print(f"move_speedup: error: --before {args.before}: {first}", file=sys.stderr)
+        return 2
+    sides = {"before": tree / "src", "after": ROOT / "src"}
+    runs: dict[str, list[dict[str, float]]] = {"before": [], "after": []}
+    try:
+        for src in sides.values():  # compile each side's kernels (not counted)
+            _timed(src)
+        with LoadMonitor() as load:
+            for r in range(args.rounds):
+                for side, src in sides.items():
+                    t = _timed(src)
+                    runs[side].append({**t, "ratio": t["move_ms"] / t["update_ms"]})
+                    print(f"{side} round {r}: move {t['move_ms']:.1f} ms, update "
+                          f"{t['update_ms']:.3f} ms, {runs[side][-1]['ratio']:.0f}×",
+                          flush=True)  # fmt: skip
+    finally:
+        subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)],
+                       capture_output=True)  # fmt: skip
+        shutil.rmtree(work, ignore_errors=True)
+
+    def median(side: str, key: str) -> float:
+        return float(np.median([run[key] for run in runs[side]]))
+
+    summary = {
+        f"{side}_{key}": median(side, key)
+        for side in sides
+        for key in ("move_ms", "update_ms", "ratio")
+    }
+    summary["move_speedup"] = summary["before_move_ms"] / summary["after_move_ms"]
+    summary["update_speedup"] = summary["before_update_ms"] / summary["after_update_ms"]
+    ratios = f"{summary['before_ratio']:.0f}× -> {summary['after_ratio']:.0f}×"
+    print(f"move {summary['move_speedup']:.2f}× faster, update {summary['update_speedup']:.2f}× "
+          f"faster; move / update {ratios}")  # fmt: skip
+    record = load.record()
+    if warning := load_warning(record):
+        print(warning)
+    if args.json:
+        write_json(
+            args.json,
+            {
+                "machine": machine_record(),
+                "load": record,
+                "before": args.before,
+                "runs": runs,
+                **summary,
+                "ratio_target": 76.0,
+            },
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
