@@ -15,7 +15,6 @@ docs/performance.md is generated from it).
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import shutil
@@ -26,8 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from dcee.io import write_json
-from dcee.perf.machine import LoadMonitor, load_warning, machine_record
+from dcee.errors import DceeInputError
+from dcee.perf.machine import LoadMonitor, alternation_args, code_at, store_timing
 
 ROOT = Path(__file__).resolve().parent.parent
 DEMO = ["run", "--scenario", "paper:1", "--strategy", "dcee-cl", "--seed", "0"]
@@ -43,54 +42,40 @@ def _search(src: Path, out: Path) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--before", required=True, help="the commit to compare with")
-    ap.add_argument("--rounds", type=int, default=3)
-    ap.add_argument("--json", type=Path)
-    args = ap.parse_args(argv)
+    try:
+        args = alternation_args(argv, __doc__.splitlines()[0], 3)
+    except DceeInputError as e:
+        print(f"demo_decision: error: {e}", file=sys.stderr)
+        return 2
     if shutil.which("taskset") is None:
         print(
             "demo_decision: error: taskset (util-linux) is needed to pin one core", file=sys.stderr
         )
         return 2
-    if args.json is not None and not args.json.parent.is_dir():
-        print(f"demo_decision: error: --json: no folder {args.json.parent}", file=sys.stderr)
-        return 2
-    if args.rounds < 1:
-        print(f"demo_decision: error: --rounds must be ≥ 1, got {args.rounds}", file=sys.stderr)
-        return 2
     work = Path(tempfile.mkdtemp())
-    tree = work / "before"
-    made = subprocess.run(
-        ["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), args.before],
-        capture_output=True,
-        text=True,
-    )
-    if made.returncode != 0:
-        first = (made.stderr.strip().splitlines() or ["git worktree add failed"])[0]
-        print(f"demo_decision: error: --before {args.before}: {first}", file=sys.stderr)
-        return 2
-    sides = {"before": tree / "src", "after": ROOT / "src"}
     runs: dict[str, list[dict]] = {"before": [], "after": []}
     try:
-        for side, src in sides.items():  # compile each side's kernels (not counted)
-            _search(src, work / f"warm-{side}")
-        with LoadMonitor() as load:
-            for r in range(args.rounds):
-                for side, src in sides.items():
-                    summary = _search(src, work / f"{side}-{r}")
-                    runs[side].append(
-                        {
-                            "decision_ms_mean": 1e3 * summary["decision_seconds_mean"],
-                            "final_rmse": summary["final_rmse"],
-                            "steps": summary["steps"],
-                        }
-                    )
-                    print(f"{side} round {r}: {runs[side][-1]['decision_ms_mean']:.1f} ms",
-                          flush=True)  # fmt: skip
+        with code_at(ROOT, args.before) as before_src:
+            sides = {"before": before_src, "after": ROOT / "src"}
+            for side, src in sides.items():  # compile each side's kernels (not counted)
+                _search(src, work / f"warm-{side}")
+            with LoadMonitor() as load:
+                for r in range(args.rounds):
+                    for side, src in sides.items():
+                        summary = _search(src, work / f"{side}-{r}")
+                        runs[side].append(
+                            {
+                                "decision_ms_mean": 1e3 * summary["decision_seconds_mean"],
+                                "final_rmse": summary["final_rmse"],
+                                "steps": summary["steps"],
+                            }
+                        )
+                        print(f"{side} round {r}: {runs[side][-1]['decision_ms_mean']:.1f} ms",
+                              flush=True)  # fmt: skip
+    except DceeInputError as e:
+        print(f"demo_decision: error: {e}", file=sys.stderr)
+        return 2
     finally:
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)],
-                       capture_output=True)  # fmt: skip
         shutil.rmtree(work, ignore_errors=True)
     before = float(np.median([r["decision_ms_mean"] for r in runs["before"]]))
     after = float(np.median([r["decision_ms_mean"] for r in runs["after"]]))
@@ -100,26 +85,19 @@ def main(argv: list[str] | None = None) -> int:
     )
     print(f"mean decision: {before:.1f} ms -> {after:.1f} ms ({before / after:.2f}x); "
           f"same search: {same}")  # fmt: skip
-    record = load.record()
-    if warning := load_warning(record):
-        print(warning)
-    if args.json:
-        write_json(
-            args.json,
-            {
-                "machine": machine_record(),
-                "load": record,
-                "before": args.before,
-                "command": "dcee " + " ".join(DEMO),
-                "threads": ONE_CORE,
-                "runs": runs,
-                "before_ms": before,
-                "after_ms": after,
-                "speedup": before / after,
-                "same_search": same,
-                "target_ms": 15.0,
-            },
-        )
+    store_timing(
+        args.json,
+        load.record(),
+        before=args.before,
+        command="dcee " + " ".join(DEMO),
+        threads=ONE_CORE,
+        runs=runs,
+        before_ms=before,
+        after_ms=after,
+        speedup=before / after,
+        same_search=same,
+        target_ms=15.0,
+    )
     return 0
 
 

@@ -16,19 +16,16 @@ speed table on docs/performance.md is generated from it).
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
-import shutil
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from dcee.io import write_json
-from dcee.perf.machine import LoadMonitor, load_warning, machine_record
+from dcee.errors import DceeInputError
+from dcee.perf.machine import LoadMonitor, alternation_args, code_at, store_timing
 
 ROOT = Path(__file__).resolve().parent.parent
 TIMED = (
@@ -48,52 +45,35 @@ def _timed(src: Path) -> dict[str, float]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--before", required=True, help="the commit to compare with")
-    ap.add_argument("--rounds", type=int, default=3)
-    ap.add_argument("--json", type=Path)
-    args = ap.parse_args(argv)
-    if args.json is not None and not args.json.parent.is_dir():
-        print(f"move_speedup: error: --json: no folder {args.json.parent}", file=sys.stderr)
+    try:
+        args = alternation_args(argv, __doc__.splitlines()[0], 3)
+    except DceeInputError as e:
+        print(f"move_speedup: error: {e}", file=sys.stderr)
         return 2
-    if args.rounds < 1:
-        print(f"move_speedup: error: --rounds must be ≥ 1, got {args.rounds}", file=sys.stderr)
-        return 2
-    work = Path(tempfile.mkdtemp())
-    tree = work / "before"
-    made = subprocess.run(
-        ["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), args.before],
-        capture_output=True,
-        text=True,
-    )
-    if made.returncode != 0:
-        first = (made.stderr.strip().splitlines() or ["git worktree add failed"])[0]
-        print(f"move_speedup: error: --before {args.before}: {first}", file=sys.stderr)
-        return 2
-    sides = {"before": tree / "src", "after": ROOT / "src"}
     runs: dict[str, list[dict[str, float]]] = {"before": [], "after": []}
     try:
-        for src in sides.values():  # compile each side's kernels (not counted)
-            _timed(src)
-        with LoadMonitor() as load:
-            for r in range(args.rounds):
-                for side, src in sides.items():
-                    t = _timed(src)
-                    runs[side].append({**t, "ratio": t["move_ms"] / t["update_ms"]})
-                    print(f"{side} round {r}: move {t['move_ms']:.1f} ms, update "
-                          f"{t['update_ms']:.3f} ms, {runs[side][-1]['ratio']:.0f}×",
-                          flush=True)  # fmt: skip
-    finally:
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)],
-                       capture_output=True)  # fmt: skip
-        shutil.rmtree(work, ignore_errors=True)
+        with code_at(ROOT, args.before) as before:
+            sides = {"before": before, "after": ROOT / "src"}
+            for src in sides.values():  # compile each side's kernels (not counted)
+                _timed(src)
+            with LoadMonitor() as load:
+                for r in range(args.rounds):
+                    for side, src in sides.items():
+                        t = _timed(src)
+                        runs[side].append({**t, "ratio": t["move_ms"] / t["update_ms"]})
+                        print(f"{side} round {r}: move {t['move_ms']:.1f} ms, update "
+                              f"{t['update_ms']:.3f} ms, {runs[side][-1]['ratio']:.0f}×",
+                              flush=True)  # fmt: skip
+    except DceeInputError as e:
+        print(f"move_speedup: error: {e}", file=sys.stderr)
+        return 2
 
     def median(side: str, key: str) -> float:
         return float(np.median([run[key] for run in runs[side]]))
 
     summary = {
         f"{side}_{key}": median(side, key)
-        for side in sides
+        for side in runs
         for key in ("move_ms", "update_ms", "ratio")
     }
     summary["move_speedup"] = summary["before_move_ms"] / summary["after_move_ms"]
@@ -101,21 +81,8 @@ def main(argv: list[str] | None = None) -> int:
     ratios = f"{summary['before_ratio']:.0f}× -> {summary['after_ratio']:.0f}×"
     print(f"move {summary['move_speedup']:.2f}× faster, update {summary['update_speedup']:.2f}× "
           f"faster; move / update {ratios}")  # fmt: skip
-    record = load.record()
-    if warning := load_warning(record):
-        print(warning)
-    if args.json:
-        write_json(
-            args.json,
-            {
-                "machine": machine_record(),
-                "load": record,
-                "before": args.before,
-                "runs": runs,
-                **summary,
-                "ratio_target": 76.0,
-            },
-        )
+    store_timing(args.json, load.record(), before=args.before, runs=runs, **summary,
+                 ratio_target=76.0)  # fmt: skip
     return 0
 
 

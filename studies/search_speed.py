@@ -18,20 +18,18 @@ generated from it).
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import shutil
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
 from demo_decision import ONE_CORE, ROOT
 
-from dcee.io import write_json
-from dcee.perf.machine import LoadMonitor, load_warning, machine_record
+from dcee.errors import DceeInputError
+from dcee.perf.machine import LoadMonitor, alternation_args, code_at, store_timing
 
 PLANNERS = ("mpc", "dcee", "infotaxis", "entrotaxis", "dcee-ms")
 # run in a fresh process with one side's package first on sys.path: the campaign's own search
@@ -88,43 +86,30 @@ def _fail(message: str) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--before", required=True, help="the commit to compare with")
-    ap.add_argument("--rounds", type=int, default=2)
-    ap.add_argument("--json", type=Path)
-    args = ap.parse_args(argv)
+    try:
+        args = alternation_args(argv, __doc__.splitlines()[0], 2)
+    except DceeInputError as e:
+        print(f"search_speed: error: {e}", file=sys.stderr)
+        return 2
     if shutil.which("taskset") is None:
         return _fail("taskset (util-linux) is needed to pin one core")
-    if args.json is not None and not args.json.parent.is_dir():
-        return _fail(f"--json: no folder {args.json.parent}")
-    if args.rounds < 1:
-        return _fail(f"--rounds must be ≥ 1, got {args.rounds}")
-    work = Path(tempfile.mkdtemp())
-    tree = work / "before"
-    made = subprocess.run(
-        ["git", "-C", str(ROOT), "worktree", "add", "--detach", str(tree), args.before],
-        capture_output=True,
-        text=True,
-    )
-    if made.returncode != 0:
-        first = (made.stderr.strip().splitlines() or ["git worktree add failed"])[0]
-        return _fail(f"--before {args.before}: {first}")
-    sides = {"before": tree / "src", "after": ROOT / "src"}
-    runs: dict[str, dict[str, list[dict]]] = {side: {p: [] for p in PLANNERS} for side in sides}
+    runs: dict[str, dict[str, list[dict]]] = {
+        side: {p: [] for p in PLANNERS} for side in ("before", "after")
+    }
     try:
-        with LoadMonitor() as load:
-            for r in range(args.rounds):
-                for side, src in sides.items():
-                    result = _searches(src)
-                    for planner in PLANNERS:
-                        runs[side][planner].append(result[planner])
-                    print(f"{side} round {r}: "
-                          + ", ".join(f"{p} {result[p]['wall_s']:.2f} s" for p in PLANNERS),
-                          flush=True)  # fmt: skip
-    finally:
-        subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)],
-                       capture_output=True)  # fmt: skip
-        shutil.rmtree(work, ignore_errors=True)
+        with code_at(ROOT, args.before) as before_src:
+            sides = {"before": before_src, "after": ROOT / "src"}
+            with LoadMonitor() as load:
+                for r in range(args.rounds):
+                    for side, src in sides.items():
+                        result = _searches(src)
+                        for planner in PLANNERS:
+                            runs[side][planner].append(result[planner])
+                        print(f"{side} round {r}: "
+                              + ", ".join(f"{p} {result[p]['wall_s']:.2f} s" for p in PLANNERS),
+                              flush=True)  # fmt: skip
+    except DceeInputError as e:
+        return _fail(str(e))
     summary = {}
     for planner in PLANNERS:
         b, a = runs["before"][planner], runs["after"][planner]
@@ -140,22 +125,15 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{planner}: {c['before']:.2f} s -> {c['after']:.2f} s "
               f"({c['before'] / c['after']:.2f}x); same search: "
               f"{summary[planner]['same_search']}")  # fmt: skip
-    record = load.record()
-    if warning := load_warning(record):
-        print(warning)
-    if args.json:
-        write_json(
-            args.json,
-            {
-                "machine": machine_record(),
-                "load": record,
-                "before": args.before,
-                "searches": "dcee bench --suite paper: configuration 1, seed 0, each planner",
-                "threads": ONE_CORE,
-                "runs": runs,
-                "summary": summary,
-            },
-        )
+    store_timing(
+        args.json,
+        load.record(),
+        before=args.before,
+        searches="dcee bench --suite paper: configuration 1, seed 0, each planner",
+        threads=ONE_CORE,
+        runs=runs,
+        summary=summary,
+    )
     return 0
 
 

@@ -4,13 +4,24 @@ mark a run that was not idle."""
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
-from dcee.perf.machine import IDLE_OTHER_CORES, LoadMonitor, load_warning, machine_record
+from dcee.errors import DceeInputError
+from dcee.perf.machine import (
+    IDLE_OTHER_CORES,
+    LoadMonitor,
+    alternation_args,
+    code_at,
+    load_warning,
+    machine_record,
+    store_timing,
+)
 from tests.test_study_tables import _script
 
 pytestmark = pytest.mark.skipif(
@@ -69,3 +80,42 @@ def test_the_speed_table_marks_a_shared_run():
     )
     assert timed({"machine": machine, "load": idle}) == "2026-11-26, 2 CPUs, idle, `0123456`"
     assert load_warning(idle) is None and IDLE_OTHER_CORES < 1
+
+
+def test_code_at_checks_out_a_commit_and_removes_it(tmp_path):
+    """The "before" side of an alternated timing: this repository's HEAD in a temporary
+    worktree (its package present), gone afterwards; an unknown commit is a one-line input
+    error naming --before, with nothing left behind."""
+    root = Path(__file__).resolve().parent.parent
+    with code_at(root, "HEAD") as src:
+        assert (src / "dcee" / "perf" / "machine.py").is_file()
+    assert not src.exists()
+    listed = subprocess.run(["git", "-C", str(root), "worktree", "list"], capture_output=True,
+                            text=True, check=True).stdout  # fmt: skip
+    assert str(src.parent) not in listed
+    with pytest.raises(DceeInputError, match="--before") as info:
+        with code_at(root, "no-such-commit-anywhere"):
+            pass
+    assert "\n" not in str(info.value)
+
+
+def test_store_timing_writes_the_machine_the_load_and_the_fields(tmp_path, capsys):
+    shared = {"idle": False, "other_cores": 1.2, "started": "2026-11-29T10:00:00+00:00"}
+    store_timing(tmp_path / "t.json", shared, before="abc", speedup=2.0)
+    stored = json.loads((tmp_path / "t.json").read_text())
+    assert stored["load"] == shared and stored["before"] == "abc" and stored["speedup"] == 2.0
+    assert stored["machine"]["cpus"] >= 1
+    assert capsys.readouterr().out.strip() == load_warning(shared)
+    store_timing(None, {"idle": True}, before="abc")  # nothing written, nothing said
+    assert capsys.readouterr().out == ""
+
+
+def test_alternation_args_checks_before_any_work(tmp_path):
+    args = alternation_args(["--before", "abc", "--json", str(tmp_path / "t.json")], "d", 3)
+    assert (args.before, args.rounds, args.json) == ("abc", 3, tmp_path / "t.json")
+    for argv, field in (
+        (["--before", "abc", "--rounds", "0"], "--rounds"),
+        (["--before", "abc", "--json", str(tmp_path / "no" / "t.json")], "--json"),
+    ):
+        with pytest.raises(DceeInputError, match=field):
+            alternation_args(argv, "d", 3)

@@ -10,15 +10,23 @@ other processes using more than :data:`IDLE_OTHER_CORES` cores on average is mar
 
 from __future__ import annotations
 
+import argparse
 import importlib.metadata
 import os
 import platform
 import resource
+import shutil
+import subprocess
+import tempfile
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from dcee.errors import DceeInputError
+from dcee.io import write_json
 from dcee.provenance import code_version
 
 IDLE_OTHER_CORES = 0.25
@@ -117,3 +125,53 @@ def load_warning(load: dict[str, Any]) -> str | None:
 
 
 __all__ = ["IDLE_OTHER_CORES", "LoadMonitor", "load_warning", "machine_record"]
+
+
+def alternation_args(argv: list[str] | None, description: str, rounds: int) -> argparse.Namespace:
+    """The options of a timing that alternates two code versions: ``--before`` (the commit,
+    required), ``--rounds`` (≥ 1; default ``rounds``) and ``--json`` (a file in an existing
+    folder), checked before any work; :class:`DceeInputError` naming the option otherwise."""
+    ap = argparse.ArgumentParser(description=description)
+    ap.add_argument("--before", required=True, help="the commit to compare with")
+    ap.add_argument("--rounds", type=int, default=rounds)
+    ap.add_argument("--json", type=Path)
+    args = ap.parse_args(argv)
+    if args.json is not None and not args.json.parent.is_dir():
+        raise DceeInputError("--json", f"no folder {args.json.parent}")
+    if args.rounds < 1:
+        raise DceeInputError("--rounds", f"must be ≥ 1, got {args.rounds}")
+    return args
+
+
+@contextmanager
+def code_at(root: Path, commit: str) -> Iterator[Path]:
+    """``with code_at(root, commit) as src:`` the ``src`` folder of ``commit`` of the git
+    repository ``root``, checked out in a temporary worktree that is removed afterwards: the
+    "before" side of a timing that alternates two code versions (``studies/*_speedup.py``,
+    ``studies/demo_decision.py``). :class:`DceeInputError` (``--before``) when git cannot
+    check it out."""
+    work = Path(tempfile.mkdtemp())
+    tree = work / "before"
+    git = ["git", "-C", str(root), "worktree"]
+    made = subprocess.run(
+        [*git, "add", "--detach", str(tree), commit], capture_output=True, text=True
+    )
+    if made.returncode != 0:
+        shutil.rmtree(work, ignore_errors=True)
+        first = (made.stderr.strip().splitlines() or ["git worktree add failed"])[0]
+        raise DceeInputError("--before", f"{commit}: {first}")
+    try:
+        yield tree / "src"
+    finally:
+        subprocess.run([*git, "remove", "--force", str(tree)], capture_output=True)
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def store_timing(path: Path | None, load: dict[str, Any], **fields: Any) -> None:
+    """Print :func:`load_warning`'s line for a run that was not idle, and write ``path`` (JSON;
+    None: nothing): the machine (:func:`machine_record`), the ``load`` beside the run
+    (:meth:`LoadMonitor.record`) and ``fields``."""
+    if warning := load_warning(load):
+        print(warning)
+    if path is not None:
+        write_json(path, {"machine": machine_record(), "load": load, **fields})
