@@ -15,6 +15,7 @@ table compares X with it.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import sys
 from pathlib import Path
@@ -69,6 +70,15 @@ def release_footprints(scenario: Scenario) -> np.ndarray:
     return (1.0 - missed >= FOOTPRINT_DETECTION).sum(axis=1) * FOOTPRINT_CELL**2
 
 
+@functools.cache
+def least_footprint(name: str) -> float:
+    """m²: the least :func:`release_footprints` of the configuration ``name``'s built-in
+    scenario (its sensor), for a row read from a campaign folder and one filled in the stored
+    CSV alike: the same number whichever folders a machine holds (a filament or puff campaign's
+    own scenario has another sensor)."""
+    return float(release_footprints(load_scenario(name)).min())
+
+
 def rows_of(folder: Path) -> list[dict]:
     out = []
     for run in find_runs(folder):
@@ -103,11 +113,7 @@ def rows_of(folder: Path) -> list[dict]:
                 "mean_release_error": float(near.mean()),
                 "explore_guard_fired": int(summary.get("explore_guard_fired", 0)),
                 "least_reached_readings": int(reached.min()),
-                # the configuration's (its built-in scenario's sensor), as with_footprints
-                # fills stored rows: the same number whichever campaign folders a machine holds
-                "least_footprint_m2": float(
-                    release_footprints(load_scenario(summary["scenario"])).min()
-                ),
+                "least_footprint_m2": least_footprint(summary["scenario"]),
                 "decision_ms": 1e3 * float(summary["decision_seconds_mean"]),
                 "code": summary.get("code", {}).get("commit", "")
                 if isinstance(summary.get("code"), dict)
@@ -241,12 +247,8 @@ def with_footprints(df: pd.DataFrame) -> pd.DataFrame:
     if "least_footprint_m2" not in df:
         df = df.assign(least_footprint_m2=np.nan)
     missing = df["least_footprint_m2"].isna()
-    cache: dict[str, float] = {}
     for i in df.index[missing]:
-        name = df.at[i, "scenario"]
-        if name not in cache:
-            cache[name] = float(release_footprints(load_scenario(name)).min())
-        df.at[i, "least_footprint_m2"] = cache[name]
+        df.at[i, "least_footprint_m2"] = least_footprint(df.at[i, "scenario"])
     return df
 
 

@@ -82,7 +82,7 @@ def test_the_speed_table_marks_a_shared_run():
     assert load_warning(idle) is None and IDLE_OTHER_CORES < 1
 
 
-def test_code_at_checks_out_a_commit_and_removes_it(tmp_path):
+def test_code_at_checks_out_a_commit_and_removes_it():
     """The "before" side of an alternated timing: this repository's HEAD in a temporary
     worktree (its package present), gone afterwards; an unknown commit is a one-line input
     error naming --before, with nothing left behind."""

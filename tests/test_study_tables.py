@@ -263,5 +263,7 @@ def test_the_observable_table_keeps_searches_whose_every_release_has_a_footprint
     filled = script.with_footprints(frame)
     assert filled.loc[0, "least_footprint_m2"] == 0.0  # computed from the scenario
     assert (filled.loc[1:, "least_footprint_m2"] >= script.OBSERVABLE_M2).all()
+    # what a row read from a campaign folder gets: the configuration's, not the folder's
+    assert filled.loc[1, "least_footprint_m2"] == script.least_footprint("random2:1000")
     table = script.observable(filled)
     assert "| 2 | 2/2 (100 %)" in table  # the unobservable search is left out

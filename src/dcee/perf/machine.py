@@ -124,9 +124,6 @@ def load_warning(load: dict[str, Any]) -> str | None:
     )
 
 
-__all__ = ["IDLE_OTHER_CORES", "LoadMonitor", "load_warning", "machine_record"]
-
-
 def alternation_args(argv: list[str] | None, description: str, rounds: int) -> argparse.Namespace:
     """The options of a timing that alternates two code versions: ``--before`` (the commit,
     required), ``--rounds`` (≥ 1; default ``rounds``) and ``--json`` (a file in an existing
@@ -175,3 +172,14 @@ def store_timing(path: Path | None, load: dict[str, Any], **fields: Any) -> None
         print(warning)
     if path is not None:
         write_json(path, {"machine": machine_record(), "load": load, **fields})
+
+
+__all__ = [
+    "IDLE_OTHER_CORES",
+    "LoadMonitor",
+    "alternation_args",
+    "code_at",
+    "load_warning",
+    "machine_record",
+    "store_timing",
+]
