@@ -291,20 +291,6 @@ class ApproachingAgent(RestrictedAgent):
         return closer if closer.any() else after < now - 1e-9
 
 
-class SurveyAgent(RestrictedAgent):
-    """The moves that head straight for the survey's next waypoint ``target`` (3,) m: closer
-    by at least 0.9 of a step (the move along the line to it), or where none is, the moves
-    that bring it closest; what :meth:`dcee.searcher.Searcher.survey_goal` hands a planner, so
-    that the lanes stay straight and the survey covers what it plans to."""
-
-    def allowed(self, cands: np.ndarray) -> np.ndarray:
-        site = self.agent.site
-        now = float(travel_xy(site, self.target, self.start[None])[0])
-        after = travel_xy(site, self.target, cands)
-        straight = after <= now - 0.9 * self.agent.step
-        return straight if straight.any() else after <= after.min() + 1e-9
-
-
 def wander_goal(
     estimator: Estimator,
     anchor: np.ndarray,
@@ -330,37 +316,3 @@ def wander_goal(
 
 WANDER_LEAST_INFORMATION = 1e-3
 """nats: a grid point telling less than this is no reason to leave a region."""
-
-
-def survey_route(
-    agent: GridAgent, position: np.ndarray, spacing: float, wind_direction: float | None
-) -> list[np.ndarray]:
-    """Waypoints (each (3,) m, at the robot's altitude) of a boustrophedon survey of the area:
-    straight lanes ``spacing`` m apart across the mean wind (lanes along y where the wind blows
-    mostly along x, ``wind_direction`` rad counter-clockwise from +x; along x otherwise or when
-    it is None), each lane's ends 1 m inside the area, the lanes in order from the edge nearest
-    the robot and each entered at the end nearest the previous one. A lane crossing the wind
-    meets every plume longer than ``spacing`` downwind. Waypoints in a site's blocked cells or
-    not reachable from ``position`` are left out."""
-    lo, hi = np.asarray(agent.volume.low), np.asarray(agent.volume.high)
-    along_x = wind_direction is not None and abs(math.cos(wind_direction)) >= abs(
-        math.sin(wind_direction)
-    )
-    a = 0 if along_x else 1  # the axis the lanes step along (the wind's)
-    b = 1 - a
-    offsets = np.arange(lo[a] + 0.5 * spacing, hi[a], spacing)
-    if len(offsets) == 0:
-        offsets = np.array([0.5 * (lo[a] + hi[a])])
-    if abs(position[a] - offsets[-1]) < abs(position[a] - offsets[0]):
-        offsets = offsets[::-1]
-    ends = (lo[b] + 1.0, hi[b] - 1.0)
-    near = 0 if abs(position[b] - ends[0]) <= abs(position[b] - ends[1]) else 1
-    route = []
-    for offset in offsets:
-        for end in (ends[near], ends[1 - near]):
-            point = np.empty(3)
-            point[a], point[b], point[2] = offset, end, position[2]
-            route.append(point)
-        near = 1 - near
-    points = reachable_points(agent, position, np.array(route))
-    return [p.copy() for p in points]

@@ -14,17 +14,9 @@ import numpy as np
 from dcee.blas import one_blas_thread
 from dcee.errors import DceeInputError
 from dcee.estimation.base import Estimator, UpdateInfo
-from dcee.exploration import (
-    ApproachingAgent,
-    RestrictedAgent,
-    SurveyAgent,
-    exploration_goal,
-    survey_route,
-    wander_goal,
-)
+from dcee.exploration import ApproachingAgent, RestrictedAgent, exploration_goal, wander_goal
 from dcee.io import write_atomic
 from dcee.models.agent import GridAgent, stall_start
-from dcee.models.plume import PARAMETER_NAMES
 from dcee.planning.base import Belief, Decision, Planner
 from dcee.planning.particle_terms import ParticleTerms
 from dcee.planning.team import decide_team
@@ -124,10 +116,8 @@ class Searcher:
         guard_spread: float = DEFAULT_GUARD_SPREAD,
         stop_rule: StopRule | None = DEFAULT_STOP_RULE,
         explore_guard: bool = False,
-        survey: float = 0.0,
     ) -> None:
-        checked = (("stall_guard", stall_guard), ("guard_spread", guard_spread), ("survey", survey))
-        for name, value in checked:
+        for name, value in (("stall_guard", stall_guard), ("guard_spread", guard_spread)):
             if isinstance(value, bool) or not (
                 isinstance(value, int | float) and math.isfinite(value) and value >= 0
             ):
@@ -150,11 +140,6 @@ class Searcher:
         """how many of them because the robot kept to one region (:meth:`wander_goal`)"""
         self.wander_target: np.ndarray | None = None
         """where the wander guard sends the robot, held until it is within a step of it"""
-        self.survey = float(survey)
-        self.survey_left: list[np.ndarray] | None = None
-        """the survey's waypoints not yet reached (None: not planned yet)"""
-        self.survey_fired = 0
-        """how many decisions the survey restricted"""
         self.filter = particle_filter
         self.planner = planner
         self.agent = agent
@@ -225,21 +210,16 @@ class Searcher:
         self.last_decision_seconds = _time.perf_counter() - t0
         return self.last_decision.position.copy()
 
-    def decision_agent(self) -> GridAgent | RestrictedAgent:
+    def decision_agent(self) -> GridAgent | LeavingAgent | ApproachingAgent:
         """The agent the next :meth:`ask` plans with: :attr:`agent`, a :class:`LeavingAgent`
         that only offers moves away from the stall while the stall guard fires
-        (:meth:`stall_anchor`), a :class:`~dcee.exploration.SurveyAgent` while a survey is
-        flown (:meth:`survey_goal`), or with ``explore_guard`` an
+        (:meth:`stall_anchor`), or with ``explore_guard`` an
         :class:`~dcee.exploration.ApproachingAgent` that only offers moves towards where
         readings are informative when no move within reach is
         (:func:`~dcee.exploration.exploration_goal`)."""
         anchor = self.stall_anchor()
         if anchor is not None:
             return LeavingAgent(self.agent, anchor, self.position)
-        goal = self.survey_goal()
-        if goal is not None:
-            self.survey_fired += 1
-            return SurveyAgent(self.agent, goal, self.position)
         if self.explore_guard:
             goal = self.wander_goal()
             if goal is None:
@@ -248,26 +228,6 @@ class Searcher:
                 self.explore_fired += 1
                 return ApproachingAgent(self.agent, goal, self.position)
         return self.agent
-
-    def survey_goal(self) -> np.ndarray | None:
-        """With ``survey`` s > 0 m: the next waypoint (3,) m of a boustrophedon survey of the area
-        flown first, lanes ``survey`` m apart across the belief's mean wind
-        (:func:`~dcee.exploration.survey_route`, planned at the first decision); a waypoint is
-        done once the robot is within one step of it. The planner chooses among the moves that
-        head straight for it (:class:`~dcee.exploration.SurveyAgent`). None once the survey is
-        flown (or off)."""
-        if self.survey <= 0.0 or self.position is None:
-            return None
-        if self.survey_left is None:
-            theta, weights = self.filter.theta, self.filter.weights
-            phi = theta[:, PARAMETER_NAMES.index("phi")]
-            wind = math.atan2(float(weights @ np.sin(phi)), float(weights @ np.cos(phi)))
-            self.survey_left = survey_route(self.agent, self.position, self.survey, wind)
-        while self.survey_left and (
-            math.dist(self.survey_left[0][:2], self.position[:2]) <= self.agent.step
-        ):
-            self.survey_left.pop(0)
-        return self.survey_left[0] if self.survey_left else None
 
     def wander_goal(self) -> np.ndarray | None:
         """The exploration guard's region-wide part: once the told positions of the last
@@ -358,10 +318,6 @@ class Searcher:
             # and before the wander guard: it had not fired
             "wander_fired": 0,
             "wander_target": None,
-            # and before the survey: none
-            "survey": 0.0,
-            "survey_left": None,
-            "survey_fired": 0,
             **state,
         }
         self.__dict__.update(state)

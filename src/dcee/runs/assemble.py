@@ -100,7 +100,6 @@ def make_searcher(
         guard_spread=search.guard_share * search.acquired_rmse,
         stop_rule=scenario.stop_rule(on_robot),
         explore_guard=scenario.explore_guard,
-        survey=search.survey,
     )
 
 

@@ -221,7 +221,6 @@ def search_summary(
     out["stall_guard_fired"] = searcher.guard_fired  # decisions the stall guard restricted
     out["explore_guard_fired"] = searcher.explore_fired  # and the exploration guard,
     out["wander_guard_fired"] = searcher.wander_fired  # of them for keeping to one region
-    out["survey_fired"] = searcher.survey_fired  # decisions the survey (search.survey) steered
     if isinstance(pf, SourceCountBank):  # the count was unknown: what the search made of it
         out.update(pf.count_summary())
         out["count_correct"] = out["estimated_count"] == out["true_sources"]

@@ -145,13 +145,6 @@ class SearchSpec(BaseModel):
     uninformative (:mod:`dcee.exploration`): the search does not wander where nothing can be
     learnt. None: on with several releases (``estimator.max_sources`` > 1) and on a site
     (a ``[world]`` that is not empty), off in open terrain (open-terrain searches unchanged)"""
-    survey: Annotated[float, Field(ge=0, le=1e3, allow_inf_nan=False)] = 0.0
-    """m: fly a boustrophedon survey of the area first, straight lanes this far apart across the
-    mean wind (:func:`dcee.exploration.survey_route`), the planner choosing among the moves that
-    approach the survey's next waypoint; then search as usual. 0 (the default): no survey. A
-    lane across the wind meets every plume longer than the spacing: an option for an unknown
-    number of releases, where a release the search has not met cannot be counted
-    (docs/multi-source.md)"""
     resample_threshold: Annotated[float, Field(gt=0, le=1)] = 0.5
     """resample when the effective sample size falls below this share of the particles"""
     mcmc_steps: Annotated[int, Field(ge=0, le=100)] = 1
