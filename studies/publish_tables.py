@@ -858,6 +858,38 @@ def lbm_near_source_table() -> str:
     return table(header, rows)
 
 
+def lbm_endgame_table() -> str:
+    """Where each planner reads last and ends on the lbm plume (studies/lbm_endgame.py,
+    docs/results/lbm-plume/endgame.csv; a lab note on eight tuning configurations)."""
+    frame = pd.read_csv(RESULTS / "lbm-plume" / "endgame.csv")
+    rows = []
+    for strategy, g in frame.groupby("strategy", sort=False):
+        m = g.median(numeric_only=True)
+        rows.append(
+            [
+                f"`{strategy}`",
+                str(len(g)),
+                f"{m['late_along_median_m']:+.2f}",
+                f"{100 * m['late_detections_upwind_share']:.0f} %",
+                f"{m['final_along_m']:+.2f}",
+                f"{m['final_spread_m']:.2f}",
+                f"{m['final_rmse_m']:.2f}",
+                f"{int(g['truth_in_95'].sum())}/{len(g)}",
+            ]
+        )
+    header = [
+        "planner",
+        "searches",
+        "last 300 s: median reading along the wind (m; < 0 upwind)",
+        "last 300 s: detections upwind",
+        "final mean along the wind (m)",
+        "final spread √tr P (m)",
+        "final RMSE (m)",
+        "truth in 95 %",
+    ]
+    return table(header, rows)
+
+
 def source_radius_tuning_table() -> str:
     """A release spread over a disc, learned, against the defaults it was measured against (the
     backflow rows of docs/results/tuning-backflow-13-40: the same searches), on the tuning
@@ -1511,6 +1543,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "backflow-tuning": backflow_tuning_table,
     "source-radius-tuning": source_radius_tuning_table,
     "lbm-near-source": lbm_near_source_table,
+    "lbm-endgame": lbm_endgame_table,
     "cross-truth": cross_truth_table,
     "cross-truth-latest": lambda: cross_truth_table(latest_only=True),
     "radius-prior-point": lambda: radius_prior_table("point"),

@@ -484,6 +484,16 @@ case "${1:---list}" in
       --vague results/anemometer-off-vague results/anemometer-on-vague \
       --csv docs/results/anemometer/anemometer.csv
     $P studies/publish_tables.py ;;
+  lbm-endgame)  # issue 42, a lab note: where each planner reads last and ends on the lbm plume, eight tuning configurations (docs/plumes.md)
+    for s in dcee-cl dcee-cl:horizon=2 dcee-mcts dcee-mcts:depth=1 infotaxis; do
+      for k in 13 14 15 16 17 18 19 20; do
+        [ -f "results/lbm-endgame/$s-$k/summary.json" ] || $D run --scenario random:$k --unknown full \
+          --likelihood fluctuation --truth lbm --particles 10000 --set truth.z=4.0 --strategy "$s" \
+          --seed 0 --out "results/lbm-endgame/$s-$k" -q --no-figure
+      done
+    done
+    $P studies/lbm_endgame.py results/lbm-endgame/*-[0-9]* --csv docs/results/lbm-plume/endgame.csv
+    $P studies/publish_tables.py ;;
   lbm-plume)  # the fluid solver's plume against published plume measurements (docs/scenarios.md)
     $P studies/lbm_statistics.py
     $P studies/publish_tables.py ;;
