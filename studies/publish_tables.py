@@ -935,6 +935,26 @@ def radius_prior_table(release: str) -> str:
     )
 
 
+def horizon_tuning_table() -> str:
+    """``dcee-cl:horizon=2`` on the tuning range, each search paired with today's ``dcee-cl``
+    (the ``prior`` rows of docs/results/tuning-radius-prior-13-40, their 95 % region the
+    mixture's, as docs/results/mixture-region-prior-13-40 recomputed it: today's default).
+    The rule: docs/results/tuning-horizon-13-40."""
+    key = ["truth", "scenario", "seed"]
+    base = pd.read_csv(RESULTS / "tuning-radius-prior-13-40" / "variants.csv")
+    base = base[base["variant"] == "prior"].drop(columns="truth_in_95")
+    region = pd.read_csv(RESULTS / "mixture-region-prior-13-40" / "searches.csv")
+    region = region[region["variant"] == "prior"][[*key, "mixture_in_95"]]
+    base = base.merge(region, on=key).rename(columns={"mixture_in_95": "truth_in_95"})
+    candidate = pd.read_csv(RESULTS / "tuning-horizon-13-40" / "variants.csv")
+    frame = pd.concat([base.assign(variant="base"), candidate.assign(variant="horizon2")])
+    names = {
+        "base": "`dcee-cl` (today's defaults, one move ahead)",
+        "horizon2": "`dcee-cl:horizon=2` (two moves ahead)",
+    }
+    return _variant_table(frame, names, ("base", "horizon2"), "today's `dcee-cl`", "planner")
+
+
 def _by_truth(rows: pd.DataFrame) -> Iterator[tuple[str, pd.DataFrame]]:
     """(truth, rows) for the filament, the puffs and both together (the last only when both
     are there: one truth's own row says it all); truths without rows are skipped."""
@@ -1081,7 +1101,9 @@ def release_area_table() -> str:
     return table(header, rows)
 
 
-def _variant_table(frame: pd.DataFrame, names: dict, order: tuple, base_name: str) -> str:
+def _variant_table(
+    frame: pd.DataFrame, names: dict, order: tuple, base_name: str, kind: str = "reading model"
+) -> str:
     """Rows per variant and truth (and both truths), each variant paired by search with the
     variant ``base``: acquisition, median final RMSE, share in the 95 % region, along-wind
     error; Wilcoxon on the final RMSE, exact binomial on the region gained / lost."""
@@ -1119,7 +1141,7 @@ def _variant_table(frame: pd.DataFrame, names: dict, order: tuple, base_name: st
                 ]
             )
     header = [
-        "reading model",
+        kind,
         "truth",
         "n",
         "acquired",
@@ -1544,6 +1566,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "source-radius-tuning": source_radius_tuning_table,
     "lbm-near-source": lbm_near_source_table,
     "lbm-endgame": lbm_endgame_table,
+    "horizon-tuning": horizon_tuning_table,
     "cross-truth": cross_truth_table,
     "cross-truth-latest": lambda: cross_truth_table(latest_only=True),
     "radius-prior-point": lambda: radius_prior_table("point"),

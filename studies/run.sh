@@ -484,6 +484,10 @@ case "${1:---list}" in
       --vague results/anemometer-off-vague results/anemometer-on-vague \
       --csv docs/results/anemometer/anemometer.csv
     $P studies/publish_tables.py ;;
+  tune-horizon)  # issue 42: dcee-cl looking two moves ahead on the tuning range, filament + puffs (docs/results/tuning-horizon-13-40)
+    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+      --variant horizon2: --strategy dcee-cl:horizon=2 --workers "${WORKERS:-2}" \
+      --csv docs/results/tuning-horizon-13-40/variants.csv ;;
   lbm-endgame)  # issue 42, a lab note: where each planner reads last and ends on the lbm plume, eight tuning configurations (docs/plumes.md)
     for s in dcee-cl dcee-cl:horizon=2 dcee-mcts dcee-mcts:depth=1 infotaxis; do
       for k in 13 14 15 16 17 18 19 20; do
@@ -569,6 +573,10 @@ case "${1:---list}" in
     STRATEGIES=infotaxis OUT_SUFFIX=-dm-info bash studies/study_turbulent_held_out.sh \
       --set truth.z=4.0
     STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-dm bash studies/study_turbulent_held_out.sh \
+      --set truth.z=4.0
+    # an option measured at today's defaults (it decides nothing): dcee-cl looking two moves
+    # ahead (chosen as a candidate on the tuning range: bash studies/run.sh tune-horizon)
+    STRATEGIES=dcee-cl:horizon=2 OUT_SUFFIX=-dm-h2 bash studies/study_turbulent_held_out.sh \
       --set truth.z=4.0
     # the defaults of 2026-11-27 (b): the backflow member learned, alone (pinned)
     bf=(--set truth.z=4.0 --set 'estimator.learn={backflow=[0.0,0.05]}')
