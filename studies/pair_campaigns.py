@@ -5,6 +5,9 @@ acquisition and on the truth lying in the 95 % region, Wilcoxon on the final RMS
     .venv/bin/python studies/pair_campaigns.py results/turbulent-puffs-held-out-100 \\
         results/turbulent-puffs-held-out-100-climb [--csv out.csv --tag truth_model=puffs]
 
+``--as SPEC=NAME`` pairs side b's planner ``SPEC`` with side a's ``NAME`` (a planner option
+against the planner: ``--as dcee-cl:horizon=2=dcee-cl``).
+
 Either side may be a stored study's rows instead of a campaign folder whose searches are gone
 (``searches.csv`` of studies/collect_metrics.py), its rows picked by their tags as
 studies/ablation_table.py picks them (``FILE.csv=KEY:VALUE[:KEY:VALUE…]``):
@@ -66,10 +69,22 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("b")
     ap.add_argument("--csv", default=None, help="append the rows to this file")
     ap.add_argument("--tag", action="append", default=[], help="KEY=VALUE column for the rows")
-    args = ap.parse_args(argv)
-    pairs = _load(args.a).merge(
-        _load(args.b), on=["scenario", "seed", "strategy"], suffixes=("_a", "_b")
+    ap.add_argument(
+        "--as",
+        dest="rename",
+        action="append",
+        default=[],
+        help="SPEC=NAME: pair b's planner SPEC with a's NAME (e.g. dcee-cl:horizon=2=dcee-cl)",
     )
+    args = ap.parse_args(argv)
+    b = _load(args.b)
+    for item in args.rename:
+        spec, _, name = item.rpartition("=")
+        if not spec or not name:
+            print(f"pair_campaigns: --as {item!r}: give SPEC=NAME", file=sys.stderr)
+            raise SystemExit(2)
+        b["strategy"] = b["strategy"].replace(spec, name)
+    pairs = _load(args.a).merge(b, on=["scenario", "seed", "strategy"], suffixes=("_a", "_b"))
     rows = []
     for strategy, x in pairs.groupby("strategy"):
         acq_a, acq_b = x.source_acquired_a.astype(bool), x.source_acquired_b.astype(bool)

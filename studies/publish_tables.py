@@ -781,10 +781,13 @@ def cross_truth_table(latest_only: bool = False) -> str:
         .map({TODAY_DEFAULTS: 0, "2026-11-27b": 1, "2026-11-27": 2})
         .fillna(3)
     ).sort_values("order", kind="stable")
+    option = lbm["strategy"].astype(str).str.contains(":")  # a planner's option, e.g. horizon=2
     if latest_only:  # per planner, the latest defaults flown, no options
-        lbm = lbm[lbm["learn"] == "none"].drop_duplicates("strategy", keep="first")
+        lbm = lbm[(lbm["learn"] == "none") & ~option].drop_duplicates("strategy", keep="first")
     for _, r in lbm.iterrows():
         how = "" if r["learn"] == "none" else f", `estimator.learn` {r['learn']} (an option)"
+        if ":" in str(r["strategy"]):
+            how += ", a planner option (chosen on the tuning range, measured here)"
         if int(r.get("particles", 10000)) != 10000:
             how += f", {int(r['particles']):,} particles (measured, not chosen on)"
         how += flown(str(r["defaults"]))

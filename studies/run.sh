@@ -608,6 +608,7 @@ case "${1:---list}" in
       --particles 20000
     r=results/turbulent-lbm-held-out-100
     report turbulent-lbm-held-out-100-dm turbulent-lbm-held-out-100-dm-info turbulent-lbm-held-out-100-mcts-dm \
+      turbulent-lbm-held-out-100-dm-h2 \
       turbulent-lbm-held-out-100-bf turbulent-lbm-held-out-100-mcts-bf turbulent-lbm-held-out-100-radius \
       turbulent-lbm-held-out-100-radius-prior \
       turbulent-lbm-held-out-100 turbulent-lbm-held-out-100-mcts-today \
@@ -617,6 +618,7 @@ case "${1:---list}" in
       "$r-dm=defaults:2026-11-27c,learn:none,particles:10000" \
       "$r-dm-info=defaults:2026-11-27c,learn:none,particles:10000" \
       "$r-mcts-dm=defaults:2026-11-27c,learn:none,particles:10000" \
+      "$r-dm-h2=defaults:2026-11-27c,learn:none,particles:10000" \
       "$r-bf=defaults:2026-11-27b,learn:none,particles:10000" \
       "$r-mcts-bf=defaults:2026-11-27b,learn:none,particles:10000" \
       "$r-radius=defaults:2026-11-27b,learn:backflow+source_radius,particles:10000" \

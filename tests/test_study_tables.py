@@ -119,6 +119,29 @@ def test_pair_campaigns_pairs_two_generations_of_a_stored_study(tmp_path: Path, 
         assert stop.value.code == 2 and says in capsys.readouterr().err
 
 
+def test_pair_campaigns_pairs_a_planner_option_with_the_planner(tmp_path: Path, capsys) -> None:
+    """``--as SPEC=NAME``: side b's planner option ``var:opt=2`` (the variant rows renamed)
+    paired with side a's ``ref``: the variant's hand counts against the reference's."""
+    pair = _script("pair_campaigns")
+    path = _stored(tmp_path)
+    frame = pd.read_csv(path)
+    ref, var = frame[frame["strategy"] == "ref"], frame[frame["strategy"] == "var"]
+    ref.to_csv(tmp_path / "ref.csv", index=False)
+    var.assign(strategy="var:opt=2").to_csv(tmp_path / "var.csv", index=False)
+    out = tmp_path / "pairs.csv"
+    a, b = f"{tmp_path / 'ref.csv'}=truth_model:a", f"{tmp_path / 'var.csv'}=truth_model:a"
+    assert pair.main([a, b, "--as", "var:opt=2=ref", "--csv", str(out)]) == 0
+    row = pd.read_csv(out).set_index("strategy").loc["ref"]
+    # the variant (b) acquires k = 4 that the reference (a) does not; 0.1 m closer everywhere;
+    # the region: the variant misses k = 0, which the reference holds
+    assert (row["pairs"], row["acquired_a_only"], row["acquired_b_only"]) == (6, 0, 1)
+    assert row["median_rmse_b_minus_a"] == pytest.approx(-0.1)
+    assert (row["in95_a_only"], row["in95_b_only"]) == (1, 0)
+    with pytest.raises(SystemExit) as stop:
+        pair.main([a, b, "--as", "=ref"])
+    assert stop.value.code == 2 and "SPEC=NAME" in capsys.readouterr().err
+
+
 def test_collect_metrics_keeps_a_stored_generation(tmp_path: Path, capsys) -> None:
     collect = _script("collect_metrics")
     out = _stored(tmp_path).parent
