@@ -655,8 +655,15 @@ case "${1:---list}" in
       $P studies/pair_campaigns.py "${pair%%:*}" "${pair#*:}" \
         --csv docs/results/lbm-held-out-100/disc_vs_before.csv --tag truth_model=lbm
     done
+    # dcee-cl looking two moves ahead (a planner option) against each planner at today's defaults
+    rm -f docs/results/lbm-held-out-100/horizon_vs_default.csv
+    for ref in dcee-cl infotaxis dcee-mcts; do
+      $P studies/pair_campaigns.py "$r-dm=$ref" "$r-dm-h2" --as "dcee-cl:horizon=2=$ref" \
+        --csv docs/results/lbm-held-out-100/horizon_vs_default.csv --tag truth_model=lbm
+    done
     $P studies/worst_searches.py "$r-dm=dcee-cl" "$r-dm-info=infotaxis" --out docs/figures/lbm-held-out-worst.png
     $P studies/upwind_detections.py "$r-dm=dcee-cl" "$r-dm-info=infotaxis" "$r-mcts-dm=dcee-mcts" \
+      "$r-dm-h2=dcee-cl:horizon=2" \
       "$r-bf=dcee-cl" "$r-bf=infotaxis" "$r-mcts-bf=dcee-mcts" \
       "$r=dcee-cl" "$r=infotaxis" "$r-nsl25=dcee-cl" \
       "$r-nsl25=infotaxis" "$r-decay=dcee-cl" "$r-mcts=dcee-mcts" "$r-nsl=dcee-cl"

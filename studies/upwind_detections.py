@@ -13,6 +13,7 @@ import argparse
 import json
 import math
 from pathlib import Path
+from urllib.parse import quote
 
 import numpy as np
 import pandas as pd
@@ -24,7 +25,10 @@ def along_wind(folder: Path, strategy: str) -> dict[str, float]:
     along, cross, spread = [], [], []
     upwind = np.zeros(3)
     detections = 0
-    for summary in sorted(folder.glob(f"runs/*/strategy={strategy}/*/summary.json")):
+    # the campaign's folder names quote the planner spec (dcee-cl:horizon=2 → dcee-cl%3Ahorizon%3D2)
+    for summary in sorted(
+        folder.glob(f"runs/*/strategy={quote(strategy, safe='')}/*/summary.json")
+    ):
         s = json.loads(summary.read_text())
         scenario = load_scenario(s["config"])
         t = scenario.truth
