@@ -727,6 +727,7 @@ case "${1:---list}" in
     $P studies/kernel_speedup.py --before f52a5b6 --json docs/results/perf/kernel-speedup.json
     $P studies/kernel_speedup.py --before cae7e4f --json docs/results/perf/kernel-speedup-blas.json
     $P studies/move_speedup.py --before 825da4d --rounds 5 --json docs/results/perf/move-speedup.json
+    $P studies/horizon_timing.py --rounds 2 --json docs/results/perf/horizon-timing.json
     $P studies/demo_decision.py --before cae7e4f --json docs/results/perf/demo-decision.json
     $P studies/search_speed.py --before 31f49fd --json docs/results/perf/search-speed.json
     rm -rf results/perf-stonesoup-mcts  # every seed timed in this run

@@ -290,3 +290,72 @@ def test_the_observable_table_keeps_searches_whose_every_release_has_a_footprint
     assert filled.loc[1, "least_footprint_m2"] == script.least_footprint("random2:1000")
     table = script.observable(filled)
     assert "| 2 | 2/2 (100 %)" in table  # the unobservable search is left out
+
+
+def test_lbm_endgame_by_hand(tmp_path: Path) -> None:
+    """One made-up search: the wind from 180° (φ = π, the gas goes towards +x), the release at
+    (10, 10); in the last 300 s readings at along-wind −1, −2, +2, −1 m, detections at the
+    first, third and fourth; the final mean at (9.5, 10.5)."""
+    endgame = _script("lbm_endgame")
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "config.json").write_text(
+        '{"strategy": "dcee-cl:horizon=2", "scenario": {"truth": {"x": 10, "y": 10, "phi": 180}}}'
+    )
+    (run / "summary.json").write_text(
+        '{"scenario": "random:13", "final_rmse": 0.8, "truth_in_95": true, "version": "v"}'
+    )
+    x = [0.0, 4.0, 6.0, 9.0, 8.0, 12.0, 9.0]
+    pd.DataFrame(
+        {
+            "time": [0.0, 100.0, 200.0, 300.0, 400.0, 500.0, 600.0],
+            "x": x,
+            "y": [10.0] * 7,
+            "detection": [False, False, True, True, False, True, True],
+            "mean_x": [20.0] * 6 + [9.5],
+            "mean_y": [20.0] * 6 + [10.5],
+            "spread": [5.0] * 6 + [0.25],
+        }
+    ).to_parquet(run / "steps.parquet")
+    row = endgame.endgame(run)
+    assert row["strategy"] == "dcee-cl:horizon=2" and row["scenario"] == "random:13"
+    assert row["late_along_median_m"] == pytest.approx(-1.0)
+    assert row["late_distance_median_m"] == pytest.approx(1.5)  # 1, 2, 2, 1 m
+    assert row["late_upwind_share"] == pytest.approx(0.75)
+    assert row["late_within_2m_share"] == pytest.approx(0.5)  # 1 and 1 m; 2 m is not within
+    assert row["late_detections_upwind_share"] == pytest.approx(2 / 3)
+    assert row["final_along_m"] == pytest.approx(-0.5)
+    assert row["final_cross_m"] == pytest.approx(0.5)
+    assert (row["final_spread_m"], row["final_rmse_m"], row["truth_in_95"]) == (0.25, 0.8, True)
+
+
+def test_upwind_detections_finds_a_planner_option_by_its_quoted_folder(tmp_path: Path) -> None:
+    """A campaign stores ``dcee-cl:horizon=2``'s searches under ``strategy=dcee-cl%3Ahorizon%3D2``:
+    the planner spec as given finds them. One search of ``paper:1``: detections 1 m and 3 m
+    upwind of the source and 2 m downwind; the final mean 0.5 m downwind."""
+    import math
+
+    from dcee.scenarios import load_scenario
+
+    upwind = _script("upwind_detections")
+    scenario = load_scenario("paper:1")
+    t = scenario.truth
+    down = -np.array([math.cos(math.radians(t.phi)), math.sin(math.radians(t.phi))])
+    source = np.array([t.x, t.y])
+    run = tmp_path / "c" / "runs" / "config=paper%3A1" / "strategy=dcee-cl%3Ahorizon%3D2" / "s0"
+    run.mkdir(parents=True)
+    mean = source + 0.5 * down
+    (run / "summary.json").write_text(
+        f'{{"config": "paper:1", "final_mean": [{mean[0]}, {mean[1]}], "final_spread": 0.3}}'
+    )
+    points = source + np.outer([-1.0, -3.0, 2.0, 0.0], down)
+    reading = [1.0, 1.0, 1.0, 0.0]  # the last below any threshold: not a detection
+    pd.DataFrame({"x": points[:, 0], "y": points[:, 1], "reading": reading}).to_parquet(
+        run / "steps.parquet"
+    )
+    row = upwind.along_wind(tmp_path / "c", "dcee-cl:horizon=2")
+    assert row["searches"] == 1 and row["detections"] == 3
+    assert row["median_along_m"] == pytest.approx(0.5)
+    assert row["upwind_share"] == pytest.approx(2 / 3)
+    assert row["upwind_1m_share"] == pytest.approx(1 / 3)  # only the 3 m one is beyond 1 m
+    assert row["upwind_2m_share"] == pytest.approx(1 / 3)
