@@ -58,8 +58,12 @@ def paired(name: str) -> pd.DataFrame:
 
 
 def pick(frame: pd.DataFrame, strategy: str, **where: object) -> pd.Series:
+    """The one row of ``strategy`` where every column equals its value (a dict value: the value
+    for this strategy, e.g. :data:`TODAY_DEFAULTS`)."""
     rows = frame[frame["strategy"] == strategy]
     for key, value in where.items():
+        if isinstance(value, dict):
+            value = value[strategy]
         rows = rows[rows[key] == value]
     if len(rows) != 1:
         raise KeyError(f"{strategy} {where}: {len(rows)} rows")

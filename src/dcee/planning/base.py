@@ -100,6 +100,9 @@ class Planner(ABC):
     """One line for listings (``dcee strategies``)."""
     uses_hypotheses: ClassVar[bool] = False
     """True if the planner accepts ``n_hypotheses`` (hypothesised readings per candidate)."""
+    follows_lookahead: ClassVar[bool] = False
+    """True if the planner's ``horizon`` defaults to the scenario's look-ahead
+    (``search.lookahead``, :attr:`dcee.scenarios.Scenario.lookahead`): ``dcee-cl``."""
 
     @abstractmethod
     def costs(

@@ -86,6 +86,8 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
 
     needs_kl = False
     default_expectation = "stratified"
+    # two moves in a turbulent plume (search.lookahead, chosen on filament and puffs)
+    follows_lookahead = True
 
     def __init__(
         self,
@@ -179,6 +181,7 @@ class ScenarioTreeDCEEPlanner(ClosedLoopDCEEPlanner):
     (docs/dual-control.md measures whether the exact second step adds anything)."""
 
     summary = "closed-loop DCEE over a two-move scenario tree (second move after the reading)"
+    follows_lookahead = False  # its own two stages
 
     def __init__(self, branch_hypotheses: int = 10, **options: Any) -> None:
         super().__init__(**options)

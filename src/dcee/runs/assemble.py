@@ -106,9 +106,14 @@ def make_searcher(
 def planner_defaults(
     strategy: str, scenario: Scenario, options: dict[str, Any] | None
 ) -> dict[str, Any]:
-    """Constructor defaults: the scenario's hypothesis count (a spec's own, ``dcee:hypotheses=25``,
-    overrides it in :func:`dcee.planning.get`)."""
+    """Constructor defaults: the scenario's hypothesis count and, for a planner that follows it
+    (``dcee-cl``), its look-ahead :attr:`Scenario.lookahead` (a spec's own, ``dcee:hypotheses=25``
+    or ``dcee-cl:horizon=1``, overrides either in :func:`dcee.planning.get`)."""
     opts = dict(options or {})
-    if planner_class(strategy).uses_hypotheses:
+    cls = planner_class(strategy)
+    if cls.uses_hypotheses:
         opts.setdefault("n_hypotheses", scenario.search.hypotheses)
+    if cls.follows_lookahead:
+        # the scenario's look-ahead (Scenario.lookahead: 2 in a turbulent plume in open terrain)
+        opts.setdefault("horizon", scenario.lookahead)
     return opts

@@ -16,6 +16,7 @@ from dcee.scenarios import (
     default_learn,
     default_learn_prior,
     unset_climb,
+    unset_lookahead,
 )
 
 
@@ -65,6 +66,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("truth", "wind_from"): None,
     # one release before issue 45's further releases
     ("truth", "extra_sources"): [],
+    # dcee-cl looked one move ahead everywhere before search.lookahead (issue 42)
+    ("search", "lookahead"): 1,
 }
 """Scenario settings added after campaigns were first stored, with the value a stored scenario
 without one ran with, so the two compare equal."""
@@ -176,6 +179,16 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
         # unset: the climb it resolved to (Scenario.resolved_climb), compared as that number
         likelihood = estimator.get("likelihood", "paper") if isinstance(estimator, dict) else ""
         agent["climb"] = unset_climb(likelihood, agent.get("model", "grid"))
+    search = out.get("search")
+    if isinstance(search, dict) and "lookahead" in search and search["lookahead"] is None:
+        # unset: the look-ahead it resolved to (Scenario.lookahead), compared as that number
+        est = estimator if isinstance(estimator, dict) else {}
+        world = out.get("world") if isinstance(out.get("world"), dict) else {}
+        open_terrain = not (world.get("obstacles") or world.get("no_go") or world.get("map"))
+        model = agent.get("model", "grid") if isinstance(agent, dict) else "grid"
+        search["lookahead"] = unset_lookahead(
+            est.get("likelihood", "paper"), model, int(est.get("max_sources", 1)), open_terrain
+        )
     sensor, truth = out.get("sensor"), out.get("truth")
     if isinstance(sensor, dict) and "dropout" not in sensor and isinstance(truth, dict):
         # stored before sensor.dropout existed, when the instrument missed 1 − pd of the

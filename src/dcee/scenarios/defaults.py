@@ -108,6 +108,11 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
         "unset: on with several releases or on a site ([world] not empty), off in open terrain "
         "(open-terrain searches unchanged; measured on the sites, docs/scenarios.md)",
     ),
+    ("search", "lookahead"): Provenance(
+        ("filament", "puffs"),
+        "2 (dcee-cl looks two moves ahead) with the fluctuation likelihood, one release, open "
+        "terrain, grid UAV: random:13-40, dcee-cl (issue 42); 1 elsewhere (not measured there)",
+    ),
     ("search", "stall_guard"): Provenance(("isotropic",), "held-out tuning, docs/held-out.md"),
     ("search", "guard_share"): Provenance(("filament", "puffs"), "random:13-40, dcee-cl"),
     ("search", "stop_hold"): Provenance(("isotropic",), "random-tune, 40 configurations"),

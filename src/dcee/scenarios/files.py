@@ -136,6 +136,7 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
         ("agent", "dwell"): scenario.dwell,
         ("agent", "climb"): scenario.climb,
         ("world", "resolution"): scenario.site_resolution,
+        ("search", "lookahead"): scenario.lookahead,
         ("search", "explore_guard"): scenario.explore_guard,
         ("estimator", "wall_diffusivity"): scenario.wall_diffusivity,
         ("estimator", "wall_wind"): scenario.wall_wind,

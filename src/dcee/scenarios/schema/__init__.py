@@ -2,11 +2,13 @@
 
 from dcee.scenarios.schema.agent import (
     AUTO_CLIMB,
+    AUTO_LOOKAHEAD,
     AgentSpec,
     SearchSpec,
     UnicycleSpec,
     team_starts,
     unset_climb,
+    unset_lookahead,
 )
 from dcee.scenarios.schema.common import FROZEN, Finite, Positive
 from dcee.scenarios.schema.estimator import (
@@ -40,6 +42,7 @@ from dcee.scenarios.schema.truth import (
 
 __all__ = [
     "AUTO_CLIMB",
+    "AUTO_LOOKAHEAD",
     "FIELD_MARK",
     "FROZEN",
     "LEARN_DEFAULT",
@@ -74,5 +77,6 @@ __all__ = [
     "default_priors",
     "team_starts",
     "unset_climb",
+    "unset_lookahead",
     "validate_scenario",
 ]

@@ -42,6 +42,25 @@ def unset_climb(likelihood: str, model: str, on_robot: bool = False) -> float:
     return AUTO_CLIMB if turbulent_uav and not on_robot else 0.0
 
 
+AUTO_LOOKAHEAD = 2
+"""moves ``dcee-cl`` looks ahead when ``search.lookahead`` is unset in a turbulent plume (grid
+UAV, fluctuation likelihood, one release, open terrain). Chosen on the tuning range random:13-40
+of filament and puffs against one move by a rule written before the run (acquisition not lower,
+truth in the 95 % region not lower by more than 2 points, median paired final error no more than
+0.05 m worse): 56/56 both, region 96.4 against 98.2 %, final RMSE 0.44 against 0.54 m (paired
+-0.05 m, Wilcoxon p = 0.016; docs/results/tuning-horizon-13-40). A decision costs about 3x one
+move's (docs/results/perf/horizon-timing.json). Not measured with several releases, on a site
+or on the unicycle robot, which keep 1."""
+
+
+def unset_lookahead(likelihood: str, model: str, max_sources: int, open_terrain: bool) -> int:
+    """Moves ``dcee-cl`` looks ahead when ``search.lookahead`` is unset: :data:`AUTO_LOOKAHEAD`
+    where it was chosen (the grid UAV, the fluctuation likelihood, one release, open terrain),
+    else 1 (the look-ahead before the setting existed)."""
+    chosen_here = likelihood == "fluctuation" and model == "grid" and max_sources == 1
+    return AUTO_LOOKAHEAD if chosen_here and open_terrain else 1
+
+
 class UnicycleSpec(BaseModel):
     """The differential-drive robot of ``agent.model = "unicycle"`` (:mod:`dcee.models.motion`).
     Its top speed is ``agent.speed``. Defaults: a Turtlebot-2-class robot as Nav2 drives it
@@ -138,6 +157,11 @@ class SearchSpec(BaseModel):
     before, let dcee-cl hover > 60 s at a narrow but wrong belief in 19 of 56 searches and 0.15 in
     1, acquisition and final error unchanged; isotropic random-tune searches unchanged
     (docs/turbulent.md)"""
+    lookahead: Annotated[int, Field(ge=1, le=3)] | None = None
+    """moves ``dcee-cl`` looks ahead (its beam search, :class:`~dcee.planning.HypothesisPlanner`'s
+    ``horizon``; a spec's own ``dcee-cl:horizon=`` overrides it). None: :data:`AUTO_LOOKAHEAD` (2)
+    for the grid UAV with the fluctuation likelihood, one release, in open terrain (a turbulent
+    plume expected; chosen there), else 1 (see :func:`unset_lookahead`)"""
     explore_guard: bool | None = None
     """before each decision, compare how much the best move's next reading would tell (the
     mutual information of detection or not with the hypotheses) with a coarse grid over the

@@ -13,7 +13,13 @@ from dcee.errors import DceeInputError
 from dcee.models.agent import GridAgent, SearchVolume
 from dcee.models.plume import PARAMETER_NAMES
 from dcee.scenarios.builders import ScenarioBuilders
-from dcee.scenarios.schema.agent import AgentSpec, SearchSpec, team_starts, unset_climb
+from dcee.scenarios.schema.agent import (
+    AgentSpec,
+    SearchSpec,
+    team_starts,
+    unset_climb,
+    unset_lookahead,
+)
 from dcee.scenarios.schema.common import FIELD_MARK, FROZEN, phi_prior_from_bearing
 from dcee.scenarios.schema.estimator import (
     MEANDER_DEFAULT,
@@ -305,6 +311,16 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
         return unset_climb(self.estimator.likelihood, self.agent.model, on_robot)
 
     @property
+    def lookahead(self) -> int:
+        """Moves ``dcee-cl`` looks ahead (``search.lookahead``, or when unset
+        :func:`~dcee.scenarios.schema.agent.unset_lookahead`: 2 in a turbulent plume in open
+        terrain with one release, else 1)."""
+        if self.search.lookahead is not None:
+            return self.search.lookahead
+        e = self.estimator
+        return unset_lookahead(e.likelihood, self.agent.model, e.max_sources, self.world.empty)
+
+    @property
     def climb(self) -> float:
         """m per climb or descent move in a simulated search (:meth:`resolved_climb`)."""
         return self.resolved_climb()
@@ -368,6 +384,7 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
             "repeat_radius": self.repeat_radius,
             "repeat_power": self.repeat_power,
             "climb": self.climb,
+            "lookahead": self.lookahead,
             "explore_guard": self.explore_guard,
             "estimator_plume": self.estimator.plume,
         }
