@@ -90,6 +90,7 @@ def test_the_unset_lookahead_is_the_two_move_planner_decision_for_decision():
     auto = run_episode(scenario, "dcee-cl", seed=3)
     spec = run_episode(scenario, "dcee-cl:horizon=2", seed=3)
     one = run_episode(scenario, "dcee-cl:horizon=1", seed=3)
+
     def path(result):
         return np.array([[r["x"], r["y"], r["z"]] for r in result.records])
 
