@@ -115,8 +115,19 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=1)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--csv", default=None)
+    ap.add_argument(
+        "--pin",
+        action="append",
+        default=[],
+        help="PATH=VALUE set in every variant before its own overrides (e.g. a default of "
+        "the day the rows were flown: search.lookahead=1)",
+    )
     args = ap.parse_args()
-    variants = [parse_variant(v) for v in (args.variant or ["base:"])]
+    pins = parse_variant("pins:" + ",".join(args.pin))[1]
+    variants = [
+        (label, {**pins, **over})
+        for label, over in (parse_variant(v) for v in (args.variant or ["base:"]))
+    ]
     tasks = [
         (label, over, name, truth, seed, args.strategy)
         for label, over in variants

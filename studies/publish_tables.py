@@ -214,17 +214,19 @@ def what_we_found() -> str:
             repeat_radius=2,
         ),
     ]
+    turbulent_today = study("turbulent-held-out-100-today")
     for truth, what in (("filament", "filament truth"), ("puffs", "puff truth")):
+        newest = latest_defaults(turbulent_today, ("dcee-cl", "infotaxis"), truth_model=truth)
         rows.append(
             planners_row(
                 f"**held-out**, {what}, all eight unknown, fluctuation likelihood, "
-                "`held-out-100`, today's defaults (since 2026-11-27 (c): the backflow and "
-                "disc members learned, the mixture's region), `dcee-cl` / `infotaxis` "
+                f"`held-out-100`, {defaults_words(newest)} (the backflow and disc members "
+                "learned, the mixture's region), `dcee-cl` / `infotaxis` "
                 "(`turbulent-held-out-100-today`)",
-                study("turbulent-held-out-100-today"),
+                turbulent_today,
                 ("dcee-cl", "infotaxis"),
                 truth_model=truth,
-                defaults=TODAY_DEFAULTS,
+                defaults=newest,
             )
         )
     return table(
@@ -701,11 +703,14 @@ CROSS_HEADER = [
 ]
 
 
-TODAY_DEFAULTS = "2026-11-27c"
-"""The ``defaults`` tag of rows flown at today's defaults (a 0.5 m near-source fall, repeat
-power 1/2, the backflow member and the disc member at prior odds 9 : 1 learned, the 95 % region
-the members' mixture's)."""
+TODAY_DEFAULTS = {"dcee-cl": "2026-11-29", "infotaxis": "2026-11-27c", "dcee-mcts": "2026-11-27c"}
+"""Per planner, the ``defaults`` tag of rows flown at today's defaults (a 0.5 m near-source
+fall, repeat power 1/2, the backflow member and the disc member at prior odds 9 : 1 learned, the
+95 % region the members' mixture's; since 2026-11-29 ``dcee-cl`` looks two moves ahead in a
+turbulent plume, ``search.lookahead``, which changed no other planner: their rows of 2026-11-27
+(c) are today's)."""
 EARLIER_DEFAULTS = {
+    "2026-11-27c": "defaults of 2026-11-27 (c): `dcee-cl` one move ahead",
     "2026-11-27b": "defaults of 2026-11-27 (b): the backflow member alone, the selected "
     "member's region",
     "2026-11-27": "defaults of 2026-11-27 before the backflow member",
@@ -713,6 +718,29 @@ EARLIER_DEFAULTS = {
 }
 """How a row flown before today's defaults says so, by its ``defaults`` tag."""
 OLD_DEFAULTS = EARLIER_DEFAULTS["2026-11-23"]
+
+
+def latest_defaults(frame: pd.DataFrame, strategies: tuple[str, ...], **where: object) -> dict:
+    """Per planner, the newest ``defaults`` tag among its rows where every column equals its
+    value (the tags sort by date)."""
+    out = {}
+    for strategy in strategies:
+        rows = frame[frame["strategy"] == strategy]
+        for key, value in where.items():
+            rows = rows[rows[key] == value]
+        out[strategy] = max(rows["defaults"].astype(str))
+    return out
+
+
+def defaults_words(tags: dict) -> str:
+    """"today's defaults" when every planner's newest rows are today's, else which of them."""
+    if all(tag == TODAY_DEFAULTS.get(s) for s, tag in tags.items()):
+        return "today's defaults (`dcee-cl` two moves ahead since 2026-11-29)"
+    parts = [
+        f"`{s}` " + ("today's" if tag == TODAY_DEFAULTS.get(s) else EARLIER_DEFAULTS[tag])
+        for s, tag in tags.items()
+    ]
+    return "; ".join(parts)
 
 
 def cross_truth_table(latest_only: bool = False) -> str:
@@ -739,8 +767,12 @@ def cross_truth_table(latest_only: bool = False) -> str:
             ]
         )
 
-    def flown(defaults: str) -> str:
-        return "" if defaults == TODAY_DEFAULTS else f", {EARLIER_DEFAULTS[defaults]}"
+    def flown(defaults: str, strategy: str) -> str:
+        if defaults == TODAY_DEFAULTS.get(strategy):
+            return ""
+        if strategy == "dcee-cl:horizon=2" and defaults == "2026-11-27c":
+            return ", flown as a planner option before it became `dcee-cl`'s default"
+        return f", {EARLIER_DEFAULTS[defaults]}"
 
     for strategy in ("dcee-cl", "infotaxis", "dcee-mcts"):
         add(
@@ -767,7 +799,7 @@ def cross_truth_table(latest_only: bool = False) -> str:
                     continue
                 latest.add(strategy)
                 add(
-                    f"{truth}, fluctuation likelihood{flown(defaults)}",
+                    f"{truth}, fluctuation likelihood{flown(defaults, strategy)}",
                     chosen,
                     pick(part, strategy, truth_model=truth),
                     "turbulent-held-out-100-today",
@@ -779,11 +811,9 @@ def cross_truth_table(latest_only: bool = False) -> str:
                 pick(today, "dcee-mcts", study="filament"),
                 "held-out-today",
             )
+    generation = {"2026-11-29": 0, "2026-11-27c": 1, "2026-11-27b": 2, "2026-11-27": 3}
     lbm = lbm.assign(
-        order=lbm["defaults"]
-        .astype(str)
-        .map({TODAY_DEFAULTS: 0, "2026-11-27b": 1, "2026-11-27": 2})
-        .fillna(3)
+        order=lbm["defaults"].astype(str).map(generation).fillna(len(generation))
     ).sort_values("order", kind="stable")
     option = lbm["strategy"].astype(str).str.contains(":")  # a planner's option, e.g. horizon=2
     if latest_only:  # per planner, the latest defaults flown, no options
@@ -794,7 +824,7 @@ def cross_truth_table(latest_only: bool = False) -> str:
             how += ", a planner option (chosen on the tuning range, measured here)"
         if int(r.get("particles", 10000)) != 10000:
             how += f", {int(r['particles']):,} particles (measured, not chosen on)"
-        how += flown(str(r["defaults"]))
+        how += flown(str(r["defaults"]), str(r["strategy"]))
         if int(r["searches"]) < 100:
             how += f", {int(r['searches'])} configurations (small sample)"
         add(f"**lbm** (fluid solver), fluctuation likelihood{how}", "none", r, "lbm-held-out-100")
@@ -943,10 +973,10 @@ def radius_prior_table(release: str) -> str:
 
 
 def horizon_tuning_table() -> str:
-    """``dcee-cl:horizon=2`` on the tuning range, each search paired with today's ``dcee-cl``
-    (the ``prior`` rows of docs/results/tuning-radius-prior-13-40, their 95 % region the
-    mixture's, as docs/results/mixture-region-prior-13-40 recomputed it: today's default).
-    The rule: docs/results/tuning-horizon-13-40."""
+    """``dcee-cl:horizon=2`` on the tuning range, each search paired with ``dcee-cl`` one move
+    ahead at the defaults of 2026-11-27 (c) (the ``prior`` rows of docs/results/tuning-radius-prior-13-40, their 95 % region the
+    mixture's, as docs/results/mixture-region-prior-13-40 recomputed it). The rule, by which two
+    moves became the default (``search.lookahead``): docs/results/tuning-horizon-13-40."""
     key = ["truth", "scenario", "seed"]
     base = pd.read_csv(RESULTS / "tuning-radius-prior-13-40" / "variants.csv")
     base = base[base["variant"] == "prior"].drop(columns="truth_in_95")
@@ -956,10 +986,12 @@ def horizon_tuning_table() -> str:
     candidate = pd.read_csv(RESULTS / "tuning-horizon-13-40" / "variants.csv")
     frame = pd.concat([base.assign(variant="base"), candidate.assign(variant="horizon2")])
     names = {
-        "base": "`dcee-cl` (today's defaults, one move ahead)",
-        "horizon2": "`dcee-cl:horizon=2` (two moves ahead)",
+        "base": "`dcee-cl` one move ahead (the defaults of 2026-11-27 (c))",
+        "horizon2": "`dcee-cl:horizon=2` (two moves ahead: today's default, `search.lookahead`)",
     }
-    return _variant_table(frame, names, ("base", "horizon2"), "today's `dcee-cl`", "planner")
+    return _variant_table(
+        frame, names, ("base", "horizon2"), "`dcee-cl` one move ahead", "planner"
+    )
 
 
 def _by_truth(rows: pd.DataFrame) -> Iterator[tuple[str, pd.DataFrame]]:

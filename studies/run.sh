@@ -8,6 +8,10 @@ D=.venv/bin/dcee
 P=.venv/bin/python
 [ -x "$D" ] || bash scripts/setup.sh
 report() { for dir in "$@"; do $D report "results/$dir"; cat "results/$dir/report/metrics.md"; done; }
+# dcee-cl looked one move ahead everywhere until search.lookahead (2026-11-29, issue 42); today it
+# looks two ahead in a turbulent plume (grid UAV, one release, open terrain). The turbulent
+# studies flown before pin one move, so that each reproduces what it published.
+LA1=(--set search.lookahead=1)
 count_campaigns() {  # PLANNER SUFFIX: its two- and three-release held-out campaigns (issue 45)
   for N in two three; do
     $D bench --suite "$N-source-held-out-100" --repeats 1 --strategies "$1" \
@@ -88,7 +92,7 @@ case "${1:---list}" in
     $P studies/bias_table.py results/filament-calm
     $P studies/ablation_table.py results/filament-calm=infotaxis results/filament-info-loc=infotaxis ;;
   turbulent-held-out)  # both turbulent truths on held-out configurations (docs/turbulent.md)
-    bash studies/study_turbulent_held_out.sh
+    bash studies/study_turbulent_held_out.sh "${LA1[@]}"
     export SUITE=held-out-100 WORKERS=${WORKERS:-2}
     # the first three ran at commit 43cea93 (each result records it), before dcee-cl's vertical
     # reach and today's turbulent defaults: their settings are pinned here, and today's code
@@ -96,11 +100,11 @@ case "${1:---list}" in
     # before the fourth round: a detection's mean C, no repeat discount
     rr0=(--set estimator.repeat_radius=0.0)
     cm0=(--set estimator.conserve_mean=false "${rr0[@]}")
-    bash studies/study_turbulent_held_out.sh --set agent.climb=0.0 \
+    bash studies/study_turbulent_held_out.sh "${LA1[@]}" --set agent.climb=0.0 \
       --set estimator.near_source_length=5.0 "${cm0[@]}"
-    OUT_SUFFIX=-climb bash studies/study_turbulent_held_out.sh --set agent.climb=1.0 \
+    OUT_SUFFIX=-climb bash studies/study_turbulent_held_out.sh "${LA1[@]}" --set agent.climb=1.0 \
       --set estimator.near_source_length=5.0 "${cm0[@]}"
-    OUT_SUFFIX=-climb-nsl25 bash studies/study_turbulent_held_out.sh --set agent.climb=1.0 \
+    OUT_SUFFIX=-climb-nsl25 bash studies/study_turbulent_held_out.sh "${LA1[@]}" --set agent.climb=1.0 \
       --set estimator.near_source_length=2.5 "${cm0[@]}"
     # the third round's defaults (the climbing UAV, near-source length 2.5 m, dcee-cl's
     # vertical reach; a detection's mean C): the puffs on held-out-100, the filament on all 200
@@ -108,17 +112,17 @@ case "${1:---list}" in
     # its held-out-100 rows
     # (2.5 m was the near-source fall's default until 2026-11-27: pinned since)
     nsl25=(--set estimator.near_source_length=2.5)
-    OUT_SUFFIX=-defaults TRUTHS=puffs bash studies/study_turbulent_held_out.sh "${cm0[@]}" \
+    OUT_SUFFIX=-defaults TRUTHS=puffs bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${cm0[@]}" \
       "${nsl25[@]}"
-    SUITE=held-out OUT_SUFFIX=-defaults TRUTHS=filament bash studies/study_turbulent_held_out.sh \
+    SUITE=held-out OUT_SUFFIX=-defaults TRUTHS=filament bash studies/study_turbulent_held_out.sh "${LA1[@]}" \
       "${cm0[@]}" "${nsl25[@]}"
     # the fourth round's mean-conserving intermittency alone, the same searches
-    OUT_SUFFIX=-cm TRUTHS=puffs bash studies/study_turbulent_held_out.sh "${rr0[@]}" "${nsl25[@]}"
-    SUITE=held-out OUT_SUFFIX=-cm TRUTHS=filament bash studies/study_turbulent_held_out.sh \
+    OUT_SUFFIX=-cm TRUTHS=puffs bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${rr0[@]}" "${nsl25[@]}"
+    SUITE=held-out OUT_SUFFIX=-cm TRUTHS=filament bash studies/study_turbulent_held_out.sh "${LA1[@]}" \
       "${rr0[@]}" "${nsl25[@]}"
     # the defaults of 2026-11-23 to 11-27: with the gentle repeat discount (2 m, power 0.25),
     # held-out-100 (today's: turbulent-held-out-today)
-    OUT_SUFFIX=-cm-rr bash studies/study_turbulent_held_out.sh "${nsl25[@]}" \
+    OUT_SUFFIX=-cm-rr bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${nsl25[@]}" \
       --set estimator.repeat_radius=2.0 --set estimator.repeat_power=0.25
     report turbulent-filament-held-out-24 turbulent-puffs-held-out-24
     out=docs/results/turbulent-held-out-100
@@ -167,7 +171,7 @@ case "${1:---list}" in
     export SUITE=held-out-100 WORKERS=${WORKERS:-2}
     today=(--set estimator.near_source_length=0.5 --set estimator.repeat_radius=2.0
       --set estimator.repeat_power=0.5 --set 'estimator.learn={}')
-    OUT_SUFFIX=-today bash studies/study_turbulent_held_out.sh "${today[@]}"
+    OUT_SUFFIX=-today bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${today[@]}"
     out=docs/results/turbulent-held-out-100-today
     mkdir -p "$out"
     report turbulent-puffs-held-out-100-today turbulent-filament-held-out-100-today
@@ -188,7 +192,7 @@ case "${1:---list}" in
     # result; the rows stored beside those of turbulent-held-out-today (defaults 2026-11-27b)
     # and paired with them search by search from the stored rows
     export SUITE=held-out-100 WORKERS=${WORKERS:-2}
-    OUT_SUFFIX=-today-bf bash studies/study_turbulent_held_out.sh \
+    OUT_SUFFIX=-today-bf bash studies/study_turbulent_held_out.sh "${LA1[@]}" \
       --set estimator.near_source_length=0.5 --set estimator.repeat_radius=2.0 \
       --set estimator.repeat_power=0.5
     out=docs/results/turbulent-held-out-100-today
@@ -210,8 +214,8 @@ case "${1:---list}" in
     export SUITE=held-out-100 WORKERS=${WORKERS:-2}
     pinned=(--set estimator.near_source_length=0.5 --set estimator.repeat_radius=2.0
       --set estimator.repeat_power=0.5)
-    STRATEGIES=dcee-cl OUT_SUFFIX=-today-dm bash studies/study_turbulent_held_out.sh "${pinned[@]}"
-    STRATEGIES=infotaxis OUT_SUFFIX=-today-dm-info bash studies/study_turbulent_held_out.sh "${pinned[@]}"
+    STRATEGIES=dcee-cl OUT_SUFFIX=-today-dm bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${pinned[@]}"
+    STRATEGIES=infotaxis OUT_SUFFIX=-today-dm-info bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${pinned[@]}"
     out=docs/results/turbulent-held-out-100-today
     runs=()
     for t in puffs filament; do
@@ -240,7 +244,7 @@ case "${1:---list}" in
       for t in filament puffs; do
         $D bench --suite paper --strategies dcee-cl,infotaxis --repeats 5 --unknown full \
           --likelihood fluctuation --truth $t --particles 10000 --workers "${WORKERS:-2}" \
-          --allow-code-change "${pinned[@]}" --out "results/turbulent-$t-public-$name"
+          --allow-code-change "${pinned[@]}" "${LA1[@]}" --out "results/turbulent-$t-public-$name"
         report "turbulent-$t-public-$name"
       done
       $P studies/collect_metrics.py --out "docs/results/turbulent-public-$name" \
@@ -267,8 +271,8 @@ case "${1:---list}" in
     # (the defaults of 2026-11-23 to 11-27, pinned; today's: turbulent-held-out-today)
     old=(--set estimator.near_source_length=2.5 --set estimator.repeat_radius=2.0
       --set estimator.repeat_power=0.25)
-    OUT_SUFFIX=-cm-rr bash studies/study_turbulent_held_out.sh --allow-code-change "${old[@]}"
-    OUT_SUFFIX=-cm-rr-mcts STRATEGIES=dcee-mcts bash studies/study_turbulent_held_out.sh \
+    OUT_SUFFIX=-cm-rr bash studies/study_turbulent_held_out.sh "${LA1[@]}" --allow-code-change "${old[@]}"
+    OUT_SUFFIX=-cm-rr-mcts STRATEGIES=dcee-mcts bash studies/study_turbulent_held_out.sh "${LA1[@]}" \
       --allow-code-change "${old[@]}"
     out=docs/results/held-out-today
     mkdir -p "$out"
@@ -330,7 +334,7 @@ case "${1:---list}" in
     # (near_source_length 10 m, reading_weight 1), so it reproduces with today's defaults
     old=estimator.near_source_length=10,estimator.reading_weight=1.0
     mkdir -p docs/results
-    $P studies/precision_variants.py --configs random:1-12 --truths puffs filament \
+    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:1-12 --truths puffs filament \
       --variant "defaults:$old" --variant "hold8:$old,agent.dwell=8" \
       --variant "logsd2:$old,estimator.log_sd=2.0" \
       --variant "intermittency0.8:$old,estimator.intermittency=0.8" \
@@ -344,7 +348,7 @@ case "${1:---list}" in
     out=docs/results/tuning-turbulent-13-40
     tune() {  # CSV, then --variant/--strategy arguments
       local csv=$1; shift
-      $P studies/precision_variants.py --configs random:13-40 --truths filament puffs "$@" \
+      $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths filament puffs "$@" \
         --csv "$out/$csv"
     }
     # second round, with the defaults of its day: a fixed altitude unless climbing, the
@@ -485,7 +489,7 @@ case "${1:---list}" in
       --csv docs/results/anemometer/anemometer.csv
     $P studies/publish_tables.py ;;
   tune-horizon)  # issue 42: dcee-cl looking two moves ahead on the tuning range, filament + puffs (docs/results/tuning-horizon-13-40)
-    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
       --variant horizon2: --strategy dcee-cl:horizon=2 --workers "${WORKERS:-2}" \
       --csv docs/results/tuning-horizon-13-40/variants.csv ;;
   lbm-endgame)  # issue 42, a lab note: where each planner reads last and ends on the lbm plume, eight tuning configurations (docs/plumes.md)
@@ -493,7 +497,7 @@ case "${1:---list}" in
       for k in 13 14 15 16 17 18 19 20; do
         [ -f "results/lbm-endgame/$s-$k/summary.json" ] || $D run --scenario random:$k --unknown full \
           --likelihood fluctuation --truth lbm --particles 10000 --set truth.z=4.0 --strategy "$s" \
-          --seed 0 --out "results/lbm-endgame/$s-$k" -q --no-figure
+          "${LA1[@]}" --seed 0 --out "results/lbm-endgame/$s-$k" -q --no-figure
       done
     done
     $P studies/lbm_endgame.py results/lbm-endgame/*-[0-9]* --csv docs/results/lbm-plume/endgame.csv
@@ -502,112 +506,155 @@ case "${1:---list}" in
     $P studies/lbm_statistics.py
     $P studies/publish_tables.py ;;
   tune-learn)  # the learned reading model (estimator.learn) on the tuning range, filament + puffs (docs/plumes.md)
-    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
       --variant base: \
       --variant 'decay:estimator.learn={decay=[1.0,0.5]}' \
       --variant 'nsl:estimator.learn={near_source_length=[2.5,0.0]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-learn-13-40/variants.csv
     $P studies/publish_tables.py ;;
   tune-log-sd)  # the learned log-normal spread on the tuning range, filament + puffs (docs/plumes.md)
-    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
       --variant base: \
       --variant 'sd:estimator.learn={log_sd=[1.3,2.0,3.0]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-log-sd-13-40/variants.csv
     $P studies/publish_tables.py ;;
   tune-near-sd)  # the learned near-source spread on the tuning range, filament + puffs (docs/plumes.md)
-    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
       --variant 'nearsd:estimator.log_sd_length=1.5,estimator.learn={log_sd_near=[0.0,3.0,6.0]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-near-sd-13-40/variants.csv
     $P studies/publish_tables.py ;;
   tune-nsl05)  # a 0.5 m near-source fall on the tuning range, filament + puffs (docs/plumes.md)
-    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
       --variant 'nsl05:estimator.near_source_length=0.5' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-nsl05-13-40/variants.csv
     $P studies/publish_tables.py ;;
   tune-nsl05-rp05)  # the 0.5 m fall with a repeat discount of power 1/2, tuning range (docs/plumes.md)
-    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
       --variant 'nsl05rp05:estimator.near_source_length=0.5,estimator.repeat_power=0.5' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-nsl05-rp05-13-40/variants.csv
     $P studies/publish_tables.py ;;
   tune-backflow)  # gas upwind of the release, learned, on the tuning range (docs/plumes.md)
-    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
       --variant base: --variant 'backflow:estimator.learn={backflow=[0.0,0.05]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-backflow-13-40/variants.csv
     $P studies/publish_tables.py ;;
   tune-source-radius)  # a release spread over a disc, learned, on the tuning range (docs/plumes.md)
     # paired with today's defaults: the backflow rows of docs/results/tuning-backflow-13-40
-    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
       --variant 'radius:estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-source-radius-13-40/variants.csv
     $P studies/publish_tables.py ;;
   tune-area-release)  # the tuning truths released over an area: do they reproduce the lbm failure? (docs/plumes.md)
-    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
       --variant 'area:truth.model.puff_radius=0.5' \
       --variant 'area-radius:truth.model.puff_radius=0.5,estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-area-release-13-40/variants.csv ;;
   tune-area-release-1m)  # the tuning truths released over a 1 m disc at today's defaults: a closer stand-in for the lbm plume? (docs/plumes.md)
-    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
       --variant 'area1:truth.model.puff_radius=1.0' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-area-release-1m-13-40/variants.csv ;;
   tune-radius-prior)  # disc members with prior odds 9:1 against, on point and area releases (docs/plumes.md)
     cand='estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]},estimator.learn_prior={source_radius=[0.9,0.1]}'
-    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
       --variant "prior:$cand" --variant "area-prior:truth.model.puff_radius=0.5,$cand" \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-radius-prior-13-40/variants.csv ;;
   mixture-region)  # the 95 % region of the reading models' mixture beside the selected one's, disc members (docs/plumes.md)
     cand='estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}'
-    $P studies/mixture_region.py --configs random:13-40 --truths puffs filament \
+    $P studies/mixture_region.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
       --variant "radius:$cand" --variant "area-radius:truth.model.puff_radius=0.5,$cand" \
       --workers "${WORKERS:-2}" --csv docs/results/mixture-region-13-40/searches.csv ;;
   mixture-region-prior)  # disc members with prior odds 9:1 against and the mixture's region, point and area releases (docs/plumes.md)
     cand='estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]},estimator.learn_prior={source_radius=[0.9,0.1]}'
-    $P studies/mixture_region.py --configs random:13-40 --truths puffs filament \
+    $P studies/mixture_region.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
       --variant "prior:$cand" --variant "area-prior:truth.model.puff_radius=0.5,$cand" \
       --workers "${WORKERS:-2}" --csv docs/results/mixture-region-prior-13-40/searches.csv ;;
+  lookahead-held-out)  # issue 42: dcee-cl at today's defaults (two moves ahead, search.lookahead) on the held-out lbm plume and both turbulent truths, stored beside the earlier generations
+    # the lbm plume held out (no default chosen on it); filament and puffs, where the look-ahead
+    # was chosen (a check, not an independent result). The other planners did not change: their
+    # rows of 2026-11-27 (c) are today's. Rows of earlier generations kept from the stored study
+    # (their search folders need not be on this machine), each new search paired with them.
+    export SUITE=held-out-100 WORKERS=${WORKERS:-2}
+    r=results/turbulent-lbm-held-out-100
+    TRUTHS=lbm STRATEGIES=dcee-cl OUT_SUFFIX=-d29 bash studies/study_turbulent_held_out.sh \
+      --set truth.z=4.0
+    STRATEGIES=dcee-cl OUT_SUFFIX=-today-d29 bash studies/study_turbulent_held_out.sh
+    report turbulent-lbm-held-out-100-d29
+    lbm=docs/results/lbm-held-out-100
+    keep=()
+    for g in 2026-11-27c 2026-11-27b 2026-11-27 2026-11-23; do keep+=(--keep "defaults:$g"); done
+    $P studies/collect_metrics.py --out "$lbm" "${keep[@]}" \
+      "$r-d29=defaults:2026-11-29,learn:none,particles:10000"
+    rm -f "$lbm/lookahead_vs_before.csv"
+    pick="learn:none:particles:10000.0:defaults:2026-11-27c"
+    for ref in dcee-cl infotaxis dcee-mcts; do
+      $P studies/pair_campaigns.py "$lbm/searches.csv=strategy:$ref:$pick" "$r-d29" \
+        --as "dcee-cl=$ref" --csv "$lbm/lookahead_vs_before.csv" --tag truth_model=lbm
+    done
+    $P studies/upwind_detections.py "$r-d29=dcee-cl"
+    out=docs/results/turbulent-held-out-100-today
+    runs=()
+    for t in puffs filament; do
+      [ -d "results/turbulent-$t-held-out-100-today-d29" ] || continue
+      report "turbulent-$t-held-out-100-today-d29"
+      runs+=("results/turbulent-$t-held-out-100-today-d29=truth_model:$t,defaults:2026-11-29")
+    done
+    $P studies/collect_metrics.py --out "$out" --keep defaults:2026-11-27 \
+      --keep defaults:2026-11-27b --keep defaults:2026-11-27c "${runs[@]}"
+    rm -f "$out/lookahead_vs_before.csv"
+    for t in puffs filament; do
+      [ -d "results/turbulent-$t-held-out-100-today-d29" ] || continue
+      $P studies/pair_campaigns.py "$out/searches.csv=truth_model:$t:defaults:2026-11-27c" \
+        "results/turbulent-$t-held-out-100-today-d29" --csv "$out/lookahead_vs_before.csv" \
+        --tag "truth_model=$t"
+    done
+    $P studies/publish_tables.py ;;
   cross-truth)  # every truth at today's defaults; the lbm plume held out (docs/plumes.md, README)
     # dcee-cl, infotaxis and the tree search at today's defaults, 100 held-out configurations
     export SUITE=held-out-100 TRUTHS=lbm WORKERS=${WORKERS:-2}
-    # today's defaults (since 2026-11-27 (c): the disc member at prior odds 9:1, the mixture's
-    # region; the same searches as -radius-prior below, the region now the mixture's)
-    STRATEGIES=dcee-cl OUT_SUFFIX=-dm bash studies/study_turbulent_held_out.sh --set truth.z=4.0
-    STRATEGIES=infotaxis OUT_SUFFIX=-dm-info bash studies/study_turbulent_held_out.sh \
+    # today's defaults (since 2026-11-29: dcee-cl two moves ahead; the other planners as below)
+    STRATEGIES=dcee-cl OUT_SUFFIX=-d29 bash studies/study_turbulent_held_out.sh --set truth.z=4.0
+    # the defaults of 2026-11-27 (c): the disc member at prior odds 9:1, the mixture's
+    # region; the same searches as -radius-prior below, the region now the mixture's
+    STRATEGIES=dcee-cl OUT_SUFFIX=-dm bash studies/study_turbulent_held_out.sh "${LA1[@]}" --set truth.z=4.0
+    STRATEGIES=infotaxis OUT_SUFFIX=-dm-info bash studies/study_turbulent_held_out.sh "${LA1[@]}" \
       --set truth.z=4.0
-    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-dm bash studies/study_turbulent_held_out.sh \
+    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-dm bash studies/study_turbulent_held_out.sh "${LA1[@]}" \
       --set truth.z=4.0
     # an option measured at today's defaults (it decides nothing): dcee-cl looking two moves
     # ahead (chosen as a candidate on the tuning range: bash studies/run.sh tune-horizon)
-    STRATEGIES=dcee-cl:horizon=2 OUT_SUFFIX=-dm-h2 bash studies/study_turbulent_held_out.sh \
+    STRATEGIES=dcee-cl:horizon=2 OUT_SUFFIX=-dm-h2 bash studies/study_turbulent_held_out.sh "${LA1[@]}" \
       --set truth.z=4.0
     # the defaults of 2026-11-27 (b): the backflow member learned, alone (pinned)
     bf=(--set truth.z=4.0 --set 'estimator.learn={backflow=[0.0,0.05]}')
-    OUT_SUFFIX=-bf bash studies/study_turbulent_held_out.sh "${bf[@]}"
-    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-bf bash studies/study_turbulent_held_out.sh "${bf[@]}"
+    OUT_SUFFIX=-bf bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${bf[@]}"
+    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-bf bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${bf[@]}"
     # an option measured at today's defaults (it decides nothing): a release spread over a disc
-    STRATEGIES=dcee-cl OUT_SUFFIX=-radius bash studies/study_turbulent_held_out.sh \
+    STRATEGIES=dcee-cl OUT_SUFFIX=-radius bash studies/study_turbulent_held_out.sh "${LA1[@]}" \
       --set truth.z=4.0 --set 'estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}'
     # the same with prior odds 9:1 against the disc (tune-radius-prior decides whether it is a default)
-    STRATEGIES=dcee-cl OUT_SUFFIX=-radius-prior bash studies/study_turbulent_held_out.sh \
+    STRATEGIES=dcee-cl OUT_SUFFIX=-radius-prior bash studies/study_turbulent_held_out.sh "${LA1[@]}" \
       --set truth.z=4.0 --set 'estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}' \
       --set 'estimator.learn_prior={source_radius=[0.9,0.1]}'
     # the defaults of 2026-11-27 before the backflow member (pinned: no learned setting)
     nobf=(--set truth.z=4.0 --set 'estimator.learn={}')
-    bash studies/study_turbulent_held_out.sh "${nobf[@]}"
-    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-today bash studies/study_turbulent_held_out.sh "${nobf[@]}"
+    bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${nobf[@]}"
+    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts-today bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${nobf[@]}"
     # the same at the defaults of 2026-11-23 to 11-27 (a 2.5 m near-source fall, repeat power 1/4),
     # and options measured at those defaults (they decide nothing): dcee-cl with the learned
     # decay and the learned near-source intermittency, the tree search, 20,000 particles
     old=(--set truth.z=4.0 --set estimator.near_source_length=2.5 --set estimator.repeat_power=0.25
       --set 'estimator.learn={}')
-    OUT_SUFFIX=-nsl25 bash studies/study_turbulent_held_out.sh "${old[@]}"
-    STRATEGIES=dcee-cl OUT_SUFFIX=-decay bash studies/study_turbulent_held_out.sh "${old[@]}" \
+    OUT_SUFFIX=-nsl25 bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${old[@]}"
+    STRATEGIES=dcee-cl OUT_SUFFIX=-decay bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${old[@]}" \
       --set 'estimator.learn={decay=[1.0,0.5]}'
-    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts bash studies/study_turbulent_held_out.sh "${old[@]}"
-    STRATEGIES=dcee-cl OUT_SUFFIX=-nsl bash studies/study_turbulent_held_out.sh "${old[@]}" \
+    STRATEGIES=dcee-mcts OUT_SUFFIX=-mcts bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${old[@]}"
+    STRATEGIES=dcee-cl OUT_SUFFIX=-nsl bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${old[@]}" \
       --set 'estimator.learn={near_source_length=[2.5,0.0]}'
-    STRATEGIES=dcee-cl OUT_SUFFIX=-20k bash studies/study_turbulent_held_out.sh "${old[@]}" \
+    STRATEGIES=dcee-cl OUT_SUFFIX=-20k bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${old[@]}" \
       --particles 20000
     r=results/turbulent-lbm-held-out-100
-    report turbulent-lbm-held-out-100-dm turbulent-lbm-held-out-100-dm-info turbulent-lbm-held-out-100-mcts-dm \
+    report turbulent-lbm-held-out-100-d29 \
+      turbulent-lbm-held-out-100-dm turbulent-lbm-held-out-100-dm-info turbulent-lbm-held-out-100-mcts-dm \
       turbulent-lbm-held-out-100-dm-h2 \
       turbulent-lbm-held-out-100-bf turbulent-lbm-held-out-100-mcts-bf turbulent-lbm-held-out-100-radius \
       turbulent-lbm-held-out-100-radius-prior \
@@ -615,6 +662,7 @@ case "${1:---list}" in
       turbulent-lbm-held-out-100-nsl25 turbulent-lbm-held-out-100-decay \
       turbulent-lbm-held-out-100-mcts turbulent-lbm-held-out-100-nsl turbulent-lbm-held-out-100-20k
     $P studies/collect_metrics.py --out docs/results/lbm-held-out-100 \
+      "$r-d29=defaults:2026-11-29,learn:none,particles:10000" \
       "$r-dm=defaults:2026-11-27c,learn:none,particles:10000" \
       "$r-dm-info=defaults:2026-11-27c,learn:none,particles:10000" \
       "$r-mcts-dm=defaults:2026-11-27c,learn:none,particles:10000" \

@@ -11,7 +11,8 @@ D=.venv/bin/dcee
 # --allow-code-change: these campaigns span commits that did not change a search (each version
 # used is recorded in campaign.json)
 HO="--suite held-out --repeats 1 --particles 10000 --allow-code-change"
-FIL="--unknown full --truth filament --likelihood fluctuation"
+# dcee-cl looked one move ahead before search.lookahead (2026-11-29): pinned so this reproduces
+FIL="--unknown full --truth filament --likelihood fluctuation --set search.lookahead=1"
 # the two one-step planners the done-when compares, on the three studies. The wind-known study
 # ran before the stall guard existed (search.stall_guard = 0); studies/guard_replay.py finds
 # the searches in which the guard would have fired and reruns those with it

@@ -8,7 +8,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 D=.venv/bin/dcee
-C="--repeats 1 --particles 10000 --strategies dcee-cl --allow-code-change"
+# dcee-cl looked one move ahead before search.lookahead (2026-11-29): pinned so this reproduces
+C="--repeats 1 --particles 10000 --strategies dcee-cl --allow-code-change --set search.lookahead=1"
 # tuning range
 $D bench --suite random-tune $C --unknown source --out results/stop-tune-wind-known
 $D bench --suite random-tune $C --unknown full --out results/stop-tune-full
@@ -20,4 +21,4 @@ $D bench --suite held-out-24 --repeats 4 --particles 10000 --strategies dcee-cl 
     --allow-code-change --unknown full --out results/stop-held-out-full
 $D bench --suite held-out-24 --repeats 2 --particles 10000 --strategies dcee-cl \
     --allow-code-change --unknown full --truth filament --likelihood fluctuation \
-    --out results/stop-held-out-filament
+    --set search.lookahead=1 --out results/stop-held-out-filament

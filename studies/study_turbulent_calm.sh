@@ -10,7 +10,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 D=.venv/bin/dcee
-FIL="--suite paper --unknown full --truth filament --likelihood fluctuation"
+# dcee-cl looked one move ahead before search.lookahead (2026-11-29): pinned so this reproduces
+FIL="--suite paper --unknown full --truth filament --likelihood fluctuation --set search.lookahead=1"
 # the done-when check: 12 configurations, one repeat, 10,000 particles
 $D bench $FIL --strategies infotaxis --repeats 1 --particles 10000 --out results/filament-dropout-10k
 # the filament study at paper scale (20,000 particles), infotaxis 12 × 10
