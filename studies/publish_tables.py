@@ -733,14 +733,15 @@ def latest_defaults(frame: pd.DataFrame, strategies: tuple[str, ...], **where: o
 
 
 def defaults_words(tags: dict) -> str:
-    """"today's defaults" when every planner's newest rows are today's, else which of them."""
+    """ "today's defaults" when every planner's newest rows are today's, else which of them."""
     if all(tag == TODAY_DEFAULTS.get(s) for s, tag in tags.items()):
         return "today's defaults (`dcee-cl` two moves ahead since 2026-11-29)"
     parts = [
-        f"`{s}` " + ("today's" if tag == TODAY_DEFAULTS.get(s) else EARLIER_DEFAULTS[tag])
+        f"`{s}` at "
+        + ("today's" if tag == TODAY_DEFAULTS.get(s) else f"the {EARLIER_DEFAULTS[tag]}")
         for s, tag in tags.items()
     ]
-    return "; ".join(parts)
+    return ", ".join(parts)
 
 
 def cross_truth_table(latest_only: bool = False) -> str:
@@ -974,9 +975,10 @@ def radius_prior_table(release: str) -> str:
 
 def horizon_tuning_table() -> str:
     """``dcee-cl:horizon=2`` on the tuning range, each search paired with ``dcee-cl`` one move
-    ahead at the defaults of 2026-11-27 (c) (the ``prior`` rows of docs/results/tuning-radius-prior-13-40, their 95 % region the
-    mixture's, as docs/results/mixture-region-prior-13-40 recomputed it). The rule, by which two
-    moves became the default (``search.lookahead``): docs/results/tuning-horizon-13-40."""
+    ahead at the defaults of 2026-11-27 (c) (the ``prior`` rows of
+    docs/results/tuning-radius-prior-13-40, their 95 % region the mixture's, as
+    docs/results/mixture-region-prior-13-40 recomputed it). The rule, by which two moves became
+    the default (``search.lookahead``): docs/results/tuning-horizon-13-40."""
     key = ["truth", "scenario", "seed"]
     base = pd.read_csv(RESULTS / "tuning-radius-prior-13-40" / "variants.csv")
     base = base[base["variant"] == "prior"].drop(columns="truth_in_95")
@@ -989,9 +991,7 @@ def horizon_tuning_table() -> str:
         "base": "`dcee-cl` one move ahead (the defaults of 2026-11-27 (c))",
         "horizon2": "`dcee-cl:horizon=2` (two moves ahead: today's default, `search.lookahead`)",
     }
-    return _variant_table(
-        frame, names, ("base", "horizon2"), "`dcee-cl` one move ahead", "planner"
-    )
+    return _variant_table(frame, names, ("base", "horizon2"), "`dcee-cl` one move ahead", "planner")
 
 
 def _by_truth(rows: pd.DataFrame) -> Iterator[tuple[str, pd.DataFrame]]:
