@@ -591,6 +591,7 @@ case "${1:---list}" in
         --as "dcee-cl=$ref" --csv "$lbm/lookahead_vs_before.csv" --tag truth_model=lbm
     done
     $P studies/upwind_detections.py "$r-d29=dcee-cl"
+    $P studies/worst_searches.py "$r-d29=dcee-cl" --out docs/figures/lbm-held-out-worst-lookahead.png
     out=docs/results/turbulent-held-out-100-today
     runs=()
     for t in puffs filament; do
