@@ -772,7 +772,7 @@ def cross_truth_table(latest_only: bool = False) -> str:
         if defaults == TODAY_DEFAULTS.get(strategy):
             return ""
         if strategy == "dcee-cl:horizon=2" and defaults == "2026-11-27c":
-            return ", flown as a planner option before it became `dcee-cl`'s default"
+            return ", the same planner as today's `dcee-cl`, flown before it became the default"
         return f", {EARLIER_DEFAULTS[defaults]}"
 
     for strategy in ("dcee-cl", "infotaxis", "dcee-mcts"):
