@@ -217,11 +217,13 @@ def what_we_found() -> str:
     turbulent_today = study("turbulent-held-out-100-today")
     for truth, what in (("filament", "filament truth"), ("puffs", "puff truth")):
         newest = latest_defaults(turbulent_today, ("dcee-cl", "infotaxis"), truth_model=truth)
+        cl = pick(turbulent_today, "dcee-cl", truth_model=truth, defaults=newest)
+        small = f" (`dcee-cl`{small_sample(cl)})" if small_sample(cl) else ""
         rows.append(
             planners_row(
                 f"**held-out**, {what}, all eight unknown, fluctuation likelihood, "
                 f"`held-out-100`, {defaults_words(newest)} (the backflow and disc members "
-                "learned, the mixture's region), `dcee-cl` / `infotaxis` "
+                f"learned, the mixture's region){small}, `dcee-cl` / `infotaxis` "
                 "(`turbulent-held-out-100-today`)",
                 turbulent_today,
                 ("dcee-cl", "infotaxis"),
@@ -720,6 +722,12 @@ EARLIER_DEFAULTS = {
 OLD_DEFAULTS = EARLIER_DEFAULTS["2026-11-23"]
 
 
+def small_sample(r: pd.Series) -> str:
+    """ ", N configurations (small sample)" for a row of fewer than the 100 held-out ones."""
+    n = int(r["searches"])
+    return f", {n} configurations (small sample)" if n < 100 else ""
+
+
 def latest_defaults(frame: pd.DataFrame, strategies: tuple[str, ...], **where: object) -> dict:
     """Per planner, the newest ``defaults`` tag among its rows where every column equals its
     value (the tags sort by date)."""
@@ -799,10 +807,12 @@ def cross_truth_table(latest_only: bool = False) -> str:
                 if latest_only and strategy in latest:
                     continue
                 latest.add(strategy)
+                r = pick(part, strategy, truth_model=truth)
+                small = small_sample(r)
                 add(
-                    f"{truth}, fluctuation likelihood{flown(defaults, strategy)}",
+                    f"{truth}, fluctuation likelihood{flown(defaults, strategy)}{small}",
                     chosen,
-                    pick(part, strategy, truth_model=truth),
+                    r,
                     "turbulent-held-out-100-today",
                 )
         if truth == "filament" and not latest_only:
@@ -825,9 +835,7 @@ def cross_truth_table(latest_only: bool = False) -> str:
             how += ", a planner option (chosen on the tuning range, measured here)"
         if int(r.get("particles", 10000)) != 10000:
             how += f", {int(r['particles']):,} particles (measured, not chosen on)"
-        how += flown(str(r["defaults"]), str(r["strategy"]))
-        if int(r["searches"]) < 100:
-            how += f", {int(r['searches'])} configurations (small sample)"
+        how += flown(str(r["defaults"]), str(r["strategy"])) + small_sample(r)
         add(f"**lbm** (fluid solver), fluctuation likelihood{how}", "none", r, "lbm-held-out-100")
     return table(CROSS_HEADER, rows)
 
