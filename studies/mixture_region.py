@@ -22,7 +22,12 @@ import os
 from multiprocessing import Pool
 
 import numpy as np
-from precision_variants import append_row, parse_variant, variant_scenario
+from precision_variants import (
+    add_variant_arguments,
+    append_row,
+    pinned_variants,
+    variant_scenario,
+)
 
 from dcee.scenarios import expand_names
 
@@ -74,22 +79,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--configs", nargs="+", default=["random:13-40"])
     ap.add_argument("--truths", nargs="+", default=["puffs", "filament"])
-    ap.add_argument("--variant", action="append", default=[])
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--csv", default=None)
-    ap.add_argument(
-        "--pin",
-        action="append",
-        default=[],
-        help="PATH=VALUE set in every variant before its own overrides (e.g. a default of "
-        "the day the rows were flown: search.lookahead=1)",
-    )
+    add_variant_arguments(ap)
     args = ap.parse_args()
-    pins = parse_variant("pins:" + ",".join(args.pin))[1]
-    variants = [
-        (label, {**pins, **over})
-        for label, over in (parse_variant(v) for v in (args.variant or ["base:"]))
-    ]
+    variants = pinned_variants(args)
     tasks = [
         (label, over, name, truth, 0)
         for label, over in variants

@@ -49,6 +49,28 @@ def parse_variant(text: str) -> tuple[str, dict]:
     return label, over
 
 
+def add_variant_arguments(ap: argparse.ArgumentParser) -> None:
+    """``--variant NAME:PATH=VALUE,...`` (repeatable) and ``--pin PATH=VALUE`` (repeatable)."""
+    ap.add_argument("--variant", action="append", default=[])
+    ap.add_argument(
+        "--pin",
+        action="append",
+        default=[],
+        help="PATH=VALUE set in every variant before its own overrides (e.g. a default of "
+        "the day the rows were flown: search.lookahead=1)",
+    )
+
+
+def pinned_variants(args: argparse.Namespace) -> list[tuple[str, dict]]:
+    """(label, overrides) per ``--variant`` (default one ``base`` with none), each with the
+    ``--pin`` settings first (a variant's own override of the same path wins)."""
+    pins = parse_variant("pins:" + ",".join(args.pin))[1]
+    return [
+        (label, {**pins, **over})
+        for label, over in (parse_variant(v) for v in (args.variant or ["base:"]))
+    ]
+
+
 def variant_scenario(name: str, truth: str, over: dict):
     """Configuration ``name`` on ``truth``, all eight unknown, the fluctuation likelihood,
     10,000 particles, then the variant's overrides ``over``."""
@@ -110,24 +132,13 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--configs", nargs="+", default=["random:1-12"])
     ap.add_argument("--truths", nargs="+", default=["puffs", "filament"])
-    ap.add_argument("--variant", action="append", default=[])
     ap.add_argument("--strategy", default="dcee-cl")
     ap.add_argument("--seeds", type=int, default=1)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--csv", default=None)
-    ap.add_argument(
-        "--pin",
-        action="append",
-        default=[],
-        help="PATH=VALUE set in every variant before its own overrides (e.g. a default of "
-        "the day the rows were flown: search.lookahead=1)",
-    )
+    add_variant_arguments(ap)
     args = ap.parse_args()
-    pins = parse_variant("pins:" + ",".join(args.pin))[1]
-    variants = [
-        (label, {**pins, **over})
-        for label, over in (parse_variant(v) for v in (args.variant or ["base:"]))
-    ]
+    variants = pinned_variants(args)
     tasks = [
         (label, over, name, truth, seed, args.strategy)
         for label, over in variants

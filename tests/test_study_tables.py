@@ -359,3 +359,23 @@ def test_upwind_detections_finds_a_planner_option_by_its_quoted_folder(tmp_path:
     assert row["upwind_share"] == pytest.approx(2 / 3)
     assert row["upwind_1m_share"] == pytest.approx(1 / 3)  # only the 3 m one is beyond 1 m
     assert row["upwind_2m_share"] == pytest.approx(1 / 3)
+
+
+def test_pinned_variants_set_the_pins_first_and_a_variant_overrides_them():
+    """precision_variants --pin: a setting of the day the rows were flown, in every variant."""
+    import argparse
+
+    pv = _script("precision_variants")
+    ap = argparse.ArgumentParser()
+    pv.add_variant_arguments(ap)
+    args = ap.parse_args(
+        ["--pin", "search.lookahead=1", "--variant", "a:", "--variant", "b:search.lookahead=2"]
+    )
+    assert pv.pinned_variants(args) == [
+        ("a", {"search.lookahead": 1}),
+        ("b", {"search.lookahead": 2}),
+    ]
+    assert pv.pinned_variants(ap.parse_args([])) == [("base", {})]
+    scenario = pv.variant_scenario("random:13", "puffs", pv.pinned_variants(args)[0][1])
+    assert scenario.lookahead == 1  # a turbulent scenario, two moves ahead unless pinned
+    assert pv.variant_scenario("random:13", "puffs", {}).lookahead == 2
