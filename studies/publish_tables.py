@@ -218,12 +218,13 @@ def what_we_found() -> str:
     for truth, what in (("filament", "filament truth"), ("puffs", "puff truth")):
         newest = latest_defaults(turbulent_today, ("dcee-cl", "infotaxis"), truth_model=truth)
         cl = pick(turbulent_today, "dcee-cl", truth_model=truth, defaults=newest)
-        small = f" (`dcee-cl`{small_sample(cl)})" if small_sample(cl) else ""
+        n = int(cl["searches"])
+        small = f"; `dcee-cl` on {n} of them (a small sample)" if n < 100 else ""
         rows.append(
             planners_row(
                 f"**held-out**, {what}, all eight unknown, fluctuation likelihood, "
-                f"`held-out-100`, {defaults_words(newest)} (the backflow and disc members "
-                f"learned, the mixture's region){small}, `dcee-cl` / `infotaxis` "
+                f"`held-out-100`{small}, {defaults_words(newest)} (the backflow and disc "
+                "members learned, the mixture's region), `dcee-cl` / `infotaxis` "
                 "(`turbulent-held-out-100-today`)",
                 turbulent_today,
                 ("dcee-cl", "infotaxis"),
@@ -743,7 +744,7 @@ def latest_defaults(frame: pd.DataFrame, strategies: tuple[str, ...], **where: o
 def defaults_words(tags: dict) -> str:
     """ "today's defaults" when every planner's newest rows are today's, else which of them."""
     if all(tag == TODAY_DEFAULTS.get(s) for s, tag in tags.items()):
-        return "today's defaults (`dcee-cl` two moves ahead since 2026-11-29)"
+        return "today's defaults, `dcee-cl` two moves ahead since 2026-11-29"
     parts = [
         f"`{s}` at "
         + ("today's" if tag == TODAY_DEFAULTS.get(s) else f"the {EARLIER_DEFAULTS[tag]}")
