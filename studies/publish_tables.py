@@ -375,7 +375,9 @@ def turbulent_table() -> str:
     rows = []
     for name, how in (
         ("turbulent-public-defaults", "the third round's defaults"),
-        ("turbulent-public-today", "**today's defaults**"),
+        # flown 2026-11-26 (the folder's name is of that day): a 2.5 m near-source fall, repeat
+        # power 1/4, no learned member, dcee-cl one move ahead
+        ("turbulent-public-today", "the fourth round's defaults (2026-11-26, one move ahead)"),
     ):
         frame = study(name)
         for truth in ("filament", "puffs"):
