@@ -57,14 +57,21 @@ def paired(name: str) -> pd.DataFrame:
     return pd.read_csv(RESULTS / name / "paired.csv")
 
 
-def pick(frame: pd.DataFrame, strategy: str, **where: object) -> pd.Series:
-    """The one row of ``strategy`` where every column equals its value (a dict value: the value
+def matching(frame: pd.DataFrame, strategy: str, **where: object) -> pd.DataFrame:
+    """The rows of ``strategy`` where every column equals its value (a dict value: the value
     for this strategy, e.g. :data:`TODAY_DEFAULTS`)."""
     rows = frame[frame["strategy"] == strategy]
     for key, value in where.items():
         if isinstance(value, dict):
             value = value[strategy]
         rows = rows[rows[key] == value]
+    return rows
+
+
+def pick(frame: pd.DataFrame, strategy: str, **where: object) -> pd.Series:
+    """The one row of ``strategy`` where every column equals its value (a dict value: the value
+    for this strategy, e.g. :data:`TODAY_DEFAULTS`)."""
+    rows = matching(frame, strategy, **where)
     if len(rows) != 1:
         raise KeyError(f"{strategy} {where}: {len(rows)} rows")
     return rows.iloc[0]
@@ -219,7 +226,7 @@ def what_we_found() -> str:
         newest = latest_defaults(turbulent_today, ("dcee-cl", "infotaxis"), truth_model=truth)
         cl = pick(turbulent_today, "dcee-cl", truth_model=truth, defaults=newest)
         n = int(cl["searches"])
-        small = f"; `dcee-cl` on {n} of them (a small sample)" if n < 100 else ""
+        small = f"; `dcee-cl` on {n} of them (a small sample)" if small_sample(cl) else ""
         rows.append(
             planners_row(
                 f"**held-out**, {what}, all eight unknown, fluctuation likelihood, "
@@ -734,13 +741,7 @@ def small_sample(r: pd.Series) -> str:
 def latest_defaults(frame: pd.DataFrame, strategies: tuple[str, ...], **where: object) -> dict:
     """Per planner, the newest ``defaults`` tag among its rows where every column equals its
     value (the tags sort by date)."""
-    out = {}
-    for strategy in strategies:
-        rows = frame[frame["strategy"] == strategy]
-        for key, value in where.items():
-            rows = rows[rows[key] == value]
-        out[strategy] = max(rows["defaults"].astype(str))
-    return out
+    return {s: max(matching(frame, s, **where)["defaults"].astype(str)) for s in strategies}
 
 
 def defaults_words(tags: dict) -> str:
@@ -825,10 +826,10 @@ def cross_truth_table(latest_only: bool = False) -> str:
                 pick(today, "dcee-mcts", study="filament"),
                 "held-out-today",
             )
-    generation = {"2026-11-29": 0, "2026-11-27c": 1, "2026-11-27b": 2, "2026-11-27": 3}
-    lbm = lbm.assign(
-        order=lbm["defaults"].astype(str).map(generation).fillna(len(generation))
-    ).sort_values("order", kind="stable")
+    # newest generation first (the tags sort by date, as latest_defaults reads them)
+    lbm = lbm.assign(order=lbm["defaults"].astype(str)).sort_values(
+        "order", ascending=False, kind="stable"
+    )
     option = lbm["strategy"].astype(str).str.contains(":")  # a planner's option, e.g. horizon=2
     if latest_only:  # per planner, the latest defaults flown, no options
         lbm = lbm[(lbm["learn"] == "none") & ~option].drop_duplicates("strategy", keep="first")

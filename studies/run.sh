@@ -12,6 +12,7 @@ report() { for dir in "$@"; do $D report "results/$dir"; cat "results/$dir/repor
 # looks two ahead in a turbulent plume (grid UAV, one release, open terrain). The turbulent
 # studies flown before pin one move, so that each reproduces what it published.
 LA1=(--set search.lookahead=1)
+LA1P=(--pin search.lookahead=1)  # the same for studies/precision_variants.py, mixture_region.py
 count_campaigns() {  # PLANNER SUFFIX: its two- and three-release held-out campaigns (issue 45)
   for N in two three; do
     $D bench --suite "$N-source-held-out-100" --repeats 1 --strategies "$1" \
@@ -334,7 +335,7 @@ case "${1:---list}" in
     # (near_source_length 10 m, reading_weight 1), so it reproduces with today's defaults
     old=estimator.near_source_length=10,estimator.reading_weight=1.0
     mkdir -p docs/results
-    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:1-12 --truths puffs filament \
+    $P studies/precision_variants.py "${LA1P[@]}" --configs random:1-12 --truths puffs filament \
       --variant "defaults:$old" --variant "hold8:$old,agent.dwell=8" \
       --variant "logsd2:$old,estimator.log_sd=2.0" \
       --variant "intermittency0.8:$old,estimator.intermittency=0.8" \
@@ -348,7 +349,7 @@ case "${1:---list}" in
     out=docs/results/tuning-turbulent-13-40
     tune() {  # CSV, then --variant/--strategy arguments
       local csv=$1; shift
-      $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths filament puffs "$@" \
+      $P studies/precision_variants.py "${LA1P[@]}" --configs random:13-40 --truths filament puffs "$@" \
         --csv "$out/$csv"
     }
     # second round, with the defaults of its day: a fixed altitude unless climbing, the
@@ -489,7 +490,7 @@ case "${1:---list}" in
       --csv docs/results/anemometer/anemometer.csv
     $P studies/publish_tables.py ;;
   tune-horizon)  # issue 42: dcee-cl looking two moves ahead on the tuning range, filament + puffs (docs/results/tuning-horizon-13-40)
-    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant horizon2: --strategy dcee-cl:horizon=2 --workers "${WORKERS:-2}" \
       --csv docs/results/tuning-horizon-13-40/variants.csv ;;
   lbm-endgame)  # issue 42, a lab note: where each planner reads last and ends on the lbm plume, eight tuning configurations (docs/plumes.md)
@@ -506,66 +507,66 @@ case "${1:---list}" in
     $P studies/lbm_statistics.py
     $P studies/publish_tables.py ;;
   tune-learn)  # the learned reading model (estimator.learn) on the tuning range, filament + puffs (docs/plumes.md)
-    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant base: \
       --variant 'decay:estimator.learn={decay=[1.0,0.5]}' \
       --variant 'nsl:estimator.learn={near_source_length=[2.5,0.0]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-learn-13-40/variants.csv
     $P studies/publish_tables.py ;;
   tune-log-sd)  # the learned log-normal spread on the tuning range, filament + puffs (docs/plumes.md)
-    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant base: \
       --variant 'sd:estimator.learn={log_sd=[1.3,2.0,3.0]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-log-sd-13-40/variants.csv
     $P studies/publish_tables.py ;;
   tune-near-sd)  # the learned near-source spread on the tuning range, filament + puffs (docs/plumes.md)
-    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant 'nearsd:estimator.log_sd_length=1.5,estimator.learn={log_sd_near=[0.0,3.0,6.0]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-near-sd-13-40/variants.csv
     $P studies/publish_tables.py ;;
   tune-nsl05)  # a 0.5 m near-source fall on the tuning range, filament + puffs (docs/plumes.md)
-    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant 'nsl05:estimator.near_source_length=0.5' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-nsl05-13-40/variants.csv
     $P studies/publish_tables.py ;;
   tune-nsl05-rp05)  # the 0.5 m fall with a repeat discount of power 1/2, tuning range (docs/plumes.md)
-    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant 'nsl05rp05:estimator.near_source_length=0.5,estimator.repeat_power=0.5' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-nsl05-rp05-13-40/variants.csv
     $P studies/publish_tables.py ;;
   tune-backflow)  # gas upwind of the release, learned, on the tuning range (docs/plumes.md)
-    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant base: --variant 'backflow:estimator.learn={backflow=[0.0,0.05]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-backflow-13-40/variants.csv
     $P studies/publish_tables.py ;;
   tune-source-radius)  # a release spread over a disc, learned, on the tuning range (docs/plumes.md)
     # paired with today's defaults: the backflow rows of docs/results/tuning-backflow-13-40
-    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant 'radius:estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-source-radius-13-40/variants.csv
     $P studies/publish_tables.py ;;
   tune-area-release)  # the tuning truths released over an area: do they reproduce the lbm failure? (docs/plumes.md)
-    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant 'area:truth.model.puff_radius=0.5' \
       --variant 'area-radius:truth.model.puff_radius=0.5,estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-area-release-13-40/variants.csv ;;
   tune-area-release-1m)  # the tuning truths released over a 1 m disc at today's defaults: a closer stand-in for the lbm plume? (docs/plumes.md)
-    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant 'area1:truth.model.puff_radius=1.0' \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-area-release-1m-13-40/variants.csv ;;
   tune-radius-prior)  # disc members with prior odds 9:1 against, on point and area releases (docs/plumes.md)
     cand='estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]},estimator.learn_prior={source_radius=[0.9,0.1]}'
-    $P studies/precision_variants.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
+    $P studies/precision_variants.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant "prior:$cand" --variant "area-prior:truth.model.puff_radius=0.5,$cand" \
       --workers "${WORKERS:-2}" --csv docs/results/tuning-radius-prior-13-40/variants.csv ;;
   mixture-region)  # the 95 % region of the reading models' mixture beside the selected one's, disc members (docs/plumes.md)
     cand='estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]}'
-    $P studies/mixture_region.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
+    $P studies/mixture_region.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant "radius:$cand" --variant "area-radius:truth.model.puff_radius=0.5,$cand" \
       --workers "${WORKERS:-2}" --csv docs/results/mixture-region-13-40/searches.csv ;;
   mixture-region-prior)  # disc members with prior odds 9:1 against and the mixture's region, point and area releases (docs/plumes.md)
     cand='estimator.learn={backflow=[0.0,0.05],source_radius=[0.0,1.0]},estimator.learn_prior={source_radius=[0.9,0.1]}'
-    $P studies/mixture_region.py --pin search.lookahead=1 --configs random:13-40 --truths puffs filament \
+    $P studies/mixture_region.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant "prior:$cand" --variant "area-prior:truth.model.puff_radius=0.5,$cand" \
       --workers "${WORKERS:-2}" --csv docs/results/mixture-region-prior-13-40/searches.csv ;;
   lookahead-held-out)  # issue 42: dcee-cl at today's defaults (two moves ahead, search.lookahead) on the held-out lbm plume and both turbulent truths, stored beside the earlier generations

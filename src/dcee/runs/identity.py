@@ -18,6 +18,7 @@ from dcee.scenarios import (
     unset_climb,
     unset_lookahead,
 )
+from dcee.scenarios.schema.world import WorldSpec
 
 
 def _unicycle_defaults() -> dict[str, Any]:
@@ -183,11 +184,10 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
     if isinstance(search, dict) and "lookahead" in search and search["lookahead"] is None:
         # unset: the look-ahead it resolved to (Scenario.lookahead), compared as that number
         est = estimator if isinstance(estimator, dict) else {}
-        world = out.get("world") if isinstance(out.get("world"), dict) else {}
-        open_terrain = not (world.get("obstacles") or world.get("no_go") or world.get("map"))
+        world = WorldSpec.model_validate(out.get("world") or {})  # a stored dump round-trips
         model = agent.get("model", "grid") if isinstance(agent, dict) else "grid"
         search["lookahead"] = unset_lookahead(
-            est.get("likelihood", "paper"), model, int(est.get("max_sources", 1)), open_terrain
+            est.get("likelihood", "paper"), model, int(est.get("max_sources", 1)), world.empty
         )
     sensor, truth = out.get("sensor"), out.get("truth")
     if isinstance(sensor, dict) and "dropout" not in sensor and isinstance(truth, dict):
