@@ -1006,6 +1006,22 @@ def horizon_tuning_table() -> str:
     return _variant_table(frame, names, ("base", "horizon2"), "`dcee-cl` one move ahead", "planner")
 
 
+def lookahead3_tuning_table() -> str:
+    """``search.lookahead = 3`` on the tuning range, each search paired with today's ``dcee-cl``
+    (two moves ahead: the ``horizon2`` rows of docs/results/tuning-horizon-13-40, the same
+    planner decision for decision). The rule: docs/results/tuning-lookahead3-13-40."""
+    base = pd.read_csv(RESULTS / "tuning-horizon-13-40" / "variants.csv")
+    candidate = pd.read_csv(RESULTS / "tuning-lookahead3-13-40" / "variants.csv")
+    frame = pd.concat([base.assign(variant="base"), candidate.assign(variant="lookahead3")])
+    names = {
+        "base": "`dcee-cl` two moves ahead (today's default)",
+        "lookahead3": "`search.lookahead = 3` (three moves ahead)",
+    }
+    return _variant_table(
+        frame, names, ("base", "lookahead3"), "`dcee-cl` two moves ahead", "planner"
+    )
+
+
 def _by_truth(rows: pd.DataFrame) -> Iterator[tuple[str, pd.DataFrame]]:
     """(truth, rows) for the filament, the puffs and both together (the last only when both
     are there: one truth's own row says it all); truths without rows are skipped."""
@@ -1618,6 +1634,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "lbm-near-source": lbm_near_source_table,
     "lbm-endgame": lbm_endgame_table,
     "horizon-tuning": horizon_tuning_table,
+    "lookahead3-tuning": lookahead3_tuning_table,
     "cross-truth": cross_truth_table,
     "cross-truth-latest": lambda: cross_truth_table(latest_only=True),
     "radius-prior-point": lambda: radius_prior_table("point"),

@@ -493,6 +493,11 @@ case "${1:---list}" in
     $P studies/precision_variants.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant horizon2: --strategy dcee-cl:horizon=2 --workers "${WORKERS:-2}" \
       --csv docs/results/tuning-horizon-13-40/variants.csv ;;
+  tune-lookahead3)  # issue 42: dcee-cl looking three moves ahead on the tuning range, filament + puffs (docs/results/tuning-lookahead3-13-40)
+    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+      --variant lookahead3:search.lookahead=3 --strategy dcee-cl --workers "${WORKERS:-2}" \
+      --csv docs/results/tuning-lookahead3-13-40/variants.csv
+    $P studies/publish_tables.py ;;
   lbm-endgame)  # issue 42, a lab note: where each planner reads last and ends on the lbm plume, eight tuning configurations (docs/plumes.md)
     for s in dcee-cl dcee-cl:horizon=2 dcee-mcts dcee-mcts:depth=1 infotaxis; do
       for k in 13 14 15 16 17 18 19 20; do
