@@ -1,6 +1,6 @@
-"""The decision time of `dcee-cl` one and two moves ahead (docs/plumes.md, issue 42): the same
-lbm search (`random:13`, all eight unknown, the fluctuation likelihood, 10,000 particles,
-seed 0) flown with `dcee-cl` and `dcee-cl:horizon=2`, ``--rounds`` times in alternation, each a
+"""The decision time of `dcee-cl` one, two and three moves ahead (docs/plumes.md, issue 42): the
+same lbm search (`random:13`, all eight unknown, the fluctuation likelihood, 10,000 particles,
+seed 0) flown with `dcee-cl:horizon=1`, `=2` and `=3`, ``--rounds`` times in alternation, each a
 `dcee run` of its own on one pinned core with one numba, OpenMP and BLAS thread. Writes JSON
 with each search's mean decision time, the machine and the load beside the run
 (docs/results/perf/horizon-timing.json); run it with nothing else on the machine.
@@ -24,7 +24,7 @@ from demo_decision import ONE_CORE, ROOT
 
 from dcee.perf.machine import LoadMonitor, store_timing
 
-PLANNERS = ("dcee-cl", "dcee-cl:horizon=2")
+PLANNERS = ("dcee-cl:horizon=1", "dcee-cl:horizon=2", "dcee-cl:horizon=3")
 SEARCH = [
     "run", "--scenario", "random:13", "--unknown", "full", "--likelihood", "fluctuation",
     "--truth", "lbm", "--particles", "10000", "--set", "truth.z=4.0", "--seed", "0",
@@ -53,14 +53,19 @@ def main() -> None:
             for planner in PLANNERS:
                 out = Path(scratch) / f"{k}-{planner.replace(':', '_')}"
                 times[planner].append(_decision_ms(planner, out))
-    one, two = (float(np.mean(times[p])) for p in PLANNERS)
-    print(f"mean decision: one move {one:.1f} ms, two moves {two:.1f} ms, {two / one:.2f}x")
+    one, two, three = (float(np.mean(times[p])) for p in PLANNERS)
+    print(
+        f"mean decision: one move {one:.1f} ms, two moves {two:.1f} ms ({two / one:.2f}x), "
+        f"three moves {three:.1f} ms ({three / one:.2f}x, {three / two:.2f}x two moves)"
+    )
     store_timing(
         args.json,
         load.record(),
         search=" ".join(SEARCH),
         decision_ms=times,
         ratio=two / one,
+        ratio_three=three / one,
+        ratio_three_to_two=three / two,
     )
 
 
