@@ -7,6 +7,7 @@ from dcee.provenance import (
     FALLBACK_VERSION,
     code_version,
     describe,
+    platform_record,
     version_from_describe,
     version_without_tag,
 )
@@ -52,3 +53,27 @@ def test_version_without_a_tag_follows_setuptools_scm() -> None:
 def test_the_fallback_version_is_pyprojects() -> None:
     text = (Path(__file__).parents[1] / "pyproject.toml").read_text()
     assert f'fallback_version = "{FALLBACK_VERSION}"' in text
+
+
+def test_every_summary_records_the_platform_its_kernels_were_compiled_for(monkeypatch) -> None:
+    import llvmlite.binding as llvm
+    import numba
+    import numpy
+
+    from dcee.runs.episode import run_episode
+    from dcee.scenarios import load_scenario
+
+    platform_record.cache_clear()
+    monkeypatch.delenv("NUMBA_CPU_NAME", raising=False)
+    here = platform_record()
+    assert here["cpu"] == llvm.get_host_cpu_name() and here["numba"] == numba.__version__
+    assert here["numpy"] == numpy.__version__ and here["machine"]
+    platform_record.cache_clear()
+    monkeypatch.setenv("NUMBA_CPU_NAME", "generic")
+    assert platform_record()["cpu"] == "generic"  # the target numba compiles for, not the host
+    platform_record.cache_clear()
+    monkeypatch.delenv("NUMBA_CPU_NAME")
+    scenario = load_scenario("paper:1").with_overrides(
+        **{"search.particles": 500, "search.hypotheses": 5, "search.budget": 30.0}
+    )
+    assert run_episode(scenario, "dcee", 0).summary["platform"] == here

@@ -1,5 +1,6 @@
 """Which code made a result: the package version, the git commit, a dirty flag and a hash of the
-source files, recorded in every summary and campaign.
+source files, recorded in every summary and campaign; and the platform it ran on (the CPU the
+kernels were compiled for, numpy's and numba's versions), recorded in every summary.
 
 The installed version alone is not enough: an editable install freezes it at install time, so
 every result would claim the same version whatever the code. In a git work tree the version is
@@ -13,6 +14,8 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import os
+import platform
 import re
 import subprocess
 from importlib.metadata import PackageNotFoundError, version
@@ -51,6 +54,26 @@ def code_version() -> dict[str, Any]:
         "commit": _git("rev-parse", "HEAD"),
         "dirty": dirty,
         "source_hash": source_hash(),
+    }
+
+
+@functools.cache
+def platform_record() -> dict[str, Any]:
+    """``{"cpu", "machine", "numpy", "numba"}``: the CPU numba compiles the kernels for (the
+    host's, or ``NUMBA_CPU_NAME`` where set), the architecture and the two libraries whose
+    arithmetic a search runs on. Two machines with the same code can round the compiled sums
+    differently in the last bit, and a search that meets nearly tied decisions (the lbm plume)
+    then parts from its twin (docs/design.md, "Reproducibility"): a comparison search for search
+    is one made on one platform."""
+    import llvmlite.binding as llvm
+    import numba
+    import numpy
+
+    return {
+        "cpu": os.environ.get("NUMBA_CPU_NAME") or llvm.get_host_cpu_name(),
+        "machine": platform.machine(),
+        "numpy": numpy.__version__,
+        "numba": numba.__version__,
     }
 
 

@@ -10,7 +10,7 @@ import numpy as np
 from dcee.estimation.base import Estimator
 from dcee.planning import get as get_planner
 from dcee.planning.team import check_team_planner
-from dcee.provenance import code_version
+from dcee.provenance import code_version, platform_record
 from dcee.runs.assemble import planner_defaults
 from dcee.runs.result import EpisodeResult
 from dcee.runs.simulation import SearchSimulation
@@ -75,6 +75,7 @@ def run_episode(
         "code": code_version(),
     }
     summary["code"] = config["code"]
+    summary["platform"] = platform_record()
     summary["version"] = config["code"]["version"]
     # a count bank's most probable count, every release (figures colour each); else the filter's
     final = getattr(pf, "estimate_particles", None)

@@ -48,7 +48,7 @@ UAV, fluctuation likelihood, one release, open terrain). Chosen on the tuning ra
 of filament and puffs against one move by a rule written before the run (acquisition not lower,
 truth in the 95 % region not lower by more than 2 points, median paired final error no more than
 0.05 m worse): 56/56 both, region 96.4 against 98.2 %, final RMSE 0.44 against 0.54 m (paired
--0.05 m, Wilcoxon p = 0.016; docs/results/tuning-horizon-13-40). A decision costs about 3x one
+-0.05 m, Wilcoxon p = 0.016; docs/results/tuning-horizon-13-40). A decision costs 3-4x one
 move's (docs/results/perf/horizon-timing.json). Not measured with several releases, on a site
 or on the unicycle robot, which keep 1."""
 
