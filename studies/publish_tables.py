@@ -715,13 +715,15 @@ CROSS_HEADER = [
 ]
 
 
-TODAY_DEFAULTS = {"dcee-cl": "2026-11-29", "infotaxis": "2026-11-27c", "dcee-mcts": "2026-11-27c"}
+TODAY_DEFAULTS = {"dcee-cl": "2026-11-29b", "infotaxis": "2026-11-27c", "dcee-mcts": "2026-11-27c"}
 """Per planner, the ``defaults`` tag of rows flown at today's defaults (a 0.5 m near-source
 fall, repeat power 1/2, the backflow member and the disc member at prior odds 9 : 1 learned, the
-95 % region the members' mixture's; since 2026-11-29 ``dcee-cl`` looks two moves ahead in a
-turbulent plume, ``search.lookahead``, which changed no other planner: their rows of 2026-11-27
+95 % region the members' mixture's; ``dcee-cl`` looks three moves ahead in a turbulent plume
+since 2026-11-29 (b) (two on 2026-11-29), ``search.lookahead``, which changed no other planner:
+their rows of 2026-11-27
 (c) are today's)."""
 EARLIER_DEFAULTS = {
+    "2026-11-29": "defaults of 2026-11-29: `dcee-cl` two moves ahead",
     "2026-11-27c": "defaults of 2026-11-27 (c): `dcee-cl` one move ahead",
     "2026-11-27b": "defaults of 2026-11-27 (b): the backflow member alone, the selected "
     "member's region",
@@ -747,7 +749,7 @@ def latest_defaults(frame: pd.DataFrame, strategies: tuple[str, ...], **where: o
 def defaults_words(tags: dict) -> str:
     """ "today's defaults" when every planner's newest rows are today's, else which of them."""
     if all(tag == TODAY_DEFAULTS.get(s) for s, tag in tags.items()):
-        return "today's defaults, `dcee-cl` two moves ahead since 2026-11-29"
+        return "today's defaults, `dcee-cl` three moves ahead since 2026-11-29 (b)"
     parts = [
         f"`{s}` at "
         + ("today's" if tag == TODAY_DEFAULTS.get(s) else f"the {EARLIER_DEFAULTS[tag]}")
@@ -784,7 +786,10 @@ def cross_truth_table(latest_only: bool = False) -> str:
         if defaults == TODAY_DEFAULTS.get(strategy):
             return ""
         if strategy == "dcee-cl:horizon=2" and defaults == "2026-11-27c":
-            return ", the same planner as today's `dcee-cl`, flown before it became the default"
+            return (
+                ", the same planner as `dcee-cl` at the defaults of 2026-11-29, flown before "
+                "they were the defaults"
+            )
         return f", {EARLIER_DEFAULTS[defaults]}"
 
     for strategy in ("dcee-cl", "infotaxis", "dcee-mcts"):
@@ -990,7 +995,7 @@ def horizon_tuning_table() -> str:
     ahead at the defaults of 2026-11-27 (c) (the ``prior`` rows of
     docs/results/tuning-radius-prior-13-40, their 95 % region the mixture's, as
     docs/results/mixture-region-prior-13-40 recomputed it). The rule, by which two moves became
-    the default (``search.lookahead``): docs/results/tuning-horizon-13-40."""
+    the default of 2026-11-29 (``search.lookahead``): docs/results/tuning-horizon-13-40."""
     key = ["truth", "scenario", "seed"]
     base = pd.read_csv(RESULTS / "tuning-radius-prior-13-40" / "variants.csv")
     base = base[base["variant"] == "prior"].drop(columns="truth_in_95")
@@ -1001,21 +1006,22 @@ def horizon_tuning_table() -> str:
     frame = pd.concat([base.assign(variant="base"), candidate.assign(variant="horizon2")])
     names = {
         "base": "`dcee-cl` one move ahead (the defaults of 2026-11-27 (c))",
-        "horizon2": "`dcee-cl:horizon=2` (two moves ahead: today's default, `search.lookahead`)",
+        "horizon2": "`dcee-cl:horizon=2` (two moves ahead: the default of 2026-11-29)",
     }
     return _variant_table(frame, names, ("base", "horizon2"), "`dcee-cl` one move ahead", "planner")
 
 
 def lookahead3_tuning_table() -> str:
-    """``search.lookahead = 3`` on the tuning range, each search paired with today's ``dcee-cl``
-    (two moves ahead: the ``horizon2`` rows of docs/results/tuning-horizon-13-40, the same
-    planner decision for decision). The rule: docs/results/tuning-lookahead3-13-40."""
+    """``search.lookahead = 3`` on the tuning range, each search paired with ``dcee-cl`` two moves
+    ahead (the default of 2026-11-29: the ``horizon2`` rows of docs/results/tuning-horizon-13-40,
+    the same planner decision for decision). The rule, by which three moves became the default:
+    docs/results/tuning-lookahead3-13-40."""
     base = pd.read_csv(RESULTS / "tuning-horizon-13-40" / "variants.csv")
     candidate = pd.read_csv(RESULTS / "tuning-lookahead3-13-40" / "variants.csv")
     frame = pd.concat([base.assign(variant="base"), candidate.assign(variant="lookahead3")])
     names = {
-        "base": "`dcee-cl` two moves ahead (today's default)",
-        "lookahead3": "`search.lookahead = 3` (three moves ahead)",
+        "base": "`dcee-cl` two moves ahead (the default of 2026-11-29)",
+        "lookahead3": "`search.lookahead = 3` (three moves ahead: today's default)",
     }
     return _variant_table(
         frame, names, ("base", "lookahead3"), "`dcee-cl` two moves ahead", "planner"

@@ -8,11 +8,13 @@ D=.venv/bin/dcee
 P=.venv/bin/python
 [ -x "$D" ] || bash scripts/setup.sh
 report() { for dir in "$@"; do $D report "results/$dir"; cat "results/$dir/report/metrics.md"; done; }
-# dcee-cl looked one move ahead everywhere until search.lookahead (2026-11-29, issue 42); today it
-# looks two ahead in a turbulent plume (grid UAV, one release, open terrain). The turbulent
-# studies flown before pin one move, so that each reproduces what it published.
+# dcee-cl looked one move ahead everywhere until search.lookahead (2026-11-29, issue 42), two in a
+# turbulent plume (grid UAV, one release, open terrain) on 2026-11-29, three since 2026-11-29 (b).
+# The turbulent studies flown before pin what they flew, so that each reproduces what it
+# published.
 LA1=(--set search.lookahead=1)
 LA1P=(--pin search.lookahead=1)  # the same for studies/precision_variants.py, mixture_region.py
+LA2=(--set search.lookahead=2)
 count_campaigns() {  # PLANNER SUFFIX: its two- and three-release held-out campaigns (issue 45)
   for N in two three; do
     $D bench --suite "$N-source-held-out-100" --repeats 1 --strategies "$1" \
@@ -574,7 +576,31 @@ case "${1:---list}" in
     $P studies/mixture_region.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant "prior:$cand" --variant "area-prior:truth.model.puff_radius=0.5,$cand" \
       --workers "${WORKERS:-2}" --csv docs/results/mixture-region-prior-13-40/searches.csv ;;
-  lookahead-held-out)  # issue 42: dcee-cl at today's defaults (two moves ahead, search.lookahead) on the held-out lbm plume and both turbulent truths, stored beside the earlier generations
+  lookahead3-held-out)  # issue 42: dcee-cl at today's defaults (three moves ahead since 2026-11-29 (b)) on the held-out lbm plume, stored beside the earlier generations
+    # the lbm plume held out (no default chosen on it); paired with the two-move rows of
+    # 2026-11-29 and the other planners' rows of 2026-11-27 (c) (unchanged: today's)
+    export SUITE=held-out-100 WORKERS=${WORKERS:-2}
+    r=results/turbulent-lbm-held-out-100
+    TRUTHS=lbm STRATEGIES=dcee-cl OUT_SUFFIX=-d29b bash studies/study_turbulent_held_out.sh \
+      --set truth.z=4.0
+    report turbulent-lbm-held-out-100-d29b
+    lbm=docs/results/lbm-held-out-100
+    keep=()
+    for g in 2026-11-29 2026-11-27c 2026-11-27b 2026-11-27 2026-11-23; do keep+=(--keep "defaults:$g"); done
+    $P studies/collect_metrics.py --out "$lbm" "${keep[@]}" \
+      "$r-d29b=defaults:2026-11-29b,learn:none,particles:10000"
+    rm -f "$lbm/lookahead3_vs_before.csv"
+    $P studies/pair_campaigns.py "$lbm/searches.csv=strategy:dcee-cl:learn:none:particles:10000.0:defaults:2026-11-29" \
+      "$r-d29b" --csv "$lbm/lookahead3_vs_before.csv" --tag truth_model=lbm
+    pick="learn:none:particles:10000.0:defaults:2026-11-27c"
+    for ref in dcee-cl infotaxis dcee-mcts; do
+      $P studies/pair_campaigns.py "$lbm/searches.csv=strategy:$ref:$pick" "$r-d29b" \
+        --as "dcee-cl=$ref" --csv "$lbm/lookahead3_vs_before.csv" --tag truth_model=lbm
+    done
+    $P studies/upwind_detections.py "$r-d29b=dcee-cl"
+    $P studies/worst_searches.py "$r-d29b=dcee-cl" --out docs/figures/lbm-held-out-worst-lookahead3.png
+    $P studies/publish_tables.py ;;
+  lookahead-held-out)  # issue 42: dcee-cl at the defaults of 2026-11-29 (two moves ahead, search.lookahead) on the held-out lbm plume and both turbulent truths, stored beside the earlier generations
     # the lbm plume held out (no default chosen on it); filament and puffs, where the look-ahead
     # was chosen (a check, not an independent result). The other planners did not change: their
     # rows of 2026-11-27 (c) are today's. Rows of earlier generations kept from the stored study
@@ -582,12 +608,12 @@ case "${1:---list}" in
     export SUITE=held-out-100 WORKERS=${WORKERS:-2}
     r=results/turbulent-lbm-held-out-100
     TRUTHS=lbm STRATEGIES=dcee-cl OUT_SUFFIX=-d29 bash studies/study_turbulent_held_out.sh \
-      --set truth.z=4.0
-    STRATEGIES=dcee-cl OUT_SUFFIX=-today-d29 bash studies/study_turbulent_held_out.sh
+      "${LA2[@]}" --set truth.z=4.0
+    STRATEGIES=dcee-cl OUT_SUFFIX=-today-d29 bash studies/study_turbulent_held_out.sh "${LA2[@]}"
     report turbulent-lbm-held-out-100-d29
     lbm=docs/results/lbm-held-out-100
     keep=()
-    for g in 2026-11-27c 2026-11-27b 2026-11-27 2026-11-23; do keep+=(--keep "defaults:$g"); done
+    for g in 2026-11-29b 2026-11-27c 2026-11-27b 2026-11-27 2026-11-23; do keep+=(--keep "defaults:$g"); done
     $P studies/collect_metrics.py --out "$lbm" "${keep[@]}" \
       "$r-d29=defaults:2026-11-29,learn:none,particles:10000"
     rm -f "$lbm/lookahead_vs_before.csv"

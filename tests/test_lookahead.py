@@ -1,5 +1,5 @@
 """``search.lookahead``: how many moves ``dcee-cl`` looks ahead. Unset, it follows the expected
-plume: two moves where it was chosen (the grid UAV, the fluctuation likelihood, one release, open
+plume: three moves where it was chosen (the grid UAV, the fluctuation likelihood, one release, open
 terrain), one everywhere else (every search there unchanged)."""
 
 import numpy as np
@@ -15,12 +15,12 @@ def _turbulent():
     return load_scenario("random:16").with_overrides(**{"estimator.likelihood": "fluctuation"})
 
 
-def test_an_unset_lookahead_is_two_only_where_it_was_chosen():
+def test_an_unset_lookahead_is_three_only_where_it_was_chosen():
     paper = load_scenario("random:16")
     turbulent = _turbulent()
-    assert AUTO_LOOKAHEAD == 2
+    assert AUTO_LOOKAHEAD == 3
     assert paper.search.lookahead is None and paper.lookahead == 1
-    assert turbulent.lookahead == 2
+    assert turbulent.lookahead == 3
     # not measured with several releases, on a site or on the ground robot: one move, as before
     several = {"estimator.max_sources": 2, "estimator.calm_prior": 0.0, "estimator.learn": {}}
     assert turbulent.with_overrides(**several).lookahead == 1
@@ -30,15 +30,15 @@ def test_an_unset_lookahead_is_two_only_where_it_was_chosen():
     # a value set is kept everywhere
     assert paper.with_overrides(**{"search.lookahead": 3}).lookahead == 3
     assert turbulent.with_overrides(**{"search.lookahead": 1}).lookahead == 1
-    assert unset_lookahead("fluctuation", "grid", 1, True) == 2
+    assert unset_lookahead("fluctuation", "grid", 1, True) == 3
     assert unset_lookahead("paper", "grid", 1, True) == 1
     assert unset_lookahead("fluctuation", "grid", 1, False) == 1
 
 
 def test_only_dcee_cl_follows_it_and_a_spec_overrides_it():
     turbulent = _turbulent()
-    assert planner_defaults("dcee-cl", turbulent, None)["horizon"] == 2
-    assert get_planner("dcee-cl", **planner_defaults("dcee-cl", turbulent, None)).horizon == 2
+    assert planner_defaults("dcee-cl", turbulent, None)["horizon"] == 3
+    assert get_planner("dcee-cl", **planner_defaults("dcee-cl", turbulent, None)).horizon == 3
     spec = "dcee-cl:horizon=1"
     assert get_planner(spec, **planner_defaults(spec, turbulent, None)).horizon == 1
     # the paper's likelihood: the planner's own one move
@@ -55,12 +55,14 @@ def test_only_dcee_cl_follows_it_and_a_spec_overrides_it():
 
 def test_the_resolved_lookahead_is_shown_and_decides_a_campaign_identity():
     turbulent = _turbulent()
-    assert "# lookahead = 2  (unset: the default for this scenario)" in to_toml(turbulent)
+    assert "# lookahead = 3  (unset: the default for this scenario)" in to_toml(turbulent)
     stored = turbulent.model_dump(mode="json")
-    explicit = turbulent.with_overrides(**{"search.lookahead": 2}).model_dump(mode="json")
+    explicit = turbulent.with_overrides(**{"search.lookahead": 3}).model_dump(mode="json")
     one = turbulent.with_overrides(**{"search.lookahead": 1}).model_dump(mode="json")
+    two = turbulent.with_overrides(**{"search.lookahead": 2}).model_dump(mode="json")
     assert scenario_identity(stored) == scenario_identity(explicit)
     assert scenario_identity(stored) != scenario_identity(one)
+    assert scenario_identity(stored) != scenario_identity(two)
     # a turbulent campaign stored before the setting existed flew one move ahead: it resumes
     # only with the look-ahead pinned to 1
     before = turbulent.model_dump(mode="json")
@@ -80,20 +82,20 @@ def test_a_lookahead_out_of_range_is_refused(bad):
         load_scenario("random:16").with_overrides(**{"search.lookahead": bad})
 
 
-def test_the_unset_lookahead_is_the_two_move_planner_decision_for_decision():
-    """A turbulent scenario's dcee-cl with the look-ahead unset decides as dcee-cl:horizon=2."""
+def test_the_unset_lookahead_is_the_three_move_planner_decision_for_decision():
+    """A turbulent scenario's dcee-cl with the look-ahead unset decides as dcee-cl:horizon=3."""
     from dcee.runs import run_episode
 
     scenario = _turbulent().with_overrides(
         **{"search.particles": 300, "search.hypotheses": 8, "search.budget": 40.0}
     )
     auto = run_episode(scenario, "dcee-cl", seed=3)
-    spec = run_episode(scenario, "dcee-cl:horizon=2", seed=3)
-    one = run_episode(scenario, "dcee-cl:horizon=1", seed=3)
+    spec = run_episode(scenario, "dcee-cl:horizon=3", seed=3)
+    two = run_episode(scenario, "dcee-cl:horizon=2", seed=3)
 
     def path(result):
         return np.array([[r["x"], r["y"], r["z"]] for r in result.records])
 
     np.testing.assert_array_equal(path(auto), path(spec))
     np.testing.assert_array_equal(auto.final_theta, spec.final_theta)
-    assert not np.array_equal(path(auto), path(one))
+    assert not np.array_equal(path(auto), path(two))

@@ -377,5 +377,5 @@ def test_pinned_variants_set_the_pins_first_and_a_variant_overrides_them():
     ]
     assert pv.pinned_variants(ap.parse_args([])) == [("base", {})]
     scenario = pv.variant_scenario("random:13", "puffs", pv.pinned_variants(args)[0][1])
-    assert scenario.lookahead == 1  # a turbulent scenario, two moves ahead unless pinned
-    assert pv.variant_scenario("random:13", "puffs", {}).lookahead == 2
+    assert scenario.lookahead == 1  # a turbulent scenario, three moves ahead unless pinned
+    assert pv.variant_scenario("random:13", "puffs", {}).lookahead == 3

@@ -86,7 +86,7 @@ class ClosedLoopDCEEPlanner(HypothesisPlanner):
 
     needs_kl = False
     default_expectation = "stratified"
-    # two moves in a turbulent plume (search.lookahead, chosen on filament and puffs)
+    # three moves in a turbulent plume (search.lookahead, chosen on filament and puffs)
     follows_lookahead = True
 
     def __init__(

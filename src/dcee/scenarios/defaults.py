@@ -110,8 +110,9 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
     ),
     ("search", "lookahead"): Provenance(
         ("filament", "puffs"),
-        "2 (dcee-cl looks two moves ahead) with the fluctuation likelihood, one release, open "
-        "terrain, grid UAV: random:13-40, dcee-cl (issue 42); 1 elsewhere (not measured there)",
+        "3 (dcee-cl looks three moves ahead) with the fluctuation likelihood, one release, open "
+        "terrain, grid UAV: random:13-40, dcee-cl, two against one then three against two "
+        "(issue 42); 1 elsewhere (not measured there)",
     ),
     ("search", "stall_guard"): Provenance(("isotropic",), "held-out tuning, docs/held-out.md"),
     ("search", "guard_share"): Provenance(("filament", "puffs"), "random:13-40, dcee-cl"),

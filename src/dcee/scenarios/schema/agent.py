@@ -42,15 +42,16 @@ def unset_climb(likelihood: str, model: str, on_robot: bool = False) -> float:
     return AUTO_CLIMB if turbulent_uav and not on_robot else 0.0
 
 
-AUTO_LOOKAHEAD = 2
+AUTO_LOOKAHEAD = 3
 """moves ``dcee-cl`` looks ahead when ``search.lookahead`` is unset in a turbulent plume (grid
 UAV, fluctuation likelihood, one release, open terrain). Chosen on the tuning range random:13-40
-of filament and puffs against one move by a rule written before the run (acquisition not lower,
-truth in the 95 % region not lower by more than 2 points, median paired final error no more than
-0.05 m worse): 56/56 both, region 96.4 against 98.2 %, final RMSE 0.44 against 0.54 m (paired
--0.05 m, Wilcoxon p = 0.016; docs/results/tuning-horizon-13-40). A decision costs 3-4x one
-move's (docs/results/perf/horizon-timing.json). Not measured with several releases, on a site
-or on the unicycle robot, which keep 1."""
+of filament and puffs, each step by a rule written before its run (acquisition not lower, truth
+in the 95 % region not lower by more than 2 points, median paired final error no more than
+0.05 m worse): two moves against one (56/56 both, region 96.4 against 98.2 %, final RMSE 0.44
+against 0.54 m, paired -0.05 m, Wilcoxon p = 0.016; docs/results/tuning-horizon-13-40), then
+three against two (RESULT3; docs/results/tuning-lookahead3-13-40). A decision costs about 7x one
+move's, 1.8x two moves' (docs/results/perf/horizon-timing.json). Not measured with several
+releases, on a site or on the unicycle robot, which keep 1."""
 
 
 def unset_lookahead(likelihood: str, model: str, max_sources: int, open_terrain: bool) -> int:
@@ -159,7 +160,7 @@ class SearchSpec(BaseModel):
     (docs/turbulent.md)"""
     lookahead: Annotated[int, Field(ge=1, le=3)] | None = None
     """moves ``dcee-cl`` looks ahead (its beam search, :class:`~dcee.planning.HypothesisPlanner`'s
-    ``horizon``; a spec's own ``dcee-cl:horizon=`` overrides it). None: :data:`AUTO_LOOKAHEAD` (2)
+    ``horizon``; a spec's own ``dcee-cl:horizon=`` overrides it). None: :data:`AUTO_LOOKAHEAD` (3)
     for the grid UAV with the fluctuation likelihood, one release, in open terrain (a turbulent
     plume expected; chosen there), else 1 (see :func:`unset_lookahead`)"""
     explore_guard: bool | None = None

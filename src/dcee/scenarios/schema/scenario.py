@@ -313,7 +313,7 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
     @property
     def lookahead(self) -> int:
         """Moves ``dcee-cl`` looks ahead (``search.lookahead``, or when unset
-        :func:`~dcee.scenarios.schema.agent.unset_lookahead`: 2 in a turbulent plume in open
+        :func:`~dcee.scenarios.schema.agent.unset_lookahead`: 3 in a turbulent plume in open
         terrain with one release, else 1)."""
         if self.search.lookahead is not None:
             return self.search.lookahead
