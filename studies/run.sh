@@ -15,6 +15,27 @@ report() { for dir in "$@"; do $D report "results/$dir"; cat "results/$dir/repor
 LA1=(--set search.lookahead=1)
 LA1P=(--pin search.lookahead=1)  # the same for studies/precision_variants.py, mixture_region.py
 LA2=(--set search.lookahead=2)
+# the generations of dcee-cl's lbm rows in docs/results/lbm-held-out-100 (column defaults)
+LBM_GENERATIONS=(2026-11-29b 2026-11-29 2026-11-27c 2026-11-27b 2026-11-27 2026-11-23)
+lbm_generation() {  # SUFFIX TAG PAIRS FIGURE [TAG...]: one dcee-cl campaign on the held-out lbm plume stored beside the other generations, paired with the TAG rows of dcee-cl and with every planner at 2026-11-27 (c), its worst searches drawn
+  local suffix=$1 tag=$2 pairs=$3 figure=$4 g ref keep=()
+  local r=results/turbulent-lbm-held-out-100$suffix lbm=docs/results/lbm-held-out-100
+  shift 4
+  report "turbulent-lbm-held-out-100$suffix"
+  for g in "${LBM_GENERATIONS[@]}"; do [ "$g" = "$tag" ] || keep+=(--keep "defaults:$g"); done
+  $P studies/collect_metrics.py --out "$lbm" "${keep[@]}" "$r=defaults:$tag,learn:none,particles:10000"
+  rm -f "$lbm/$pairs"
+  for g in "$@"; do
+    $P studies/pair_campaigns.py "$lbm/searches.csv=strategy:dcee-cl:learn:none:particles:10000.0:defaults:$g" \
+      "$r" --csv "$lbm/$pairs" --tag truth_model=lbm
+  done
+  for ref in dcee-cl infotaxis dcee-mcts; do
+    $P studies/pair_campaigns.py "$lbm/searches.csv=strategy:$ref:learn:none:particles:10000.0:defaults:2026-11-27c" \
+      "$r" --as "dcee-cl=$ref" --csv "$lbm/$pairs" --tag truth_model=lbm
+  done
+  $P studies/upwind_detections.py "$r=dcee-cl"
+  $P studies/worst_searches.py "$r=dcee-cl" --out "$figure"
+}
 count_campaigns() {  # PLANNER SUFFIX: its two- and three-release held-out campaigns (issue 45)
   for N in two three; do
     $D bench --suite "$N-source-held-out-100" --repeats 1 --strategies "$1" \
@@ -580,25 +601,10 @@ case "${1:---list}" in
     # the lbm plume held out (no default chosen on it); paired with the two-move rows of
     # 2026-11-29 and the other planners' rows of 2026-11-27 (c) (unchanged: today's)
     export SUITE=held-out-100 WORKERS=${WORKERS:-2}
-    r=results/turbulent-lbm-held-out-100
     TRUTHS=lbm STRATEGIES=dcee-cl OUT_SUFFIX=-d29b bash studies/study_turbulent_held_out.sh \
       --set truth.z=4.0
-    report turbulent-lbm-held-out-100-d29b
-    lbm=docs/results/lbm-held-out-100
-    keep=()
-    for g in 2026-11-29 2026-11-27c 2026-11-27b 2026-11-27 2026-11-23; do keep+=(--keep "defaults:$g"); done
-    $P studies/collect_metrics.py --out "$lbm" "${keep[@]}" \
-      "$r-d29b=defaults:2026-11-29b,learn:none,particles:10000"
-    rm -f "$lbm/lookahead3_vs_before.csv"
-    $P studies/pair_campaigns.py "$lbm/searches.csv=strategy:dcee-cl:learn:none:particles:10000.0:defaults:2026-11-29" \
-      "$r-d29b" --csv "$lbm/lookahead3_vs_before.csv" --tag truth_model=lbm
-    pick="learn:none:particles:10000.0:defaults:2026-11-27c"
-    for ref in dcee-cl infotaxis dcee-mcts; do
-      $P studies/pair_campaigns.py "$lbm/searches.csv=strategy:$ref:$pick" "$r-d29b" \
-        --as "dcee-cl=$ref" --csv "$lbm/lookahead3_vs_before.csv" --tag truth_model=lbm
-    done
-    $P studies/upwind_detections.py "$r-d29b=dcee-cl"
-    $P studies/worst_searches.py "$r-d29b=dcee-cl" --out docs/figures/lbm-held-out-worst-lookahead3.png
+    lbm_generation -d29b 2026-11-29b lookahead3_vs_before.csv \
+      docs/figures/lbm-held-out-worst-lookahead3.png 2026-11-29
     $P studies/publish_tables.py ;;
   lookahead-held-out)  # issue 42: dcee-cl at the defaults of 2026-11-29 (two moves ahead, search.lookahead) on the held-out lbm plume and both turbulent truths, stored beside the earlier generations
     # the lbm plume held out (no default chosen on it); filament and puffs, where the look-ahead
@@ -606,24 +612,11 @@ case "${1:---list}" in
     # rows of 2026-11-27 (c) are today's. Rows of earlier generations kept from the stored study
     # (their search folders need not be on this machine), each new search paired with them.
     export SUITE=held-out-100 WORKERS=${WORKERS:-2}
-    r=results/turbulent-lbm-held-out-100
     TRUTHS=lbm STRATEGIES=dcee-cl OUT_SUFFIX=-d29 bash studies/study_turbulent_held_out.sh \
       "${LA2[@]}" --set truth.z=4.0
     STRATEGIES=dcee-cl OUT_SUFFIX=-today-d29 bash studies/study_turbulent_held_out.sh "${LA2[@]}"
-    report turbulent-lbm-held-out-100-d29
-    lbm=docs/results/lbm-held-out-100
-    keep=()
-    for g in 2026-11-29b 2026-11-27c 2026-11-27b 2026-11-27 2026-11-23; do keep+=(--keep "defaults:$g"); done
-    $P studies/collect_metrics.py --out "$lbm" "${keep[@]}" \
-      "$r-d29=defaults:2026-11-29,learn:none,particles:10000"
-    rm -f "$lbm/lookahead_vs_before.csv"
-    pick="learn:none:particles:10000.0:defaults:2026-11-27c"
-    for ref in dcee-cl infotaxis dcee-mcts; do
-      $P studies/pair_campaigns.py "$lbm/searches.csv=strategy:$ref:$pick" "$r-d29" \
-        --as "dcee-cl=$ref" --csv "$lbm/lookahead_vs_before.csv" --tag truth_model=lbm
-    done
-    $P studies/upwind_detections.py "$r-d29=dcee-cl"
-    $P studies/worst_searches.py "$r-d29=dcee-cl" --out docs/figures/lbm-held-out-worst-lookahead.png
+    lbm_generation -d29 2026-11-29 lookahead_vs_before.csv \
+      docs/figures/lbm-held-out-worst-lookahead.png
     out=docs/results/turbulent-held-out-100-today
     runs=()
     for t in puffs filament; do
@@ -644,8 +637,11 @@ case "${1:---list}" in
   cross-truth)  # every truth at today's defaults; the lbm plume held out (docs/plumes.md, README)
     # dcee-cl, infotaxis and the tree search at today's defaults, 100 held-out configurations
     export SUITE=held-out-100 TRUTHS=lbm WORKERS=${WORKERS:-2}
-    # today's defaults (since 2026-11-29: dcee-cl two moves ahead; the other planners as below)
-    STRATEGIES=dcee-cl OUT_SUFFIX=-d29 bash studies/study_turbulent_held_out.sh --set truth.z=4.0
+    # today's defaults (since 2026-11-29 (b): dcee-cl three moves ahead; the other planners as
+    # below), and those of 2026-11-29 (dcee-cl two moves ahead, pinned)
+    STRATEGIES=dcee-cl OUT_SUFFIX=-d29b bash studies/study_turbulent_held_out.sh --set truth.z=4.0
+    STRATEGIES=dcee-cl OUT_SUFFIX=-d29 bash studies/study_turbulent_held_out.sh "${LA2[@]}" \
+      --set truth.z=4.0
     # the defaults of 2026-11-27 (c): the disc member at prior odds 9:1, the mixture's
     # region; the same searches as -radius-prior below, the region now the mixture's
     STRATEGIES=dcee-cl OUT_SUFFIX=-dm bash studies/study_turbulent_held_out.sh "${LA1[@]}" --set truth.z=4.0
@@ -686,7 +682,7 @@ case "${1:---list}" in
     STRATEGIES=dcee-cl OUT_SUFFIX=-20k bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${old[@]}" \
       --particles 20000
     r=results/turbulent-lbm-held-out-100
-    report turbulent-lbm-held-out-100-d29 \
+    report turbulent-lbm-held-out-100-d29b turbulent-lbm-held-out-100-d29 \
       turbulent-lbm-held-out-100-dm turbulent-lbm-held-out-100-dm-info turbulent-lbm-held-out-100-mcts-dm \
       turbulent-lbm-held-out-100-dm-h2 \
       turbulent-lbm-held-out-100-bf turbulent-lbm-held-out-100-mcts-bf turbulent-lbm-held-out-100-radius \
@@ -695,6 +691,7 @@ case "${1:---list}" in
       turbulent-lbm-held-out-100-nsl25 turbulent-lbm-held-out-100-decay \
       turbulent-lbm-held-out-100-mcts turbulent-lbm-held-out-100-nsl turbulent-lbm-held-out-100-20k
     $P studies/collect_metrics.py --out docs/results/lbm-held-out-100 \
+      "$r-d29b=defaults:2026-11-29b,learn:none,particles:10000" \
       "$r-d29=defaults:2026-11-29,learn:none,particles:10000" \
       "$r-dm=defaults:2026-11-27c,learn:none,particles:10000" \
       "$r-dm-info=defaults:2026-11-27c,learn:none,particles:10000" \
