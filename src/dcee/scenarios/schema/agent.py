@@ -49,9 +49,12 @@ of filament and puffs, each step by a rule written before its run (acquisition n
 in the 95 % region not lower by more than 2 points, median paired final error no more than
 0.05 m worse): two moves against one (56/56 both, region 96.4 against 98.2 %, final RMSE 0.44
 against 0.54 m, paired -0.05 m, Wilcoxon p = 0.016; docs/results/tuning-horizon-13-40), then
-three against two (RESULT3; docs/results/tuning-lookahead3-13-40). A decision costs about 7x one
-move's, 1.8x two moves' (docs/results/perf/horizon-timing.json). Not measured with several
-releases, on a site or on the unicycle robot, which keep 1."""
+three against two (56/56 both, region 53 against 54 of 56, final RMSE 0.43 against 0.44 m,
+paired -0.01 m, p = 0.56; docs/results/tuning-lookahead3-13-40; against one move the region is
+53 against 55 of 56, the two steps' losses added). On the held-out lbm plume three moves changed
+nothing against two (region 86 against 84 %, p = 0.86; docs/plumes.md). A decision costs about
+7x one move's, 1.8x two moves' (docs/results/perf/horizon-timing.json). Not measured with
+several releases, on a site or on the unicycle robot, which keep 1."""
 
 
 def unset_lookahead(likelihood: str, model: str, max_sources: int, open_terrain: bool) -> int:
