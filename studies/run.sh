@@ -444,6 +444,14 @@ case "${1:---list}" in
     $P studies/sites_table.py results/sites results/sites-mcts results/sites-robot \
       --csv docs/results/sites/sites.csv
     $P studies/publish_tables.py ;;
+  sites-tune-lookahead)  # issue 44: dcee-cl one, two and three moves ahead on the tuning sites random-site:1-20, wall-aware estimator (never reported as a result)
+    B="$D bench --suite sites-tune --strategies dcee-cl --repeats 1 --particles 10000 --workers ${WORKERS:-2} --set estimator.plume=walls"
+    for L in 1 2 3; do
+      $B --set search.lookahead=$L --out results/sites-tune-la$L
+    done
+    $P studies/sites_walls_table.py "one move ahead=results/sites-tune-la1" \
+      "two moves ahead=results/sites-tune-la2" "three moves ahead=results/sites-tune-la3" \
+      --out docs/results/sites-walls-tune/lookahead ;;
   sites-walls-tune)  # issue 44: the wall-aware estimator's variants on the tuning sites random-site:1-20 (never reported as a result)
     B="$D bench --suite sites-tune --strategies dcee-cl --repeats 1 --particles 10000 --workers ${WORKERS:-2}"
     # round 5: the diffusivity bank with a fourth member (1, 3, 10 × ζ1 is the default; ζ1 = 1 here)
