@@ -621,6 +621,11 @@ def sites_walls_table(name: str, all_only: bool = False) -> Callable[[], str]:
     return make
 
 
+def moves_ahead(n: int) -> str:
+    """'one move ahead', 'two moves ahead', ..."""
+    return f"{('one', 'two', 'three')[n - 1]} move{'s' if n > 1 else ''} ahead"
+
+
 def sites_walls_timing_table() -> str:
     """Issue 44: decision and update time on a site against open terrain, one pinned core, idle
     (studies/site_timing.py)."""
@@ -628,7 +633,7 @@ def sites_walls_timing_table() -> str:
     rows = [
         [
             f"`{r['site']}`",
-            str(r["way"]),
+            f"{r['way']}, {moves_ahead(int(r['lookahead']))}",
             f"{r['decision_ms_mean']:.1f}",
             f"{r['decision_ratio']:.2f}×",
             f"{r['update_ms_mean']:.1f}",

@@ -10,6 +10,11 @@ process pinned to core 0 with one thread (``taskset -c 0``, NUMBA/OMP/OPENBLAS t
 kernels compiled by a first warm-up search; the truths' plumes must be cached (run the suite
 first). Run it with nothing else on the machine; the load is recorded beside the times.
 
+All three ways look the same number of moves ahead (``--lookahead``, default the wall-aware
+estimator's unset default at a site, :data:`dcee.scenarios.SITE_LOOKAHEAD`): unset, open terrain
+would look :data:`~dcee.scenarios.AUTO_LOOKAHEAD` moves ahead and the wall-blind estimator one,
+and the ratio would compare planners, not terrain.
+
     python studies/site_timing.py --out docs/results/sites-walls/timing.csv
 """
 
@@ -24,6 +29,8 @@ from pathlib import Path
 import pandas as pd
 from source_count_timing import pinned_search
 
+from dcee.scenarios import SITE_LOOKAHEAD
+
 SITES = ("site:wall", "site:passage", "site:canyon")
 COMMON = ["--truth", "lbm", "--likelihood", "fluctuation", "--set", "truth.z=4"]
 WAYS = {
@@ -33,13 +40,23 @@ WAYS = {
 }
 
 
-def one(site: str, extra: list[str], folder: Path) -> dict:
-    return pinned_search(["--scenario", site, *COMMON, *extra, "--particles", "10000"], folder)
+def one(site: str, extra: list[str], folder: Path, lookahead: int) -> dict:
+    pinned = ["--set", f"search.lookahead={lookahead}"]
+    return pinned_search(
+        ["--scenario", site, *COMMON, *pinned, *extra, "--particles", "10000"], folder
+    )
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, required=True)
+    ap.add_argument(
+        "--lookahead",
+        type=int,
+        choices=(1, 2, 3),
+        default=SITE_LOOKAHEAD,
+        help="moves dcee-cl looks ahead, all three ways (default: SITE_LOOKAHEAD)",
+    )
     args = ap.parse_args(argv)
     try:
         args.out.parent.mkdir(parents=True, exist_ok=True)
@@ -48,15 +65,17 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        one(SITES[0], WAYS["site, wall-aware"], Path(tmp) / "warm-up")  # compile the kernels
+        # compile the kernels
+        one(SITES[0], WAYS["site, wall-aware"], Path(tmp) / "warm-up", args.lookahead)
         for site in SITES:
             for way, extra in WAYS.items():
                 load = os.getloadavg()[0]
-                s = one(site, extra, Path(tmp) / f"{len(rows)}")
+                s = one(site, extra, Path(tmp) / f"{len(rows)}", args.lookahead)
                 rows.append(
                     {
                         "site": site,
                         "way": way,
+                        "lookahead": args.lookahead,
                         "decision_ms_mean": 1e3 * s["decision_seconds_mean"],
                         "update_ms_mean": 1e3 * s["update_seconds_total"] / s["readings"],
                         "steps": s["steps"],

@@ -8,7 +8,13 @@ import pytest
 from dcee.errors import DceeInputError
 from dcee.planning import get as get_planner
 from dcee.runs import planner_defaults, scenario_identity
-from dcee.scenarios import AUTO_LOOKAHEAD, load_scenario, to_toml, unset_lookahead
+from dcee.scenarios import (
+    AUTO_LOOKAHEAD,
+    SITE_LOOKAHEAD,
+    load_scenario,
+    to_toml,
+    unset_lookahead,
+)
 
 
 def _turbulent():
@@ -26,13 +32,20 @@ def test_an_unset_lookahead_is_three_only_where_it_was_chosen():
     assert turbulent.with_overrides(**several).lookahead == 1
     assert turbulent.with_overrides(**{"agent.model": "unicycle"}).lookahead == 1
     site = load_scenario("site:wall").with_overrides(**{"estimator.likelihood": "fluctuation"})
-    assert site.lookahead == 1
+    assert site.lookahead == 1  # the wall-blind estimator at a site: not measured there
+    # the wall-aware estimator at a site: chosen on the tuning sites (SITE_LOOKAHEAD)
+    aware = site.with_overrides(**{"estimator.plume": "walls"})
+    assert aware.lookahead == SITE_LOOKAHEAD
+    assert aware.with_overrides(**{"agent.model": "unicycle"}).lookahead == 1
     # a value set is kept everywhere
     assert paper.with_overrides(**{"search.lookahead": 3}).lookahead == 3
     assert turbulent.with_overrides(**{"search.lookahead": 1}).lookahead == 1
     assert unset_lookahead("fluctuation", "grid", 1, True) == 3
     assert unset_lookahead("paper", "grid", 1, True) == 1
     assert unset_lookahead("fluctuation", "grid", 1, False) == 1
+    assert unset_lookahead("fluctuation", "grid", 1, False, wall_aware=True) == SITE_LOOKAHEAD
+    assert unset_lookahead("paper", "grid", 1, False, wall_aware=True) == 1
+    assert unset_lookahead("fluctuation", "grid", 2, False, wall_aware=True) == 1
 
 
 def test_only_dcee_cl_follows_it_and_a_spec_overrides_it():
@@ -74,6 +87,18 @@ def test_the_resolved_lookahead_is_shown_and_decides_a_campaign_identity():
     old = paper.model_dump(mode="json")
     del old["search"]["lookahead"]
     assert scenario_identity(old) == scenario_identity(paper.model_dump(mode="json"))
+    # at a site, the wall-aware estimator's unset look-ahead compares as SITE_LOOKAHEAD
+    aware = load_scenario("site:wall").with_overrides(
+        **{"estimator.likelihood": "fluctuation", "estimator.plume": "walls"}
+    )
+    pinned = aware.with_overrides(**{"search.lookahead": SITE_LOOKAHEAD})
+    one_move = aware.with_overrides(**{"search.lookahead": 1})
+    assert scenario_identity(aware.model_dump(mode="json")) == scenario_identity(
+        pinned.model_dump(mode="json")
+    )
+    assert scenario_identity(aware.model_dump(mode="json")) != scenario_identity(
+        one_move.model_dump(mode="json")
+    )
 
 
 @pytest.mark.parametrize("bad", [0, 4, 1.5, "two"])

@@ -187,7 +187,11 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
         world = WorldSpec.model_validate(out.get("world") or {})  # a stored dump round-trips
         model = agent.get("model", "grid") if isinstance(agent, dict) else "grid"
         search["lookahead"] = unset_lookahead(
-            est.get("likelihood", "paper"), model, int(est.get("max_sources", 1)), world.empty
+            est.get("likelihood", "paper"),
+            model,
+            int(est.get("max_sources", 1)),
+            world.empty,
+            est.get("plume", "open") == "walls",
         )
     sensor, truth = out.get("sensor"), out.get("truth")
     if isinstance(sensor, dict) and "dropout" not in sensor and isinstance(truth, dict):

@@ -5,7 +5,8 @@ README's cross-truth table and docs/scenarios.md say the same).
 The rule (DEVELOPERS.md): a default is chosen on a tuning set, on at most two truth families,
 and reported on the others. The truth families are ``isotropic`` (the paper's model, its own
 likelihood), ``filament`` and ``puffs`` (written here, with the fluctuation likelihood) and
-``lbm`` (a fluid solver's plume, :mod:`dcee.simulation.lbm`): no default was chosen on ``lbm``.
+``lbm`` (a fluid solver's plume, :mod:`dcee.simulation.lbm`): no open-terrain default was chosen
+on ``lbm``; the wall-aware estimator's settings at a site were (the tuning sites).
 """
 
 from __future__ import annotations
@@ -112,7 +113,9 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
         ("filament", "puffs"),
         "3 (dcee-cl looks three moves ahead) with the fluctuation likelihood, one release, open "
         "terrain, grid UAV: random:13-40, dcee-cl, two against one then three against two "
-        "(issue 42); 1 elsewhere (not measured there)",
+        "(issue 42); at a site with the wall-aware estimator 3, chosen on lbm round the tuning "
+        "sites random-site:1-20 among 1, 2, 3 (issue 44; lbm then not independent of it at a "
+        "site); 1 elsewhere (not measured there)",
     ),
     ("search", "stall_guard"): Provenance(("isotropic",), "held-out tuning, docs/held-out.md"),
     ("search", "guard_share"): Provenance(("filament", "puffs"), "random:13-40, dcee-cl"),

@@ -3,6 +3,7 @@
 from dcee.scenarios.schema.agent import (
     AUTO_CLIMB,
     AUTO_LOOKAHEAD,
+    SITE_LOOKAHEAD,
     AgentSpec,
     SearchSpec,
     UnicycleSpec,
@@ -54,6 +55,7 @@ __all__ = [
     "PHYSICAL_TRUNCATION",
     "READING_WEIGHT_DEFAULT",
     "REPEAT_DEFAULT",
+    "SITE_LOOKAHEAD",
     "TRUTH_KINDS",
     "TURBULENT_HOLD",
     "AgentSpec",

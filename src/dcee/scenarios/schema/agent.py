@@ -54,15 +54,34 @@ paired -0.01 m, p = 0.56; docs/results/tuning-lookahead3-13-40; against one move
 53 against 55 of 56, the two steps' losses added). On the held-out lbm plume three moves changed
 nothing against two (region 86 against 84 %, p = 0.86; docs/plumes.md). A decision costs about
 7x one move's, 1.8x two moves' (docs/results/perf/horizon-timing.json). Not measured with
-several releases, on a site or on the unicycle robot, which keep 1."""
+several releases, at a site with the wall-blind estimator or on the unicycle robot, which keep 1
+(at a site with the wall-aware estimator: :data:`SITE_LOOKAHEAD`)."""
 
 
-def unset_lookahead(likelihood: str, model: str, max_sources: int, open_terrain: bool) -> int:
-    """Moves ``dcee-cl`` looks ahead when ``search.lookahead`` is unset: :data:`AUTO_LOOKAHEAD`
-    where it was chosen (the grid UAV, the fluctuation likelihood, one release, open terrain),
+SITE_LOOKAHEAD = 3
+"""moves ``dcee-cl`` looks ahead when ``search.lookahead`` is unset at a site with the wall-aware
+estimator (``estimator.plume = "walls"``; grid UAV, fluctuation likelihood, one release). Chosen
+on the tuning sites random-site:1-20 (lbm truth round random buildings) among 1, 2 and 3 by a rule
+written before the run (most acquired; within one search the lower median final error; within
+0.05 m fewer moves): 12/20 acquired each (the same searches), median final error 0.65, 0.61 and
+0.55 m; three against one -0.06 m at the median pair (Wilcoxon p = 0.02)
+(docs/results/sites-walls-tune/lookahead). Reported on the four held-out sites (docs/results.md).
+With the wall-blind estimator a site keeps 1 (not measured)."""
+
+
+def unset_lookahead(
+    likelihood: str, model: str, max_sources: int, open_terrain: bool, wall_aware: bool = False
+) -> int:
+    """Moves ``dcee-cl`` looks ahead when ``search.lookahead`` is unset: where it was chosen
+    (the grid UAV, the fluctuation likelihood, one release) :data:`AUTO_LOOKAHEAD` in open
+    terrain and :data:`SITE_LOOKAHEAD` at a site with the wall-aware estimator (``wall_aware``),
     else 1 (the look-ahead before the setting existed)."""
     chosen_here = likelihood == "fluctuation" and model == "grid" and max_sources == 1
-    return AUTO_LOOKAHEAD if chosen_here and open_terrain else 1
+    if not chosen_here:
+        return 1
+    if open_terrain:
+        return AUTO_LOOKAHEAD
+    return SITE_LOOKAHEAD if wall_aware else 1
 
 
 class UnicycleSpec(BaseModel):

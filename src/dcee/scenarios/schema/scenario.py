@@ -314,11 +314,13 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
     def lookahead(self) -> int:
         """Moves ``dcee-cl`` looks ahead (``search.lookahead``, or when unset
         :func:`~dcee.scenarios.schema.agent.unset_lookahead`: 3 in a turbulent plume in open
-        terrain with one release, else 1)."""
+        terrain with one release and at a site with the wall-aware estimator, else 1)."""
         if self.search.lookahead is not None:
             return self.search.lookahead
         e = self.estimator
-        return unset_lookahead(e.likelihood, self.agent.model, e.max_sources, self.world.empty)
+        return unset_lookahead(
+            e.likelihood, self.agent.model, e.max_sources, self.world.empty, e.plume == "walls"
+        )
 
     @property
     def climb(self) -> float:
