@@ -444,12 +444,15 @@ case "${1:---list}" in
     $P studies/sites_table.py results/sites results/sites-mcts results/sites-robot \
       --csv docs/results/sites/sites.csv
     $P studies/publish_tables.py ;;
-  sites-walls-lookahead)  # issue 44: dcee-cl at its site look-ahead (unset: SITE_LOOKAHEAD) against one move ahead, wall-aware, the four held-out sites, 10 seeds, one code version
-    B="$D bench --suite sites-walls --strategies dcee-cl --repeats 10 --particles 10000 --workers ${WORKERS:-2} --set estimator.plume=walls"
-    $B --out results/sites-walls-aware-lookahead
-    $B --set search.lookahead=1 --out results/sites-walls-aware-one-move
-    $P studies/sites_walls_table.py "wall-aware, the site look-ahead=results/sites-walls-aware-lookahead" \
-      "wall-aware, one move ahead=results/sites-walls-aware-one-move" --out docs/results/sites-walls-lookahead
+  sites-walls-lookahead)  # issue 44: dcee-cl at its site look-ahead (unset: SITE_LOOKAHEAD) against one move ahead and the wall-blind estimator, the four held-out sites, 10 seeds, one code version
+    B="$D bench --suite sites-walls --strategies dcee-cl --repeats 10 --particles 10000 --workers ${WORKERS:-2}"
+    W="--set estimator.plume=walls"
+    $B $W --out results/sites-walls-aware-lookahead
+    $B $W --set search.lookahead=1 --out results/sites-walls-aware-one-move
+    $B --out results/sites-walls-blind-today  # the wall-blind estimator at its defaults (one move ahead)
+    $P studies/sites_walls_table.py "wall-aware, three moves ahead (default)=results/sites-walls-aware-lookahead" \
+      "wall-aware, one move ahead=results/sites-walls-aware-one-move" \
+      "wall-blind=results/sites-walls-blind-today" --out docs/results/sites-walls-lookahead
     $P studies/publish_tables.py ;;
   sites-tune-lookahead)  # issue 44: dcee-cl one, two and three moves ahead on the tuning sites random-site:1-20, wall-aware estimator (never reported as a result)
     B="$D bench --suite sites-tune --strategies dcee-cl --repeats 1 --particles 10000 --workers ${WORKERS:-2} --set estimator.plume=walls"
