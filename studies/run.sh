@@ -463,7 +463,8 @@ case "${1:---list}" in
       "two moves ahead=results/sites-tune-la2" "three moves ahead=results/sites-tune-la3" \
       --out docs/results/sites-walls-tune/lookahead ;;
   sites-walls-tune)  # issue 44: the wall-aware estimator's variants on the tuning sites random-site:1-20 (never reported as a result)
-    B="$D bench --suite sites-tune --strategies dcee-cl --repeats 1 --particles 10000 --workers ${WORKERS:-2}"
+    # every round flew dcee-cl one move ahead (the site default before 2026-11-29 (e)): pinned
+    B="$D bench --suite sites-tune --strategies dcee-cl --repeats 1 --particles 10000 --workers ${WORKERS:-2} ${LA1[*]}"
     # round 5: the diffusivity bank with a fourth member (1, 3, 10 × ζ1 is the default; ζ1 = 1 here)
     $B --set estimator.plume=walls --set 'estimator.learn={wall_diffusivity=[1.0,3.0,10.0,30.0]}' \
       --out results/sites-tune-k30
@@ -504,8 +505,11 @@ case "${1:---list}" in
     P2="--set estimator.wall_wind=potential"
     for s in dcee-cl infotaxis; do
       x=$([ $s = infotaxis ] && echo -infotaxis || true)
-      $B --strategies $s $W --out results/sites-walls-aware$x
-      $B --strategies $s $W $P2 --out results/sites-walls-aware-potential$x
+      # dcee-cl flew one move ahead here (the site default before 2026-11-29 (e)): pinned;
+      # infotaxis does not read search.lookahead
+      pin=$([ $s = dcee-cl ] && echo "${LA1[*]}" || true)
+      $B --strategies $s $W $pin --out results/sites-walls-aware$x
+      $B --strategies $s $W $P2 $pin --out results/sites-walls-aware-potential$x
       $B --strategies $s --out results/sites-walls-blind$x
     done
     $P studies/sites_walls_table.py wall-aware=results/sites-walls-aware \

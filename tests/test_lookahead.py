@@ -1,6 +1,7 @@
 """``search.lookahead``: how many moves ``dcee-cl`` looks ahead. Unset, it follows the expected
-plume: three moves where it was chosen (the grid UAV, the fluctuation likelihood, one release, open
-terrain), one everywhere else (every search there unchanged)."""
+plume: three moves where it was chosen (the grid UAV, the fluctuation likelihood, one release, in
+open terrain and at a site with the wall-aware estimator), one everywhere else (every search
+there unchanged)."""
 
 import numpy as np
 import pytest
