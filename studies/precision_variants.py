@@ -109,6 +109,9 @@ def one(task: tuple) -> dict:
         "longest_stall": s["longest_stall"],
         "model": s.get("model", ""),  # the reading model that led at the end (a bank's member)
         "model_probability": s.get("model_probability", 1.0),
+        "final_spread": s["final_spread"],  # m, the particles' RMS spread about their mean
+        # the truth in the 95 % region at each model-discrepancy floor (m) of the grid
+        **{f"truth_in_95_floor_{k}": v for k, v in s["truth_in_95_floor"].items()},
     }
 
 

@@ -538,6 +538,12 @@ case "${1:---list}" in
     $P studies/precision_variants.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant horizon2: --strategy dcee-cl:horizon=2 --workers "${WORKERS:-2}" \
       --csv docs/results/tuning-horizon-13-40/variants.csv ;;
+  tune-region-floor)  # issue 42: the 95 % region's model-discrepancy floor on the tuning range, filament + puffs, rule written first (docs/results/tuning-region-floor-13-40)
+    out=docs/results/tuning-region-floor-13-40
+    $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
+      --variant today: --strategy dcee-cl --workers "${WORKERS:-2}" --csv "$out/variants.csv"
+    $P studies/region_floor.py "$out/variants.csv" --csv "$out/coverage.csv" --choose 0.95
+    $P studies/publish_tables.py ;;
   tune-lookahead3)  # issue 42: dcee-cl looking three moves ahead on the tuning range, filament + puffs (docs/results/tuning-lookahead3-13-40)
     $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
       --variant lookahead3:search.lookahead=3 --strategy dcee-cl --workers "${WORKERS:-2}" \

@@ -15,10 +15,11 @@ from dcee.estimation import SourcePrior
 from dcee.estimation.filter_kernels import history_log_likelihood, history_log_likelihood_reference
 from dcee.estimation.grid import location_grid_posterior
 from dcee.estimation.priors import Fixed, Uniform
+from dcee.estimation.summaries import in_credible_ellipsoid
 from dcee.models.plume import isotropic_concentration, isotropic_concentration_reference
 from dcee.planning import get as get_planner
 from dcee.runs import run_episode
-from dcee.scenarios import load_scenario
+from dcee.scenarios import REGION_FLOOR_DEFAULT, load_scenario
 from dcee.searcher import Searcher
 from dcee.simulation import InjectedTruth, make_truth
 from tests.helpers import random_theta, run_cli, spike_ess_share
@@ -354,6 +355,52 @@ def test_credible_region_covers_the_truth_at_its_level():
     pf.theta[:, 1] = 20 + rng.standard_t(4, pf.n)  # heavy tails: no Gaussian shortcut
     hits = [pf.in_credible_region(np.array([*pf.theta[i, :2], 1.0])) for i in range(4000)]
     assert np.mean(hits) == pytest.approx(0.95, abs=0.01)
+
+
+def test_floored_region_is_the_convolved_posteriors_region():
+    """Hand calculation: particles N(0, s² I) in 2-D convolved with N(0, σ² I) are N(0, (s² +
+    σ²) I), whose 95 % region is the disc of radius √(χ²₂(0.95) (s² + σ²)) = 2.448 √(s² + σ²):
+    0.774 m at s = 0.1, σ = 0.3. A truth at 0.70 m lies inside it and outside the particles'
+    own region (0.245 m); one at 0.85 m lies outside both. Floor 0 is the unfloored region,
+    and the same particles give the same answer twice (a seeded summary)."""
+    rng = np.random.default_rng(5)
+    pts = 0.1 * rng.standard_normal((20000, 2))
+    w = np.full(20000, 1 / 20000)
+    inside = np.array([0.70 / np.sqrt(2), 0.70 / np.sqrt(2)])
+    outside = np.array([0.85, 0.0])
+    assert in_credible_ellipsoid(pts, w, inside, 0.95, floor=0.3)
+    assert not in_credible_ellipsoid(pts, w, inside, 0.95)
+    assert not in_credible_ellipsoid(pts, w, outside, 0.95, floor=0.3)
+    assert in_credible_ellipsoid(pts, w, [0.76, 0.0], floor=0.3)
+    assert not in_credible_ellipsoid(pts, w, [0.79, 0.0], floor=0.3)
+    assert in_credible_ellipsoid(pts, w, [0.24, 0.0], floor=0.0)
+    assert not in_credible_ellipsoid(pts, w, [0.25, 0.0], floor=0.0)
+
+
+def test_floored_region_covers_truths_from_the_convolved_posterior():
+    """Truths drawn as a particle plus N(0, σ² I) error are inside the floored 95 % region
+    95 % of the time, and the particles' own region misses many of them."""
+    rng = np.random.default_rng(6)
+    pf = ParticleFilter(_xy_prior(), Sensor.paper_exact(), n_particles=4000, seed=0)
+    pf.theta[:, 0] = 20 + 0.2 * rng.standard_normal(pf.n)
+    pf.theta[:, 1] = 20 + 0.1 * rng.standard_t(4, pf.n)
+    idx = rng.integers(0, pf.n, 1500)
+    truths = pf.theta[idx, :2] + 0.4 * rng.standard_normal((1500, 2))
+    hits = [pf.in_credible_region(np.array([*t, 1.0]), 0.95, floor=0.4) for t in truths]
+    plain = [pf.in_credible_region(np.array([*t, 1.0])) for t in truths[:300]]
+    assert np.mean(hits) == pytest.approx(0.95, abs=0.015)
+    assert np.mean(plain) < 0.6
+
+
+def test_region_floor_defaults_follow_the_likelihood():
+    paper = load_scenario("paper:1")
+    fluct = paper.with_overrides(**{"estimator.likelihood": "fluctuation"})
+    assert paper.region_floor == 0.0
+    assert fluct.region_floor == REGION_FLOOR_DEFAULT["fluctuation"]
+    assert fluct.with_overrides(**{"estimator.region_floor": 0.25}).region_floor == 0.25
+    assert fluct.resolved_settings()["region_floor"] == fluct.region_floor
+    with pytest.raises(DceeInputError, match="region_floor"):
+        paper.with_overrides(**{"estimator.region_floor": -0.1})
 
 
 # --- command line ---

@@ -111,7 +111,14 @@ class Estimator(Protocol):
         """Posterior RMSE (m) of the source location about ``true_location`` (3,)."""
         ...
 
-    def in_credible_region(self, true_location: np.ndarray, level: float = 0.95) -> bool: ...
+    def in_credible_region(
+        self, true_location: np.ndarray, level: float = 0.95, floor: float = 0.0
+    ) -> bool:
+        """Whether ``true_location`` (3,) lies in the ``level`` credible region of the source
+        location, widened by a model-discrepancy ``floor`` σ (m): the posterior convolved with
+        N(0, σ² I) (:func:`~dcee.estimation.summaries.in_credible_ellipsoid`)."""
+        ...
+
     def reading_model(self) -> ReadingModelChoice | None:
         """The reading model the readings chose, or None when there is only one."""
         ...

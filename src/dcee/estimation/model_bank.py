@@ -200,10 +200,13 @@ class ModelBank:
     def rmse(self, true_location: np.ndarray) -> float:
         return self.current.rmse(true_location)
 
-    def in_credible_region(self, true_location: np.ndarray, level: float = 0.95) -> bool:
+    def in_credible_region(
+        self, true_location: np.ndarray, level: float = 0.95, floor: float = 0.0
+    ) -> bool:
         """Whether ``true_location`` (3,) lies in the ``level`` credible region of the models'
-        mixture: every member's particles, each weighted by its posterior probability P(m |
-        readings) (the Bayesian average over the reading models; one member: its own region).
+        mixture, widened by ``floor`` (m) as the particle filter's: every member's particles,
+        each weighted by its posterior probability P(m | readings) (the Bayesian average over
+        the reading models; one member: its own region).
         Where the readings cannot yet tell the models apart, the region holds the locations
         each of them supports, not only the selected one's (measured on point and area
         releases of the tuning truths: docs/results/mixture-region-prior-13-40)."""
@@ -215,7 +218,7 @@ class ModelBank:
             [p * m.weights for p, m in zip(self.probabilities, self.members, strict=True)]
         )
         truth = np.asarray(true_location, dtype=np.float64)[cols]
-        return in_credible_ellipsoid(points, weights / weights.sum(), truth, level)
+        return in_credible_ellipsoid(points, weights / weights.sum(), truth, level, floor)
 
     def history(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return self.current.history()

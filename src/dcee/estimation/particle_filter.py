@@ -203,16 +203,18 @@ class ParticleFilter(ResampleMove):
         """√(Σ wᵢ ‖sᵢ − s‖²): RMSE of the particles' source locations about ``true_location``."""
         return weighted_rmse(self.source_locations, self.weights, true_location)
 
-    def in_credible_region(self, true_location: np.ndarray, level: float = 0.95) -> bool:
+    def in_credible_region(
+        self, true_location: np.ndarray, level: float = 0.95, floor: float = 0.0
+    ) -> bool:
         """Whether ``true_location`` (3,) lies in the posterior's ``level`` credible region of
-        the unknown location coordinates (see
+        the unknown location coordinates, widened by a model-discrepancy ``floor`` (m; see
         :func:`~dcee.estimation.summaries.in_credible_ellipsoid`)."""
         cols = self._loc_block  # unknown location columns, in order
         if not cols:
             return True
         x = self.theta[:, cols]
         truth = np.asarray(true_location, dtype=np.float64)[cols]
-        return in_credible_ellipsoid(x, self.weights, truth, level)
+        return in_credible_ellipsoid(x, self.weights, truth, level, floor)
 
     @property
     def ess(self) -> float:

@@ -429,15 +429,14 @@ class SourceCountBank:
         points, weights = self._nearest_release(true_location)
         return weighted_rmse(points, weights, true_location)
 
-    def in_credible_region(self, true_location: np.ndarray, level: float = 0.95) -> bool:
-        """Whether ``true_location`` lies in the ``level`` region of the most probable count's
-        nearest release."""
+    def in_credible_region(self, true_location: np.ndarray, level=0.95, floor=0.0) -> bool:
+        """Whether ``true_location`` is in the ``level`` region (floored) of the nearest release."""
         cols = self.members[0]._loc_block
         if not cols:
             return True
         points, weights = self._nearest_release(true_location)
         truth = np.asarray(true_location, dtype=np.float64)[cols]
-        return in_credible_ellipsoid(points[:, cols], weights, truth, level)
+        return in_credible_ellipsoid(points[:, cols], weights, truth, level, floor)
 
     def count_summary(self) -> dict[str, object]:
         """What a summary reports of the count: the estimate, P(K) and the releases."""

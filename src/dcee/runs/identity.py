@@ -11,6 +11,7 @@ from typing import Any
 from dcee.scenarios import (
     OLD_OUTLIER_DEFAULT,
     READING_WEIGHT_DEFAULT,
+    REGION_FLOOR_DEFAULT,
     REPEAT_DEFAULT,
     UnicycleSpec,
     default_learn,
@@ -69,6 +70,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("truth", "extra_sources"): [],
     # dcee-cl looked one move ahead everywhere before search.lookahead (issue 42)
     ("search", "lookahead"): 1,
+    # the particles' own 95 % region before issue 42's model-discrepancy floor
+    ("estimator", "region_floor"): 0.0,
 }
 """Scenario settings added after campaigns were first stored, with the value a stored scenario
 without one ran with, so the two compare equal."""
@@ -158,6 +161,9 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
         if "reading_weight" in estimator and estimator["reading_weight"] is None:
             # unset: the likelihood's default, compared as the number it stands for
             estimator["reading_weight"] = READING_WEIGHT_DEFAULT[likelihood]
+        if "region_floor" in estimator and estimator["region_floor"] is None:
+            # unset: the likelihood's default, compared as the number it stands for
+            estimator["region_floor"] = REGION_FLOOR_DEFAULT[likelihood]
         for k, key in enumerate(("repeat_radius", "repeat_power")):
             if key in estimator and estimator[key] is None:
                 # unset: the likelihood's default, compared as the number it stands for

@@ -74,6 +74,11 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
     ("estimator", "repeat_power"): Provenance(
         ("filament", "puffs"), "random:13-40, dcee-cl, with near_source_length 0.5 (issue 42)"
     ),
+    ("estimator", "region_floor"): Provenance(
+        ("filament", "puffs"),
+        "the fluctuation likelihood's: random:13-40, dcee-cl, the smallest floor of the grid "
+        "calibrating the 95 % region on each truth (issue 42); the paper's likelihood: 0",
+    ),
     ("estimator", "outlier"): Provenance(
         ("isotropic",), "random:1-6, dcee-cl, one 10^6 x reading, studies/spike_study.py"
     ),

@@ -122,6 +122,12 @@ checked on held-out random:1000-1023 with dcee-cl and infotaxis: the truth insid
 in 29 more searches and 10 fewer of 96 paired ones (exact McNemar p = 0.003), acquisition and
 final error no worse (docs/turbulent.md)."""
 
+REGION_FLOOR_DEFAULT: dict[str, float] = {"paper": 0.0, "fluctuation": 0.0}
+"""``estimator.region_floor`` (m) per likelihood when not given: 0 for the paper's model (the
+isotropic truth's own model: no discrepancy to allow for); for the fluctuation model chosen on
+the tuning range random:13-40 by the rule of docs/results/tuning-region-floor-13-40 (written
+before its run)."""
+
 REPEAT_DEFAULT: dict[str, tuple[float, float]] = {"paper": (0.0, 1.0), "fluctuation": (2.0, 0.5)}
 """(``repeat_radius`` m, ``repeat_power``) per likelihood when not given: off for the paper's
 model (independent readings, the paper's update); for the fluctuation model a run of readings
@@ -376,6 +382,13 @@ class EstimatorSpec(BaseModel):
     """m²/s: the eddy viscosity ν_t of the wake wind (``wall_wind = "wake"``); None:
     :data:`dcee.models.site_flow.WAKE_VISCOSITY` (1 m²/s, kept against 0.25 and 0.5 on the
     tuning sites, docs/results/sites-walls-tune/viscosity)"""
+    region_floor: Annotated[float | None, Field(ge=0, le=10, allow_inf_nan=False)] = None
+    """m: the model-discrepancy scale σ of the reported 95 % region (``truth_in_95``): the
+    posterior of the source location convolved with N(0, σ² I), the error of a reading model
+    that no reading removes (a point-source model of a plume that is not one). It widens what
+    the estimator reports, never what it decides: the filter, the planners and the stop rule
+    read the particles. 0: the particles' own region. None: the likelihood's default,
+    :data:`REGION_FLOOR_DEFAULT`"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the

@@ -24,6 +24,7 @@ from dcee.scenarios.schema.common import FIELD_MARK, FROZEN, phi_prior_from_bear
 from dcee.scenarios.schema.estimator import (
     MEANDER_DEFAULT,
     READING_WEIGHT_DEFAULT,
+    REGION_FLOOR_DEFAULT,
     REPEAT_DEFAULT,
     AnemometerSpec,
     EstimatorSpec,
@@ -372,6 +373,12 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
         e = self.estimator
         return e.repeat_power if e.repeat_power is not None else REPEAT_DEFAULT[e.likelihood][1]
 
+    @property
+    def region_floor(self) -> float:
+        """m, the reported region's model-discrepancy floor (``estimator.region_floor``)."""
+        e = self.estimator
+        return e.region_floor if e.region_floor is not None else REGION_FLOOR_DEFAULT[e.likelihood]
+
     def resolved_settings(self) -> dict[str, Any]:
         """The defaults resolved for this truth (stored with every result)."""
         return {
@@ -385,6 +392,7 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
             "reading_weight": self.reading_weight,
             "repeat_radius": self.repeat_radius,
             "repeat_power": self.repeat_power,
+            "region_floor": self.region_floor,
             "climb": self.climb,
             "lookahead": self.lookahead,
             "explore_guard": self.explore_guard,
