@@ -29,6 +29,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from dcee.scenarios import REGION_FLOOR_DEFAULT
+
 ROOT = Path(__file__).resolve().parent.parent
 RESULTS = ROOT / "docs" / "results"
 PAGES = (
@@ -1033,6 +1035,34 @@ def lookahead3_tuning_table() -> str:
     )
 
 
+def region_floor_table(path: str, chosen: float | None = None) -> str:
+    """The share of searches with the truth in the 95 % region at each model-discrepancy floor
+    (studies/region_floor.py's table at ``path`` under docs/results), one column per truth, and
+    the floored region's median RMS radius; the ``chosen`` floor in bold."""
+    frame = pd.read_csv(RESULTS / path)
+    truths = list(dict.fromkeys(frame["truth"]))
+    rows = []
+    for f, part in frame.groupby("floor", sort=True):
+        cells = []
+        for t in truths:
+            r = part[part["truth"] == t].iloc[0]
+            cells.append(
+                f"{int(r['inside'])}/{int(r['n'])}, {r['share']:.0%} [{r['lo']:.0%}, {r['hi']:.0%}]"
+            )
+        radius = part[part["truth"] == truths[-1]].iloc[0]["median_radius"]
+        label = f"{f:.2f}"
+        if chosen is not None and abs(f - chosen) < 1e-9:
+            label = f"**{label}** (the default)"
+        rows.append([label, *cells, f"{radius:.2f}"])
+    names = {"all": "both truths"}
+    header = [
+        "floor σ (m)",
+        *[f"{names.get(t, t)}: truth in 95 % region" for t in truths],
+        f"median RMS radius of the region, {names.get(truths[-1], truths[-1])} (m)",
+    ]
+    return table(header, rows)
+
+
 def _by_truth(rows: pd.DataFrame) -> Iterator[tuple[str, pd.DataFrame]]:
     """(truth, rows) for the filament, the puffs and both together (the last only when both
     are there: one truth's own row says it all); truths without rows are skipped."""
@@ -1646,6 +1676,9 @@ TABLES: dict[str, Callable[[], str]] = {
     "lbm-endgame": lbm_endgame_table,
     "horizon-tuning": horizon_tuning_table,
     "lookahead3-tuning": lookahead3_tuning_table,
+    "region-floor-tuning": lambda: region_floor_table(
+        "tuning-region-floor-13-40/coverage.csv", REGION_FLOOR_DEFAULT["fluctuation"]
+    ),
     "cross-truth": cross_truth_table,
     "cross-truth-latest": lambda: cross_truth_table(latest_only=True),
     "radius-prior-point": lambda: radius_prior_table("point"),

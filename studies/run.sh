@@ -12,11 +12,15 @@ report() { for dir in "$@"; do $D report "results/$dir"; cat "results/$dir/repor
 # turbulent plume (grid UAV, one release, open terrain) on 2026-11-29, three since 2026-11-29 (b).
 # The turbulent studies flown before pin what they flew, so that each reproduces what it
 # published.
-LA1=(--set search.lookahead=1)
-LA1P=(--pin search.lookahead=1)  # the same for studies/precision_variants.py, mixture_region.py
-LA2=(--set search.lookahead=2)
+# Every campaign stored before 2026-12-02 reported the particles' own 95 % region, before the
+# fluctuation likelihood's model-discrepancy floor (estimator.region_floor, issue 42; it changes
+# no decision): F0 pins it where such a study is flown again, and the look-ahead pins carry it.
+F0=(--set estimator.region_floor=0.0)
+LA1=(--set search.lookahead=1 "${F0[@]}")
+LA1P=(--pin search.lookahead=1 --pin estimator.region_floor=0.0)  # for precision_variants.py, mixture_region.py
+LA2=(--set search.lookahead=2 "${F0[@]}")
 # the generations of dcee-cl's lbm rows in docs/results/lbm-held-out-100 (column defaults)
-LBM_GENERATIONS=(2026-11-29b 2026-11-29 2026-11-27c 2026-11-27b 2026-11-27 2026-11-23)
+LBM_GENERATIONS=(2026-12-02 2026-11-29b 2026-11-29 2026-11-27c 2026-11-27b 2026-11-27 2026-11-23)
 lbm_generation() {  # SUFFIX TAG PAIRS FIGURE [TAG...]: one dcee-cl campaign on the held-out lbm plume stored beside the other generations, paired with the TAG rows of dcee-cl and with every planner at 2026-11-27 (c), its worst searches drawn
   local suffix=$1 tag=$2 pairs=$3 figure=$4 g ref keep=()
   local r=results/turbulent-lbm-held-out-100$suffix lbm=docs/results/lbm-held-out-100
@@ -449,7 +453,7 @@ case "${1:---list}" in
     W="--set estimator.plume=walls"
     $B $W --out results/sites-walls-aware-lookahead
     $B $W --set search.lookahead=1 --out results/sites-walls-aware-one-move
-    $B --out results/sites-walls-blind-today  # the wall-blind estimator at its defaults (one move ahead)
+    $B "${F0[@]}" --out results/sites-walls-blind-today  # the wall-blind estimator at its defaults (one move ahead)
     $P studies/sites_walls_table.py "wall-aware, three moves ahead (default)=results/sites-walls-aware-lookahead" \
       "wall-aware, one move ahead=results/sites-walls-aware-one-move" \
       "wall-blind=results/sites-walls-blind-today" --out docs/results/sites-walls-lookahead
@@ -510,7 +514,7 @@ case "${1:---list}" in
       pin=$([ $s = dcee-cl ] && echo "${LA1[*]}" || true)
       $B --strategies $s $W $pin --out results/sites-walls-aware$x
       $B --strategies $s $W $P2 $pin --out results/sites-walls-aware-potential$x
-      $B --strategies $s --out results/sites-walls-blind$x
+      $B --strategies $s "${F0[@]}" --out results/sites-walls-blind$x
     done
     $P studies/sites_walls_table.py wall-aware=results/sites-walls-aware \
       "wall-aware, potential wind=results/sites-walls-aware-potential" \
@@ -521,7 +525,7 @@ case "${1:---list}" in
   sites-walls-planners)  # issue 44: the other planners on the four sites with walls, wall-aware against wall-blind, 10 seeds
     B="$D bench --suite sites-walls --repeats 10 --particles 10000 --workers ${WORKERS:-2} --strategies dcee,dcee-ms,mpc,entrotaxis,dcee-mcts"
     $B --set estimator.plume=walls --out results/sites-walls-aware-planners
-    $B --out results/sites-walls-blind-planners
+    $B "${F0[@]}" --out results/sites-walls-blind-planners
     $P studies/sites_walls_table.py wall-aware=results/sites-walls-aware-planners \
       wall-blind=results/sites-walls-blind-planners --out docs/results/sites-walls-planners
     $P studies/publish_tables.py ;;
@@ -546,7 +550,8 @@ case "${1:---list}" in
     $P studies/publish_tables.py ;;
   tune-lookahead3)  # issue 42: dcee-cl looking three moves ahead on the tuning range, filament + puffs (docs/results/tuning-lookahead3-13-40)
     $P studies/precision_variants.py --configs random:13-40 --truths puffs filament \
-      --variant lookahead3:search.lookahead=3 --strategy dcee-cl --workers "${WORKERS:-2}" \
+      --variant lookahead3:search.lookahead=3 --pin estimator.region_floor=0.0 --strategy dcee-cl \
+      --workers "${WORKERS:-2}" \
       --csv docs/results/tuning-lookahead3-13-40/variants.csv
     $P studies/publish_tables.py ;;
   lbm-endgame)  # issue 42, a lab note: where each planner reads last and ends on the lbm plume, eight tuning configurations (docs/plumes.md)
@@ -625,12 +630,23 @@ case "${1:---list}" in
     $P studies/mixture_region.py "${LA1P[@]}" --configs random:13-40 --truths puffs filament \
       --variant "prior:$cand" --variant "area-prior:truth.model.puff_radius=0.5,$cand" \
       --workers "${WORKERS:-2}" --csv docs/results/mixture-region-prior-13-40/searches.csv ;;
+  region-floor-held-out)  # issue 42: dcee-cl at today's defaults (the region's model-discrepancy floor since 2026-12-02) on the held-out lbm plume, stored beside the earlier generations
+    # nothing is decided on the lbm plume; the floor changes what is reported and no decision,
+    # so the pairs with 2026-11-29 (b) (the same planner) show what the floor does to the region
+    export SUITE=held-out-100 WORKERS=${WORKERS:-2}
+    TRUTHS=lbm STRATEGIES=dcee-cl OUT_SUFFIX=-d1202 bash studies/study_turbulent_held_out.sh \
+      --set truth.z=4.0
+    lbm_generation -d1202 2026-12-02 floor_vs_before.csv \
+      docs/figures/lbm-held-out-worst-floor.png 2026-11-29b
+    $P studies/region_floor.py results/turbulent-lbm-held-out-100-d1202 \
+      --csv docs/results/lbm-held-out-100/region_floor.csv
+    $P studies/publish_tables.py ;;
   lookahead3-held-out)  # issue 42: dcee-cl at today's defaults (three moves ahead since 2026-11-29 (b)) on the held-out lbm plume, stored beside the earlier generations
     # the lbm plume held out (no default chosen on it); paired with the two-move rows of
     # 2026-11-29 and the other planners' rows of 2026-11-27 (c) (unchanged: today's)
     export SUITE=held-out-100 WORKERS=${WORKERS:-2}
     TRUTHS=lbm STRATEGIES=dcee-cl OUT_SUFFIX=-d29b bash studies/study_turbulent_held_out.sh \
-      --set truth.z=4.0
+      --set truth.z=4.0 "${F0[@]}"
     lbm_generation -d29b 2026-11-29b lookahead3_vs_before.csv \
       docs/figures/lbm-held-out-worst-lookahead3.png 2026-11-29
     $P studies/publish_tables.py ;;
@@ -667,7 +683,8 @@ case "${1:---list}" in
     export SUITE=held-out-100 TRUTHS=lbm WORKERS=${WORKERS:-2}
     # today's defaults (since 2026-11-29 (b): dcee-cl three moves ahead; the other planners as
     # below), and those of 2026-11-29 (dcee-cl two moves ahead, pinned)
-    STRATEGIES=dcee-cl OUT_SUFFIX=-d29b bash studies/study_turbulent_held_out.sh --set truth.z=4.0
+    STRATEGIES=dcee-cl OUT_SUFFIX=-d29b bash studies/study_turbulent_held_out.sh --set truth.z=4.0 \
+      "${F0[@]}"
     STRATEGIES=dcee-cl OUT_SUFFIX=-d29 bash studies/study_turbulent_held_out.sh "${LA2[@]}" \
       --set truth.z=4.0
     # the defaults of 2026-11-27 (c): the disc member at prior odds 9:1, the mixture's

@@ -19,7 +19,7 @@ from dcee.estimation.summaries import in_credible_ellipsoid
 from dcee.models.plume import isotropic_concentration, isotropic_concentration_reference
 from dcee.planning import get as get_planner
 from dcee.runs import run_episode
-from dcee.scenarios import REGION_FLOOR_DEFAULT, load_scenario
+from dcee.scenarios import REGION_FLOOR_DEFAULT, load_scenario, unset_region_floor
 from dcee.searcher import Searcher
 from dcee.simulation import InjectedTruth, make_truth
 from tests.helpers import random_theta, run_cli, spike_ess_share
@@ -392,6 +392,22 @@ def test_floored_region_covers_truths_from_the_convolved_posterior():
     assert np.mean(plain) < 0.6
 
 
+def test_region_floor_changes_the_reported_region_and_no_decision():
+    """The floor is read by the summary alone: the same search at floor 0 and at 1 m takes the
+    same readings at the same places; only ``truth_in_95`` may differ, and it is the
+    summary's entry for that floor of the grid."""
+    sc = load_scenario("paper:1").with_overrides(
+        **{"search.particles": 500, "search.budget": 40, "estimator.likelihood": "fluctuation"}
+    )
+    plain = run_episode(sc.with_overrides(**{"estimator.region_floor": 0.0}), "dcee-cl", 0)
+    wide = run_episode(sc.with_overrides(**{"estimator.region_floor": 0.5}), "dcee-cl", 0)
+    for a, b in zip(plain.records, wide.records, strict=True):
+        assert (a["x"], a["y"], a["z"], a["reading"]) == (b["x"], b["y"], b["z"], b["reading"])
+    assert plain.summary["truth_in_95_floor"] == wide.summary["truth_in_95_floor"]
+    assert wide.summary["truth_in_95"] == wide.summary["truth_in_95_floor"]["0.50"]
+    assert plain.summary["truth_in_95"] == plain.summary["truth_in_95_floor"]["0.00"]
+
+
 def test_region_floor_defaults_follow_the_likelihood():
     paper = load_scenario("paper:1")
     fluct = paper.with_overrides(**{"estimator.likelihood": "fluctuation"})
@@ -399,6 +415,7 @@ def test_region_floor_defaults_follow_the_likelihood():
     assert fluct.region_floor == REGION_FLOOR_DEFAULT["fluctuation"]
     assert fluct.with_overrides(**{"estimator.region_floor": 0.25}).region_floor == 0.25
     assert fluct.resolved_settings()["region_floor"] == fluct.region_floor
+    assert unset_region_floor("fluctuation", "walls") == 0.0  # no floor chosen there
     with pytest.raises(DceeInputError, match="region_floor"):
         paper.with_overrides(**{"estimator.region_floor": -0.1})
 

@@ -379,3 +379,32 @@ def test_pinned_variants_set_the_pins_first_and_a_variant_overrides_them():
     scenario = pv.variant_scenario("random:13", "puffs", pv.pinned_variants(args)[0][1])
     assert scenario.lookahead == 1  # a turbulent scenario, three moves ahead unless pinned
     assert pv.variant_scenario("random:13", "puffs", {}).lookahead == 3
+
+
+def test_region_floor_table_and_rule_by_hand(tmp_path: Path, capsys) -> None:
+    """Four searches per truth: on ``a`` the truth is inside from floor 0 in 3 of 4 and in all 4
+    from 0.2 m; on ``b`` in all 4 from 0.1 m. The rule at 95 % takes 0.2 m (the smallest floor
+    at which both truths reach it), at 75 % 0.1 m; the radius is √(spread² + 3 σ²)."""
+    region_floor = _script("region_floor")
+    floors = ("0.00", "0.10", "0.20")
+    path = tmp_path / "variants.csv"
+    inside = {"a": [(1, 1, 1), (1, 1, 1), (1, 1, 1), (0, 0, 1)], "b": [(0, 1, 1)] * 4}
+    rows = [
+        {
+            "truth": t,
+            "final_spread": 0.3,
+            **{f"truth_in_95_floor_{f}": bool(v) for f, v in zip(floors, hit, strict=True)},
+        }
+        for t, hits in inside.items()
+        for hit in hits
+    ]
+    pd.DataFrame(rows).to_csv(path, index=False)
+    assert region_floor.main([str(path), "--csv", str(tmp_path / "c.csv"), "--choose", "0.95"]) == 0
+    assert "chosen floor: 0.20" in capsys.readouterr().out
+    table = pd.read_csv(tmp_path / "c.csv")
+    a0 = table[(table["truth"] == "a") & (table["floor"] == 0.0)].iloc[0]
+    assert (a0["inside"], a0["n"]) == (3, 4)
+    both = table[(table["truth"] == "all") & (table["floor"] == 0.2)].iloc[0]
+    assert both["inside"] == 8 and both["median_radius"] == pytest.approx(math.sqrt(0.09 + 0.12))
+    assert region_floor.main([str(path), "--choose", "0.75"]) == 0
+    assert "chosen floor: 0.10" in capsys.readouterr().out

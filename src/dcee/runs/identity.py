@@ -11,13 +11,13 @@ from typing import Any
 from dcee.scenarios import (
     OLD_OUTLIER_DEFAULT,
     READING_WEIGHT_DEFAULT,
-    REGION_FLOOR_DEFAULT,
     REPEAT_DEFAULT,
     UnicycleSpec,
     default_learn,
     default_learn_prior,
     unset_climb,
     unset_lookahead,
+    unset_region_floor,
 )
 from dcee.scenarios.schema.world import WorldSpec
 
@@ -163,7 +163,9 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
             estimator["reading_weight"] = READING_WEIGHT_DEFAULT[likelihood]
         if "region_floor" in estimator and estimator["region_floor"] is None:
             # unset: the likelihood's default, compared as the number it stands for
-            estimator["region_floor"] = REGION_FLOOR_DEFAULT[likelihood]
+            estimator["region_floor"] = unset_region_floor(
+                likelihood, estimator.get("plume", "open")
+            )
         for k, key in enumerate(("repeat_radius", "repeat_power")):
             if key in estimator and estimator[key] is None:
                 # unset: the likelihood's default, compared as the number it stands for

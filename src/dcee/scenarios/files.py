@@ -133,6 +133,7 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
         ("estimator", "reading_weight"): scenario.reading_weight,
         ("estimator", "repeat_radius"): scenario.repeat_radius,
         ("estimator", "repeat_power"): scenario.repeat_power,
+        ("estimator", "region_floor"): scenario.region_floor,
         ("agent", "dwell"): scenario.dwell,
         ("agent", "climb"): scenario.climb,
         ("world", "resolution"): scenario.site_resolution,

@@ -28,6 +28,7 @@ from dcee.scenarios.schema.estimator import (
     PriorSpec,
     SensorSpec,
     default_priors,
+    unset_region_floor,
 )
 from dcee.scenarios.schema.learn import default_learn, default_learn_prior
 from dcee.scenarios.schema.scenario import FIELD_MARK, Scenario, validate_scenario
@@ -82,5 +83,6 @@ __all__ = [
     "team_starts",
     "unset_climb",
     "unset_lookahead",
+    "unset_region_floor",
     "validate_scenario",
 ]

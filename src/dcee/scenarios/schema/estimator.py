@@ -122,11 +122,21 @@ checked on held-out random:1000-1023 with dcee-cl and infotaxis: the truth insid
 in 29 more searches and 10 fewer of 96 paired ones (exact McNemar p = 0.003), acquisition and
 final error no worse (docs/turbulent.md)."""
 
-REGION_FLOOR_DEFAULT: dict[str, float] = {"paper": 0.0, "fluctuation": 0.0}
-"""``estimator.region_floor`` (m) per likelihood when not given: 0 for the paper's model (the
-isotropic truth's own model: no discrepancy to allow for); for the fluctuation model chosen on
-the tuning range random:13-40 by the rule of docs/results/tuning-region-floor-13-40 (written
-before its run)."""
+REGION_FLOOR_DEFAULT: dict[str, float] = {"paper": 0.0, "fluctuation": 0.25}
+"""``estimator.region_floor`` (m) per likelihood when not given, in open terrain: 0 for the
+paper's model (the isotropic truth's own model: no discrepancy to allow for); 0.25 m for the
+fluctuation model, chosen on the tuning range random:13-40 (dcee-cl, filament + puffs, 56
+searches) by the rule of docs/results/tuning-region-floor-13-40, written before its run: the
+smallest floor of the grid 0-0.5 m at which the truth lies in the 95 % region in ≥ 95 % of
+each truth's searches (filament 25/28 up to 0.2 m, 27/28 at 0.25 m; puffs 28/28 from 0); the
+region's median RMS radius 0.33 → 0.55 m. The wall-aware plume (``plume = "walls"``), on which
+no floor was chosen, keeps 0."""
+
+
+def unset_region_floor(likelihood: str, plume: str = "open") -> float:
+    """What an unset ``estimator.region_floor`` resolves to (:data:`REGION_FLOOR_DEFAULT`)."""
+    return REGION_FLOOR_DEFAULT[likelihood] if plume == "open" else 0.0
+
 
 REPEAT_DEFAULT: dict[str, tuple[float, float]] = {"paper": (0.0, 1.0), "fluctuation": (2.0, 0.5)}
 """(``repeat_radius`` m, ``repeat_power``) per likelihood when not given: off for the paper's
@@ -388,7 +398,7 @@ class EstimatorSpec(BaseModel):
     that no reading removes (a point-source model of a plume that is not one). It widens what
     the estimator reports, never what it decides: the filter, the planners and the stop rule
     read the particles. 0: the particles' own region. None: the likelihood's default,
-    :data:`REGION_FLOOR_DEFAULT`"""
+    :func:`unset_region_floor`"""
     calm_prior: Annotated[float, Field(ge=0, lt=1)] = 0.1
     """fluctuation: prior probability that the plume is calm (the paper's model, run in a second
     filter and selected by the readings' evidence: the turbulence level estimated online); 0: the

@@ -24,13 +24,13 @@ from dcee.scenarios.schema.common import FIELD_MARK, FROZEN, phi_prior_from_bear
 from dcee.scenarios.schema.estimator import (
     MEANDER_DEFAULT,
     READING_WEIGHT_DEFAULT,
-    REGION_FLOOR_DEFAULT,
     REPEAT_DEFAULT,
     AnemometerSpec,
     EstimatorSpec,
     PriorSpec,
     SensorSpec,
     default_priors,
+    unset_region_floor,
 )
 from dcee.scenarios.schema.messages import one_line_error
 from dcee.scenarios.schema.reading_models import ReadingModelSettings
@@ -354,12 +354,8 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
 
     @property
     def reading_weight(self) -> float:
-        e = self.estimator
-        return (
-            e.reading_weight
-            if e.reading_weight is not None
-            else READING_WEIGHT_DEFAULT[e.likelihood]
-        )
+        e, default = self.estimator, READING_WEIGHT_DEFAULT
+        return e.reading_weight if e.reading_weight is not None else default[e.likelihood]
 
     @property
     def repeat_radius(self) -> float:
@@ -375,9 +371,10 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
 
     @property
     def region_floor(self) -> float:
-        """m, the reported region's model-discrepancy floor (``estimator.region_floor``)."""
+        """m, the reported region's floor (``estimator.region_floor`` or its default)."""
         e = self.estimator
-        return e.region_floor if e.region_floor is not None else REGION_FLOOR_DEFAULT[e.likelihood]
+        floor = unset_region_floor(e.likelihood, e.plume)
+        return floor if e.region_floor is None else e.region_floor
 
     def resolved_settings(self) -> dict[str, Any]:
         """The defaults resolved for this truth (stored with every result)."""
