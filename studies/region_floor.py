@@ -2,9 +2,10 @@
 share of searches with the truth inside it, per truth, and the rule that chooses the default.
 
 Reads searches that recorded ``truth_in_95_floor`` (every summary since the floor existed):
-a ``studies/precision_variants.py`` CSV (columns ``truth_in_95_floor_<σ>``) or campaign folders
-(their ``*/summary.json``). Writes one row per truth and floor: n, inside, the share with its
-Wilson 95 % interval, and the median RMS radius of the floored region √(spread² + D σ²), m.
+a ``studies/precision_variants.py`` CSV (columns ``truth_in_95_floor_<σ>``) or campaign
+folders (every ``summary.json`` below them). Writes one row per truth and floor: n, inside, the
+share with its Wilson 95 % interval, and the median RMS radius of the floored region
+√(spread² + D σ²), m.
 
     .venv/bin/python studies/region_floor.py docs/results/tuning-region-floor-13-40/variants.csv \\
         --csv docs/results/tuning-region-floor-13-40/coverage.csv --choose 0.95
@@ -51,7 +52,7 @@ def _searches(source: Path) -> list[dict]:
                     }
                 )
         return out
-    for path in sorted(source.glob("*/summary.json")):
+    for path in sorted(source.rglob("summary.json")):  # a campaign's runs/config=…/…/seed=…/
         s = json.loads(path.read_text())
         if "truth_in_95_floor" not in s:
             continue

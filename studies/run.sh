@@ -681,8 +681,10 @@ case "${1:---list}" in
   cross-truth)  # every truth at today's defaults; the lbm plume held out (docs/plumes.md, README)
     # dcee-cl, infotaxis and the tree search at today's defaults, 100 held-out configurations
     export SUITE=held-out-100 TRUTHS=lbm WORKERS=${WORKERS:-2}
-    # today's defaults (since 2026-11-29 (b): dcee-cl three moves ahead; the other planners as
-    # below), and those of 2026-11-29 (dcee-cl two moves ahead, pinned)
+    # today's defaults (since 2026-12-02: the region's floor; dcee-cl three moves ahead since
+    # 2026-11-29 (b); the other planners as below, flown before the floor: pinned), those of
+    # 2026-11-29 (b) (three moves, no floor) and of 2026-11-29 (dcee-cl two moves ahead, pinned)
+    STRATEGIES=dcee-cl OUT_SUFFIX=-d1202 bash studies/study_turbulent_held_out.sh --set truth.z=4.0
     STRATEGIES=dcee-cl OUT_SUFFIX=-d29b bash studies/study_turbulent_held_out.sh --set truth.z=4.0 \
       "${F0[@]}"
     STRATEGIES=dcee-cl OUT_SUFFIX=-d29 bash studies/study_turbulent_held_out.sh "${LA2[@]}" \
@@ -727,7 +729,7 @@ case "${1:---list}" in
     STRATEGIES=dcee-cl OUT_SUFFIX=-20k bash studies/study_turbulent_held_out.sh "${LA1[@]}" "${old[@]}" \
       --particles 20000
     r=results/turbulent-lbm-held-out-100
-    report turbulent-lbm-held-out-100-d29b turbulent-lbm-held-out-100-d29 \
+    report turbulent-lbm-held-out-100-d1202 turbulent-lbm-held-out-100-d29b turbulent-lbm-held-out-100-d29 \
       turbulent-lbm-held-out-100-dm turbulent-lbm-held-out-100-dm-info turbulent-lbm-held-out-100-mcts-dm \
       turbulent-lbm-held-out-100-dm-h2 \
       turbulent-lbm-held-out-100-bf turbulent-lbm-held-out-100-mcts-bf turbulent-lbm-held-out-100-radius \
@@ -736,6 +738,7 @@ case "${1:---list}" in
       turbulent-lbm-held-out-100-nsl25 turbulent-lbm-held-out-100-decay \
       turbulent-lbm-held-out-100-mcts turbulent-lbm-held-out-100-nsl turbulent-lbm-held-out-100-20k
     $P studies/collect_metrics.py --out docs/results/lbm-held-out-100 \
+      "$r-d1202=defaults:2026-12-02,learn:none,particles:10000" \
       "$r-d29b=defaults:2026-11-29b,learn:none,particles:10000" \
       "$r-d29=defaults:2026-11-29,learn:none,particles:10000" \
       "$r-dm=defaults:2026-11-27c,learn:none,particles:10000" \

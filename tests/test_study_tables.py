@@ -5,6 +5,7 @@ studies/collect_metrics.py writes), and a stored generation kept by collect_metr
 from __future__ import annotations
 
 import importlib.util
+import json
 import math
 from pathlib import Path
 
@@ -408,3 +409,24 @@ def test_region_floor_table_and_rule_by_hand(tmp_path: Path, capsys) -> None:
     assert both["inside"] == 8 and both["median_radius"] == pytest.approx(math.sqrt(0.09 + 0.12))
     assert region_floor.main([str(path), "--choose", "0.75"]) == 0
     assert "chosen floor: 0.10" in capsys.readouterr().out
+
+
+def test_region_floor_reads_a_campaigns_nested_summaries(tmp_path: Path, capsys) -> None:
+    """A campaign keeps each search at runs/config=…/strategy=…/seed=…/summary.json; a planar
+    search (x, y unknown) counts two location coordinates in the region's radius."""
+    region_floor = _script("region_floor")
+    for k, inside in enumerate((True, False)):
+        folder = tmp_path / "runs" / f"config=random%3A{k}" / "strategy=dcee-cl" / "seed=0"
+        folder.mkdir(parents=True)
+        summary = {
+            "truth_model": "lbm",
+            "parameter_names": ["x", "y", "q", "u", "phi", "zeta1", "zeta2"],
+            "final_spread": 0.2,
+            "truth_in_95_floor": {"0.00": False, "0.25": inside},
+        }
+        (folder / "summary.json").write_text(json.dumps(summary))
+    assert region_floor.main([str(tmp_path), "--csv", str(tmp_path / "c.csv")]) == 0
+    table = pd.read_csv(tmp_path / "c.csv")
+    row = table[table["floor"] == 0.25].iloc[0]
+    assert (row["inside"], row["n"]) == (1, 2)
+    assert row["median_radius"] == pytest.approx(math.sqrt(0.04 + 2 * 0.0625))
