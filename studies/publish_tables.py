@@ -722,16 +722,20 @@ CROSS_HEADER = [
 ]
 
 
-TODAY_DEFAULTS = {"dcee-cl": "2026-11-29b", "infotaxis": "2026-11-27c", "dcee-mcts": "2026-11-27c"}
+TODAY_DEFAULTS = {"dcee-cl": "2026-12-02", "infotaxis": "2026-12-02", "dcee-mcts": "2026-12-02"}
 """Per planner, the ``defaults`` tag of rows flown at today's defaults (a 0.5 m near-source
 fall, repeat power 1/2, the backflow member and the disc member at prior odds 9 : 1 learned, the
 95 % region the members' mixture's; ``dcee-cl`` looks three moves ahead in a turbulent plume
-since 2026-11-29 (b) (two on 2026-11-29), ``search.lookahead``, which changed no other planner:
-their rows of 2026-11-27
-(c) are today's)."""
+since 2026-11-29 (b) (two on 2026-11-29), ``search.lookahead``, which changed no other planner;
+the region widened by the model-discrepancy floor, ``estimator.region_floor`` = 0.25 m, since
+2026-12-02, for every planner: rows flown before it report the particles' own region)."""
 EARLIER_DEFAULTS = {
-    "2026-11-29": "defaults of 2026-11-29: `dcee-cl` two moves ahead",
-    "2026-11-27c": "defaults of 2026-11-27 (c): `dcee-cl` one move ahead",
+    "2026-11-29b": "defaults of 2026-11-29 (b) (`dcee-cl` three moves ahead), the particles' "
+    "own 95 % region",
+    "2026-11-29": "defaults of 2026-11-29 (`dcee-cl` two moves ahead), the particles' own 95 % "
+    "region",
+    "2026-11-27c": "defaults of 2026-11-27 (c) (`dcee-cl` one move ahead), the particles' own "
+    "95 % region",
     "2026-11-27b": "defaults of 2026-11-27 (b): the backflow member alone, the selected "
     "member's region",
     "2026-11-27": "defaults of 2026-11-27 before the backflow member",
@@ -756,7 +760,7 @@ def latest_defaults(frame: pd.DataFrame, strategies: tuple[str, ...], **where: o
 def defaults_words(tags: dict) -> str:
     """ "today's defaults" when every planner's newest rows are today's, else which of them."""
     if all(tag == TODAY_DEFAULTS.get(s) for s, tag in tags.items()):
-        return "today's defaults, `dcee-cl` three moves ahead since 2026-11-29 (b)"
+        return "today's defaults (`dcee-cl` three moves ahead, the region's floor 0.25 m)"
     parts = [
         f"`{s}` at "
         + ("today's" if tag == TODAY_DEFAULTS.get(s) else f"the {EARLIER_DEFAULTS[tag]}")
@@ -1047,7 +1051,8 @@ def region_floor_table(path: str, chosen: float | None = None) -> str:
         for t in truths:
             r = part[part["truth"] == t].iloc[0]
             cells.append(
-                f"{int(r['inside'])}/{int(r['n'])}, {r['share']:.0%} [{r['lo']:.0%}, {r['hi']:.0%}]"
+                f"{int(r['inside'])}/{int(r['n'])}, {100 * r['share']:.0f} % "
+                f"[{100 * r['lo']:.0f}, {100 * r['hi']:.0f}]"
             )
         radius = part[part["truth"] == truths[-1]].iloc[0]["median_radius"]
         label = f"{f:.2f}"
@@ -1678,6 +1683,9 @@ TABLES: dict[str, Callable[[], str]] = {
     "lookahead3-tuning": lookahead3_tuning_table,
     "region-floor-tuning": lambda: region_floor_table(
         "tuning-region-floor-13-40/coverage.csv", REGION_FLOOR_DEFAULT["fluctuation"]
+    ),
+    "region-floor-lbm": lambda: region_floor_table(
+        "lbm-held-out-100/region_floor.csv", REGION_FLOOR_DEFAULT["fluctuation"]
     ),
     "cross-truth": cross_truth_table,
     "cross-truth-latest": lambda: cross_truth_table(latest_only=True),
