@@ -641,6 +641,22 @@ case "${1:---list}" in
     $P studies/region_floor.py results/turbulent-lbm-held-out-100-d1202 \
       --csv docs/results/lbm-held-out-100/region_floor.csv
     $P studies/publish_tables.py ;;
+  region-floor-held-out-infotaxis)  # issue 42: infotaxis at today's defaults (the region's floor) on the held-out lbm plume, beside dcee-cl's generation of 2026-12-02
+    export SUITE=held-out-100 WORKERS=${WORKERS:-2}
+    TRUTHS=lbm STRATEGIES=infotaxis OUT_SUFFIX=-d1202-info bash studies/study_turbulent_held_out.sh \
+      --set truth.z=4.0
+    r=results/turbulent-lbm-held-out-100-d1202-info lbm=docs/results/lbm-held-out-100
+    report turbulent-lbm-held-out-100-d1202-info
+    keep=()
+    for g in "${LBM_GENERATIONS[@]}"; do keep+=(--keep "defaults:$g"); done
+    $P studies/collect_metrics.py --out "$lbm" "${keep[@]}" \
+      "$r=defaults:2026-12-02,learn:none,particles:10000"
+    rm -f "$lbm/floor_infotaxis_vs_before.csv"
+    $P studies/pair_campaigns.py \
+      "$lbm/searches.csv=strategy:infotaxis:learn:none:particles:10000.0:defaults:2026-11-27c" "$r" \
+      --csv "$lbm/floor_infotaxis_vs_before.csv" --tag truth_model=lbm
+    $P studies/region_floor.py "$r" --csv "$lbm/region_floor_infotaxis.csv"
+    $P studies/publish_tables.py ;;
   lookahead3-held-out)  # issue 42: dcee-cl at today's defaults (three moves ahead since 2026-11-29 (b)) on the held-out lbm plume, stored beside the earlier generations
     # the lbm plume held out (no default chosen on it); paired with the two-move rows of
     # 2026-11-29 and the other planners' rows of 2026-11-27 (c) (unchanged: today's)
