@@ -1687,6 +1687,9 @@ TABLES: dict[str, Callable[[], str]] = {
     "region-floor-lbm": lambda: region_floor_table(
         "lbm-held-out-100/region_floor.csv", REGION_FLOOR_DEFAULT["fluctuation"]
     ),
+    "region-floor-lbm-infotaxis": lambda: region_floor_table(
+        "lbm-held-out-100/region_floor_infotaxis.csv", REGION_FLOOR_DEFAULT["fluctuation"]
+    ),
     "cross-truth": cross_truth_table,
     "cross-truth-latest": lambda: cross_truth_table(latest_only=True),
     "radius-prior-point": lambda: radius_prior_table("point"),
