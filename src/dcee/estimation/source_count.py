@@ -320,8 +320,7 @@ class SourceCountBank:
         return locations, f.weights
 
     def source_mean(self) -> np.ndarray:
-        """(3,) the settled target's posterior mean (the estimate the stop rule and the
-        records read)."""
+        """(3,) the settled target's posterior mean (what the stop rule and the records read)."""
         locations, weights = self._settled_release()
         return weights @ locations
 
@@ -414,8 +413,7 @@ class SourceCountBank:
         return self.members[0].log_likelihood(theta, position, reading)
 
     def _nearest_release(self, true_location: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(N, 3) locations and (N,) weights of the most probable count's release nearest to
-        ``true_location`` (the one-release filter's when the count is 0)."""
+        """(N, 3) locations, (N,) weights: the most probable count's release nearest the truth."""
         k = max(self.estimated_count, 1)
         f = self.member(k)
         if not isinstance(f, MultiSourceFilter):
@@ -429,7 +427,9 @@ class SourceCountBank:
         points, weights = self._nearest_release(true_location)
         return weighted_rmse(points, weights, true_location)
 
-    def in_credible_region(self, true_location: np.ndarray, level=0.95, floor=0.0) -> bool:
+    def in_credible_region(
+        self, true_location: np.ndarray, level: float = 0.95, floor: float = 0.0
+    ) -> bool:
         """Whether ``true_location`` is in the ``level`` region (floored) of the nearest release."""
         cols = self.members[0]._loc_block
         if not cols:

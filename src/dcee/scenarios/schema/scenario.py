@@ -354,8 +354,9 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
 
     @property
     def reading_weight(self) -> float:
-        e, default = self.estimator, READING_WEIGHT_DEFAULT
-        return e.reading_weight if e.reading_weight is not None else default[e.likelihood]
+        e = self.estimator
+        default = READING_WEIGHT_DEFAULT[e.likelihood]
+        return default if e.reading_weight is None else e.reading_weight
 
     @property
     def repeat_radius(self) -> float:
