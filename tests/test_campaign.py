@@ -319,6 +319,8 @@ def test_report_tables_and_figures(finished, tmp_path):
     assert html.count("data:image/png;base64,") == 4
     # the campaign's edit of every configuration is named, so it is not read as the built-ins
     assert "settings changed from the configurations' own: search.particles = 300" in html
+    # the paper's likelihood keeps the particles' own 95 % region (floor 0), and says so
+    assert "The 95% region is the particles' own." in html
     # Paired comparison recounted by hand: searches acquired by one strategy and not the other.
     pairs = pd.read_csv(tmp_path / "report/pairwise.csv")
     assert len(pairs) == 1 and pairs.loc[0, "pairs"] == 4
@@ -473,6 +475,15 @@ def test_bench_bad_input_is_one_line_exit_2(tmp_path, capsys, args, field):
         main(["bench", "--suite", "smoke", "--out", str(tmp_path / "c"), *args])
     err = capsys.readouterr().err
     assert exc.value.code == 2 and field in err and err.count("\n") == 1
+
+
+def test_report_names_the_region_floor():
+    from dcee.analysis.report import region_floor_text
+
+    assert region_floor_text(pd.DataFrame({"x": [1]})) == "The 95% region is the particles' own."
+    assert region_floor_text(pd.DataFrame({"region_floor": [0.0, 0.0]})).endswith("own.")
+    mixed = region_floor_text(pd.DataFrame({"region_floor": [0.25, 0.0, 0.25, None]}))
+    assert "estimator.region_floor = 0, 0.25 m" in mixed
 
 
 def test_report_on_a_folder_without_results_is_exit_2(tmp_path, capsys):

@@ -102,6 +102,23 @@ def _fmt_stall(longest: float, stalled: int, limit: float = STALL_SECONDS) -> st
     return f"{longest:.0f} ({stalled} > {limit:.0f} s)"
 
 
+def region_floor_text(runs: pd.DataFrame) -> str:
+    """The sentence that says which 95 % region "truth in 95% region" counts: the particles'
+    own, or widened by ``estimator.region_floor`` σ (m, docs/plumes.md); a summary written
+    before the floor existed has none (the particles' own)."""
+    floors = (
+        sorted({float(f) for f in runs["region_floor"].dropna()}) if "region_floor" in runs else []
+    )
+    if not any(f > 0 for f in floors):
+        return "The 95% region is the particles' own."
+    return (
+        "The 95% region is the posterior's widened by the reading model's own error, "
+        f"estimator.region_floor = {', '.join(f'{f:g}' for f in floors)} m (0: the "
+        "particles' own region; the region at every floor is in each summary, "
+        "truth_in_95_floor)."
+    )
+
+
 def markdown_table(table: pd.DataFrame) -> str:
     head = (
         "| strategy | n | source acquired | plume acquired | mean final RMSE (m) | "
@@ -210,6 +227,7 @@ def write_report(results_dir: Path, out_dir: Path) -> list[Path]:
         **({"search.particles": s["particles"]} if s.get("particles") else {}),
         **(s.get("overrides") or {}),
     }
+    floor_text = region_floor_text(runs)
     edits_text = (
         "; settings changed from the configurations' own: "
         + ", ".join(f"{k} = {v}" for k, v in sorted(edits.items()))
@@ -226,7 +244,7 @@ def write_report(results_dir: Path, out_dir: Path) -> list[Path]:
         f"{s.get('unknown') or 'as configured'}; ground truth: {', '.join(truths)}{edits_text}; "
         "code: "
         f"dcee {code_text}. Intervals are 95%; times to an RMSE level are Kaplan–Meier "
-        "medians with searches that never got there censored at the budget.</p>",
+        f"medians with searches that never got there censored at the budget. {floor_text}</p>",
         _md_to_html(md),
         "<h2>paired comparisons (common configurations and seeds)</h2>",
         _md_to_html(pairs_md) if len(pairs) else "<p>fewer than two strategies</p>",
