@@ -745,6 +745,16 @@ EARLIER_DEFAULTS = {
 OLD_DEFAULTS = EARLIER_DEFAULTS["2026-11-23"]
 
 
+def earlier_defaults(tag: str, strategy: str) -> str:
+    """How a row of ``strategy`` flown at the earlier defaults ``tag`` says so: the words of
+    :data:`EARLIER_DEFAULTS`, without the parenthesis on how far ``dcee-cl`` looked ahead on a
+    row of another planner (``search.lookahead`` changed no other planner)."""
+    words = EARLIER_DEFAULTS[tag]
+    if strategy != "dcee-cl":
+        words = re.sub(r" \(`dcee-cl` \w+ moves? ahead\)", "", words)
+    return words
+
+
 def small_sample(r: pd.Series) -> str:
     """ ", N configurations (small sample)" for a row of fewer than the 100 held-out ones."""
     n = int(r["searches"])
@@ -763,7 +773,7 @@ def defaults_words(tags: dict) -> str:
         return "today's defaults (`dcee-cl` three moves ahead, the region's floor 0.25 m)"
     parts = [
         f"`{s}` at "
-        + ("today's" if tag == TODAY_DEFAULTS.get(s) else f"the {EARLIER_DEFAULTS[tag]}")
+        + ("today's" if tag == TODAY_DEFAULTS.get(s) else f"the {earlier_defaults(tag, s)}")
         for s, tag in tags.items()
     ]
     return ", ".join(parts)
@@ -801,7 +811,7 @@ def cross_truth_table(latest_only: bool = False) -> str:
                 ", the same planner as `dcee-cl` at the defaults of 2026-11-29, flown before "
                 "they were the defaults"
             )
-        return f", {EARLIER_DEFAULTS[defaults]}"
+        return f", {earlier_defaults(defaults, strategy)}"
 
     for strategy in ("dcee-cl", "infotaxis", "dcee-mcts"):
         add(
