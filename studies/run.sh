@@ -19,6 +19,11 @@ F0=(--set estimator.region_floor=0.0)
 LA1=(--set search.lookahead=1 "${F0[@]}")
 LA1P=(--pin search.lookahead=1 --pin estimator.region_floor=0.0)  # for precision_variants.py, mixture_region.py
 LA2=(--set search.lookahead=2 "${F0[@]}")
+# With the count of releases unknown the UAV flew at the paper's fixed 4 m until 2026-12-02 (b),
+# when an unset agent.climb became 1 m there too (issue 45): C0 pins the fixed altitude where a
+# several-release campaign stored before is flown again (the fluctuation likelihood climbed
+# before and after).
+C0=(--set agent.climb=0)
 # the generations of dcee-cl's lbm rows in docs/results/lbm-held-out-100 (column defaults)
 LBM_GENERATIONS=(2026-12-02 2026-11-29b 2026-11-29 2026-11-27c 2026-11-27b 2026-11-27 2026-11-23)
 lbm_generation() {  # SUFFIX TAG PAIRS FIGURE [TAG...]: one dcee-cl campaign on the held-out lbm plume stored beside the other generations, paired with the TAG rows of dcee-cl and with every planner at 2026-11-27 (c), its worst searches drawn
@@ -40,10 +45,12 @@ lbm_generation() {  # SUFFIX TAG PAIRS FIGURE [TAG...]: one dcee-cl campaign on 
   $P studies/upwind_detections.py "$r=dcee-cl"
   $P studies/worst_searches.py "$r=dcee-cl" --out "$figure"
 }
-count_campaigns() {  # PLANNER SUFFIX: its two- and three-release held-out campaigns (issue 45)
+count_campaigns() {  # PLANNER SUFFIX [SETTINGS...]: its two- and three-release held-out campaigns (issue 45)
+  local planner=$1 suffix=$2
+  shift 2
   for N in two three; do
-    $D bench --suite "$N-source-held-out-100" --repeats 1 --strategies "$1" \
-      --workers "${WORKERS:-2}" --out "results/$N-source-held-out-100$2"
+    $D bench --suite "$N-source-held-out-100" --repeats 1 --strategies "$planner" "$@" \
+      --workers "${WORKERS:-2}" --out "results/$N-source-held-out-100$suffix"
   done
 }
 
@@ -57,7 +64,7 @@ source_count_tables() {
     results/*-source-held-out-100-9f200ee results/one-source-*-held-out-100 \
     results/two-source-wind-unknown-held-out-50 results/two-source-filament-held-out-100 \
     results/two-source-puffs-held-out-100 results/two-source-held-out-100-infotaxis \
-    results/*-source-held-out-100-mcts \
+    results/*-source-held-out-100-mcts results/*-source-held-out-100-climb \
     results/*-source-held-out-100-5d04d27 results/*-source-held-out-100-d207b1e \
     results/three-source-held-out-100-20k 2>/dev/null) \
     --csv docs/results/source-count/searches.csv
@@ -811,19 +818,19 @@ case "${1:---list}" in
       "$r-nsl25=infotaxis" "$r-decay=dcee-cl" "$r-mcts=dcee-mcts" "$r-nsl=dcee-cl"
     $P studies/publish_tables.py ;;
   source-count)  # issue 45: an unknown number of releases, dcee-cl, 100 held-out configurations of two and of three releases (docs/multi-source.md)
-    count_campaigns dcee-cl ""
+    count_campaigns dcee-cl "" "${C0[@]}"
     source_count_tables
     $P studies/publish_tables.py ;;
   source-count-one)  # issue 45: one release, the count unknown (0-3) against the one-release filter, 100 held-out configurations (docs/multi-source.md)
     for ARM in unknown-count known-count; do
       $D bench --suite "one-source-$ARM-held-out-100" --repeats 1 --strategies dcee-cl \
-        --workers "${WORKERS:-2}" --out "results/one-source-$ARM-held-out-100"
+        "${C0[@]}" --workers "${WORKERS:-2}" --out "results/one-source-$ARM-held-out-100"
     done
     source_count_tables
     $P studies/publish_tables.py ;;
   source-count-wind-unknown)  # issue 45: two releases with the wind unknown too, the first 50 held-out configurations (docs/multi-source.md)
     $D bench --suite two-source-wind-unknown-held-out-50 --repeats 1 --strategies dcee-cl \
-      --workers "${WORKERS:-2}" --out results/two-source-wind-unknown-held-out-50
+      "${C0[@]}" --workers "${WORKERS:-2}" --out results/two-source-wind-unknown-held-out-50
     source_count_tables
     $P studies/publish_tables.py ;;
   source-count-turbulent)  # issue 45: two releases in the filament and the puff truths, the fluctuation likelihood with one reading model (docs/multi-source.md)
@@ -836,27 +843,38 @@ case "${1:---list}" in
     $P studies/publish_tables.py ;;
   source-count-infotaxis)  # issue 45: infotaxis on the joint belief, the same 100 two-release held-out configurations (docs/multi-source.md)
     $D bench --suite two-source-held-out-100 --repeats 1 --strategies infotaxis \
-      --workers "${WORKERS:-2}" --out results/two-source-held-out-100-infotaxis
+      "${C0[@]}" --workers "${WORKERS:-2}" --out results/two-source-held-out-100-infotaxis
     source_count_tables
     $P studies/publish_tables.py ;;
   source-count-mcts)  # issue 45: the tree search on the joint belief, the same 100 held-out configurations of two and of three releases (docs/multi-source.md)
-    count_campaigns dcee-mcts -mcts
+    count_campaigns dcee-mcts -mcts "${C0[@]}"
     source_count_tables
     $P studies/publish_tables.py ;;
   source-count-paper-scale)  # issue 45: the three-release held-out campaign at the paper's 20,000 particles
     $D bench --suite three-source-held-out-100 --repeats 1 --strategies dcee-cl --particles 20000 \
-      --workers "${WORKERS:-2}" --out results/three-source-held-out-100-20k
+      "${C0[@]}" --workers "${WORKERS:-2}" --out results/three-source-held-out-100-20k
     source_count_tables
     $P studies/publish_tables.py ;;
   source-count-timing)  # issue 45: decision and update time with the count unknown against one release (idle machine, one pinned core)
     $P studies/source_count_timing.py --out docs/results/source-count/timing.csv
     $P studies/publish_tables.py ;;
-  source-count-tune)  # issue 45: the same on the tuning range random2/3:1-60 (never reported as a result)
+  source-count-tune)  # issue 45: the same on the tuning range random2/3:1-60 at the fixed altitude (never reported as a result)
     for N in two three; do
-      $D bench --suite "$N-source-tune" --repeats 1 --strategies dcee-cl \
+      $D bench --suite "$N-source-tune" --repeats 1 --strategies dcee-cl "${C0[@]}" \
         --workers "${WORKERS:-2}" --out "results/$N-source-tune"
     done
     $P studies/source_count_table.py results/two-source-tune results/three-source-tune ;;
+  source-count-tune-climb)  # issue 45: the tuning range random3/2:1-60 with the UAV free to climb (agent.climb = 1, today's default with the count unknown; -60-climb in docs/results/source-count-tune)
+    for N in three two; do
+      $D bench --suite "$N-source-tune" --repeats 1 --strategies dcee-cl \
+        --workers "${WORKERS:-2}" --out "results/$N-source-tune-60-climb"
+    done
+    $P studies/source_count_table.py results/three-source-tune-60-climb \
+      results/two-source-tune-60-climb --csv docs/results/source-count-tune/searches.csv ;;
+  source-count-climb)  # issue 45: dcee-cl at today's defaults (the UAV free to climb with the count unknown), the 100 held-out configurations of three and of two releases (docs/multi-source.md)
+    count_campaigns dcee-cl -climb
+    source_count_tables
+    $P studies/publish_tables.py ;;
   publish)  # the tables of README.md, docs/index.md, docs/results.md from docs/results/
     $P studies/publish_tables.py ;;
   stonesoup-mcts)  # our tree search against Stone Soup's MCTS on its own example, 10 seeds

@@ -105,6 +105,20 @@ def test_an_unset_climb_follows_the_expected_plume_and_the_platform():
     before = paper.model_dump(mode="json")
     del before["agent"]["climb"]  # a paper campaign stored before the setting existed
     assert scenario_identity(before) == scenario_identity(paper.model_dump(mode="json"))
+    # the count of releases unknown: 1 m with the paper's likelihood too (issue 45), not on a
+    # robot or the ground robot; one release known keeps the paper's fixed altitude
+    several = paper.with_overrides(**{"estimator.max_sources": 3})
+    assert several.agent.climb is None and several.climb == AUTO_CLIMB
+    assert several.make_agent().n_moves == 10 and several.make_agent(on_robot=True).n_moves == 8
+    assert several.with_overrides(**{"agent.model": "unicycle"}).climb == 0.0
+    assert paper.with_overrides(**{"estimator.max_sources": 1}).climb == 0.0
+    stored = several.model_dump(mode="json")
+    assert scenario_identity(stored) == scenario_identity(
+        several.with_overrides(**{"agent.climb": 1.0}).model_dump(mode="json")
+    )
+    assert scenario_identity(stored) != scenario_identity(
+        several.with_overrides(**{"agent.climb": 0.0}).model_dump(mode="json")
+    )
 
 
 def test_the_command_line_says_when_an_unset_climb_resolves_to_a_climbing_uav(capsys):
@@ -119,3 +133,6 @@ def test_the_command_line_says_when_an_unset_climb_resolves_to_a_climbing_uav(ca
     climb_notice(turbulent)
     err = capsys.readouterr().err
     assert "agent.climb unset" in err and "1 m" in err and err.count("\n") == 1
+    climb_notice(paper.with_overrides(**{"estimator.max_sources": 2}))
+    err = capsys.readouterr().err
+    assert "count of releases is unknown" in err and err.count("\n") == 1

@@ -101,9 +101,17 @@ def compile_notice(quiet: bool) -> None:
         )
 
 
+def _why_climb(scenario: Any) -> str:
+    """Why an unset climb resolved to a climbing UAV (:func:`dcee.scenarios.unset_climb`)."""
+    if scenario.estimator.likelihood == "fluctuation":
+        return "a turbulent plume is expected (fluctuation likelihood)"
+    return "the count of releases is unknown (estimator.max_sources > 1)"
+
+
 def climb_notice(scenarios: Any, quiet: bool = False) -> None:
     """Say so when ``agent.climb`` was left unset and resolves to a climbing UAV (the
-    fluctuation likelihood's default, :meth:`dcee.scenarios.Scenario.resolved_climb`): the agent
+    fluctuation likelihood's default and the count-unknown one,
+    :meth:`dcee.scenarios.Scenario.resolved_climb`): the agent
     then has two moves more than the paper's; and when a planar truth's source height is off the
     agent's plane. ``scenarios``: one scenario or several."""
     if quiet:
@@ -112,9 +120,9 @@ def climb_notice(scenarios: Any, quiet: bool = False) -> None:
     auto = [s for s in many if s.agent.climb is None and s.climb > 0]
     if auto:
         click.echo(
-            f"dcee: agent.climb unset: a turbulent plume is expected (fluctuation likelihood), so "
-            f"the UAV may also climb and descend {auto[0].climb:g} m; set agent.climb = 0 for a "
-            "fixed altitude (docs/turbulent.md)",
+            f"dcee: agent.climb unset: {_why_climb(auto[0])}, so the UAV may also climb and "
+            f"descend {auto[0].climb:g} m; set agent.climb = 0 for a fixed altitude "
+            "(docs/scenarios.md)",
             err=True,
         )
     # a planar truth is one plane: the reading model takes the source at truth.z, so a source

@@ -186,8 +186,12 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
     agent = out.get("agent")
     if isinstance(agent, dict) and "climb" in agent and agent["climb"] is None:
         # unset: the climb it resolved to (Scenario.resolved_climb), compared as that number
-        likelihood = estimator.get("likelihood", "paper") if isinstance(estimator, dict) else ""
-        agent["climb"] = unset_climb(likelihood, agent.get("model", "grid"))
+        est = estimator if isinstance(estimator, dict) else {}
+        agent["climb"] = unset_climb(
+            est.get("likelihood", "paper"),
+            agent.get("model", "grid"),
+            max_sources=int(est.get("max_sources", 1)),
+        )
     search = out.get("search")
     if isinstance(search, dict) and "lookahead" in search and search["lookahead"] is None:
         # unset: the look-ahead it resolved to (Scenario.lookahead), compared as that number

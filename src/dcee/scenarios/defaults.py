@@ -44,9 +44,10 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
         ("filament",), "4 s hold on a time-varying truth: infotaxis, paper configurations, 12 x 3"
     ),
     ("agent", "climb"): Provenance(
-        ("filament", "puffs"),
-        "1 m with the fluctuation likelihood, random:13-40, dcee-cl; 0 on a planar truth, where "
-        "nothing tells altitude",
+        ("isotropic", "filament", "puffs"),
+        "1 m with the fluctuation likelihood, filament + puffs random:13-40, dcee-cl; 1 m with "
+        "the count of releases unknown, isotropic random2/3:1-60, dcee-cl; 0 on a planar truth, "
+        "where nothing tells altitude",
     ),
     ("estimator", "intermittency"): Provenance(
         ("filament",), "maximum-likelihood fit to 4 s holds, studies/fluctuation_stats.py"

@@ -302,14 +302,14 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
         return TURBULENT_HOLD if self.time_varying_truth else 1.0
 
     def resolved_climb(self, on_robot: bool = False) -> float:
-        """m per climb or descent move (``agent.climb``, or when unset :data:`AUTO_CLIMB` for
-        the grid UAV in a turbulent plume, the fluctuation likelihood, else 0). ``on_robot``:
-        unset means 0 (the robot cycle reads planar poses)."""
+        """m per climb or descent move: ``agent.climb``, or when unset :func:`unset_climb`'s
+        (0 on a planar truth). ``on_robot``: unset means 0 (the robot reads planar poses)."""
         if self.agent.climb is not None:
             return self.agent.climb
         if self.planar_truth:
             return 0.0
-        return unset_climb(self.estimator.likelihood, self.agent.model, on_robot)
+        e = self.estimator
+        return unset_climb(e.likelihood, self.agent.model, on_robot, e.max_sources)
 
     @property
     def lookahead(self) -> int:
