@@ -97,10 +97,12 @@ def rows_of(folder: Path) -> list[dict]:
         )
         probs = summary.get("count_probabilities", [])
         k_hat = int(summary.get("estimated_count", 1))
+        # a `dcee run --set` search names its edited scenario NAME+hash: the configuration is NAME
+        name = str(summary["scenario"]).split("+", 1)[0]
         out.append(
             {
                 "campaign": folder.name,
-                "scenario": summary["scenario"],
+                "scenario": name,
                 "strategy": summary["strategy"],
                 "seed": summary["seed"],
                 "true_count": int(summary["true_sources"]),
@@ -113,7 +115,7 @@ def rows_of(folder: Path) -> list[dict]:
                 "mean_release_error": float(near.mean()),
                 "explore_guard_fired": int(summary.get("explore_guard_fired", 0)),
                 "least_reached_readings": int(reached.min()),
-                "least_footprint_m2": least_footprint(summary["scenario"]),
+                "least_footprint_m2": least_footprint(name),
                 "decision_ms": 1e3 * float(summary["decision_seconds_mean"]),
                 "code": summary.get("code", {}).get("commit", "")
                 if isinstance(summary.get("code"), dict)
