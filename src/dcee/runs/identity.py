@@ -191,6 +191,7 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
             est.get("likelihood", "paper"),
             agent.get("model", "grid"),
             max_sources=int(est.get("max_sources", 1)),
+            open_terrain=WorldSpec.model_validate(out.get("world") or {}).empty,
         )
     search = out.get("search")
     if isinstance(search, dict) and "lookahead" in search and search["lookahead"] is None:

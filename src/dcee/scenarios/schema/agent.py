@@ -32,18 +32,25 @@ on the tuning range random:13-40 (both turbulent truths, all eight unknown): dce
 loss (docs/turbulent.md). A fixed altitude cannot meet a plume from a source far below it: in
 the held-out fixed-altitude searches the failures were low sources (median 0.5 m) in strong
 wind. Left at 0 for the paper's likelihood, so the paper's study flies the paper's agent; but
-1 m with the count of releases unknown (``estimator.max_sources`` > 1, any likelihood): a weak
+1 m with the count of releases unknown in open terrain (``estimator.max_sources`` > 1): a weak
 release near the ground shows at the paper's fixed 4 m only in a patch a few metres wide.
 Measured on the tuning ranges random3:1-60 and random2:1-60 (isotropic truth, dcee-cl:
 docs/results/source-count-tune ``-60-climb``, docs/multi-source.md)."""
 
 
-def unset_climb(likelihood: str, model: str, on_robot: bool = False, max_sources: int = 1) -> float:
+def unset_climb(
+    likelihood: str,
+    model: str,
+    on_robot: bool = False,
+    max_sources: int = 1,
+    open_terrain: bool = True,
+) -> float:
     """m, what an unset ``agent.climb`` resolves to: :data:`AUTO_CLIMB` for the grid UAV with the
     fluctuation likelihood (a turbulent plume expected) or with the count of releases unknown
-    (``estimator.max_sources`` > 1), else 0; on a robot's cycle always 0 (it reads planar
-    poses)."""
-    climbing = likelihood == "fluctuation" or max_sources > 1
+    (``estimator.max_sources`` > 1) in open terrain (where it was measured), else 0; on a
+    robot's cycle always 0 (it reads planar poses)."""
+    several = max_sources > 1 and open_terrain
+    climbing = likelihood == "fluctuation" or several
     return AUTO_CLIMB if climbing and model == "grid" and not on_robot else 0.0
 
 

@@ -308,8 +308,8 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
             return self.agent.climb
         if self.planar_truth:
             return 0.0
-        e = self.estimator
-        return unset_climb(e.likelihood, self.agent.model, on_robot, e.max_sources)
+        e, open_terrain = self.estimator, self.world.empty
+        return unset_climb(e.likelihood, self.agent.model, on_robot, e.max_sources, open_terrain)
 
     @property
     def lookahead(self) -> int:
