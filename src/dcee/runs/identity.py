@@ -184,20 +184,19 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
             # no repeat discount: its power decides nothing
             estimator.pop("repeat_power", None)
     agent = out.get("agent")
+    est = estimator if isinstance(estimator, dict) else {}
+    world = WorldSpec.model_validate(out.get("world") or {})  # a stored dump round-trips
     if isinstance(agent, dict) and "climb" in agent and agent["climb"] is None:
         # unset: the climb it resolved to (Scenario.resolved_climb), compared as that number
-        est = estimator if isinstance(estimator, dict) else {}
         agent["climb"] = unset_climb(
             est.get("likelihood", "paper"),
             agent.get("model", "grid"),
             max_sources=int(est.get("max_sources", 1)),
-            open_terrain=WorldSpec.model_validate(out.get("world") or {}).empty,
+            open_terrain=world.empty,
         )
     search = out.get("search")
     if isinstance(search, dict) and "lookahead" in search and search["lookahead"] is None:
         # unset: the look-ahead it resolved to (Scenario.lookahead), compared as that number
-        est = estimator if isinstance(estimator, dict) else {}
-        world = WorldSpec.model_validate(out.get("world") or {})  # a stored dump round-trips
         model = agent.get("model", "grid") if isinstance(agent, dict) else "grid"
         search["lookahead"] = unset_lookahead(
             est.get("likelihood", "paper"),
