@@ -164,12 +164,22 @@ def table(df: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
+CLIMB = "-climb"
+"""A campaign named X-climb is X's searches at today's defaults with the UAV free to climb (an
+unset ``agent.climb`` with the count unknown, since 2026-12-02); X itself flew at the paper's
+fixed 4 m. Where both are stored, X-climb is today's and X an earlier default."""
+
+
 def table_latest(df: pd.DataFrame) -> str:
     """:func:`table` of today's campaigns only (names without a code suffix: they end in
-    ``held-out-N``, or ``held-out-N-infotaxis`` / ``-mcts`` for another planner's; the README's
-    table)."""
-    latest = r"held-out-\d+(?:-infotaxis|-mcts)?$"
-    return table(df[df["campaign"].str.contains(latest, regex=True)])
+    ``held-out-N``, or ``held-out-N-infotaxis`` / ``-mcts`` for another planner's, or
+    ``held-out-N-climb`` for today's defaults where the UAV climbs; a campaign X with its
+    X-climb stored is left out for it; the README's table)."""
+    latest = r"held-out-\d+(?:-infotaxis|-mcts|-climb)?$"
+    names = set(df["campaign"])
+    superseded = {c for c in names if c + CLIMB in names}
+    keep = df["campaign"].str.contains(latest, regex=True) & ~df["campaign"].isin(superseded)
+    return table(df[keep])
 
 
 BEFORE = "-before"
@@ -184,13 +194,16 @@ PAIRS = (
     ("two-source-held-out-100-infotaxis", "two-source-held-out-100"),
     ("two-source-held-out-100-mcts", "two-source-held-out-100"),
     ("three-source-held-out-100-mcts", "three-source-held-out-100"),
+    ("two-source-held-out-100-climb", "two-source-held-out-100"),
+    ("three-source-held-out-100-climb", "three-source-held-out-100"),
 )
 """Campaigns compared on the same configurations besides each X against X-before: one release
 with the count unknown against the one-release filter (issue 45, K = 1); two releases with the
 wind unknown against the wind known (the 50 configurations both flew); two releases in a
 turbulent truth (filament, puffs; the fluctuation likelihood) against the isotropic truth;
 infotaxis and the tree search ``dcee-mcts`` against dcee-cl (campaigns of one planner each are
-paired across planners)."""
+paired across planners); the UAV free to climb (today's default with the count unknown)
+against the fixed 4 m."""
 
 
 def paired(df: pd.DataFrame) -> str:

@@ -250,6 +250,23 @@ def test_the_source_count_tables_pair_two_planners_on_the_same_configurations() 
     assert "| 3 | 1 / 0 (p = 1) |" in row and "-0.10" in row
 
 
+def test_the_climbing_campaign_replaces_the_fixed_altitude_one_among_todays() -> None:
+    """X-climb (today's defaults, the UAV free to climb) stands for X in the latest table and is
+    paired with it on the same configurations; X without X-climb stays today's."""
+    script = _script("source_count_table")
+    fixed = _count_rows("three-source-held-out-100", [True, False, False], [0.5, 2.0, 1.5])
+    climb = _count_rows("three-source-held-out-100-climb", [True, True, False], [0.3, 0.4, 1.4])
+    two = _count_rows("two-source-held-out-100", [True], [0.2])
+    frame = pd.DataFrame(fixed + climb + two)
+    latest = script.table_latest(frame)
+    assert "| three-source-held-out-100-climb |" in latest
+    assert "| three-source-held-out-100 |" not in latest
+    assert "| two-source-held-out-100 |" in latest
+    (row,) = [line for line in script.paired(frame).splitlines() if "-climb − " in line]
+    # one search right only when climbing; OSPA differences −0.2, −1.6, −0.1
+    assert "| 3 | 1 / 0 (p = 1) |" in row and "-0.20" in row
+
+
 def test_a_releases_footprint_is_where_one_reading_detects_its_gas() -> None:
     """The footprint counts the 0.5 m cells of the flight plane where one reading detects the
     release's mean gas with probability ≥ 0.1: by hand from the sensor's Pd and noise on
