@@ -138,3 +138,41 @@ def test_the_command_line_says_when_an_unset_climb_resolves_to_a_climbing_uav(ca
     climb_notice(paper.with_overrides(**{"estimator.max_sources": 2}))
     err = capsys.readouterr().err
     assert "count of releases is unknown" in err and err.count("\n") == 1
+
+
+def test_a_least_altitude_keeps_the_climbing_uav_above_it_and_the_prior_whole(capsys, tmp_path):
+    """agent.min_altitude: the agent's moves stay at or above it (the descent from it is
+    inadmissible), the releases' prior keeps the area's whole altitude range, a stored campaign
+    without the setting keeps its identity, and a value outside the area or above the start is
+    refused in one line with exit 2 before anything is written."""
+    from dcee.runs import scenario_identity
+    from tests.helpers import run_cli
+
+    sc = load_scenario("random:16").with_overrides(
+        **{"search.particles": 1000, "search.hypotheses": 10, "search.budget": 200.0}
+    )
+    high = sc.with_overrides(**{"agent.climb": 1.0, "agent.min_altitude": 3.0})
+    agent = high.make_agent()
+    assert agent.volume.low[2] == 3.0 and high.volume.low[2] == 0.0
+    _, heads = agent.candidates(np.array([10.0, 10.0, 3.0]))
+    assert 8 in heads and 9 not in heads  # up, not down
+    _, heads = agent.candidates(np.array([10.0, 10.0, 4.0]))
+    assert 9 in heads
+    result = run_episode(high, "infotaxis", 0)
+    z = np.array([r["z"] for r in result.records])
+    assert z.min() >= 3.0 and len(set(z)) > 1
+    # the filter's prior over the release's height is the area's (0-5 m), not the agent's
+    z_prior = high.make_prior().sample(np.random.default_rng(0), 1000)[:, 2]
+    assert z_prior.min() < 1.0 and z_prior.max() > 4.0
+    # unset: the area's floor, as before the setting existed
+    assert sc.make_agent().volume.low[2] == 0.0
+    stored = sc.model_dump(mode="json")
+    del stored["agent"]["min_altitude"]
+    assert scenario_identity(stored) == scenario_identity(sc.model_dump(mode="json"))
+    assert scenario_identity(stored) != scenario_identity(high.model_dump(mode="json"))
+    for value, why in (("4.5", "above agent.start's altitude 4 m"), ("-1", "altitude range")):
+        out = tmp_path / f"run{value}"
+        argv = ["run", "--scenario", "paper:1", "--set", f"agent.min_altitude={value}"]
+        code, _, err = run_cli([*argv, "--out", str(out)], capsys)
+        assert code == 2 and "agent.min_altitude" in err and why in err, err
+        assert err.strip().count("\n") == 0 and not out.exists()

@@ -34,6 +34,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("agent", "model"): "grid",
     ("agent", "heading"): 0.0,
     ("agent", "localisation_sd"): 0.0,
+    # the area's floor bounded the agent before agent.min_altitude
+    ("agent", "min_altitude"): None,
     ("agent", "unicycle"): _unicycle_defaults(),
     # the fluctuation likelihood ran without the calm model before the setting existed (so a
     # campaign stored before resumes only with calm_prior = 0, not with the new default)

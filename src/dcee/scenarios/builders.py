@@ -114,7 +114,12 @@ class ScenarioBuilders:
     it reads is a validated scenario field or property)."""
 
     def search_volume(self) -> SearchVolume:
-        return SearchVolume(tuple(self.volume.low), tuple(self.volume.high))
+        """The volume the agent may move in: the area, its floor raised to
+        ``agent.min_altitude`` where that is set (the releases' prior keeps the whole area)."""
+        low = list(self.volume.low)
+        if self.agent.min_altitude is not None:
+            low[2] = max(low[2], float(self.agent.min_altitude))
+        return SearchVolume(tuple(low), tuple(self.volume.high))
 
     def make_sensor(self) -> Sensor:
         """The instrument that produces the (simulated) real readings: the ``[sensor]``

@@ -150,6 +150,9 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
             f"{DEFAULT_STOP_SHARE * scenario.search.acquired_rmse:g} m, in a simulation never"
         ),
         ("world", "map"): "unset: no occupancy-grid map",
+        ("agent", "min_altitude"): (
+            f"unset: the area's floor, {scenario.volume.low[2]:g} m; the agent flies no lower"
+        ),
         ("estimator", "count_prior"): "unset: every count 0 … max_sources equally likely",
         ("estimator", "wall_lifetime"): "unset: no decay, a conserved gas (the wall-aware plume)",
     }

@@ -8,7 +8,7 @@ from typing import Annotated, Literal
 import numpy as np
 from pydantic import BaseModel, Field
 
-from dcee.scenarios.schema.common import FROZEN, Finite, Positive
+from dcee.scenarios.schema.common import FIELD_MARK, FROZEN, Finite, Positive
 from dcee.stopping import DEFAULT_STOP_HOLD, DEFAULT_STOP_SHARE
 
 
@@ -144,6 +144,11 @@ class AgentSpec(BaseModel):
     only. Unset: :data:`AUTO_CLIMB` (1 m) where a turbulent plume is expected
     (``estimator.likelihood = "fluctuation"``) and the agent is the grid UAV, else 0; a robot
     (the ROS 2 node, ``dcee replay``) flies at one altitude unless it is set (docs/turbulent.md)"""
+    min_altitude: Annotated[float | None, Field(allow_inf_nan=False)] = None
+    """m: the least altitude the agent may fly at (a climbing UAV keeping clear of the ground or
+    of the crowns of a site's trees); within the area's altitude range and at most
+    ``start``'s. Unset: the area's floor. Only the agent's moves are bounded by it: the
+    releases' prior keeps the whole area (a release below it is still found from above)"""
     count: Annotated[int, Field(ge=1, le=16)] = 1
     """robots searching together with one shared belief; robot k starts k · step metres from
     ``start`` along +y (along −y where +y would leave the area)"""
@@ -158,6 +163,23 @@ class AgentSpec(BaseModel):
     localisation_sd: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 0.0
     """m: standard deviation of the localisation error (per axis, horizontal) on the position
     told to the estimator with every reading; the reading itself is taken at the true position"""
+
+    def checked_min_altitude(self, floor: float, top: float) -> None:
+        """Raise ValueError (one line) where ``min_altitude`` is outside the area's altitude
+        range [``floor``, ``top``] m or above the start's altitude."""
+        least = self.min_altitude
+        if least is None:
+            return
+        if not floor <= least <= top:
+            raise ValueError(
+                f"{FIELD_MARK}agent.min_altitude: {least:g} m is outside the area's altitude "
+                f"range {floor:g}..{top:g} m"
+            )
+        if least > self.start[2]:
+            raise ValueError(
+                f"{FIELD_MARK}agent.min_altitude: {least:g} m is above agent.start's altitude "
+                f"{self.start[2]:g} m; allowed: at most the start's altitude"
+            )
 
 
 class SearchSpec(BaseModel):

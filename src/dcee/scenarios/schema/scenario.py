@@ -10,7 +10,7 @@ import numpy as np
 from pydantic import BaseModel, Field, PrivateAttr, ValidationError, model_validator
 
 from dcee.errors import DceeInputError
-from dcee.models.agent import GridAgent, SearchVolume
+from dcee.models.agent import GridAgent
 from dcee.models.plume import PARAMETER_NAMES
 from dcee.scenarios.builders import ScenarioBuilders
 from dcee.scenarios.schema.agent import (
@@ -109,6 +109,7 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
             )
         if self.dimensions == 3 and not hi[2] > lo[2]:
             raise ValueError("volume: a 3-D scenario needs high z > low z")
+        self.agent.checked_min_altitude(float(lo[2]), float(hi[2]))
         for k in (0, 1):
             if not hi[k] > lo[k]:
                 raise ValueError(f"volume: high[{k}] must be > low[{k}]")
@@ -133,7 +134,7 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, BaseModel):
         self._checked_planar(start)
         site = self._checked_site(start, src)
         agent = GridAgent(
-            SearchVolume(tuple(lo), tuple(hi)),
+            self.search_volume(),
             self.agent.step,
             self.agent.speed,
             self.dwell,
