@@ -84,6 +84,33 @@ def test_changed_configuration_in_the_same_folder_is_refused(finished):
         run_campaign(_campaign(out, particles=400), workers=1)
 
 
+def test_a_default_changed_since_a_campaign_was_stored_is_refused(tmp_path, monkeypatch):
+    """A campaign records what each unset default resolved to; resumed after that default
+    changed (here the climb with the count unknown, 1 m → 2 m) it is refused, naming the
+    setting; pinning the value it flew with resumes it. One stored before the record is compared
+    by today's rules, as before."""
+    import dcee.scenarios.schema.agent as agent_schema
+
+    several = {"estimator.max_sources": 2}
+
+    def prepare(out: Path, overrides: dict) -> None:
+        Campaign(out, "smoke", ("mpc",), 1, particles=200, overrides=overrides).prepare()
+
+    prepare(tmp_path, several)
+    meta = json.loads((tmp_path / "campaign.json").read_text())
+    assert meta["settings"]["resolved"]["paper:1"]["agent.climb"] == 1.0
+    prepare(tmp_path, several)  # the same defaults: resumes
+    monkeypatch.setattr(agent_schema, "AUTO_CLIMB", 2.0)
+    with pytest.raises(DceeInputError, match=r"agent\.climb: stored 1\.0, now 2\.0"):
+        prepare(tmp_path, several)
+    prepare(tmp_path, {**several, "agent.climb": 1.0})
+    older = tmp_path / "older"
+    older.mkdir()
+    del meta["settings"]["resolved"]
+    (older / "campaign.json").write_text(json.dumps(meta))
+    prepare(older, several)  # unset on both sides, resolved by today's rule
+
+
 def test_a_reworded_description_does_not_orphan_a_campaign(finished, tmp_path):
     """Free text changes no result: a campaign whose stored scenario descriptions differ from
     today's still resumes (it refused before, a whole chain of studies once stopped on it)."""

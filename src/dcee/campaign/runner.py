@@ -170,6 +170,8 @@ class Campaign:
             "unknown": self.unknown,
             "particles": self.particles,
             "scenarios": {k: v.model_dump(mode="json") for k, v in self.scenarios.items()},
+            # what each unset default resolved to: a later change of one is refused on resume
+            "resolved": {k: v.resolved_unset() for k, v in self.scenarios.items()},
         }
         if self.truth is not None:  # absent, not null, so that older campaign folders resume
             settings["truth"] = self.truth
@@ -194,7 +196,10 @@ class Campaign:
                 raise DceeInputError(
                     "out", f"{path} is unreadable; move the folder aside or choose another --out"
                 ) from None
-            before, now = settings_identity(stored.get("settings", {})), settings_identity(settings)
+            kept = stored.get("settings", {})
+            if "resolved" not in kept:  # stored before campaigns recorded it (2026-12-02)
+                settings = {k: v for k, v in settings.items() if k != "resolved"}
+            before, now = settings_identity(kept), settings_identity(settings)
             if before != now:
                 changed = first_difference(before, now)
                 raise DceeInputError(

@@ -139,11 +139,31 @@ def settings_identity(settings: dict[str, Any]) -> dict[str, Any]:
         else:
             out.pop("overrides")
     scenarios = out.get("scenarios")
+    # what a campaign's unset defaults resolved to when it was stored (since 2026-12-02): each
+    # scenario compared as if they had been set to those values, so that a default changed
+    # since is a difference (and pinning the old value with --set resumes the campaign)
+    resolved = out.pop("resolved", None)
     if isinstance(scenarios, dict):
         out["scenarios"] = {
-            name: scenario_identity(sc) if isinstance(sc, dict) else sc
+            name: scenario_identity(_with_resolved(sc, (resolved or {}).get(name)))
+            if isinstance(sc, dict)
+            else sc
             for name, sc in scenarios.items()
         }
+    return out
+
+
+def _with_resolved(scenario: dict[str, Any], resolved: Any) -> dict[str, Any]:
+    """The stored ``scenario`` with each unset setting named in ``resolved`` ({"section.key":
+    value}) set to that value."""
+    if not isinstance(resolved, dict) or not resolved:
+        return scenario
+    out = copy.deepcopy(scenario)
+    for dotted, value in resolved.items():
+        section, _, key = str(dotted).partition(".")
+        node = out.get(section)
+        if isinstance(node, dict) and node.get(key) is None:
+            node[key] = value
     return out
 
 

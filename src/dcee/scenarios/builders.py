@@ -9,7 +9,7 @@ import dataclasses
 import functools
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -112,6 +112,42 @@ def inside_world(world: WorldSpec, xy: np.ndarray, no_go: bool = True) -> np.nda
 class ScenarioBuilders:
     """The ``make_*`` methods of a :class:`~dcee.scenarios.Scenario` (a mixin: every attribute
     it reads is a validated scenario field or property)."""
+
+    def resolution_map(self) -> dict[tuple[str, str], Any]:
+        """{(section, key): value} for each setting whose unset (None) default follows the
+        truth, the likelihood, the count or the platform: the value this scenario resolves it to
+        (whether set or not; :meth:`resolved_unset` keeps the unset ones)."""
+        return {
+            ("sensor", "dropout"): round(1.0 - self.instrument_pd, 12),
+            ("sensor", "average"): self.average,
+            ("estimator", "meander"): self.meander,
+            ("estimator", "learn"): self.learn,
+            ("estimator", "learn_prior"): self.learn_prior,
+            ("estimator", "reading_weight"): self.reading_weight,
+            ("estimator", "repeat_radius"): self.repeat_radius,
+            ("estimator", "repeat_power"): self.repeat_power,
+            ("estimator", "region_floor"): self.region_floor,
+            ("agent", "dwell"): self.dwell,
+            ("agent", "climb"): self.climb,
+            ("world", "resolution"): self.site_resolution,
+            ("search", "lookahead"): self.lookahead,
+            ("search", "explore_guard"): self.explore_guard,
+            ("estimator", "wall_diffusivity"): self.wall_diffusivity,
+            ("estimator", "wall_wind"): self.wall_wind,
+            ("estimator", "wall_viscosity"): self.wall_viscosity,
+        }
+
+    def resolved_unset(self) -> dict[str, Any]:
+        """{"section.key": value}: each setting of :meth:`resolution_map` left unset, as the
+        value it resolves to today. A campaign records it beside its scenarios, so that a later
+        change of such a default is refused on resume instead of mixing the searches flown
+        under the old and the new value (:func:`dcee.runs.identity.settings_identity`)."""
+        dump = self.model_dump(mode="json")
+        return {
+            f"{section}.{key}": value
+            for (section, key), value in self.resolution_map().items()
+            if dump.get(section, {}).get(key) is None
+        }
 
     def search_volume(self) -> SearchVolume:
         """The volume the agent may move in: the area, its floor raised to

@@ -124,25 +124,7 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
     data = scenario.model_dump(mode="json", exclude_none=True)
     # settings left unset follow the truth or the likelihood: shown as comments with the value
     # this scenario resolves them to, so the file reads back with them still unset
-    resolved = {
-        ("sensor", "dropout"): round(1.0 - scenario.instrument_pd, 12),
-        ("sensor", "average"): scenario.average,
-        ("estimator", "meander"): scenario.meander,
-        ("estimator", "learn"): scenario.learn,
-        ("estimator", "learn_prior"): scenario.learn_prior,
-        ("estimator", "reading_weight"): scenario.reading_weight,
-        ("estimator", "repeat_radius"): scenario.repeat_radius,
-        ("estimator", "repeat_power"): scenario.repeat_power,
-        ("estimator", "region_floor"): scenario.region_floor,
-        ("agent", "dwell"): scenario.dwell,
-        ("agent", "climb"): scenario.climb,
-        ("world", "resolution"): scenario.site_resolution,
-        ("search", "lookahead"): scenario.lookahead,
-        ("search", "explore_guard"): scenario.explore_guard,
-        ("estimator", "wall_diffusivity"): scenario.wall_diffusivity,
-        ("estimator", "wall_wind"): scenario.wall_wind,
-        ("estimator", "wall_viscosity"): scenario.wall_viscosity,
-    }
+    resolved = scenario.resolution_map()
     # unset with no single resolved value: what unset means, in words
     unset = {
         ("search", "stop_spread"): (
