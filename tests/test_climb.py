@@ -164,6 +164,12 @@ def test_a_least_altitude_keeps_the_climbing_uav_above_it_and_the_prior_whole(ca
     # the filter's prior over the release's height is the area's (0-5 m), not the agent's
     z_prior = high.make_prior().sample(np.random.default_rng(0), 1000)[:, 2]
     assert z_prior.min() < 1.0 and z_prior.max() > 4.0
+    # the gym environment's action mask offers no descent from the least altitude
+    env = dcee.gym.SourceSearchEnv(
+        scenario=high.with_overrides(**{"agent.min_altitude": 4.0}), particles=300, budget=60.0
+    )
+    _, info = env.reset(seed=0)
+    assert info["action_mask"][8] == 1 and info["action_mask"][9] == 0
     # unset: the area's floor, as before the setting existed
     assert sc.make_agent().volume.low[2] == 0.0
     stored = sc.model_dump(mode="json")
