@@ -5,6 +5,9 @@
 # of 0.05 s). x86-64 Linux, CPython 3.10-3.14 only (what the ROS wheels are built for).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# scripts/test.sh sets this once both venvs are installed, so that the steps it runs side by
+# side do not install into the same source tree at once
+if [ "${DCEE_SETUP_DONE:-0}" = 1 ]; then exit 0; fi
 PYTHON=${PYTHON:-python3}
 if [ ! -x .venv-ros/bin/python ]; then
   "$PYTHON" -m venv .venv-ros

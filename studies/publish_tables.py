@@ -146,110 +146,96 @@ def table(header: list[str], rows: list[list[str]]) -> str:
 # --- the tables ----------------------------------------------------------------------------
 
 
-def what_we_found() -> str:
-    """The headline table (README and docs/index.md)."""
-    ps = study("paper-source")
-    cur = pick(ps, "dcee-cl")
-    rows = [
-        [
-            "`dcee-cl` (closed-loop DCEE, this project), current defaults (`paper-source`)",
-            count(cur),
-            f"{rmse(cur).split(' ')[0]} m",
-            f"{time_to_1m(cur).split(' ')[0]} s",
-        ]
-    ]
-    for strategy, label in (
-        ("infotaxis", "`infotaxis` (`paper-source`)"),
-        ("dcee", "`dcee` (the paper's theorem 1, as written; `paper-source`)"),
-        ("mpc", "`mpc` (`paper-source`)"),
+HEADLINE_HEADER = [
+    "result (held-out: configurations nothing was chosen on)",
+    "`dcee-cl`: acquired, median final error",
+    "`infotaxis`: acquired, median final error",
+    "defaults tuned on this truth (other configurations)",
+    "stored in docs/results/",
+    "details",
+]
+
+
+def _headline_cell(r: pd.Series | None) -> str:
+    """ "120/120, 0.21 m" (a missing row: "—")."""
+    if r is None:
+        return "—"
+    return f"{count(r)}, {r['median_final_rmse']:.2f} m"
+
+
+def headline_table(docs: str = "docs/") -> str:
+    """The README's one table (docs/index.md too, ``docs`` "" for links from there): short
+    labels, the study folder and the page that says what each row is, when it was flown and at
+    which defaults. Per planner the latest defaults flown on that truth (the linked page says
+    which)."""
+    rows: list[list[str]] = []
+
+    def add(label: str, cl, info, chosen: str, source: str, page: str) -> None:
+        assert len(label) <= 60, label
+        rows.append([label, _headline_cell(cl), _headline_cell(info), chosen, f"`{source}`", page])
+
+    paper_source, paper_full = study("paper-source"), study("paper-full")
+    results = f"[results]({docs}results.md)"
+    for label, frame, name in (
+        ("The paper's study: 12 configurations × 10, wind known", paper_source, "paper-source"),
+        ("The paper's study, all eight parameters unknown", paper_full, "paper-full"),
     ):
-        r = pick(ps, strategy)
-        t = r["time_to_1m"]
-        when = "> 900 s" if math.isinf(t) else f"{t:.0f} s"
-        if r["reached_1m"] < 1:
-            when += f" ({100 * r['reached_1m']:.0f} % ever get there)"
-        rows.append([label, count(r), f"{r['median_final_rmse']:.2f} m", when])
-
-    def planners_row(
-        label: str,
-        frame: pd.DataFrame,
-        strategies: tuple[str, ...],
-        note: str = "",
-        **where: object,
-    ) -> list[str]:
-        """One study, several planners: "a / b / …" in each cell."""
-        rs = [pick(frame, strategy, **where) for strategy in strategies]
-        times = (
-            "> budget" if math.isinf(r["time_to_1m"]) else f"{r['time_to_1m']:.0f}" for r in rs
-        )
-        return [
+        add(label, pick(frame, "dcee-cl"), pick(frame, "infotaxis"), "yes", name, results)
+    today = study("held-out-today")
+    held_out = f"[held-out]({docs}held-out.md)"
+    for label, name in (
+        ("200 held-out configurations, wind known", "wind-known"),
+        ("200 held-out configurations, all eight unknown", "full"),
+    ):
+        add(
             label,
-            " / ".join(count(r) for r in rs),
-            " / ".join(f"{r['median_final_rmse']:.2f}" for r in rs) + " m",
-            " / ".join(times) + " s" + note,
-        ]
-
-    today, today_pairs = study("held-out-today"), paired("held-out-today")
-
-    def today_row(label: str, name: str) -> list[str]:
-        p = pick(today_pairs, "dcee-cl", study=name, reference="infotaxis")
-        note = ""
-        if not math.isnan(p["time_to_1m_difference"]):
-            note = (
-                f" (`dcee-cl` − infotaxis, paired: {p['time_to_1m_difference']:+.0f} s, "
-                f"Wilcoxon p = {p['time_wilcoxon_p']:.1g})"
-            )
-        return planners_row(label, today, PLANNERS, note, study=name)
-
-    rows += [
-        today_row(
-            "**held-out**, wind known: 200 random configurations never tuned on, today's "
-            "defaults (`held-out-today`), `dcee-cl` / `infotaxis` / tree search `dcee-mcts`",
-            "wind-known",
-        ),
-        today_row("**held-out**, all eight parameters unknown, the same 200", "full"),
-        today_row(
-            "**held-out**, filament truth, all eight unknown, fluctuation likelihood, "
-            "100 of them (`held-out-100`), defaults of 2026-11-23",
-            "filament",
-        ),
-        planners_row(
-            "**held-out**, the independent puff truth (Farrell et al. 2002), all eight unknown, "
-            "fluctuation likelihood, `held-out-100`, `dcee-cl` / `infotaxis` "
-            "(`turbulent-held-out-100`), defaults of 2026-11-23",
-            study("turbulent-held-out-100"),
-            ("dcee-cl", "infotaxis"),
-            truth_model="puffs",
-            repeat_radius=2,
-        ),
-    ]
-    turbulent_today = study("turbulent-held-out-100-today")
-    for truth, what in (("filament", "filament truth"), ("puffs", "puff truth")):
-        newest = latest_defaults(turbulent_today, ("dcee-cl", "infotaxis"), truth_model=truth)
-        cl = pick(turbulent_today, "dcee-cl", truth_model=truth, defaults=newest)
-        n = int(cl["searches"])
-        small = f"; `dcee-cl` on {n} of them (a small sample)" if small_sample(cl) else ""
-        rows.append(
-            planners_row(
-                f"**held-out**, {what}, all eight unknown, fluctuation likelihood, "
-                f"`held-out-100`{small}, {defaults_words(newest)} (the backflow and disc "
-                "members learned, the mixture's region), `dcee-cl` / `infotaxis` "
-                "(`turbulent-held-out-100-today`)",
-                turbulent_today,
-                ("dcee-cl", "infotaxis"),
-                truth_model=truth,
-                defaults=newest,
-            )
+            pick(today, "dcee-cl", study=name),
+            pick(today, "infotaxis", study=name),
+            "yes",
+            "held-out-today",
+            held_out,
         )
-    return table(
-        [
-            "study (stored in docs/results/…)",
-            "source acquired",
-            "median final RMSE",
-            "median time to RMSE < 1 m",
-        ],
-        rows,
+    turbulent = study("turbulent-held-out-100-today")
+    for label, truth in (
+        ("100 held-out, turbulent filament plume (ours)", "filament"),
+        ("100 held-out, turbulent puff plume (Farrell et al. 2002)", "puffs"),
+    ):
+        newest = latest_defaults(turbulent, ("dcee-cl", "infotaxis"), truth_model=truth)
+        add(
+            label,
+            pick(turbulent, "dcee-cl", truth_model=truth, defaults=newest),
+            pick(turbulent, "infotaxis", truth_model=truth, defaults=newest),
+            "yes",
+            "turbulent-held-out-100-today",
+            f"[turbulent plumes]({docs}turbulent.md)",
+        )
+    lbm = study("lbm-held-out-100")
+    lbm = lbm[(lbm["learn"] == "none") & ~lbm["strategy"].astype(str).str.contains(":")]
+    newest = latest_defaults(lbm, ("dcee-cl", "infotaxis"))
+    add(
+        "100 held-out, a fluid solver's plume (lbmpy)",
+        pick(lbm, "dcee-cl", defaults=newest),
+        pick(lbm, "infotaxis", defaults=newest),
+        "**no**",
+        "lbm-held-out-100",
+        f"[plumes nobody here wrote]({docs}plumes.md)",
     )
+    searches = pd.read_csv(RESULTS / "source-count" / "searches.csv")
+    two = searches[searches["campaign"] == "two-source-held-out-100-climb"]
+    label = "100 held-out, two releases, their number unknown"
+    assert len(label) <= 60
+    rows.append(
+        [
+            label,
+            f"count right {int(two['count_correct'].sum())}/{len(two)}, "
+            f"median OSPA {two['final_ospa'].median():.2f} m",
+            "—",
+            "yes",
+            "`source-count`",
+            f"[several releases]({docs}multi-source.md)",
+        ]
+    )
+    return table(HEADLINE_HEADER, rows)
 
 
 FULL_HEADER = [
@@ -1708,7 +1694,8 @@ TABLES: dict[str, Callable[[], str]] = {
     "mixture-prior": mixture_prior_table,
     "release-area": release_area_table,
     "lbm-statistics": lbm_statistics_table,
-    "what-we-found": what_we_found,
+    "headline": headline_table,
+    "headline-docs": lambda: headline_table(""),
     "wind-known": public_table("paper-source"),
     "full-unknown": public_table("paper-full"),
     "held-out": held_out_table,

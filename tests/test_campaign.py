@@ -146,7 +146,7 @@ def test_failing_search_is_recorded_and_does_not_raise(tmp_path):
     assert not is_done(task)
 
 
-BENCH = ["bench", "--suite", "smoke", "--strategies", "mpc,dcee", "--repeats", "5"]
+BENCH = ["bench", "--suite", "smoke", "--strategies", "mpc,dcee", "--repeats", "3"]
 BENCH += ["--particles", "300", "--workers", "2"]
 
 
@@ -206,7 +206,7 @@ def test_interrupted_bench_keeps_finished_searches_and_resumes(tmp_path, capsys,
         assert not _group_alive(proc.pid), "a worker process outlived the driver"
     else:
         assert proc.returncode == -signal.SIGKILL
-    tasks = Campaign(out, "smoke", ("mpc", "dcee"), 5, particles=300).tasks()
+    tasks = Campaign(out, "smoke", ("mpc", "dcee"), 3, particles=300).tasks()
     finished = {
         t.folder: (t.folder / "summary.json").stat().st_mtime_ns for t in tasks if is_done(t)
     }

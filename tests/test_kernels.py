@@ -323,7 +323,7 @@ def test_compiled_task_list_equals_the_numpy_reference(stages):
     from dcee.planning.reading_terms import task_layout, unique_tasks
 
     rng = np.random.default_rng(stages)
-    for j_count in (1, 4, 40):
+    for j_count in (1, 4, 40, 65, 500):  # 65 and 500: the merge-sort path (INSERTION_SORT_MAX)
         # few distinct values: many equal hypotheses (the non-detections) and equal prefixes
         readings = rng.choice([0.0, 0.0, 0.0, 1e-3, 2.5e-3, 7.0], size=(9, j_count, stages))
         got = unique_tasks(readings)

@@ -76,7 +76,25 @@ def test_the_check_catches_a_number_typed_by_hand():
     edited = text.replace(body, body.replace("120/120", "119/120", 1))
     assert edited != text
     _, stale = pub.render(edited)
-    assert stale == ["what-we-found"]
+    assert stale == ["headline"]
+
+
+def test_the_readme_is_a_front_door():
+    """The README shows the product in one screen (issue 79): at most 150 lines, one results
+    table of at most 8 rows whose labels are at most 60 characters (what a row is, its range
+    and its date are on the page it links), and links that reach a first study and one's own
+    plume data."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    assert len(text.splitlines()) <= 150
+    tables = [m.group("body") for m in _publisher().MARKER.finditer(text)]
+    assert len(tables) == 1
+    rows = [line for line in tables[0].splitlines() if line.startswith("| ")][1:]
+    assert 1 <= len(rows) <= 8
+    for row in rows:
+        label = row.split(" | ")[0].removeprefix("| ")
+        assert len(label) <= 60, label
+    for page in ("docs/guide/first-study.md", "docs/guide/plume-data.md", "docs/guide/site.md"):
+        assert f"]({page})" in text and (ROOT / page).is_file(), page
 
 
 def test_every_stored_study_says_where_it_came_from():

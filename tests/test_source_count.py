@@ -217,8 +217,10 @@ def _bank(kmax: int = 3, n: int = 3000, seed: int = 0) -> SourceCountBank:
 
 
 def _lawnmower() -> np.ndarray:
-    """A survey across the wind (the paper's wind blows along −x): legs along y every 3 m."""
-    ys = np.arange(1.0, 50.0, 2.0)
+    """A survey across the wind (the paper's wind blows along −x): legs along y every 3 m, a
+    reading every 3 m along them (272 readings; every 2 m, 400, found the same counts and
+    releases at 1.5× the time)."""
+    ys = np.arange(1.0, 50.0, 3.0)
     legs = [
         np.column_stack([np.full(len(ys), x), ys if i % 2 == 0 else ys[::-1]])
         for i, x in enumerate(np.arange(2.0, 50.0, 3.0))
