@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Set up, then lint (ruff), run the test suite (pytest on two processes, one per core of the
-# 2-core machine the README's five minutes are measured on; PYTEST_WORKERS overrides), the ROS 2
-# tests in .venv-ros (scripts/test-ros.sh) and build the documentation site with its executed
+# Set up, then lint (ruff), compile the kernels (scripts/warm_kernels.py), run the test suite
+# (pytest on two processes, one per core of the 2-core machine the README's five minutes are
+# measured on; PYTEST_WORKERS overrides), the ROS 2 tests in .venv-ros (scripts/test-ros.sh) and build the documentation site with its executed
 # examples (mkdocs --strict: any warning fails) and its browser check.
 # .venv-ros installs while the suite runs (pip waits mostly on the disk and the registry, the
 # suite on the cores), and the documentation builds while the ROS 2 tests run (they wait mostly
@@ -14,6 +14,12 @@ bash scripts/setup-ros.sh >"$logs/setup-ros.log" 2>&1 &
 setup_ros=$!
 .venv/bin/ruff check src tests examples studies scripts ros
 .venv/bin/ruff format --check src tests examples studies scripts ros
+# the numerical kernels compiled into numba's cache once, on both cores (scripts/warm_kernels.py
+# says why; seconds when the cache is filled already)
+.venv/bin/python scripts/warm_kernels.py 0 2 &
+warm=$!
+.venv/bin/python scripts/warm_kernels.py 1 2
+wait "$warm"
 .venv/bin/python -m pytest -q -n "${PYTEST_WORKERS:-2}" "$@"
 if ! wait "$setup_ros"; then
   cat "$logs/setup-ros.log" >&2

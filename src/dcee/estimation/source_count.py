@@ -49,14 +49,10 @@ from dcee.estimation.evidence import bridge_log_evidence, one_more_log_evidence
 from dcee.estimation.multi_source import MultiSourceFilter
 from dcee.estimation.particle_filter import ParticleFilter
 from dcee.estimation.priors import SourcePrior
+from dcee.estimation.release_target import DEFAULT_PLAUSIBLE, FOUND_SHARE, choose_targets
 from dcee.estimation.summaries import in_credible_ellipsoid, weighted_moments, weighted_rmse
 from dcee.models.plume import IsotropicPlume
 from dcee.models.sensor import Sensor
-
-DEFAULT_PLAUSIBLE = 0.05
-"""P(K) at or above which a count's releases count for the target and the stop rule: a search
-ends only when every count at least this probable has its releases localised."""
-
 
 EVIDENCE_EVERY = 30
 """Readings between two bridge-sampling anchors of each count's evidence. The SMC estimate
@@ -67,15 +63,6 @@ re-estimated from its present particles, and the SMC terms of the readings since
 it. Set for cost: an anchor of the counts 1-3 (three bridge estimates and two of one release
 more) takes about 1 s at 10,000 particles and 450 readings, 15 anchors in the paper's 450
 readings."""
-
-
-FOUND_SHARE = 1 / 3
-"""A release whose spread √tr P is at most this share of ``search.acquired_rmse`` (1 m at the
-default 3 m) counts as found for the planners' target: once every release of the most probable
-count is found, they look for a further one (:meth:`SourceCountBank.target`). Chosen on the
-tuning range random3:1-20 (docs/results/source-count-tune): with the stop rule's 0.45 m a
-found release whose height stayed uncertain (spread 0.5-0.9 m) held the robot for the rest of
-the search."""
 
 
 class NoSource:
@@ -238,37 +225,18 @@ class SourceCountBank:
         return self._targets()[1]
 
     def _targets(self) -> tuple[tuple[int, int], tuple[int, int]]:
-        """(:meth:`target`, :meth:`settled_target`), chosen once per belief state from each
-        count's widest release (its moments computed once for both)."""
+        """(:meth:`target`, :meth:`settled_target`), chosen once per belief state
+        (:func:`~dcee.estimation.release_target.choose_targets`)."""
         state = self._state()
         if self._target is None or self._target[0] != state:
-            probs = self.count_probabilities
-            best_count = max(int(np.argmax(probs)), 1)
-            widest: dict[int, tuple[int, float]] = {}
-
-            def widest_of(k: int) -> tuple[int, float]:
-                if k not in widest:
-                    traces = np.trace(self.release_summary(k)[1], axis1=1, axis2=2)
-                    widest[k] = int(np.argmax(traces)), float(traces.max())
-                return widest[k]
-
-            def choose(threshold: float, extra: int | None) -> tuple[int, int]:
-                j, trace = widest_of(best_count)
-                if trace > threshold**2:
-                    return best_count, j
-                counts = [k for k in range(1, self.max_sources + 1) if probs[k] >= self.plausible]
-                if extra is not None and extra <= self.max_sources and extra not in counts:
-                    counts = sorted([*counts, extra])
-                if not counts:
-                    return best_count, j
-                k = max(counts, key=lambda k: widest_of(k)[1])  # the first of equals
-                return k, widest_of(k)[0]
-
-            self._target = (
-                state,
-                choose(self.found, best_count + 1),
-                choose(self.localised, None),
+            target, settled = choose_targets(
+                self.count_probabilities,
+                lambda k: self.release_summary(k)[1],
+                self.plausible,
+                found=self.found,
+                localised=self.localised,
             )
+            self._target = (state, target, settled)
         return self._target[1], self._target[2]
 
     def _target_member(self) -> tuple[ParticleFilter, int]:
@@ -447,3 +415,6 @@ class SourceCountBank:
             "count_switches": self.switches,
             "estimated_sources": [[float(v) for v in row] for row in self.estimated_sources()],
         }
+
+
+__all__ = ["DEFAULT_PLAUSIBLE", "EVIDENCE_EVERY", "FOUND_SHARE", "NoSource", "SourceCountBank"]
