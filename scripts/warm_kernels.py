@@ -1,14 +1,14 @@
 """Compile dcee's numerical kernels into numba's on-disk cache before the test suite runs
-(scripts/test.sh): ``python scripts/warm_kernels.py SHARD SHARDS`` flies this shard's share of
-toy searches that between them reach every family of kernels (each planner, both likelihoods,
-all eight parameters unknown, a measured wind, several releases, a site with walls, the
-turbulent truths).
+(scripts/test.sh): toy searches that between them reach every family of kernels (each
+planner, both likelihoods, all eight parameters unknown, a measured wind, several releases, a
+site with walls, the turbulent truths).
 
 Why: on a fresh machine the kernels compile on first use (about two minutes of one core), and
 in a suite run on two processes, whose campaign tests start worker processes of their own,
 the same kernel was compiled by several processes at once: the suite took 265 s there against
-124 s with the cache filled. Two shards side by side compile each kernel about once, on both
-cores, while nothing else waits for them. A kernel the searches below miss is still compiled
+124 s with the cache filled. ``core`` compiles what every search uses on one core (the other
+installs the ROS 2 venv meanwhile), then two shards side by side compile the rest, each kernel
+about once. A kernel the searches below miss is still compiled
 where a test first needs it; this only moves work, it checks nothing."""
 
 from __future__ import annotations
@@ -61,12 +61,22 @@ def jobs() -> list[Callable[[], object]]:
 
 
 def main(argv: list[str]) -> int:
-    shard, shards = (int(a) for a in argv) if argv else (0, 1)
+    """``core``: the first job alone (the kernels every search uses: the filter's history
+    likelihood, the planners' position rows and statistics); ``SHARD SHARDS``: that shard's
+    share of the rest; nothing: every job."""
+    every = jobs()
+    if argv == ["core"]:
+        chosen, what = every[:1], "core"
+    elif argv:
+        shard, shards = (int(a) for a in argv)
+        chosen = [job for i, job in enumerate(every[1:]) if i % shards == shard]
+        what = f"shard {shard + 1}/{shards}"
+    else:
+        chosen, what = every, "all"
     t0 = time.perf_counter()
-    for i, job in enumerate(jobs()):
-        if i % shards == shard:
-            job()
-    print(f"warm_kernels: shard {shard + 1}/{shards} in {time.perf_counter() - t0:.0f} s")
+    for job in chosen:
+        job()
+    print(f"warm_kernels: {what} in {time.perf_counter() - t0:.0f} s")
     return 0
 
 
