@@ -1,0 +1,382 @@
+"""Speed (recipes perf, search-speed, precision-*, agreement, stonesoup-mcts)."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pandas as pd
+
+from studies.tables.common import (
+    RESULTS,
+    acquired,
+    paired,
+    pick,
+    rmse,
+    share,
+    study,
+    table,
+    time_to_1m,
+)
+
+
+def _perf(name: str) -> dict:
+    return json.loads((RESULTS / "perf" / f"{name}.json").read_text(encoding="utf-8"))
+
+
+def _timed(record: dict) -> str:
+    """When and how a stored timing was taken: date, cores, and the load beside it."""
+    load, machine = record["load"], record["machine"]
+    when = (load.get("started") or "")[:10]
+    other = load.get("other_cores")
+    if load.get("idle") is True:
+        state = "idle"
+    elif other is None:
+        state = "load unknown"
+    else:
+        state = f"**shared** (other processes {other:.1f} cores)"
+    commit = (machine.get("code", {}).get("commit") or "")[:7]
+    return f"{when}, {machine['cpus']} CPUs, {state}, `{commit}`"
+
+
+def _repeats_text(result: dict) -> str:
+    """How many runs of the alternation a comparison's figures are the median of."""
+    n = result.get("repeats", 1)
+    return f"; the median of {n} such runs in one process" if n > 1 else ""
+
+
+def speed_table() -> str:
+    """Speed, from the stored `dcee perf` outputs of docs/results/perf/ (bash studies/run.sh
+    perf): every ratio's two sides timed in the same run."""
+    ste, mcts, work = _perf("stonesoup-ste"), _perf("stonesoup-mcts"), _perf("workloads")
+    by_name = {w["name"]: w for w in work["workloads"]}
+    rows = [
+        [
+            "our `infotaxis` decision vs Stone Soup's KL planner on Stone Soup's own STE "
+            f"workload, {ste['stonesoup']['decisions']} decisions each, in alternation"
+            + _repeats_text(ste["stonesoup"]),
+            f"{ste['stonesoup']['speedup']:.1f}× faster"
+            + (
+                " (runs {:.1f}-{:.1f}×)".format(*ste["stonesoup"]["speedup_range"])
+                if ste["stonesoup"].get("repeats", 1) > 1
+                else ""
+            ),
+            f"{ste['stonesoup']['dcee_infotaxis_median_ms']:.2f} ms vs "
+            f"{ste['stonesoup']['stonesoup_median_ms']:.1f} ms",
+            "≥ 50×",  # TARGET_SPEEDUP of dcee.perf.stonesoup_compare (older runs stored 20)
+            _timed(ste),
+        ],
+        [
+            f"our tree search (`{mcts['strategy']}`) vs Stone Soup's "
+            f"`MCTSRolloutSensorManager` on its MCTS STE example, seeds 0-{mcts['seeds'] - 1}",
+            f"{mcts['speedup']:.1f}× faster at the median decision"
+            + (
+                f" ({mcts['first10_speedup']:.0f}× over each search's first ten, before Stone "
+                "Soup's growing track history slows its decisions)"
+                if "first10_speedup" in mcts
+                else ""
+            )
+            + "; final x-y RMSE "
+            f"{mcts['dcee_median_final_rmse']:.2f} m vs {mcts['stonesoup_median_final_rmse']:.2f}"
+            f" m (lower in {mcts['dcee_lower_rmse']}/{mcts['seeds']})",
+            f"{mcts['dcee_median_ms']:.0f} ms vs {mcts['stonesoup_median_ms']:.0f} ms",
+            "≥ 50×, lower RMSE",
+            _timed(mcts),
+        ],
+    ]
+    work_rows = (
+        ("dcee-decision-20k", "floor", "a paper-scale `dcee` decision (20,000 particles, 8 moves "
+         "× 40 readings) vs the plain compiled loop computing the same statistics exactly",
+         "≤ 1.5×"),
+        ("infotaxis-decision-20k", "floor", "the same for `infotaxis`", "≤ 1.5×"),
+        ("dcee-mcts-decision-20k", "dcee-cl-decision", "a `dcee-mcts` decision vs a `dcee-cl` "
+         "decision computed exactly, 20,000 particles, in alternation", "≤ 3×"),
+        ("resample-mcmc-500-readings-20k", "filter-update", "resample + MCMC move over 500 "
+         "readings vs one filter update, 20,000 particles", "≤ 76×"),
+    )  # fmt: skip
+    for name, reference, label, target in work_rows:
+        w = by_name[name]
+        ratio = w["ratio_to"][reference]
+        rows.append([label, f"{ratio:.2f}×", f"{w['median']:.3g} ms", target, _timed(work)])
+    move_path = RESULTS / "perf" / "move-speedup.json"
+    if move_path.exists():  # studies/move_speedup.py: what moved the move / update ratio
+        move = _perf("move-speedup")
+        rows.append(
+            [
+                "the same move and one filter update vs commit "
+                f"`{move['before']}` (the move / update ratio "
+                f"{move['before_ratio']:.0f}× there), each side in a fresh process, in "
+                "alternation",
+                f"move {move['move_speedup']:.2f}× faster, update "
+                f"{move['update_speedup']:.2f}× faster (ratio {move['after_ratio']:.0f}× today)",
+                f"{move['after_move_ms']:.3g} ms vs {move['before_move_ms']:.3g} ms",
+                "the move no slower",
+                _timed(move),
+            ]
+        )
+    # issue 46: the default (interpolated sums) and precision=single against the exact decision
+    for name, label in (
+        ("dcee-cl-decision-20k", "the default (`precision=interpolated`)"),
+        ("dcee-cl-single-decision-20k", "`precision=single`"),
+    ):
+        w = by_name[name]
+        if "dcee-cl-double-decision" not in w["ratio_to"]:
+            continue  # runs stored before the interpolated sums
+        rows.append(
+            [
+                f"a paper-scale `dcee-cl` decision with {label} vs the same computed exactly in "
+                "double precision, in alternation",
+                f"{w['ratio_to']['dcee-cl-double-decision']:.2f}×",
+                f"{w['median']:.3g} ms",
+                "—",
+                _timed(work),
+            ]
+        )
+    demo_path = RESULTS / "perf" / "demo-decision.json"
+    if demo_path.exists():  # studies/demo_decision.py (issue 46)
+        demo = _perf("demo-decision")
+        rows.append(
+            [
+                "the demo's search (`paper:1`, `dcee-cl`, seed 0, 20,000 particles): mean "
+                f"decision on one pinned core, against commit `{demo['before']}` in alternation"
+                + ("" if demo["same_search"] else " (**the two flew different searches**)"),
+                f"{demo['speedup']:.2f}× faster",
+                f"{demo['after_ms']:.1f} ms vs {demo['before_ms']:.1f} ms",
+                f"≤ {demo['target_ms']:.0f} ms",
+                _timed(demo),
+            ]
+        )
+    cl = by_name["dcee-cl-decision-20k"]
+    rows.append(
+        [
+            "a paper-scale `dcee-cl` decision (20,000 particles, 8 moves × 40 readings), "
+            f"{work['machine']['numba_threads']} threads",
+            "—",
+            f"{cl['median']:.3g} ms",
+            "—",
+            _timed(work),
+        ]
+    )
+    return table(["comparison (both sides in the same run)", "ratio", "absolute", "target",
+                  "timed (date, machine, load, code)"], rows)  # fmt: skip
+
+
+def kernel_speedup_table(name: str = "kernel-speedup") -> str:
+    """The predicted-posterior kernel before and after issue 46's changes, in alternation in one
+    run (studies/kernel_speedup.py, docs/results/perf/kernel-speedup.json; the second round,
+    the sums as matrix products: kernel-speedup-blas.json)."""
+    record = _perf(name)
+    rows = [
+        [
+            w["workload"],
+            f"{w['tasks']} × {w['particles']:,}",
+            f"{w['before_ms']:.1f} ms",
+            f"{w['after_ms']:.1f} ms",
+            f"**{w['speedup']:.2f}×**",
+            f"{w['max_abs_difference']:.0e}",
+        ]
+        for w in record["workloads"]
+    ]
+    rows.append(["timed", _timed(record), f"before: `{record['before']}`", "", "", ""])
+    return table(
+        ["workload", "tasks × particles", "before", "after", "speed-up", "largest difference"],
+        rows,
+    )
+
+
+def precision_single_table(
+    name: str = "precision-single",
+    double: str = "dcee-cl",
+    single: str = "dcee-cl:precision=single",
+    label: str = "single",
+) -> str:
+    """`dcee-cl` in single and double precision on the public study's 120 searches, paired
+    (bash studies/run.sh precision-single; docs/results/precision-single); with the other
+    arguments the interpolated sums against exact double precision
+    (docs/results/precision-interpolated)."""
+    metrics, pairs = study(name), paired(name)
+    searches = pd.read_csv(RESULTS / name / "searches.csv")
+    ms = {k: 1e3 * g["decision_seconds_mean"] for k, g in searches.groupby("strategy")}
+    rows = []
+    for strategy in (double, single):
+        r = pick(metrics, strategy)
+        rows.append(
+            [
+                f"`{strategy}`",
+                acquired(r),
+                share(r, "truth_in_95"),
+                rmse(r),
+                time_to_1m(r),
+                f"{ms[strategy].mean():.1f}",
+            ]
+        )
+    p = pick(pairs, single)
+    both = searches.pivot_table(index=["scenario", "seed"], columns="strategy",
+                                values="decision_seconds_mean")  # fmt: skip
+    ratio = float((both[single] / both[double]).median())
+    final = searches.pivot_table(index=["scenario", "seed"], columns="strategy",
+                                 values="final_rmse")  # fmt: skip
+    same = int((abs(final[single] - final[double]) < 1e-9).sum())
+    time_diff, time_p = p["time_to_1m_difference"], p["time_wilcoxon_p"]
+    reach = searches.pivot_table(index=["scenario", "seed"], columns="strategy",
+                                 values="time_to_rmse_1m")  # fmt: skip
+    if not math.isnan(time_diff):
+        time_cell = f"{time_diff:+.0f} s (p = {time_p:.2g})"
+    elif (reach[single] == reach[double]).all():  # no nonzero difference for a test to use
+        time_cell = "0 s in every pair"
+    else:
+        time_cell = "—"
+    rows.append(
+        [
+            f"paired, {label} − double ({same}/{len(final)} searches end at the same final RMSE "
+            "to 1e-9 m)",
+            f"{int(p['acquired_variant_only'])} / {int(p['acquired_reference_only'])} acquired "
+            f"only by one (McNemar p = {p['mcnemar_p']:.2g})",
+            "",
+            f"{p['final_rmse_difference']:+.3f} m "
+            + (
+                "(equal in every pair)"
+                if math.isnan(p["rmse_wilcoxon_p"])  # no nonzero difference for a test to use
+                else f"(Wilcoxon p = {p['rmse_wilcoxon_p']:.2g})"
+            ),
+            time_cell,
+            f"{ratio:.2f}× per search (median of {len(both)} pairs)",
+        ]
+    )
+    return table(
+        ["planner", "source acquired (RMSE < 3 m)", "truth in 95 % region",
+         "median final RMSE (m)", "median time to RMSE < 1 m (s)", "mean decision (ms)"],
+        rows,
+    )  # fmt: skip
+
+
+def agreement_single_table(name: str = "agreement-single", whole: str | None = None) -> str:
+    """Decisions with ``precision=single`` against today's double-precision full computation,
+    per planner (studies/decision_agreement.py, docs/results/perf/agreement-single.json); with
+    ``name="agreement-interpolated"`` the interpolated sums, and the whole searches of
+    ``whole`` (the same check over every decision of longer searches) in a last row."""
+    record = _perf(name)
+    settings = record["settings"]
+    rows = []
+    for strategy in settings["strategies"]:
+        mine = [r for r in record["searches"] if r["strategy"] == strategy]
+        decisions = sum(r["decisions"] for r in mine)
+        same = sum(r["same_choice"] for r in mine)
+        worst = max(r["max_cost_diff_over_spread"] for r in mine)
+        rows.append([f"`{strategy}`", f"{same}/{decisions}", f"{worst:.0e}"])
+    rows.append(
+        [
+            "**all**",
+            f"**{record['same_choice']}/{record['decisions']}** "
+            f"({100 * record['same_choice'] / record['decisions']:.1f} %)",
+            f"{record['max_cost_diff_over_spread']:.0e}",
+        ]
+    )
+    commit = (record["machine"].get("code", {}).get("commit") or "")[:7]
+    rows.append(
+        [
+            "settings",
+            f"{', '.join(settings['configs'])}; seeds 0-{settings['seeds'] - 1}; "
+            f"{settings['steps']} decisions per search; {settings['particles']:,} particles",
+            f"`{commit}`",
+        ]
+    )
+    if whole is not None and (RESULTS / "perf" / f"{whole}.json").exists():
+        full = _perf(whole)
+        fs = full["settings"]
+        rows.append(
+            [
+                f"whole searches: `{'`, `'.join(fs['strategies'])}`, {', '.join(fs['configs'])}, "
+                f"seed 0, up to {fs['steps']} decisions each",
+                f"**{full['same_choice']}/{full['decisions']}** "
+                f"({100 * full['same_choice'] / full['decisions']:.1f} %)",
+                f"{full['max_cost_diff_over_spread']:.0e}",
+            ]
+        )
+    return table(
+        ["planner", "same choice as exact double precision", "largest cost difference / spread"],
+        rows,
+    )
+
+
+def search_speed_table() -> str:
+    """Whole searches of the public study's five planners on one pinned core, two code
+    versions in alternation (studies/search_speed.py, docs/results/perf/search-speed.json)."""
+    record = _perf("search-speed")
+    rows = []
+    total = {"before": 0.0, "after": 0.0}
+    for planner, row in record["summary"].items():
+        c, d, u = row["wall_s"], row["decision_s"], row["update_s"]
+        for side in total:
+            total[side] += c[side]
+        rows.append(
+            [
+                f"`{planner}`",
+                f"{c['before']:.2f} → **{c['after']:.2f}** ({c['before'] / c['after']:.2f}×)",
+                f"{d['before']:.2f} → {d['after']:.2f}",
+                f"{u['before']:.2f} → {u['after']:.2f}",
+                "yes" if row["same_search"] else "no (last-digit differences diverge)",
+            ]
+        )
+    rows.append(
+        [
+            "**all five** (one search each)",
+            f"{total['before']:.1f} → **{total['after']:.1f}** "
+            f"({total['before'] / total['after']:.2f}×)",
+            "",
+            "",
+            "",
+        ]
+    )
+    study = {side: 120 * total[side] / 2 / 60 for side in total}
+    rows.append(
+        [
+            "the 600-search study on 2 workers at these costs (a projection, not a measurement: "
+            "120 × the sum / 2)",
+            f"{study['before']:.0f} → {study['after']:.0f} min",
+            "",
+            "",
+            _timed(record) + f", against `{record['before']}`",
+        ]
+    )
+    # studies/study_wall.py: the campaign itself, measured; every stored run (the machine's
+    # speed differs from day to day: the same code took 25.1 and 13.5 min), the latest last
+    for study_path in sorted(
+        (RESULTS / "perf").glob("study-600*.json"), key=lambda p: (p.stem == "study-600", p.stem)
+    ):
+        run = _perf(study_path.stem)
+        means = ", ".join(f"{k} {v['mean_wall_s']:.1f} s" for k, v in run["per_planner"].items())
+        rows.append(
+            [
+                f"the study measured: `dcee bench --suite paper --repeats 10 --workers 2`, "
+                f"{run['searches']} searches (mean per search: {means})",
+                f"**{run['wall_seconds'] / 60:.1f} min** (bar ≤ {run['target_minutes']:.0f} min)",
+                "",
+                "",
+                f"{run['campaign_code'].get('commit', '')[:7]}, 2 workers, nothing else run",
+            ]
+        )
+    for extra in sorted((RESULTS / "perf").glob("search-speed-*.json")):
+        # the code of an earlier study run against today's, in one run: how much of a change in
+        # the study's wall time is the code's and how much the machine's day
+        rec = _perf(extra.stem)
+        sums = {
+            side: sum(row["wall_s"][side] for row in rec["summary"].values())
+            for side in ("before", "after")
+        }
+        same = all(v["same_search"] for v in rec["summary"].values())
+        rows.append(
+            [
+                f"the five searches with the code of `{rec['before']}` and of today, in one run "
+                "(`studies/search_speed.py`): the two study rows above differ by the machine's "
+                "day, not the code",
+                f"{sums['before']:.1f} → {sums['after']:.1f} s "
+                f"({sums['before'] / sums['after']:.2f}×)",
+                "",
+                "",
+                ("yes" if same else "no") + "; " + _timed(rec),
+            ]
+        )
+    return table(["planner (`paper:1`, seed 0, 20,000 particles, 450 readings)",
+                  "wall per search (s)", "decisions (s)", "filter updates (s)",
+                  "same search"], rows)  # fmt: skip

@@ -1,0 +1,161 @@
+"""Sites with walls, no-go zones and gas round buildings (recipes sites, sites-walls*)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import pandas as pd
+
+from studies.tables.common import (
+    RESULTS,
+    acquired,
+    interval,
+    rmse,
+    table,
+)
+
+
+def sites_table() -> str:
+    frame = pd.read_csv(RESULTS / "sites" / "sites.csv")
+    rows = []
+    for _, r in frame.iterrows():
+        rows.append(
+            [
+                f"`{r['scenario']}`",
+                f"`{r['strategy']}`",
+                str(r["motion"]),
+                acquired(r),
+                rmse(r),
+                f"{r['straight']:.0f} / {r['round']:.0f}",
+                "never"
+                if r["reached_near"] == 0
+                else f"{r['to_near']:.0f} ({100 * r['reached_near']:.0f} % got there)",
+                f"{int(r['positions_inside'])} / {int(r['drives_into_obstacles'])}",
+                f"{r['longest_stall']:.0f}",
+            ]
+        )
+    return table(
+        [
+            "site",
+            "planner",
+            "motion",
+            "source acquired",
+            "median final RMSE (m)",
+            "start → source: straight / round the obstacles (m)",
+            "median way flown until within 8 m of it (m)",
+            "positions / drives inside an obstacle",
+            "longest stall (s)",
+        ],
+        rows,
+    )
+
+
+def sites_walls_table(name: str, all_only: bool = False) -> Callable[[], str]:
+    """Issue 44's tables (studies/sites_walls_table.py): per site and estimator, then the
+    estimators paired search by search."""
+
+    def make() -> str:
+        frame = pd.read_csv(RESULTS / name / "summary.csv")
+        if all_only:  # one search per configuration: only the pooled rows say anything
+            frame = frame[frame["scenario"] == "all sites"]
+        rows = []
+        for _, r in frame.iterrows():
+            n = int(r["searches"])
+            lo, hi = 100 * r["acquired_lo"], 100 * r["acquired_hi"]
+            t1 = r["median_time_to_1m"]
+            rows.append(
+                [
+                    f"`{r['scenario']}`" if ":" in r["scenario"] else r["scenario"],
+                    f"`{r['strategy']}`, {r['estimator']}",
+                    f"{int(r['acquired'])}/{n}, "
+                    f"{100 * r['acquired_rate']:.0f} % [{lo:.0f}, {hi:.0f}]",
+                    interval(r, "median_final_rmse", ".2f"),
+                    "never"
+                    if math.isnan(t1)
+                    else f"{t1:.0f} ({100 * r['reached_1m']:.0f} % got there)",
+                    f"{100 * r['truth_in_95']:.0f} %",
+                    f"{r['longest_wander']:.0f} ({int(r['wandered'])} > 120 s)",
+                    f"{r['decision_ms']:.0f}",
+                ]
+            )
+        head = table(
+            [
+                "site",
+                "planner, estimator",
+                "source acquired",
+                "median final RMSE (m)",
+                "median time to RMSE < 1 m (s)",
+                "truth in 95 % region",
+                "longest wander (s)",
+                "decision (ms, 2 workers)",
+            ],
+            rows,
+        )
+        pairs = pd.read_csv(RESULTS / name / "paired.csv")
+        prow = [
+            [
+                f"`{r['scenario']}`" if ":" in r["scenario"] else r["scenario"],
+                f"`{r.get('strategy', 'dcee-cl')}`: {r['a']} − {r['b']}",
+                str(int(r["pairs"])),
+                f"{int(r['acquired_a_only'])} / {int(r['acquired_b_only'])}",
+                f"{r['mcnemar_p']:.2g}",
+                f"{r['median_rmse_difference']:+.2f}",
+                f"{r['wilcoxon_p']:.2g}",
+            ]
+            for _, r in pairs.iterrows()
+            if r["pairs"] >= 5 and not (all_only and r["scenario"] != "all sites")
+        ]
+        return (
+            head
+            + "\n"
+            + table(
+                [
+                    "site",
+                    "paired",
+                    "searches",
+                    "acquired by the first only / the second only",
+                    "McNemar p",
+                    "median final RMSE difference (m)",
+                    "Wilcoxon p",
+                ],
+                prow,
+            )
+        )
+
+    return make
+
+
+def moves_ahead(n: int) -> str:
+    """'one move ahead', 'two moves ahead', ..."""
+    return f"{('one', 'two', 'three')[n - 1]} move{'s' if n > 1 else ''} ahead"
+
+
+def sites_walls_timing_table() -> str:
+    """Issue 44: decision and update time on a site against open terrain, one pinned core, idle
+    (studies/site_timing.py)."""
+    frame = pd.read_csv(RESULTS / "sites-walls" / "timing.csv")
+    rows = [
+        [
+            f"`{r['site']}`",
+            f"{r['way']}, {moves_ahead(int(r['lookahead']))}",
+            f"{r['decision_ms_mean']:.1f}",
+            f"{r['decision_ratio']:.2f}×",
+            f"{r['update_ms_mean']:.1f}",
+            f"{r['update_ratio']:.2f}×",
+            f"{r['load_before']:.2f}",
+        ]
+        for _, r in frame.iterrows()
+    ]
+    return table(
+        [
+            "site",
+            "search",
+            "mean decision (ms)",
+            "× open terrain",
+            "mean update per reading (ms)",
+            "× open terrain",
+            "load before",
+        ],
+        rows,
+    )
