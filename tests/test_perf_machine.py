@@ -71,7 +71,9 @@ def test_machine_record_names_the_code_and_libraries():
 
 
 def test_the_speed_table_marks_a_shared_run():
-    timed = _script("publish_tables")._timed
+    _script("publish_tables")  # puts the studies package on the path, as the script does
+    from studies.tables.performance import _timed as timed
+
     machine = {"cpus": 2, "code": {"commit": "0123456789abcdef"}}
     shared = {"started": "2026-11-26T16:00:00+00:00", "other_cores": 1.3, "idle": False}
     idle = {"started": "2026-11-26T16:00:00+00:00", "other_cores": 0.05, "idle": True}
