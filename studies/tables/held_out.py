@@ -18,32 +18,32 @@ from studies.tables.common import (
 from studies.tables.paper import FULL_HEADER, full_row
 
 HELD_OUT = (
-    ("wind-known", "wind known, 200"),
-    ("full", "all eight unknown, 200"),
-    (
-        "filament",
-        "filament truth, all eight unknown, fluctuation likelihood, `held-out-100`, defaults of "
-        "2026-11-23",
-    ),
+    ("wind-known", "wind known", "200", "today's"),
+    ("full", "all eight unknown", "200", "today's"),
+    ("filament", "filament truth, all eight unknown, fluctuation", "`held-out-100`", "2026-11-23"),
 )
+"""(study, what is unknown and the truth, configurations, defaults flown at) of each study."""
 
 
 def held_out_table() -> str:
-    """Today's defaults on the three held-out studies (every planner on the same searches)."""
+    """The three held-out studies of ``held-out-today``, every planner on the same searches
+    (the study, its configurations and the defaults it flew in columns of their own)."""
     rows = []
     frame = study("held-out-today")
-    for name, what in HELD_OUT:
+    for name, what, configurations, flown in HELD_OUT:
         for strategy in PLANNERS:
             r = pick(frame, strategy, study=name)
-            rows.append(full_row(f"{what}: `{strategy}` (`held-out-today`)", r))
-    return table(FULL_HEADER, rows)
+            where = [what, configurations, flown, f"`{strategy}` (`held-out-today`)"]
+            rows.append(where + full_row("", r)[1:])
+    header = ["study", "configurations", "defaults of", "planner (stored in docs/results/)"]
+    return table([*header, *FULL_HEADER[1:]], rows)
 
 
 def paired_table() -> str:
     """`dcee-cl` against infotaxis, and both against the tree search, search by search."""
     frame = paired("held-out-today")
     rows = []
-    for name, _ in HELD_OUT:
+    for name, *_ in HELD_OUT:
         for variant, reference in (
             ("dcee-cl", "infotaxis"),
             ("dcee-cl", "dcee-mcts"),

@@ -6,7 +6,6 @@ from __future__ import annotations
 import pandas as pd
 
 from studies.tables.common import (
-    OLD_DEFAULTS,
     TODAY_DEFAULTS,
     acquired,
     earlier_defaults,
@@ -20,8 +19,19 @@ from studies.tables.common import (
 )
 from studies.tables.paper import FULL_HEADER, full_row
 
+TURBULENT_HEADER = [
+    "truth",
+    "configurations",
+    "flown at",
+    "planner (stored in docs/results/)",
+    *FULL_HEADER[1:],
+]
+
 
 def turbulent_table() -> str:
+    """Both turbulent truths, all eight unknown, the fluctuation likelihood: the public
+    configurations (12 × 5, 10,000 particles) and the held-out ones, at each round's defaults
+    (the truth, the configurations and the defaults in columns of their own)."""
     rows = []
     for name, how in (
         ("turbulent-public-defaults", "the third round's defaults"),
@@ -33,14 +43,14 @@ def turbulent_table() -> str:
         for truth in ("filament", "puffs"):
             for strategy in ("dcee-cl", "infotaxis"):
                 r = pick(frame, strategy, truth_model=truth)
-                label = f"{truth}, 12 public × 5, {how}, 10,000 particles: `{strategy}` (`{name}`)"
-                rows.append(full_row(label, r))
+                where = [truth, "12 public × 5", how, f"`{strategy}` (`{name}`)"]
+                rows.append(where + full_row("", r)[1:])
     frame = study("turbulent-held-out-100")
     settings = (
-        (0.0, 5.0, 0.0, 0, 0, "fixed 4 m altitude (before)"),
+        (0.0, 5.0, 0.0, 0, 0, "a fixed 4 m altitude (before the climb)"),
         (1.0, 2.5, 1.0, 0, 0, "the third round's defaults"),
-        (1.0, 2.5, 1.0, 1, 0, "mean-conserving intermittency"),
-        (1.0, 2.5, 1.0, 1, 2, "**today's defaults**"),
+        (1.0, 2.5, 1.0, 1, 0, "the mean-conserving intermittency"),
+        (1.0, 2.5, 1.0, 1, 2, "the defaults of 2026-11-23"),
     )
     for climb, near, reach, conserve, repeat, how in settings:
         for truth in ("puffs", "filament"):
@@ -56,15 +66,17 @@ def turbulent_table() -> str:
                     repeat_radius=repeat,
                 )
                 n = int(r["searches"])
-                label = f"{truth}, {n} held-out, {how}: `{strategy}` (`turbulent-held-out-100`)"
-                rows.append(full_row(label, r))
-    return table(FULL_HEADER, rows)
+                where = [truth, f"{n} held-out", how, f"`{strategy}` (`turbulent-held-out-100`)"]
+                rows.append(where + full_row("", r)[1:])
+    return table(TURBULENT_HEADER, rows)
 
 
 CROSS_HEADER = [
     "truth (held-out configurations)",
     "defaults chosen on it",
-    "planner",
+    "planner (stored in docs/results/)",
+    "flown at the defaults of",
+    "variant",
     "n",
     "source acquired (RMSE < 3 m)",
     "median final RMSE (m)",
@@ -76,19 +88,26 @@ CROSS_HEADER = [
 def cross_truth_table(latest_only: bool = False) -> str:
     """Every truth family, all eight unknown, at today's defaults, with the rows flown at the
     defaults before marked: which defaults were chosen on it (docs/plumes.md;
-    dcee.scenarios.defaults.DEFAULTS). ``latest_only`` (the README's): per truth and planner
-    only the latest defaults flown, and no options."""
+    dcee.scenarios.defaults.DEFAULTS). ``latest_only`` (docs/index.md's): per truth and planner
+    only the latest defaults flown, and no options. Each row names the defaults it was flown
+    at by date (a legend below the table says what each was) and what it varies, so that the
+    first column is the truth alone."""
     today = study("held-out-today")
     turbulent_today = study("turbulent-held-out-100-today")
     lbm = study("lbm-held-out-100")
     rows = []
+    dates: set[str] = set()
 
-    def add(truth: str, chosen: str, r: pd.Series, source: str) -> None:
+    def add(truth: str, chosen: str, r: pd.Series, source: str, flown: str, how: str) -> None:
+        if flown != "today":
+            dates.add(flown)
         rows.append(
             [
                 truth,
                 chosen,
                 f"`{r['strategy']}` (`{source}`)",
+                "today's" if flown == "today" else flown,
+                how or "—",
                 str(int(r["searches"])),
                 acquired(r),
                 rmse(r),
@@ -98,14 +117,7 @@ def cross_truth_table(latest_only: bool = False) -> str:
         )
 
     def flown(defaults: str, strategy: str) -> str:
-        if defaults == TODAY_DEFAULTS.get(strategy):
-            return ""
-        if strategy == "dcee-cl:horizon=2" and defaults == "2026-11-27c":
-            return (
-                ", the same planner as `dcee-cl` at the defaults of 2026-11-29, flown before "
-                "they were the defaults"
-            )
-        return f", {earlier_defaults(defaults, strategy)}"
+        return "today" if defaults == TODAY_DEFAULTS.get(strategy) else defaults
 
     for strategy in ("dcee-cl", "infotaxis", "dcee-mcts"):
         add(
@@ -113,6 +125,8 @@ def cross_truth_table(latest_only: bool = False) -> str:
             "outlier weight, stall guard, stop rule",
             pick(today, strategy, study="full"),
             "held-out-today",
+            "today",
+            "",
         )
     for truth, chosen in (
         (
@@ -132,19 +146,22 @@ def cross_truth_table(latest_only: bool = False) -> str:
                     continue
                 latest.add(strategy)
                 r = pick(part, strategy, truth_model=truth)
-                small = small_sample(r)
                 add(
-                    f"{truth}, fluctuation likelihood{flown(defaults, strategy)}{small}",
+                    f"{truth}, fluctuation likelihood",
                     chosen,
                     r,
                     "turbulent-held-out-100-today",
+                    flown(defaults, strategy),
+                    small_sample(r).removeprefix(", "),
                 )
         if truth == "filament" and not latest_only:
             add(
-                f"filament, fluctuation likelihood, {OLD_DEFAULTS}",
+                "filament, fluctuation likelihood",
                 chosen,
                 pick(today, "dcee-mcts", study="filament"),
                 "held-out-today",
+                "2026-11-23",
+                "",
             )
     # newest generation first (the tags sort by date, as latest_defaults reads them)
     lbm = lbm.assign(order=lbm["defaults"].astype(str)).sort_values(
@@ -154,11 +171,29 @@ def cross_truth_table(latest_only: bool = False) -> str:
     if latest_only:  # per planner, the latest defaults flown, no options
         lbm = lbm[(lbm["learn"] == "none") & ~option].drop_duplicates("strategy", keep="first")
     for _, r in lbm.iterrows():
-        how = "" if r["learn"] == "none" else f", `estimator.learn` {r['learn']} (an option)"
-        if ":" in str(r["strategy"]):
-            how += ", a planner option (chosen on the tuning range, measured here)"
+        how = [] if r["learn"] == "none" else [f"`estimator.learn` {r['learn']} (an option)"]
+        strategy, defaults = str(r["strategy"]), str(r["defaults"])
+        if ":" in strategy:
+            how.append("a planner option (chosen on the tuning range, measured here)")
+        if strategy == "dcee-cl:horizon=2" and defaults == "2026-11-27c":
+            how.append("`dcee-cl` at the defaults of 2026-11-29, flown before they were")
         if int(r.get("particles", 10000)) != 10000:
-            how += f", {int(r['particles']):,} particles (measured, not chosen on)"
-        how += flown(str(r["defaults"]), str(r["strategy"])) + small_sample(r)
-        add(f"**lbm** (fluid solver), fluctuation likelihood{how}", "none", r, "lbm-held-out-100")
-    return table(CROSS_HEADER, rows)
+            how.append(f"{int(r['particles']):,} particles (measured, not chosen on)")
+        if small_sample(r):
+            how.append(small_sample(r).removeprefix(", "))
+        add(
+            "**lbm** (fluid solver), fluctuation likelihood",
+            "none",
+            r,
+            "lbm-held-out-100",
+            flown(defaults, strategy),
+            "; ".join(how),
+        )
+    legend = [f"* **{tag}**: the {earlier_defaults(tag, 'dcee-cl')}" for tag in sorted(dates)[::-1]]
+    today_words = "* **today's**: `dcee-cl` three moves ahead, the region's floor 0.25 m"
+    return (
+        table(CROSS_HEADER, rows)
+        + "\nFlown at the defaults of:\n\n"
+        + "\n".join([today_words, *legend])
+        + "\n"
+    )
