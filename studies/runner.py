@@ -29,6 +29,7 @@ import glob
 import json
 import os
 import shlex
+import signal
 import subprocess
 import sys
 import time
@@ -190,6 +191,8 @@ def run(name: str, dry_run: bool = False, say: Callable[[str], None] = print) ->
 
 def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else argv
+    if argv is None and hasattr(signal, "SIGPIPE"):
+        signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `--list | head` ends quietly
     os.chdir(ROOT)
     try:
         if not args or args[0] in ("--list", "-l"):
