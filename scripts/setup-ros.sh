@@ -13,15 +13,6 @@ if [ ! -x .venv-ros/bin/python ]; then
   "$PYTHON" -m venv .venv-ros
 fi
 .venv-ros/bin/python -m pip install --quiet --upgrade pip
-if [ "${1:-}" = "--dependencies" ]; then
-  # dcee's dependencies and the ROS 2 extra's, read from pyproject.toml, without dcee itself:
-  # nothing is written into the source tree, so scripts/test.sh runs this beside setup.sh
-  mapfile -t requirements < <(.venv-ros/bin/python -c 'import tomllib
-project = tomllib.load(open("pyproject.toml", "rb"))["project"]
-print("\n".join(project["dependencies"] + project["optional-dependencies"]["ros"]))')
-  .venv-ros/bin/python -m pip install --quiet "${requirements[@]}" "pytest>=8.0"
-  exit 0
-fi
 # the ROS 2 extra and pytest only: the ROS 2 tests (tests/ros) need nothing else, and the rest of
 # the development tools live in .venv
 .venv-ros/bin/python -m pip install --quiet -e ".[ros]" "pytest>=8.0"
