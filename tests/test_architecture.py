@@ -30,6 +30,7 @@ LAYERS = {
     "dcee.provenance": 0,
     "dcee.blas": 0,
     "dcee.kernel_cache": 0,  # where numba keeps compiled kernels (set before numba loads)
+    "dcee.kernel_locator": 0,  # how numba files them there (numba imports it by name)
     "dcee.models": 1,
     "dcee.recordings": 1,  # plume recordings on disk: CF reader, header layout, statistics
     "dcee.estimation": 2,

@@ -47,8 +47,9 @@ def _snippet_env(workdir: Path) -> dict[str, str]:
     and a page's interpreter under its own ``HOME`` would otherwise compile every kernel again
     (about 20 s a page)."""
     env = {"MPLBACKEND": "Agg", "PATH": "/usr/bin:/bin", "HOME": str(workdir)}
-    if "NUMBA_CACHE_DIR" in os.environ:
-        env["NUMBA_CACHE_DIR"] = os.environ["NUMBA_CACHE_DIR"]
+    for name in ("NUMBA_CACHE_DIR", "NUMBA_CACHE_LOCATOR_CLASSES"):
+        if name in os.environ:
+            env[name] = os.environ[name]
     return env
 
 

@@ -81,3 +81,27 @@ def test_importing_dcee_sets_the_keyed_folder_before_numba_loads(tmp_path):
     ).stdout.split()
     assert out[0] == "True"
     assert (tmp_path / "dcee" / "numba" / out[1]).is_dir()
+
+
+def test_kernels_are_filed_by_package_folder_so_another_checkout_reuses_them(tmp_path):
+    """Where dcee chose the cache folder, a kernel's cache lies in ``<source state>/dcee/<its
+    subpackage>`` (dcee.kernel_locator), not under a hash of the checkout's absolute folder, so
+    a fresh clone of the same source finds what another compiled; a user's NUMBA_CACHE_DIR
+    keeps numba's own locator."""
+    code = (
+        "import numpy as np, dcee\n"
+        "from dcee.planning.reading_terms import task_layout\n"
+        "task_layout(np.zeros((2, 1), dtype=np.int64), 3)\n"
+    )
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+    env["XDG_CACHE_HOME"] = str(tmp_path / "cache")
+    subprocess.run([sys.executable, "-c", code], env=env, check=True, timeout=300)
+    root = tmp_path / "cache" / "dcee" / "numba" / kernel_cache.source_stamp()
+    index = sorted(p.relative_to(root) for p in root.rglob("*.nbi"))
+    assert index and all(p.parts[:2] == ("dcee", "planning") for p in index), index
+    from dcee.kernel_locator import PackageRelativeLocator
+
+    def outside(x):
+        return x
+
+    assert PackageRelativeLocator.from_function(outside, __file__) is None  # not dcee's

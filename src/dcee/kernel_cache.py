@@ -8,9 +8,11 @@ Before numba is imported, :func:`key_numba_cache` points ``NUMBA_CACHE_DIR`` at
 ``$XDG_CACHE_HOME/dcee/numba/<key>`` (``~/.cache`` by default), the key a hash of the path and
 contents of every module that uses numba: a change to any of them compiles every kernel anew
 (about a minute, once), a change elsewhere (the command line, the docs) none, and the folders
-of the last few states are kept so that switching back and forth does not recompile. A
-``NUMBA_CACHE_DIR`` set by the user wins; where the cache root cannot be written numba's own
-default is left in place.
+of the last few states are kept so that switching back and forth does not recompile. Within
+it each kernel is filed by its module's package-relative folder (:mod:`dcee.kernel_locator`),
+so that a second checkout of the same source (a fresh clone, CI) reuses what the first
+compiled. A ``NUMBA_CACHE_DIR`` set by the user wins (numba's own locator then); where the
+cache root cannot be written numba's own default is left in place.
 
 Standard library only: :mod:`dcee` imports this before anything else.
 """
@@ -26,6 +28,13 @@ from pathlib import Path
 PACKAGE_DIR = Path(__file__).resolve().parent
 KEEP = 4
 """Cache folders of this many source states are kept (the most recently used)."""
+
+LOCATORS = (
+    "dcee.kernel_locator.PackageRelativeLocator,UserProvidedCacheLocator,InTreeCacheLocator,"
+    "UserWideCacheLocator,IPythonCacheLocator,ZipCacheLocator"
+)
+"""``NUMBA_CACHE_LOCATOR_CLASSES`` where dcee chose the cache folder (:mod:`dcee.kernel_locator`
+is the first; the rest are numba's own, in numba's order)."""
 
 
 def source_stamp(package_dir: Path = PACKAGE_DIR) -> str:
@@ -92,6 +101,10 @@ def key_numba_cache() -> Path | None:
     except OSError:
         return None
     os.environ["NUMBA_CACHE_DIR"] = str(folder)
+    # kernels filed by their package-relative folder, so that another checkout of the same
+    # source reuses them (dcee.kernel_locator; the name is written out here: that module
+    # imports numba, which must not be imported yet)
+    os.environ.setdefault("NUMBA_CACHE_LOCATOR_CLASSES", LOCATORS)
     return folder
 
 
