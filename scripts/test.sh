@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # Set up, then lint (ruff), compile the kernels (scripts/warm_kernels.py), run the test suite
-# (pytest on two processes, one per core of the 2-core machine the README's five minutes are
-# measured on; PYTEST_WORKERS overrides), the ROS 2 tests in .venv-ros (scripts/test-ros.sh) and build the documentation site with its executed
-# examples (mkdocs --strict: any warning fails) and its browser check.
-# .venv-ros installs while the suite runs (pip waits mostly on the disk and the registry, the
-# suite on the cores), and the documentation builds while the ROS 2 tests run (they wait mostly
-# on message round trips); each part's output is printed whole, and any failure fails the run.
+# (pytest on two processes, one per core of the 2-core machine the README's times are measured
+# on; PYTEST_WORKERS overrides), the ROS 2 tests in .venv-ros (scripts/test-ros.sh) and build the
+# documentation site with its executed examples (mkdocs --strict: any warning fails) and its
+# browser check. Side by side, to keep both cores busy: .venv-ros installs while the kernels
+# compile and the suite runs, and the documentation builds while the ROS 2 tests run (they wait
+# mostly on message round trips); each part's output is printed whole, and any failure fails
+# the run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh

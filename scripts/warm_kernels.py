@@ -3,13 +3,13 @@
 planner, both likelihoods, all eight parameters unknown, a measured wind, several releases, a
 site with walls, the turbulent truths).
 
-Why: on a fresh machine the kernels compile on first use (about two minutes of one core), and
-in a suite run on two processes, whose campaign tests start worker processes of their own,
-the same kernel was compiled by several processes at once: the suite took 265 s there against
-124 s with the cache filled. ``core`` compiles what every search uses on one core (the other
-installs the ROS 2 venv meanwhile), then two shards side by side compile the rest, each kernel
-about once. A kernel the searches below miss is still compiled
-where a test first needs it; this only moves work, it checks nothing."""
+Why: on a fresh machine the kernels compile on first use (about 85 s of one core), and in a
+suite run on two processes, whose campaign tests start worker processes of their own, the same
+kernel was compiled by several processes at once: the suite took 265 s there against 124 s
+with the cache filled. ``core`` compiles what every search uses on one core (the other installs
+the ROS 2 venv meanwhile), then two shards side by side compile the rest, each kernel about
+once. A kernel the searches below miss is still compiled where a test first needs it; this
+only moves work, it checks nothing."""
 
 from __future__ import annotations
 

@@ -49,9 +49,17 @@ class RecipeError(ValueError):
     """A recipe or pin that cannot be run: the one-line message names the file and field."""
 
 
+def _read_toml(path: Path) -> dict:
+    """A TOML file's contents; a file that does not parse is a one-line RecipeError."""
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise RecipeError(f"{path.name}: {exc}") from None
+
+
 def load_pins(path: Path = PINS) -> dict[str, dict]:
     """Every pin by name: ``reason`` (str) and ``settings`` (["KEY=VALUE", ...])."""
-    pins = tomllib.loads(path.read_text(encoding="utf-8"))
+    pins = _read_toml(path)
     for name, pin in pins.items():
         if not (isinstance(pin.get("reason"), str) and pin["reason"].strip()):
             raise RecipeError(f"{path.name}: pin {name!r} needs a reason")
@@ -70,7 +78,7 @@ def load_recipe(name: str) -> dict:
     path = RECIPES / f"{name}.toml"
     if not path.is_file():
         raise RecipeError(f"study: no recipe {name!r} (python -m studies --list)")
-    recipe = tomllib.loads(path.read_text(encoding="utf-8"))
+    recipe = _read_toml(path)
     if not isinstance(recipe.get("description"), str):
         raise RecipeError(f"{path.name}: description must be a string")
     steps = recipe.get("step", [])

@@ -83,6 +83,14 @@ def test_tokens_expand_as_documented(tmp_path, monkeypatch):
     assert runner.expand({"dcee": "run --out elsewhere"}, pins, 0.0)
 
 
+def test_a_recipe_that_does_not_parse_is_a_one_line_error(tmp_path, monkeypatch):
+    monkeypatch.setattr(runner, "RECIPES", tmp_path)
+    (tmp_path / "broken.toml").write_text('description = "x"\n[[step]\n')
+    with pytest.raises(runner.RecipeError, match=r"^broken.toml: ") as exc:
+        runner.load_recipe("broken")
+    assert "\n" not in str(exc.value)
+
+
 def test_a_bad_recipe_or_name_is_one_line_and_exit_2(tmp_path):
     proc = subprocess.run(
         [sys.executable, "-m", "studies", "no-such-study"],
