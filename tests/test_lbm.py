@@ -121,9 +121,16 @@ def test_a_scenario_on_the_lbm_truth_is_planar(monkeypatch, tmp_path) -> None:
     from dcee.scenarios import load_scenario
 
     base = load_scenario("random:1")
-    scenario = base.with_overrides(**{"truth.model": "lbm", "estimator.likelihood": "fluctuation"})
+    # the planar plume's source lies in the plane the UAV flies: a source below it is refused
+    # in one line naming truth.z (no truth height may reach the reading model)
+    with pytest.raises(DceeInputError, match=r"^truth\.z: 1\.07 m is off the flight plane"):
+        base.with_overrides(**{"truth.model": "lbm", "estimator.likelihood": "fluctuation"})
+    scenario = base.with_overrides(
+        **{"truth.model": "lbm", "truth.z": 4.0, "estimator.likelihood": "fluctuation"}
+    )
     assert scenario.planar_truth and scenario.climb == 0.0
     assert "z" not in scenario.unknown_names
+    assert scenario.make_prior().sample(np.random.default_rng(0), 3)[:, 2].tolist() == [4.0] * 3
     with pytest.raises(DceeInputError, match=r"agent\.climb"):
         scenario.with_overrides(**{"agent.climb": 1.0})
     with pytest.raises(DceeInputError, match=r"truth\.u"):
@@ -183,7 +190,7 @@ def test_a_wall_across_the_plume_shelters_what_lies_behind_it() -> None:
 def test_a_site_grows_the_domain_round_the_search_area_and_walls_off_its_buildings() -> None:
     from dcee.scenarios import load_scenario
 
-    scenario = load_scenario("site:wall").with_overrides(**{"truth.model": "lbm"})
+    scenario = load_scenario("site:wall").with_overrides(**{"truth.model": "lbm", "truth.z": 4.0})
     theta = scenario.truth_theta()
     spec = LbmSpec(**SMALL)
     grown, solids = lbm.site_frame(

@@ -1,8 +1,10 @@
 """Defaults that follow the truth: a planar truth (a 2-D recording, the same at every altitude)
-makes the search planar. An unset climb is 0 there, whatever the likelihood (a 3-D recording
-keeps the climbing default), the source height is not estimated, a climb asked for or an agent
-off the plane a recording declares is refused in one line, and a search with default settings
-is the search with ``agent.climb = 0``, reading for reading."""
+keeps the agent at its altitude. An unset climb is 0 there, whatever the likelihood (a 3-D
+recording keeps the climbing default); the source height is estimated between the ground and the
+recording's plane unless the scenario declares it known (``dimensions = 2``); a climb asked for
+or an agent off the plane a recording declares is refused in one line, and a search with default
+settings is the search with ``agent.climb = 0``, reading for reading. No truth value other than
+the declared known ones reaches the estimator (issue 78)."""
 
 from __future__ import annotations
 
@@ -88,10 +90,38 @@ def test_cf_slice_declares_its_plane(tmp_path: Path) -> None:
 
 def test_planar_recording_sets_the_defaults(tmp_path: Path) -> None:
     flat = _scenario(_plume_2d(tmp_path / "flat.npy"))
-    assert flat.planar_truth and flat.climb == 0.0 and flat.search_dimensions == 2
-    assert "z" not in flat.unknown_names and "z" not in flat.make_prior().unknown_names
+    assert flat.planar_truth and flat.climb == 0.0 and flat.search_dimensions == 3
+    # the source height is estimated, between the ground and the plane (the agent's 4 m here)
+    prior = flat.make_prior()
+    assert "z" in flat.unknown_names and "z" in prior.unknown_names
+    z = prior.sample(np.random.default_rng(0), 4000)[:, 2]
+    assert 0.0 <= z.min() and z.max() <= 4.0 and z.max() > 3.9
+    at2 = _scenario(_plume_2d(tmp_path / "at2.npy", plane=2.0), **{"agent.start": [2, 2, 2]})
+    assert at2.make_prior().sample(np.random.default_rng(0), 4000)[:, 2].max() <= 2.0
+    # declared known: dimensions = 2 fixes it at truth.z
+    known = flat.with_overrides(dimensions=2)
+    assert known.search_dimensions == 2 and "z" not in known.unknown_names
+    assert set(known.make_prior().sample(np.random.default_rng(0), 5)[:, 2]) == {flat.truth.z}
     cube = _scenario(_plume_2d(tmp_path / "cube.npy", three_d=True))
     assert not cube.planar_truth and cube.climb == AUTO_CLIMB and "z" in cube.unknown_names
+
+
+def test_no_truth_value_reaches_the_estimator(tmp_path: Path) -> None:
+    """Over a recording the readings do not depend on the scenario's truth: two scenarios whose
+    truths differ in every parameter but the known ones (all eight unknown here) give the same
+    estimates, reading for reading; only the errors against the truth differ."""
+    quick = {"search.particles": 600, "search.hypotheses": 8, "search.budget": 60.0}
+    path = _plume_2d(tmp_path / "flat.npy")
+    a = _scenario(path, unknown="full", **quick)
+    moved = {"truth.x": 27.5, "truth.y": 23.0, "truth.z": 2.5, "truth.q": 11.0, "truth.u": 5.5}
+    b = a.with_overrides(**moved, **{"truth.zeta1": 1.4, "truth.zeta2": 6.0})
+    assert b.truth_theta()[:6].tolist() != a.truth_theta()[:6].tolist()
+    ra, rb = run_episode(a, "dcee-cl", 5), run_episode(b, "dcee-cl", 5)
+    assert len(ra.records) > 3
+    for x, y in zip(ra.records, rb.records, strict=True):
+        assert x["reading"] == y["reading"] and x["x"] == y["x"] and x["z"] == y["z"]
+        assert (x["mean_x"], x["mean_y"], x["mean_z"]) == (y["mean_x"], y["mean_y"], y["mean_z"])
+    assert [r["rmse"] for r in ra.records] != [r["rmse"] for r in rb.records]
 
 
 def test_what_cannot_work_is_one_line(tmp_path: Path) -> None:
@@ -113,7 +143,6 @@ def test_default_search_is_the_fixed_altitude_search(tmp_path: Path) -> None:
     assert [r["reading"] for r in a.records] == [r["reading"] for r in b.records]
     assert [r["rmse"] for r in a.records] == [r["rmse"] for r in b.records]
     assert {r["z"] for r in a.records} == {4.0}
-    # the error is horizontal: the source height is known (truth.z), not estimated
     assert math.isfinite(a.summary["final_rmse"])
 
 
@@ -139,17 +168,13 @@ def test_show_says_what_each_default_was_chosen_on() -> None:
     assert validate_scenario(tomllib.loads(text)) == scenario
 
 
-def test_run_says_when_the_source_is_off_a_planar_truths_plane(tmp_path: Path, capsys) -> None:
+def test_the_new_users_lbm_command_refuses_in_one_line(capsys) -> None:
+    """Issue 78's second row: the planar lbm plume with the scenario's source below the UAV
+    took the source height from the truth; now the command refuses before any work."""
     from tests.helpers import run_cli
 
-    path = _plume_2d(tmp_path / "flat.npy")
-    argv = ["run", "--scenario", "random:1", "--truth", str(path), "--budget", "20"]
-    argv += ["--particles", "300", "--no-figure"]
-    for setting in ("truth.x=25.0", "truth.y=25.0", "truth.phi=180.0", "prior.phi.mean=180.0"):
-        argv += ["--set", setting]
-    argv += ["--set", "truth.model.loop=true"]
-    code, _, err = run_cli([*argv, "--out", str(tmp_path / "a")], capsys)
-    z = load_scenario("random:1").truth.z
-    assert code == 0 and f"takes the source at truth.z = {z:g} m" in err
-    code, _, err = run_cli([*argv, "--set", "truth.z=4.0", "--out", str(tmp_path / "b")], capsys)
-    assert code == 0 and "planar" not in err
+    argv = ["run", "--scenario", "random:5000", "--truth", "lbm", "--likelihood", "fluctuation"]
+    code, out, err = run_cli([*argv, "--unknown", "full", "-q"], capsys)
+    assert code == 2 and out == ""
+    assert err.startswith("dcee: error: truth.z: ") and err.count("\n") == 1
+    assert 'truth.model = "lbm3d"' in err

@@ -112,8 +112,7 @@ def climb_notice(scenarios: Any, quiet: bool = False) -> None:
     """Say so when ``agent.climb`` was left unset and resolves to a climbing UAV (the
     fluctuation likelihood's default and the count-unknown one,
     :meth:`dcee.scenarios.Scenario.resolved_climb`): the agent
-    then has two moves more than the paper's; and when a planar truth's source height is off the
-    agent's plane. ``scenarios``: one scenario or several."""
+    then has two moves more than the paper's. ``scenarios``: one scenario or several."""
     if quiet:
         return
     many = scenarios if isinstance(scenarios, list | tuple) else [scenarios]
@@ -123,18 +122,6 @@ def climb_notice(scenarios: Any, quiet: bool = False) -> None:
             f"dcee: agent.climb unset: {_why_climb(auto[0])}, so the UAV may also climb and "
             f"descend {auto[0].climb:g} m; set agent.climb = 0 for a fixed altitude "
             "(docs/scenarios.md)",
-            err=True,
-        )
-    # a planar truth is one plane: the reading model takes the source at truth.z, so a source
-    # height off the agent's plane is a model offset the user should know about
-    off = [s for s in many if s.planar_truth and abs(s.agent.start[2] - s.truth.z) > 1e-9]
-    if off:
-        s = off[0]
-        click.echo(
-            f"dcee: the truth ({s.truth.model_name}) is planar: the agent stays at "
-            f"{s.agent.start[2]:g} m and the reading model takes the source at truth.z = "
-            f"{s.truth.z:g} m, {abs(s.agent.start[2] - s.truth.z):g} m off that plane; for the "
-            "plane through the source set truth.z to the flight height (docs/scenarios.md)",
             err=True,
         )
 

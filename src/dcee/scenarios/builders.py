@@ -335,13 +335,24 @@ class ScenarioBuilders:
         return StopRule(search.stop_spread, search.stop_hold)
 
     def make_prior(self) -> SourcePrior:
+        """The filter's prior. A known parameter is fixed at the truth's value only where the
+        scenario declares it known: the environment (u, φ, ζ1, ζ2) with ``unknown = "source"``,
+        the source height with ``dimensions = 2``; the lbm plume's source height is its plane,
+        the agent's altitude. Over a planar recording the source height's default prior is
+        uniform between the ground and the recording's plane (a slice holds the gas of a
+        release at or below it)."""
         truth = self.truth_theta()
         dists: dict[str, Distribution] = {}
         for k, name in enumerate(PARAMETER_NAMES):
             if name not in self.unknown_names:
-                dists[name] = Fixed(float(truth[k]))
+                if name == "z" and self.dimensions == 3:  # the lbm plume: the flight plane
+                    dists[name] = Fixed(float(self.agent.start[2]))
+                else:
+                    dists[name] = Fixed(float(truth[k]))
             elif k < 3 and name not in self.prior:
-                dists[name] = Uniform(self.volume.low[k], self.volume.high[k])
+                plane = self.reading_plane if k == 2 else None
+                high = self.volume.high[k] if plane is None else plane
+                dists[name] = Uniform(self.volume.low[k], high)
             else:
                 dists[name] = _distribution(name, self.prior[name])
         return SourcePrior.from_dict(dists)

@@ -5,15 +5,16 @@ README's cross-truth table and docs/scenarios.md say the same).
 The rule (DEVELOPERS.md): a default is chosen on a tuning set, on at most two truth families,
 and reported on the others. The truth families are ``isotropic`` (the paper's model, its own
 likelihood), ``filament`` and ``puffs`` (written here, with the fluctuation likelihood) and
-``lbm`` (a fluid solver's plume, :mod:`dcee.simulation.lbm`): no open-terrain default was chosen
-on ``lbm``; the wall-aware estimator's settings at a site were (the tuning sites).
+``lbm`` (a fluid solver's plume, :mod:`dcee.simulation.lbm`) and ``lbm3d`` (its 3-D surface-layer
+sibling, :mod:`dcee.simulation.lbm3d`): no open-terrain default was chosen on either; the
+wall-aware estimator's settings at a site were (the tuning sites, lbm).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-TRUTH_FAMILIES = ("isotropic", "filament", "puffs", "lbm")
+TRUTH_FAMILIES = ("isotropic", "filament", "puffs", "lbm", "lbm3d")
 """Every truth family the studies report on."""
 
 

@@ -75,17 +75,18 @@ def _resolve_recording(data: dict, base: Path) -> None:
 
 
 def truth_choice(value: str) -> str | dict[str, str]:
-    """The ``truth.model`` a ``--truth`` option names: "isotropic", "filament", "puffs", "lbm", or
-    the path of a
+    """The ``truth.model`` a ``--truth`` option names: "isotropic", "filament", "puffs", "lbm",
+    "lbm3d", or the path of a
     recording (``.npy``/``.h5``), made absolute so that it means the same file wherever the
     configuration is used later."""
-    if value in ("isotropic", "filament", "puffs", "lbm"):
+    if value in ("isotropic", "filament", "puffs", "lbm", "lbm3d"):
         return value
     path = Path(value).expanduser()
     if path.suffix.lower() not in (".npy", ".h5", ".hdf5", ".nc", ".nc4", ".netcdf", ".cdf"):
         raise DceeInputError(
             "truth",
-            f"must be isotropic, filament, puffs, lbm or a .npy/.h5/.nc recording (got {value!r})",
+            f"must be isotropic, filament, puffs, lbm, lbm3d or a .npy/.h5/.nc recording "
+            f"(got {value!r})",
         )
     if not path.is_file():
         raise DceeInputError("truth", f"no such recording {value!r}")

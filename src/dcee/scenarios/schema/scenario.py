@@ -176,7 +176,8 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, ResolvedSettings, BaseMod
     def _checked_planar(self, start: np.ndarray) -> None:
         """Read the truth's layout once (a recording's header) and refuse what cannot work over
         a planar truth: a climbing agent (the readings do not change with height, the reading
-        model does) or an agent away from the plane the truth holds."""
+        model does), an agent away from the plane the truth holds, and a source height the
+        search could only take from the truth (the lbm plume's source off its plane)."""
         try:
             layout = self.truth.layout()
         except DceeInputError as exc:
@@ -197,6 +198,27 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, ResolvedSettings, BaseMod
                 f"{FIELD_MARK}agent.start: z = {start[2]:g} m is off the plane it holds: {what}"
                 f"at every altitude, held at z = {plane:g} m; start the agent at that height"
             )
+        if self.truth.model_name == "lbm" and abs(self.truth.z - start[2]) > 1e-6:
+            raise ValueError(
+                f"{FIELD_MARK}truth.z: {self.truth.z:g} m is off the flight plane: the lbm plume "
+                f"is planar, its source in the plane the agent flies (z = {start[2]:g} m), so "
+                f'set truth.z = {start[2]:g}, or use truth.model = "lbm3d" (a 3-D plume) for '
+                "a source below the UAV"
+            )
+        if plane is None:
+            plane = float(start[2])
+        if (
+            self.dimensions == 3
+            and "z" not in self.prior
+            and self.truth.model_name != "lbm"
+            and not plane > self.volume.low[2]
+        ):
+            raise ValueError(
+                f"{FIELD_MARK}dimensions: the source height of a planar recording is estimated "
+                f"between the ground (volume.low z = {self.volume.low[2]:g} m) and its plane "
+                f"(z = {plane:g} m), which leaves no room; set dimensions = 2 to declare it known "
+                "(truth.z)"
+            )
 
     @property
     def explore_guard(self) -> bool:
@@ -209,15 +231,31 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, ResolvedSettings, BaseMod
 
     @property
     def planar_truth(self) -> bool:
-        """The truth holds one horizontal plane (a 2-D recording or the solver plume): the
-        agent stays at its altitude (an unset climb is 0) and the source height is not
-        estimated (it is ``truth.z``, as with ``dimensions = 2``; errors are horizontal)."""
+        """The truth holds one horizontal plane (a 2-D recording or the lbm solver plume): the
+        agent stays at its altitude (an unset climb is 0)."""
         return self._layout[0]
 
     @property
+    def reading_plane(self) -> float | None:
+        """m, the height a planar truth holds (the file's, else the agent's start altitude);
+        None for a truth with height."""
+        if not self.planar_truth:
+            return None
+        plane = self._layout[1]
+        return float(self.agent.start[2]) if plane is None else float(plane)
+
+    @property
+    def source_height_known(self) -> bool:
+        """The source height is not estimated: ``dimensions = 2`` declares it known (it is then
+        ``truth.z``), and the lbm solver plume's source lies in its plane, the plane the agent
+        flies (``truth.z`` must equal the start altitude). Over a planar recording it is
+        estimated, between the ground and the recording's plane, unless declared known."""
+        return self.dimensions == 2 or self.truth.model_name == "lbm"
+
+    @property
     def search_dimensions(self) -> int:
-        """2 for a planar search (``dimensions = 2`` or a planar truth), else 3."""
-        return 2 if self.planar_truth else self.dimensions
+        """2 where the source height is known (:attr:`source_height_known`), else 3."""
+        return 2 if self.source_height_known else 3
 
     def _checked_site(self, start: np.ndarray, src: np.ndarray) -> Any:
         """The ``[world]`` map, with the start outside every blocked cell, the source outside

@@ -162,6 +162,73 @@ class LbmSpec(BaseModel):
         return "lbm"
 
 
+class Lbm3dSpec(BaseModel):
+    """A 3-D plume computed by a fluid solver nobody here wrote: lbmpy's lattice Boltzmann
+    large-eddy simulation (D3Q19 cumulant, Smagorinsky) of a neutral surface layer, the log-law
+    wind over rough ground (lbmpy's wall function with the Monin-Obukhov wall model), with
+    the surface layer's eddies entering at the inflow, carrying a passive scalar from a
+    release at the scenario's source height (:mod:`dcee.simulation.lbm3d`, docs/plumes.md).
+    Computed once per parameter set and source height (the height of the lattice cell the
+    source lies in) in a canonical frame (source at x = y = 0, wind along +x at 1 m/s at
+    4 m), cached as a 3-D CF NetCDF recording (time, z, y, x) and replayed moved to the
+    scenario's source, turned to its wind direction and run at its wind speed. The readings
+    change with altitude: the search is 3-D and the source height is estimated. It ignores
+    the truth's ζ1 and ζ2. Lengths are metres in the canonical frame."""
+
+    model_config = FROZEN
+    kind: Literal["lbm3d"] = "lbm3d"
+    spacing: Annotated[float, Field(gt=0.1, le=5, allow_inf_nan=False)] = 0.5
+    """lattice spacing, m (every way)"""
+    store_stride: Annotated[int, Field(ge=1, le=16)] = 2
+    """horizontal cells stored as one block mean (vertically every cell is stored)"""
+    lattice_speed: Annotated[float, Field(gt=0, le=0.12, allow_inf_nan=False)] = 0.08
+    """mean wind at 4 m in lattice units (the wind at the lid is 1.2 times it)"""
+    relaxation: Annotated[float, Field(gt=1.0, lt=2.0, allow_inf_nan=False)] = 1.99
+    """relaxation rate ω of the flow lattice"""
+    smagorinsky: Annotated[float, Field(ge=0, le=0.5, allow_inf_nan=False)] = 0.12
+    """Smagorinsky constant of the subgrid model (0: none)"""
+    scalar_relaxation: Annotated[float, Field(gt=1.0, lt=2.0, allow_inf_nan=False)] = 1.97
+    """odd-moment relaxation rate of the scalar lattice: diffusivity (1/ω − 1/2)/3 lattice units
+    (1.97: 0.016 m²/s at 1 m/s; 1.9, the lbm truth's, smoothed the plume to a centreline
+    intensity of 0.5-0.8 and no time without gas within 40 m: one scratch run of each)"""
+    roughness: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.03
+    """m, the ground's roughness length z0 (0.03: open grassland, anchors.md)"""
+    wall_filter: Annotated[float, Field(gt=0, le=1, allow_inf_nan=False)] = 0.005
+    """exponential filter weight per step of the wall model's reference velocity"""
+    turbulence: Annotated[float, Field(ge=0, le=5, allow_inf_nan=False)] = 1.0
+    """the inflow eddies' standard deviations over the neutral surface layer's (σu, σv, σw =
+    2.4, 1.9, 1.25 u*; 0: a laminar inflow)"""
+    eddy_length: Annotated[float, Field(gt=0, le=100, allow_inf_nan=False)] = 4.0
+    """m, crosswind correlation length (Gaussian σ) of the inflow eddies (half of it vertically)"""
+    eddy_time: Annotated[float, Field(gt=0, le=1000, allow_inf_nan=False)] = 8.0
+    """canonical s, time constant of the inflow eddies"""
+    inflow_distance: Annotated[float, Field(gt=0, le=500, allow_inf_nan=False)] = 15.0
+    """how far upstream of the source the inflow is, m"""
+    downstream: Annotated[float, Field(gt=0, le=1000, allow_inf_nan=False)] = 60.0
+    """the domain reaches this far downwind of the source, m; beyond it, upstream of the
+    inflow or beyond half the width crosswind, the field is 0"""
+    width: Annotated[float, Field(gt=0, le=1000, allow_inf_nan=False)] = 48.0
+    """crosswind width of the domain, m (periodic)"""
+    height: Annotated[float, Field(gt=2, le=200, allow_inf_nan=False)] = 16.0
+    """m from the ground to the free-slip lid"""
+    store_height: Annotated[float, Field(gt=1, le=200, allow_inf_nan=False)] = 10.0
+    """m: stored up to this height (above it the field reads 0)"""
+    source_radius: Annotated[float, Field(gt=0, le=10, allow_inf_nan=False)] = 0.5
+    """radius of the ball of cells held at a fixed concentration, m"""
+    spinup: Annotated[float, Field(ge=0, le=100_000, allow_inf_nan=False)] = 120.0
+    """canonical seconds run before recording (the flow and the plume settle)"""
+    duration: Annotated[float, Field(gt=0, le=100_000, allow_inf_nan=False)] = 240.0
+    """canonical seconds recorded; a search replays them in a loop from a seeded start"""
+    frame_interval: Annotated[float, Field(gt=0, le=100, allow_inf_nan=False)] = 1.0
+    """canonical seconds between stored frames"""
+    realisation: Annotated[int, Field(ge=0, le=1_000_000)] = 0
+    """seed of the initial perturbation: another realisation of the same turbulent flow"""
+
+    @property
+    def name(self) -> str:
+        return "lbm3d"
+
+
 class PlaybackSpec(BaseModel):
     """A recorded or externally simulated plume played back as truth
     (:mod:`dcee.simulation.playback`)."""
@@ -210,13 +277,14 @@ TRUTH_KINDS: dict[str, TruthKind] = {
     "puffs": TruthKind(PuffsSpec),
     "playback": TruthKind(PlaybackSpec),
     "lbm": TruthKind(LbmSpec),
+    "lbm3d": TruthKind(Lbm3dSpec),
 }
 """The one registry of truth kinds, by the ``kind`` of ``truth.model`` (``"isotropic"`` for the
 plain string): the scenario schema validates against the specs, :func:`dcee.simulation.make_truth`
 builds with the factories. A new truth adds its spec class here and registers its factory in its
 own module under :mod:`dcee.simulation`."""
 TruthModelSpec = Annotated[
-    FilamentSpec | PuffsSpec | PlaybackSpec | LbmSpec, Field(discriminator="kind")
+    FilamentSpec | PuffsSpec | PlaybackSpec | LbmSpec | Lbm3dSpec, Field(discriminator="kind")
 ]
 
 
@@ -289,7 +357,7 @@ class Truth(BaseModel):
                 f"{FIELD_MARK}truth.extra_sources: {len(extra) + 1} releases in all; at most "
                 f"{MAX_SOURCES} (the one at truth.x, y, z and {MAX_SOURCES - 1} more)"
             )
-        if isinstance(self.model, PlaybackSpec | LbmSpec):
+        if isinstance(self.model, PlaybackSpec | LbmSpec | Lbm3dSpec):
             raise ValueError(
                 f"{FIELD_MARK}truth.extra_sources: a {self.model.kind} truth holds its own "
                 "releases; further ones need truth.model isotropic, filament or puffs"
@@ -327,14 +395,14 @@ class Truth(BaseModel):
     def _model_shorthand(cls, value: Any) -> Any:
         # "filament" is short for the filament table with every default, so that the resolved
         # configuration saved beside results records every parameter; {file = ...} needs no kind.
-        if value in ("filament", "puffs", "lbm"):
+        if value in ("filament", "puffs", "lbm", "lbm3d"):
             return {"kind": value}
         if isinstance(value, dict) and "kind" not in value:
             kind = "playback" if "file" in value else "filament"
             return {"kind": kind, **value}
         if isinstance(value, str) and value != "isotropic":
             raise ValueError(
-                f'must be "isotropic", "filament", "puffs", "lbm" or {{file = "..."}} '
+                f'must be "isotropic", "filament", "puffs", "lbm", "lbm3d" or {{file = "..."}} '
                 f"(got {value!r})"
             )
         return value
