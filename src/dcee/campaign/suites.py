@@ -14,6 +14,13 @@
   range (report here; no default is chosen on them). See docs/scenarios.md.
 * ``held-out-24`` and ``held-out-100``: ``random:1000`` … ``random:1023`` and ``random:1100`` …
   ``random:1199``, reporting samples for slow (turbulent) studies.
+* ``lbm3d-tune``, ``lbm3d-held-out-100``, ``lbm3d-slice-held-out-50``: search in three
+  dimensions on the 3-D surface-layer plume (``truth.model = "lbm3d"``, issue 78), all eight
+  parameters unknown, 10,000 particles, the fluctuation likelihood: the tuning range
+  ``random:1`` … ``random:40``; a range never flown before, ``random:7000`` … ``random:7099``;
+  and a horizontal slice of the plume at 4 m (``truth.model.plane = 4``) replayed as a planar
+  recording, over the first 50 configurations from ``random:8000`` whose source is 2-4 m below
+  it (at most 2 m above the ground).
 * ``smoke``: two of them at toy scale (1,000 particles, 10 hypothesised readings, 60 s) so a
   campaign with every strategy finishes in well under a minute; for CI and for trying options.
 """
@@ -24,7 +31,30 @@ from typing import Any
 
 from dcee.errors import DceeInputError
 from dcee.scenarios import Scenario, load_scenario
-from dcee.scenarios.builtin import RANDOM_REPORTING_FROM
+from dcee.scenarios.builtin import RANDOM_REPORTING_FROM, random_configuration
+
+LBM3D = {
+    "truth.model": "lbm3d",
+    "estimator.likelihood": "fluctuation",
+    "unknown": "full",
+    "search.particles": 10_000,
+}
+"""The 3-D studies' overrides (issue 78): the defaults otherwise."""
+LBM3D_HELD_OUT_FROM = 7000
+"""``random:7000`` on: configurations never flown before issue 78's final claim."""
+SLICE_FROM, SLICE_PLANE, SLICE_COUNT = 8000, 4.0, 50
+"""The slice study: from ``random:8000``, the plane (m) and how many configurations."""
+
+
+def _sources_below(first: int, plane: float, depth: float, count: int) -> list[str]:
+    """The first ``count`` of ``random:first`` on whose source lies ``depth`` m or more below
+    ``plane`` (from the raw configurations: K alone decides them)."""
+    out, k = [], first
+    while len(out) < count:
+        if random_configuration(k)["truth"]["z"] <= plane - depth:
+            out.append(f"random:{k}")
+        k += 1
+    return out
 
 SUITES: dict[str, dict] = {
     "paper": {"configs": [f"paper:{k}" for k in range(1, 13)], "overrides": {}},
@@ -135,6 +165,16 @@ SUITES: dict[str, dict] = {
             "search.particles": 10_000,
             "unknown": "full",
         },
+    },
+    # search in three dimensions on the 3-D plume (issue 78)
+    "lbm3d-tune": {"configs": [f"random:{k}" for k in range(1, 41)], "overrides": LBM3D},
+    "lbm3d-held-out-100": {
+        "configs": [f"random:{k}" for k in range(LBM3D_HELD_OUT_FROM, LBM3D_HELD_OUT_FROM + 100)],
+        "overrides": LBM3D,
+    },
+    "lbm3d-slice-held-out-50": {
+        "configs": _sources_below(SLICE_FROM, SLICE_PLANE, 2.0, SLICE_COUNT),
+        "overrides": {**LBM3D, "truth.model": {"kind": "lbm3d", "plane": SLICE_PLANE}},
     },
     # tuning configurations for slow studies (never report them)
     "random-tune-12": {"configs": [f"random:{k}" for k in range(1, 13)], "overrides": {}},

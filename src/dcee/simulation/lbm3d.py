@@ -61,7 +61,7 @@ def cache_key(spec: Lbm3dSpec, height: float) -> str:
     """Hash of everything that decides the computed field: the parameters and the source's
     lattice layer."""
     doc: dict[str, Any] = {"format": FORMAT, "layer": source_layer(spec, height)}
-    doc.update(spec.model_dump(mode="json"))
+    doc.update(spec.model_dump(mode="json", exclude={"plane"}))  # a slice reads the same run
     return hashlib.sha256(json.dumps(doc, sort_keys=True).encode()).hexdigest()[:16]
 
 
@@ -159,6 +159,8 @@ class SolverPlume3dTruth(TruthModel):
     phi : wind direction, rad (the wind comes from it, :mod:`dcee.models.plume`).
     start : canonical seconds into the recording at episode time 0.
     ground : m, the world's height of the ground (the search volume's floor).
+    plane : m (world z): read every position in this horizontal slice (a planar truth), or
+        None for the 3-D field.
     """
 
     name = "lbm3d"
@@ -174,6 +176,7 @@ class SolverPlume3dTruth(TruthModel):
         phi: float,
         start: float,
         ground: float = 0.0,
+        plane: float | None = None,
     ) -> None:
         if not u > 0:
             raise DceeInputError("truth.u", "the lbm3d truth needs a wind (u > 0)")
@@ -190,6 +193,7 @@ class SolverPlume3dTruth(TruthModel):
         # recording's release height
         self.lift = release_height - (self.source[2] - ground)
         self.ground = ground
+        self.plane = plane
 
     @property
     def time_step(self) -> float | None:
@@ -200,7 +204,8 @@ class SolverPlume3dTruth(TruthModel):
         """(K, 3) canonical (downwind, crosswind, height) coordinates of (K, 3) positions, m."""
         p = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
         d = p[:, :2] - self.source[:2]
-        height = p[:, 2] - self.ground + self.lift
+        z = p[:, 2] if self.plane is None else np.full(len(p), self.plane)
+        height = z - self.ground + self.lift
         return np.stack([d @ self.downwind, d @ self.left, height], axis=1)
 
     def field(self, positions: np.ndarray, time: float) -> np.ndarray:
@@ -253,7 +258,7 @@ def lbm3d_truth(scenario: Scenario, seed: int) -> SolverPlume3dTruth:
     rng = np.random.Generator(np.random.PCG64([0x3D1B, 1, seed]))
     start = float(rng.uniform(0.0, recording.period))
     return SolverPlume3dTruth(
-        recording, theta[:3], release, theta[3], theta[4], theta[5], start, ground
+        recording, theta[:3], release, theta[3], theta[4], theta[5], start, ground, spec.plane
     )
 
 

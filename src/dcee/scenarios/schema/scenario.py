@@ -207,6 +207,11 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, ResolvedSettings, BaseMod
             )
         if plane is None:
             plane = float(start[2])
+        if self.truth.model_name.startswith("lbm3d-slice") and self.truth.z > plane + 1e-9:
+            raise ValueError(
+                f"{FIELD_MARK}truth.model.plane: the slice at {plane:g} m is below the source "
+                f"(truth.z = {self.truth.z:g} m); a slice of the plume lies at or above it"
+            )
         if (
             self.dimensions == 3
             and "z" not in self.prior

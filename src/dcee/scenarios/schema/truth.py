@@ -223,10 +223,15 @@ class Lbm3dSpec(BaseModel):
     """canonical seconds between stored frames"""
     realisation: Annotated[int, Field(ge=0, le=1_000_000)] = 0
     """seed of the initial perturbation: another realisation of the same turbulent flow"""
+    plane: Annotated[float | None, Field(ge=0, le=200, allow_inf_nan=False)] = None
+    """m (the world's z): replay only this horizontal slice of the plume, the same at
+    every altitude (a planar recording of it, as a 2-D measurement or simulation holds); the
+    agent flies at this height and the source height is estimated below it. None: the 3-D
+    plume"""
 
     @property
     def name(self) -> str:
-        return "lbm3d"
+        return "lbm3d" if self.plane is None else f"lbm3d-slice@{self.plane:g}m"
 
 
 class PlaybackSpec(BaseModel):
@@ -417,6 +422,8 @@ class Truth(BaseModel):
             return recording_layout(model.file, model.variable, dict(model.axes))
         if isinstance(model, LbmSpec):
             return True, None
+        if isinstance(model, Lbm3dSpec) and model.plane is not None:
+            return True, model.plane
         return False, None
 
     @property

@@ -1,0 +1,132 @@
+"""Issue 78's tables from stored campaigns: per campaign and strategy, the searches acquired
+(final 3-D RMSE < ``search.acquired_rmse``), the median final 3-D RMSE with a 95 % bootstrap
+interval, the truth in the 95 % region, the median detections, and the altitudes the searches
+read at (the share of readings at each altitude, the lowest and the highest); the paired
+difference of two strategies on the same configurations (Wilcoxon); and each campaign's worst
+searches. Written as CSV and JSON under ``--out`` (docs/results/lbm3d/ in the recipe).
+
+    .venv/bin/python studies/lbm3d_table.py results/lbm3d-held-out-100 \\
+        results/lbm3d-slice-held-out-50 --out docs/results/lbm3d
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from dcee.analysis.report import load_campaign
+from dcee.io import write_json
+
+
+def _bootstrap_median(values: np.ndarray, seed: int = 0) -> tuple[float, float]:
+    rng = np.random.default_rng(seed)
+    draws = rng.choice(values, size=(4000, len(values)), replace=True)
+    lo, hi = np.percentile(np.median(draws, axis=1), [2.5, 97.5])
+    return float(lo), float(hi)
+
+
+def _altitudes(run_dirs: list[str]) -> tuple[dict[str, float], float, float]:
+    """(share of readings at each altitude, lowest, highest) over the searches' readings."""
+    z = np.concatenate(
+        [pd.read_parquet(Path(d) / "steps.parquet", columns=["z"])["z"].to_numpy() for d in run_dirs]
+    )
+    values, counts = np.unique(np.round(z, 2), return_counts=True)
+    share = {f"{v:g}": float(c / len(z)) for v, c in zip(values, counts, strict=True)}
+    return share, float(z.min()), float(z.max())
+
+
+def campaign_table(folder: Path) -> tuple[list[dict], list[dict], list[dict]]:
+    """(rows per strategy, paired differences, worst searches) of one campaign."""
+    _, runs = load_campaign(folder)
+    rows, worst = [], []
+    for strategy, part in runs.groupby("strategy", sort=True):
+        rmse = part["final_rmse"].to_numpy(dtype=np.float64)
+        lo, hi = _bootstrap_median(rmse)
+        share, z_min, z_max = _altitudes(list(part["run_dir"]))
+        rows.append(
+            {
+                "campaign": folder.name,
+                "strategy": strategy,
+                "searches": len(part),
+                "acquired": int(part["source_acquired"].astype(bool).sum()),
+                "median_final_rmse": float(np.median(rmse)),
+                "median_final_rmse_ci95": [lo, hi],
+                "truth_in_95": int(part["truth_in_95"].astype(bool).sum()),
+                "median_detections": float(part["detections"].median()),
+                "altitude_share": share,
+                "lowest_altitude": z_min,
+                "highest_altitude": z_max,
+            }
+        )
+        bad = part.assign(miss=~part["source_acquired"].astype(bool))
+        bad = bad.sort_values(["miss", "final_rmse"], ascending=False).head(3)
+        for _, r in bad.iterrows():
+            worst.append(
+                {
+                    "campaign": folder.name,
+                    "strategy": strategy,
+                    "scenario": r["scenario"],
+                    "final_rmse": float(r["final_rmse"]),
+                    "acquired": bool(r["source_acquired"]),
+                    "truth_in_95": bool(r["truth_in_95"]),
+                    "detections": int(r["detections"]),
+                }
+            )
+    pairs = []
+    strategies = sorted(runs["strategy"].unique())
+    for i, a in enumerate(strategies):
+        for b in strategies[i + 1 :]:
+            wide = runs.pivot_table(
+                index=["scenario", "seed"], columns="strategy", values="final_rmse"
+            )[[a, b]].dropna()
+            if len(wide) < 5:
+                continue
+            diff = (wide[a] - wide[b]).to_numpy()
+            p = float(stats.wilcoxon(diff).pvalue) if np.any(diff != 0) else 1.0
+            pairs.append(
+                {
+                    "campaign": folder.name,
+                    "a": a,
+                    "b": b,
+                    "pairs": len(wide),
+                    "median_difference": float(np.median(diff)),
+                    "wilcoxon_p": p,
+                }
+            )
+    return rows, pairs, worst
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("campaigns", nargs="+", type=Path)
+    ap.add_argument("--out", type=Path, required=True)
+    args = ap.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    for folder in args.campaigns:
+        rows, pairs, worst = campaign_table(folder)
+        write_json(
+            args.out / f"{folder.name}.json", {"rows": rows, "pairs": pairs, "worst": worst}
+        )
+        for r in rows:
+            lo, hi = r["median_final_rmse_ci95"]
+            print(
+                f"{folder.name} {r['strategy']}: acquired {r['acquired']}/{r['searches']}, "
+                f"median RMSE {r['median_final_rmse']:.2f} m [{lo:.2f}, {hi:.2f}], region "
+                f"{r['truth_in_95']}/{r['searches']}, detections {r['median_detections']:.0f}, "
+                f"altitudes {r['lowest_altitude']:g}-{r['highest_altitude']:g} m"
+            )
+        for p in pairs:
+            print(
+                f"  {p['a']} - {p['b']}: median paired {p['median_difference']:+.2f} m over "
+                f"{p['pairs']} (Wilcoxon p = {p['wilcoxon_p']:.3g})"
+            )
+        print(json.dumps(worst, indent=1))
+
+
+if __name__ == "__main__":
+    main()
