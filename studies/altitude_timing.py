@@ -72,8 +72,10 @@ def main(argv: list[str] | None = None) -> None:
         overrides=OVERRIDES,
         warm_seconds=args.warm,
         position=[float(v) for v in free.position],
-        moves={"altitude free": len(free.agent.candidates(free.position)[0]),
-               "fixed altitude": len(fixed.agent.candidates(fixed.position)[0])},
+        moves={
+            "altitude free": len(free.agent.candidates(free.position)[0]),
+            "fixed altitude": len(fixed.agent.candidates(fixed.position)[0]),
+        },
         decisions_ms=times,
         median_ms=medians,
         ratio=ratio,

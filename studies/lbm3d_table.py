@@ -33,7 +33,10 @@ def _bootstrap_median(values: np.ndarray, seed: int = 0) -> tuple[float, float]:
 def _altitudes(run_dirs: list[str]) -> tuple[dict[str, float], float, float]:
     """(share of readings at each altitude, lowest, highest) over the searches' readings."""
     z = np.concatenate(
-        [pd.read_parquet(Path(d) / "steps.parquet", columns=["z"])["z"].to_numpy() for d in run_dirs]
+        [
+            pd.read_parquet(Path(d) / "steps.parquet", columns=["z"])["z"].to_numpy()
+            for d in run_dirs
+        ]
     )
     values, counts = np.unique(np.round(z, 2), return_counts=True)
     share = {f"{v:g}": float(c / len(z)) for v, c in zip(values, counts, strict=True)}
@@ -109,9 +112,7 @@ def main(argv: list[str] | None = None) -> None:
     args.out.mkdir(parents=True, exist_ok=True)
     for folder in args.campaigns:
         rows, pairs, worst = campaign_table(folder)
-        write_json(
-            args.out / f"{folder.name}.json", {"rows": rows, "pairs": pairs, "worst": worst}
-        )
+        write_json(args.out / f"{folder.name}.json", {"rows": rows, "pairs": pairs, "worst": worst})
         for r in rows:
             lo, hi = r["median_final_rmse_ci95"]
             print(

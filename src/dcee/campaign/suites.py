@@ -56,6 +56,7 @@ def _sources_below(first: int, plane: float, depth: float, count: int) -> list[s
         k += 1
     return out
 
+
 SUITES: dict[str, dict] = {
     "paper": {"configs": [f"paper:{k}" for k in range(1, 13)], "overrides": {}},
     # where the plume points away from the start (exploitation stalls) and two where it does not:

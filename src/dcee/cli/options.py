@@ -43,8 +43,8 @@ def likelihood_names() -> list[str]:
 # Shared by ``run`` and ``bench``: what the sensor sees.
 TRUTH_OPTION = click.option(
     "--truth",
-    help="What the sensor sees: isotropic | filament | puffs | lbm (a fluid solver's plume) | "
-    "PATH of a recording "
+    help="What the sensor sees: isotropic | filament | puffs | lbm (a fluid solver's planar "
+    "plume) | lbm3d (its 3-D surface-layer plume) | PATH of a recording "
     "[default: the scenario's truth.model].",
 )
 LIKELIHOOD_OPTION = click.option(
