@@ -16,8 +16,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
-from dcee.cli import cli  # noqa: E402
 from studies import runner  # noqa: E402
+
+from dcee.cli import cli  # noqa: E402
 
 sys.path.pop(0)
 
