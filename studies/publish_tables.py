@@ -39,6 +39,7 @@ PAGES = (
     "docs/plumes.md",
     "docs/performance.md",
     "docs/multi-source.md",
+    "docs/three-d.md",
 )
 MARKER = re.compile(
     r"(<!-- generated: (?P<name>[a-z0-9-]+) \(studies/publish_tables\.py\) -->\n)"

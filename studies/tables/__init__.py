@@ -45,9 +45,19 @@ from studies.tables.tuning import (
     release_area_table,
     source_radius_tuning_table,
 )
+from studies.tables.three_d import (
+    lbm3d_altitude_table,
+    lbm3d_plume_table,
+    lbm3d_search_table,
+    lbm3d_timing_table,
+)
 from studies.tables.turbulent import cross_truth_table, turbulent_table
 
 TABLES: dict[str, Callable[[], str]] = {
+    "lbm3d-plume": lbm3d_plume_table,
+    "lbm3d-search": lbm3d_search_table,
+    "lbm3d-altitudes": lbm3d_altitude_table,
+    "lbm3d-timing": lbm3d_timing_table,
     "source-count": lambda: _source_count("table"),
     "source-count-latest": lambda: _source_count("table_latest"),
     "source-count-worst": lambda: _source_count("worst"),
