@@ -134,7 +134,9 @@ def test_bad_truth_model_is_a_one_line_error_naming_the_field(model, field):
 def test_truth_choice_rejects_what_is_neither_a_model_nor_a_recording(tmp_path):
     assert truth_choice("filament") == "filament"
     assert truth_choice("puffs") == "puffs"
-    with pytest.raises(DceeInputError, match=r"isotropic, filament, puffs, lbm or a \.npy/\.h5"):
+    with pytest.raises(
+        DceeInputError, match=r"isotropic, filament, puffs, lbm, lbm3d or a \.npy/\.h5"
+    ):
         truth_choice("gaussian")
     with pytest.raises(DceeInputError, match="no such recording"):
         truth_choice(str(tmp_path / "missing.h5"))

@@ -162,6 +162,16 @@ class _InflowEddies:
             setter["vel_2"] = self.sigma[2] * self.psi[2][j, k] * self.w_taper[k]
 
 
+def zero_streaming_targets(dh: Any, *steps: Any) -> None:
+    """Zero the streaming targets of lbmpy steps (pdf arrays, ghost layers included): lbmpy
+    allocates them uninitialised, and memory that an earlier computation in the same process
+    freed held NaN bit patterns there: the run went NaN (measured: a 3-D run after a site's
+    planar set-up in one process, never in a fresh one, whose fresh pages are zeros: the
+    results of a fresh process are unchanged)."""
+    for step in steps:
+        dh.cpu_arrays[step._tmp_arr_name][...] = 0.0
+
+
 def solve(spec: Lbm3dSpec, height: float, progress: Progress | None = None) -> dict[str, Any]:
     """Run the solver for a release ``height`` m above the ground: ``concentration`` (T, ny,
     nx, nz) float32 g/m³ for 1 g/s at 1 m/s, axes ``t`` (s from the first stored frame),
@@ -198,7 +208,7 @@ def solve(spec: Lbm3dSpec, height: float, progress: Progress | None = None) -> d
             compressible=True,
             subgrid_scale_model=sgs,
         ),
-        name="flow",
+        name="flow3d",
         compute_velocity_in_every_step=True,
     )
     profile = ulb * log_law(spec, dom.z)  # lattice units, by layer (layer 0: the ground)
@@ -242,7 +252,7 @@ def solve(spec: Lbm3dSpec, height: float, progress: Progress | None = None) -> d
     b.prepare()
     eddies = _InflowEddies(spec, dom, b, inflow_ubb, rng)
 
-    dh.add_array("scalar", values_per_cell=1)
+    dh.add_array("scalar3d", values_per_cell=1)
     scalar = LatticeBoltzmannStep(
         data_handling=dh,
         lbm_config=LBMConfig(
@@ -252,9 +262,9 @@ def solve(spec: Lbm3dSpec, height: float, progress: Progress | None = None) -> d
             compressible=True,
             zero_centered=False,
         ),
-        name="scalar",
+        name="scalar3d",
         velocity_input_array_name=flow.velocity_data_name,
-        density_data_name="scalar",
+        density_data_name="scalar3d",
         compute_density_in_every_step=True,
     )
     sx, sy, sz = dom.source
@@ -271,8 +281,9 @@ def solve(spec: Lbm3dSpec, height: float, progress: Progress | None = None) -> d
     sb.set_boundary(NeumannByCopy(), make_slice[-1, :, 1:])
     sb.set_boundary(NoSlip(), make_slice[:, :, 0])
     sb.set_boundary(NoSlip(), make_slice[1:-1, :, -1])
-    dh.fill("scalar", 0.0, ghost_layers=True)
+    dh.fill("scalar3d", 0.0, ghost_layers=True)
     scalar.set_pdf_fields_from_macroscopic_values()
+    zero_streaming_targets(dh, flow, scalar)
 
     every = max(1, round(spec.frame_interval / dom.step_seconds))
     spin = math.ceil(spec.spinup / dom.step_seconds / every)
@@ -297,7 +308,7 @@ def solve(spec: Lbm3dSpec, height: float, progress: Progress | None = None) -> d
             scalar.time_step()
         if progress is not None:
             progress((k + 1) * every * dom.step_seconds, total)
-        c = dh.gather_array("scalar")
+        c = dh.gather_array("scalar3d")
         v = dh.gather_array(flow.velocity_data_name)
         if not (np.isfinite(c[sx, sy, sz]) and np.isfinite(v[flux_column, sy, sz, 0])):
             raise DceeInputError(
@@ -360,4 +371,5 @@ __all__ = [
     "log_law",
     "solve",
     "source_layer",
+    "zero_streaming_targets",
 ]

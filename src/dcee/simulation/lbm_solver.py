@@ -203,6 +203,8 @@ def solve(
         scalar.boundary_handling.set_boundary(NoSlip(), mask_callback=walls)
     dh.fill("scalar", 0.0, ghost_layers=True)
     scalar.set_pdf_fields_from_macroscopic_values()
+    for step in (flow, scalar):  # allocated uninitialised: zeros, as in a fresh process
+        dh.cpu_arrays[step._tmp_arr_name][...] = 0.0
 
     every = max(1, round(spec.frame_interval / dom.step_seconds))
     spin = math.ceil(spec.spinup / dom.step_seconds / every)
