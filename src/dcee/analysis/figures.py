@@ -215,11 +215,46 @@ def _draw_rmse(ax: plt.Axes, result: EpisodeResult, scenario: Scenario, until: f
     ax.grid(alpha=0.3, which="both")
 
 
+def _shows_altitude(result: EpisodeResult, scenario: Scenario) -> bool:
+    """A search in three dimensions: the agent changed altitude or the source height was
+    estimated."""
+    heights = {round(float(r["z"]), 6) for r in result.records}
+    return len(heights) > 1 or "z" in scenario.unknown_names
+
+
+def _draw_altitude(ax: plt.Axes, result: EpisodeResult, scenario: Scenario, until: float) -> None:
+    """The agent's altitude over time, the estimated source height (mean ± sd) and the true
+    one."""
+    recs = [r for r in result.records if r["time"] <= until + 1e-9]
+    t = np.array([r["time"] for r in recs])
+    ax.step(t, [r["z"] for r in recs], where="post", color="tab:red", lw=1.0, label="UAV")
+    mean = np.array([r["mean_z"] for r in recs])
+    sd = np.sqrt(np.maximum([r["cov_zz"] for r in recs], 0.0))
+    ax.plot(t, mean, color="tab:blue", lw=1.0, label="source height, estimate ± sd")
+    ax.fill_between(t, mean - sd, mean + sd, color="tab:blue", alpha=0.2, lw=0)
+    ax.axhline(scenario.truth.z, color="k", lw=0.8, ls="--", label="true source height")
+    ax.set_xlim(0, scenario.search.budget)
+    ax.set_ylim(scenario.volume.low[2], scenario.volume.high[2])
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("height (m)")
+    ax.legend(fontsize=7, loc="upper right", ncol=3)
+    ax.grid(alpha=0.3)
+
+
 def draw_search_figure(result: EpisodeResult, scenario: Scenario, truth: TruthModel) -> Figure:
-    """The summary figure of one search (map with trajectory and particles, RMSE over time);
-    the caller saves or renders it and closes it."""
+    """The summary figure of one search (map with trajectory and particles, RMSE over time,
+    and in three dimensions the altitudes over time); the caller saves or renders it and closes
+    it."""
     s = result.summary
-    fig, (ax_map, ax_rmse) = plt.subplots(1, 2, figsize=(13, 6.4), width_ratios=[1.15, 1])
+    if _shows_altitude(result, scenario):
+        fig = plt.figure(figsize=(13, 6.4))
+        grid = fig.add_gridspec(3, 2, width_ratios=[1.15, 1])
+        ax_map = fig.add_subplot(grid[:, 0])
+        ax_rmse = fig.add_subplot(grid[:2, 1])
+        ax_z = fig.add_subplot(grid[2, 1])
+        _draw_altitude(ax_z, result, scenario, scenario.search.budget)
+    else:
+        fig, (ax_map, ax_rmse) = plt.subplots(1, 2, figsize=(13, 6.4), width_ratios=[1.15, 1])
     idx = np.random.default_rng(0).choice(
         len(result.final_weights),
         size=min(3000, len(result.final_weights)),
