@@ -43,6 +43,29 @@ def _altitudes(run_dirs: list[str]) -> tuple[dict[str, float], float, float]:
     return share, float(z.min()), float(z.max())
 
 
+RARE = 60
+"""Detections in a search below which gas counts as rare (issue 78, item 4)."""
+
+
+def _rare(part: pd.DataFrame) -> dict[str, float]:
+    """The searches with fewer than :data:`RARE` detections against the rest: how many, their
+    median final RMSE, their truth in the region; and Spearman's ρ between detections and the
+    final RMSE over all searches."""
+    few = part[part["detections"] < RARE]
+    many = part[part["detections"] >= RARE]
+    rho = stats.spearmanr(part["detections"], part["final_rmse"]).statistic
+    return {
+        "searches": len(few),
+        "median_final_rmse": float(few["final_rmse"].median()) if len(few) else float("nan"),
+        "truth_in_95": int(few["truth_in_95"].astype(bool).sum()),
+        "acquired": int(few["source_acquired"].astype(bool).sum()),
+        "others_median_final_rmse": float(many["final_rmse"].median())
+        if len(many)
+        else float("nan"),
+        "spearman_detections_rmse": float(rho),
+    }
+
+
 def campaign_table(folder: Path) -> tuple[list[dict], list[dict], list[dict]]:
     """(rows per strategy, paired differences, worst searches) of one campaign."""
     _, runs = load_campaign(folder)
@@ -61,6 +84,8 @@ def campaign_table(folder: Path) -> tuple[list[dict], list[dict], list[dict]]:
                 "median_final_rmse_ci95": [lo, hi],
                 "truth_in_95": int(part["truth_in_95"].astype(bool).sum()),
                 "median_detections": float(part["detections"].median()),
+                # precision where detections are rare: the searches with fewer than 60
+                "rare": _rare(part),
                 "altitude_share": share,
                 "lowest_altitude": z_min,
                 "highest_altitude": z_max,
@@ -119,7 +144,11 @@ def main(argv: list[str] | None = None) -> None:
                 f"{folder.name} {r['strategy']}: acquired {r['acquired']}/{r['searches']}, "
                 f"median RMSE {r['median_final_rmse']:.2f} m [{lo:.2f}, {hi:.2f}], region "
                 f"{r['truth_in_95']}/{r['searches']}, detections {r['median_detections']:.0f}, "
-                f"altitudes {r['lowest_altitude']:g}-{r['highest_altitude']:g} m"
+                f"altitudes {r['lowest_altitude']:g}-{r['highest_altitude']:g} m; under "
+                f"{RARE} detections: {r['rare']['searches']} searches, median RMSE "
+                f"{r['rare']['median_final_rmse']:.2f} m (others "
+                f"{r['rare']['others_median_final_rmse']:.2f} m), Spearman ρ(detections, RMSE) "
+                f"{r['rare']['spearman_detections_rmse']:.2f}"
             )
         for p in pairs:
             print(
