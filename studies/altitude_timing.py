@@ -32,6 +32,19 @@ OVERRIDES = {
 }
 
 
+def _cpu_model() -> str:
+    """The CPU's model name (Linux), or the platform's processor string."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    import platform
+
+    return platform.processor()
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--decisions", type=int, default=20, help="decisions per side")
@@ -68,6 +81,7 @@ def main(argv: list[str] | None = None) -> None:
     store_timing(
         args.json,
         load.record(),
+        cpu_model=_cpu_model(),
         scenario=SCENARIO,
         overrides=OVERRIDES,
         warm_seconds=args.warm,

@@ -123,10 +123,10 @@ def lbm3d_timing_table() -> str:
     ]
     rows.append(["ratio", "", f"{doc['ratio']:.2f}x", ""])
     body = table(["dcee-cl decision", "moves", "median (ms)", "decisions"], rows)
-    cpu = doc["machine"].get("processor") or doc["machine"].get("cpu_model", "")
+    cpu = doc.get("cpu_model") or doc["machine"].get("machine", "")
     return body + (
-        f"\nOne pinned core of {cpu}; other processes used {load.get('other_cores', 0):.2f} "
-        "cores on average.\n"
+        f"\nOne pinned core of an {cpu} ({doc['machine']['cpus']} CPUs), alternating decision by "
+        f"decision; other processes used {load.get('other_cores', 0):.2f} cores on average.\n"
     )
 
 
