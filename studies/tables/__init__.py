@@ -33,7 +33,12 @@ from studies.tables.sites import (
     sites_walls_timing_table,
 )
 from studies.tables.source_count import _source_count, source_count_timing_table
-from studies.tables.three_d import lbm3d_plume_table
+from studies.tables.three_d import (
+    lbm3d_altitude_table,
+    lbm3d_plume_table,
+    lbm3d_search_table,
+    lbm3d_timing_table,
+)
 from studies.tables.tuning import (
     backflow_tuning_table,
     horizon_tuning_table,
@@ -50,6 +55,9 @@ from studies.tables.turbulent import cross_truth_table, turbulent_table
 
 TABLES: dict[str, Callable[[], str]] = {
     "lbm3d-plume": lbm3d_plume_table,
+    "lbm3d-search": lbm3d_search_table,
+    "lbm3d-altitudes": lbm3d_altitude_table,
+    "lbm3d-timing": lbm3d_timing_table,
     "source-count": lambda: _source_count("table"),
     "source-count-latest": lambda: _source_count("table_latest"),
     "source-count-worst": lambda: _source_count("worst"),
