@@ -156,3 +156,44 @@ def test_3d_statistics_recover_a_gaussian_plume() -> None:
         assert r.sigma_z == pytest.approx(0.1 * r.x + 0.5, rel=0.01)
         assert r.centroid_z == pytest.approx(zc, abs=0.01)
         assert r.intensity == 0.0 and r.intermittency == 1.0
+
+
+def test_plume_command_reports_the_3d_comparison(monkeypatch, tmp_path, capsys) -> None:
+    import json
+
+    from tests.helpers import run_cli
+
+    monkeypatch.setenv("DCEE_CACHE", str(tmp_path))
+    rec = _canonical()
+    u_star = lbm3d_solver.friction_velocity(Lbm3dSpec())
+    heights = np.arange(0.25, 10.0, 0.5)
+
+    def fake_solve(spec: Lbm3dSpec, height: float, progress: object = None) -> dict:
+        return {
+            "concentration": rec.values.astype(np.float32),
+            "t": rec.t,
+            "x": rec.x,
+            "y": rec.y,
+            "z": rec.z,
+            "attrs": {
+                "release_height": lbm3d_solver.lattice_height(spec, height),
+                "mean_wind_heights": heights,
+                "mean_wind_profile": lbm3d_solver.log_law(spec, heights),
+                "turbulence_intensity_u": 2.4 * u_star,
+                "turbulence_intensity_v": 1.9 * u_star,
+                "turbulence_intensity_w": 1.25 * u_star,
+                "lagrangian_time_estimate": 3.0,
+            },
+        }
+
+    monkeypatch.setattr(lbm3d, "solve", fake_solve)
+    out = tmp_path / "plume.json"
+    code, stdout, _ = run_cli(
+        ["plume", "--model", "lbm3d", "--height", "1.1", "-q", "--json", str(out)], capsys
+    )
+    assert code == 0 and "release at 1.25 m" in stdout and "Briggs" in stdout
+    assert "σu/u*, σv/u*, σw/u* = 2.40 (2.4), 1.90 (1.9), 1.25 (1.25)" in stdout
+    doc = json.loads(out.read_text())
+    assert doc["release_height"] == 1.25 and [round(s["x"]) for s in doc["sections"]] == [5]
+    code, _, err = run_cli(["plume", "--model", "lbm3d", "--set", "bar_spacing=3"], capsys)
+    assert code == 2 and err.startswith("dcee: error: bar_spacing: not a setting of the lbm3d")
