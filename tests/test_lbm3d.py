@@ -49,6 +49,27 @@ def _canonical(z_release: float = 1.25) -> PlaybackTruth:
     return PlaybackTruth(c, t, x, y, z, "linear", loop=True)
 
 
+def _fake_solve(attrs: dict, calls: list[float] | None = None):
+    """A stand-in for the solver: the canonical field of :func:`_canonical`, released at the
+    lattice height of the height asked for, with ``attrs``; each height asked is appended to
+    ``calls``."""
+
+    def solve(spec: Lbm3dSpec, height: float, progress: object = None) -> dict:
+        if calls is not None:
+            calls.append(height)
+        rec = _canonical()
+        return {
+            "concentration": rec.values.astype(np.float32),
+            "t": rec.t,
+            "x": rec.x,
+            "y": rec.y,
+            "z": rec.z,
+            "attrs": {"release_height": lbm3d_solver.lattice_height(spec, height), **attrs},
+        }
+
+    return solve
+
+
 def test_the_tiny_solver_writes_a_3d_cf_recording(tmp_path) -> None:
     spec = Lbm3dSpec(**TINY)
     run = lbm3d_solver.solve(spec, 1.2)
@@ -117,21 +138,8 @@ def test_scenarios_on_the_3d_plume_and_its_slice(monkeypatch, tmp_path) -> None:
     with pytest.raises(DceeInputError, match=r"truth\.extra_sources"):
         cube.with_overrides(**{"truth.extra_sources": [{"x": 30.0, "y": 30.0, "z": 1.0}]})
     # computed once, then read back
-    calls = []
-
-    def fake_solve(spec: Lbm3dSpec, height: float, progress: object = None) -> dict:
-        calls.append(height)
-        rec = _canonical()
-        return {
-            "concentration": rec.values.astype(np.float32),
-            "t": rec.t,
-            "x": rec.x,
-            "y": rec.y,
-            "z": rec.z,
-            "attrs": {"release_height": lbm3d_solver.lattice_height(spec, height)},
-        }
-
-    monkeypatch.setattr(lbm3d, "solve", fake_solve)
+    calls: list[float] = []
+    monkeypatch.setattr(lbm3d, "solve", _fake_solve({}, calls))
     from dcee.simulation import make_truth
 
     truth = make_truth(cube, 0)
@@ -164,29 +172,17 @@ def test_plume_command_reports_the_3d_comparison(monkeypatch, tmp_path, capsys) 
     from tests.helpers import run_cli
 
     monkeypatch.setenv("DCEE_CACHE", str(tmp_path))
-    rec = _canonical()
     u_star = lbm3d_solver.friction_velocity(Lbm3dSpec())
     heights = np.arange(0.25, 10.0, 0.5)
-
-    def fake_solve(spec: Lbm3dSpec, height: float, progress: object = None) -> dict:
-        return {
-            "concentration": rec.values.astype(np.float32),
-            "t": rec.t,
-            "x": rec.x,
-            "y": rec.y,
-            "z": rec.z,
-            "attrs": {
-                "release_height": lbm3d_solver.lattice_height(spec, height),
-                "mean_wind_heights": heights,
-                "mean_wind_profile": lbm3d_solver.log_law(spec, heights),
-                "turbulence_intensity_u": 2.4 * u_star,
-                "turbulence_intensity_v": 1.9 * u_star,
-                "turbulence_intensity_w": 1.25 * u_star,
-                "lagrangian_time_estimate": 3.0,
-            },
-        }
-
-    monkeypatch.setattr(lbm3d, "solve", fake_solve)
+    attrs = {
+        "mean_wind_heights": heights,
+        "mean_wind_profile": lbm3d_solver.log_law(Lbm3dSpec(), heights),
+        "turbulence_intensity_u": 2.4 * u_star,
+        "turbulence_intensity_v": 1.9 * u_star,
+        "turbulence_intensity_w": 1.25 * u_star,
+        "lagrangian_time_estimate": 3.0,
+    }
+    monkeypatch.setattr(lbm3d, "solve", _fake_solve(attrs))
     out = tmp_path / "plume.json"
     code, stdout, _ = run_cli(
         ["plume", "--model", "lbm3d", "--height", "1.1", "-q", "--json", str(out)], capsys

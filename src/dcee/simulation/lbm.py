@@ -120,14 +120,28 @@ def site_frame(
     return grown, solids
 
 
-def write_recording(path: Path, spec: LbmSpec, run: dict[str, Any]) -> None:
-    """Write a run as a CF-convention NetCDF recording (xarray + h5netcdf), atomically."""
+def xarray_module(truth: str) -> Any:
+    """xarray, or the one-line error naming the extra that brings it."""
     try:
-        import xarray as xr
+        import xarray
     except ImportError:
         raise DceeInputError(
-            FIELD, "the lbm truth needs xarray: pip install 'dcee[fluid]'"
+            FIELD, f"the {truth} truth needs xarray: pip install 'dcee[fluid]'"
         ) from None
+    return xarray
+
+
+def save_dataset(path: Path, ds: Any) -> None:
+    """Write a solver's CF dataset to ``path`` (NetCDF-4, the concentration compressed),
+    atomically: an interrupted write leaves no file."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    encoding = {"concentration": {"zlib": True, "complevel": 4, "shuffle": True}}
+    write_atomic(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf", encoding=encoding))
+
+
+def write_recording(path: Path, spec: LbmSpec, run: dict[str, Any]) -> None:
+    """Write a run as a CF-convention NetCDF recording (xarray + h5netcdf), atomically."""
+    xr = xarray_module("lbm")
     import lbmpy
 
     ds = xr.Dataset(
@@ -156,9 +170,7 @@ def write_recording(path: Path, spec: LbmSpec, run: dict[str, Any]) -> None:
             **{k: v for k, v in run["attrs"].items()},
         },
     )
-    path.parent.mkdir(parents=True, exist_ok=True)
-    encoding = {"concentration": {"zlib": True, "complevel": 4, "shuffle": True}}
-    write_atomic(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf", encoding=encoding))
+    save_dataset(path, ds)
 
 
 def cached_recording(

@@ -29,17 +29,15 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.io import write_atomic
 from dcee.provenance import package_version
 from dcee.scenarios.schema.truth import Lbm3dSpec
-from dcee.simulation.lbm import cache_folder
+from dcee.simulation.lbm import cache_folder, save_dataset, xarray_module
 from dcee.simulation.lbm3d_solver import (
     REFERENCE_HEIGHT,
     lattice_height,
@@ -71,12 +69,7 @@ def cache_path(spec: Lbm3dSpec, height: float) -> Path:
 
 def write_recording(path: Path, spec: Lbm3dSpec, run: dict[str, Any]) -> None:
     """Write a run as a 3-D CF-convention NetCDF recording (time, z, y, x), atomically."""
-    try:
-        import xarray as xr
-    except ImportError:
-        raise DceeInputError(
-            FIELD, "the lbm3d truth needs xarray: pip install 'dcee[fluid]'"
-        ) from None
+    xr = xarray_module("lbm3d")
     import lbmpy
 
     attrs = dict(run["attrs"])
@@ -112,27 +105,19 @@ def write_recording(path: Path, spec: Lbm3dSpec, run: dict[str, Any]) -> None:
             **attrs,
         },
     )
-    path.parent.mkdir(parents=True, exist_ok=True)
-    encoding = {"concentration": {"zlib": True, "complevel": 4, "shuffle": True}}
-    write_atomic(path, lambda tmp: ds.to_netcdf(tmp, engine="h5netcdf", encoding=encoding))
+    save_dataset(path, ds)
 
 
 def cached_recording(
     spec: Lbm3dSpec,
     height: float,
     progress: Progress | None = None,
-    announce: Callable[[str], None] | None = None,
 ) -> Path:
     """The CF NetCDF recording of ``spec`` for a release ``height`` m above the ground,
     computed and cached on first use."""
     path = cache_path(spec, height)
     if path.is_file():
         return path
-    if announce is not None:
-        announce(
-            f"dcee: computing the lbm3d plume for a release at {lattice_height(spec, height):g} m "
-            f"once (cached as {path})"
-        )
     run = solve(spec, height, progress)
     write_recording(path, spec, run)
     return path

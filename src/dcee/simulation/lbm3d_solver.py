@@ -46,6 +46,8 @@ from dcee.simulation.lbm_solver import (
     _even_rate,
     _integral_time,
     _lbmpy,
+    unstable,
+    zero_streaming_targets,
 )
 
 REFERENCE_HEIGHT = 4.0
@@ -160,16 +162,6 @@ class _InflowEddies:
             setter["vel_0"] = mean + self.sigma[0] * self.psi[0][j, k]
             setter["vel_1"] = self.sigma[1] * self.psi[1][j, k]
             setter["vel_2"] = self.sigma[2] * self.psi[2][j, k] * self.w_taper[k]
-
-
-def zero_streaming_targets(dh: Any, *steps: Any) -> None:
-    """Zero the streaming targets of lbmpy steps (pdf arrays, ghost layers included): lbmpy
-    allocates them uninitialised, and memory that an earlier computation in the same process
-    freed held NaN bit patterns there: the run went NaN (measured: a 3-D run after a site's
-    planar set-up in one process, never in a fresh one, whose fresh pages are zeros: the
-    results of a fresh process are unchanged)."""
-    for step in steps:
-        dh.cpu_arrays[step._tmp_arr_name][...] = 0.0
 
 
 def solve(spec: Lbm3dSpec, height: float, progress: Progress | None = None) -> dict[str, Any]:
@@ -311,11 +303,7 @@ def solve(spec: Lbm3dSpec, height: float, progress: Progress | None = None) -> d
         c = dh.gather_array("scalar3d")
         v = dh.gather_array(flow.velocity_data_name)
         if not (np.isfinite(c[sx, sy, sz]) and np.isfinite(v[flux_column, sy, sz, 0])):
-            raise DceeInputError(
-                FIELD,
-                "the lattice Boltzmann run became unstable (NaN); lower lattice_speed or "
-                "raise smagorinsky",
-            )
+            raise unstable()
         if k < spin:
             continue
         f = k - spin
