@@ -8,11 +8,7 @@ cd "$(dirname "$0")/.."
 # scripts/test.sh sets this once both venvs are installed, so that the steps it runs side by
 # side do not install into the same source tree at once
 if [ "${DCEE_SETUP_DONE:-0}" = 1 ]; then exit 0; fi
-PYTHON=${PYTHON:-python3}
-if [ ! -x .venv-ros/bin/python ]; then
-  "$PYTHON" -m venv .venv-ros
-fi
-.venv-ros/bin/python -m pip install --quiet --upgrade pip
+source scripts/venv.sh
 # the ROS 2 extra and pytest only: the ROS 2 tests (tests/ros) need nothing else, and the rest of
 # the development tools live in .venv
-.venv-ros/bin/python -m pip install --quiet -e ".[ros]" "pytest>=8.0"
+install_into .venv-ros -e ".[ros]" "pytest>=8.0"

@@ -5,9 +5,5 @@ cd "$(dirname "$0")/.."
 # scripts/test.sh sets this once both venvs are installed, so that the steps it runs side by
 # side do not install into the same source tree at once
 if [ "${DCEE_SETUP_DONE:-0}" = 1 ]; then exit 0; fi
-PYTHON=${PYTHON:-python3}
-if [ ! -x .venv/bin/python ]; then
-  "$PYTHON" -m venv .venv
-fi
-.venv/bin/python -m pip install --quiet --upgrade pip
-.venv/bin/python -m pip install --quiet -e ".[dev,docs]"
+source scripts/venv.sh
+install_into .venv -e ".[dev,docs]"
