@@ -213,8 +213,32 @@ def stratified_readings_reference(ctx, pos_idx):
 
 
 def search_that_sleeps(task):
-    """A stand-in search that takes a minute (for the driver's signal handling)."""
+    """A stand-in search that takes a minute (for the driver's signal handling); it leaves a
+    file ``started`` in its folder first, so that a test knows it is running."""
     import time
 
+    task.folder.mkdir(parents=True, exist_ok=True)
+    (task.folder / "started").touch()
     time.sleep(60)
     return {"status": "done", "task": task}
+
+
+def run_with_numba_threads(threads: int, module: str, call: str) -> None:
+    """Run ``module.call`` (``call`` a Python call expression, say ``"_check('single')"``) in a
+    fresh interpreter whose numba pool holds ``threads`` threads, and fail with its error output
+    if it fails. For the checks that need more threads than the suite's processes have
+    (tests/conftest.py gives each one)."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    proc = subprocess.run(
+        [sys.executable, "-c", f"import {module}; {module}.{call}"],
+        cwd=Path(__file__).resolve().parent.parent,
+        env={**os.environ, "NUMBA_NUM_THREADS": str(threads)},
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert proc.returncode == 0, proc.stderr[-3000:]

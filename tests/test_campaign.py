@@ -719,8 +719,11 @@ def test_driver_answers_a_signal_while_every_search_is_still_running(tmp_path):
         text=True,
         start_new_session=True,
     )
-    time.sleep(6)  # the workers are spawned and sleeping in their searches
-    assert proc.poll() is None, proc.communicate()
+    deadline = time.monotonic() + 60
+    while len(list((tmp_path / "c").rglob("started"))) < 2:  # both searches are running
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() < deadline, "the searches did not start in time"
+        time.sleep(0.05)
     sent = time.monotonic()
     os.kill(proc.pid, signal.SIGTERM)
     out, err = proc.communicate(timeout=50)

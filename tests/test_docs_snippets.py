@@ -47,9 +47,13 @@ def _snippet_env(workdir: Path) -> dict[str, str]:
     and a page's interpreter under its own ``HOME`` would otherwise compile every kernel again
     (about 20 s a page)."""
     env = {"MPLBACKEND": "Agg", "PATH": "/usr/bin:/bin", "HOME": str(workdir)}
-    for name in ("NUMBA_CACHE_DIR", "NUMBA_CACHE_LOCATOR_CLASSES"):
+    names = ("NUMBA_CACHE_DIR", "NUMBA_CACHE_LOCATOR_CLASSES")
+    # and the thread counts the suite's processes run with (tests/conftest.py)
+    names += ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS")
+    for name in names:
         if name in os.environ:
             env[name] = os.environ[name]
+
     return env
 
 

@@ -44,10 +44,13 @@ def _assimilated(filt: ParticleFilter, path: np.ndarray, zs: np.ndarray) -> Part
     return filt
 
 
-def _two_release_grid_log_evidence(path: np.ndarray, zs: np.ndarray, h: float = 1.0) -> float:
+def _two_release_grid_log_evidence(path: np.ndarray, zs: np.ndarray, h: float = 1.25) -> float:
     """log ∫∫ prior · likelihood over both releases' (x, y) on a grid of spacing h (midpoint
     rule), pairs closer than the filter's 1 m separation at density 0, as in its prior; each
-    unordered pair once, twice over (the likelihood is symmetric in the two releases)."""
+    unordered pair once, twice over (the likelihood is symmetric in the two releases). h =
+    1.25 m: 1.3 million pairs, 2 s; at h = 1 m (3.1 million, 5 s) the integral moved by 0.006
+    nats for the one-release readings and 0.13 for the two-release ones, within the tests'
+    0.3."""
     g = np.arange(h / 2, 50.0, h)
     gx, gy = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
     first, second = np.triu_indices(len(gx), k=1)

@@ -8,7 +8,7 @@ import pytest
 from dcee.models import Sensor
 from dcee.planning import get as get_planner
 from dcee.planning.predicted_reference import predicted_posterior_stats_reference
-from tests.helpers import compiled_predicted_stats, random_theta
+from tests.helpers import compiled_predicted_stats, random_theta, run_with_numba_threads
 
 
 def _late_case(n=4000, seed=11, spread=0.5):
@@ -100,6 +100,10 @@ def test_interpolation_is_exact_where_it_does_not_apply():
 
 
 def test_interpolated_stats_do_not_depend_on_the_thread_count():
+    run_with_numba_threads(2, "tests.test_interpolated_sums", "_same_with_one_and_two_threads()")
+
+
+def _same_with_one_and_two_threads() -> None:
     import numba
 
     assert numba.config.NUMBA_NUM_THREADS >= 2, "needs two numba threads (CI has 2 cores)"

@@ -12,7 +12,7 @@ from dcee.models import Sensor
 from dcee.numeric import vexp_f32, vlog_f32
 from dcee.planning import get as get_planner
 from dcee.planning.predicted_reference import predicted_posterior_stats_reference
-from tests.helpers import compiled_predicted_stats
+from tests.helpers import compiled_predicted_stats, run_with_numba_threads
 
 
 def test_float32_exp_matches_numpy_over_its_range_and_every_power_of_two():
@@ -144,6 +144,12 @@ def test_single_precision_is_a_planner_option_everywhere_it_is_used():
 
 @pytest.mark.parametrize("precision", ["double", "single"])
 def test_predicted_stats_do_not_depend_on_the_thread_count(precision):
+    run_with_numba_threads(
+        2, "tests.test_single_precision", f"_same_with_one_and_two_threads({precision!r})"
+    )
+
+
+def _same_with_one_and_two_threads(precision: str) -> None:
     import numba
 
     assert numba.config.NUMBA_NUM_THREADS >= 2, "needs two numba threads (CI has 2 cores)"
