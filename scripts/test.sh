@@ -28,6 +28,9 @@ warm=$!
 .venv/bin/python scripts/warm_kernels.py 1 2
 wait "$warm"
 took "lint and kernels"
+# three jobs on two cores: one compute thread in each process (tests/conftest.py says why),
+# the documentation's executed examples and the ROS 2 node included
+export NUMBA_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1
 # .venv is complete: the documentation build must not install into it again
 DCEE_SETUP_DONE=1 DOCS_OUT=${DOCS_OUT:-$logs/site} bash scripts/docs.sh >"$logs/docs.log" 2>&1 &
 docs=$!
