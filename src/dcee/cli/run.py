@@ -22,8 +22,8 @@ from dcee.io import (
 @click.option(
     "--scenario",
     "scenario_name",
-    required=True,
-    help="Built-in name (see `dcee scenarios`) or path to a TOML file.",
+    help="Built-in name (see `dcee scenarios`), path to a TOML file, or a GADEN simulation "
+    "folder [default, and required otherwise: the folder --truth names, as its room's scenario].",
 )
 @click.option(
     "--strategy",
@@ -61,7 +61,7 @@ from dcee.io import (
 @click.option("--no-figure", is_flag=True, help="Skip figure.png.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress display.")
 def run(
-    scenario_name: str,
+    scenario_name: str | None,
     strategy: str,
     seed: int,
     particles: int | None,
@@ -93,6 +93,14 @@ def run(
     get_planner(strategy)  # fail fast on an unknown name or a bad option
     if truth is not None:
         truth = truth_choice(truth)
+    if scenario_name is None:
+        if not (isinstance(truth, dict) and truth.get("kind") == "gaden"):
+            raise DceeInputError(
+                "scenario",
+                "required (a built-in, a TOML file or a GADEN folder), unless "
+                "--truth names a GADEN simulation folder",
+            )
+        scenario_name = truth["folder"]
     base = load_scenario(scenario_name)
     changes = {
         "search.particles": particles,

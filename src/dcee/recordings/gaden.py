@@ -25,6 +25,7 @@ import numpy as np
 
 from dcee.recordings.gaden_files import (
     FREE,
+    GAS_MOLAR_MASS,
     GadenGrid,
     GadenResult,
     gaden_error,
@@ -35,6 +36,8 @@ from dcee.recordings.gaden_files import (
 )
 
 __all__ = [
+    "FREE",
+    "GAS_MOLAR_MASS",
     "GadenGrid",
     "GadenResult",
     "GadenSimulation",

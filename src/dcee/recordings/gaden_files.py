@@ -44,6 +44,9 @@ MAX_DECOMPRESSED_BYTES = 256 * 2**20
 """A result file that decompresses to more than this is refused (about 13 million filaments)."""
 MAX_CELLS = 200_000_000
 """A grid of more cells than this is refused (2.4 GB of wind as float32)."""
+GAS_MOLAR_MASS = {0: 46.07}
+"""g/mol of GADEN's gas types known by number (``gasType`` in ``sim.yaml`` and the result files):
+0, ethanol (the samples'); another gas needs its molar mass given."""
 FREE, OBSTACLE, OUTLET = 0, 1, 2
 """GADEN's cell states in the occupancy grid."""
 _FILAMENT = np.dtype([("xyz", "<f4", 3), ("sigma", "<f4"), ("active", "u1"), ("pad", "u1", 3)])

@@ -16,6 +16,7 @@ from dcee.scenarios.builtin import (
     random_family_name,
 )
 from dcee.scenarios.defaults import DEFAULTS
+from dcee.scenarios.gaden_room import gaden_room_configuration, is_gaden_folder
 from dcee.scenarios.schema import Scenario, validate_scenario
 from dcee.stopping import DEFAULT_STOP_SHARE
 
@@ -46,6 +47,8 @@ def load_scenario(name_or_path: str) -> Scenario:
     if family is not None:
         return validate_scenario(random_family_configuration(*family))
     path = Path(name_or_path)
+    if is_gaden_folder(path):
+        return validate_scenario(gaden_room_configuration(path))
     if not path.suffix == ".toml" and ":" in name_or_path:
         raise DceeInputError(
             "scenario",
@@ -76,16 +79,25 @@ def _resolve_recording(data: dict, base: Path) -> None:
 
 def truth_choice(value: str) -> str | dict[str, str]:
     """The ``truth.model`` a ``--truth`` option names: "isotropic", "filament", "puffs", "lbm",
-    "lbm3d", or the path of a
-    recording (``.npy``/``.h5``), made absolute so that it means the same file wherever the
+    "lbm3d", the path of a recording (``.npy``/``.h5``/``.nc``) or of a GADEN simulation folder,
+    made absolute so that it means the same file wherever the
     configuration is used later."""
     if value in ("isotropic", "filament", "puffs", "lbm", "lbm3d"):
         return value
     path = Path(value).expanduser()
+    if path.is_dir():
+        if not is_gaden_folder(path):
+            raise DceeInputError(
+                "truth",
+                f"{value!r} is a folder but not a GADEN simulation (it needs "
+                "OccupancyGrid3D.csv and result/iteration_<k> files)",
+            )
+        return {"kind": "gaden", "folder": str(path.resolve())}
     if path.suffix.lower() not in (".npy", ".h5", ".hdf5", ".nc", ".nc4", ".netcdf", ".cdf"):
         raise DceeInputError(
             "truth",
-            f"must be isotropic, filament, puffs, lbm, lbm3d or a .npy/.h5/.nc recording "
+            f"must be isotropic, filament, puffs, lbm, lbm3d, a .npy/.h5/.nc recording or a "
+            f"GADEN simulation folder "
             f"(got {value!r})",
         )
     if not path.is_file():

@@ -266,6 +266,33 @@ class PlaybackSpec(BaseModel):
         return f"playback:{Path(self.file).name}"
 
 
+class GadenSpec(BaseModel):
+    """A simulation of GADEN, the field's filament dispersion simulator for indoor scenes
+    (Monroy et al. 2017; gaden_core 3.0), played back as GADEN's player plays it
+    (:mod:`dcee.simulation.gaden`): the folder holds its ``result/iteration_<k>`` files, its
+    ``OccupancyGrid3D.csv`` and its ``wind/`` (docs/guide/plume-data.md). Concentrations in ppm
+    are converted to g/m³ with the air's molar density that GADEN wrote in the files and the
+    gas's molar mass; the scenario's source must be the release the files name."""
+
+    model_config = FROZEN
+    kind: Literal["gaden"] = "gaden"
+    folder: str = Field(min_length=1)
+    """the GADEN simulation folder (a relative path is taken from the scenario file)"""
+    start: Annotated[float, Field(ge=0, le=1e6, allow_inf_nan=False)] = 60.0
+    """s of simulated time at which the search begins (the gas has spread through the room by
+    then: on the samples the plume crosses the 10 m room in about 25 s)"""
+    loop: bool = True
+    """past the last file, replay from ``start`` (GADEN's player loops the same way); else the
+    search budget must end within the files"""
+    molar_mass: Annotated[float | None, Field(gt=0, le=1000, allow_inf_nan=False)] = None
+    """g/mol of the gas; None: from the gas type the files name (GADEN's gas type 0, ethanol,
+    46.07 g/mol; another type must give it)"""
+
+    @property
+    def name(self) -> str:
+        return f"gaden:{Path(self.folder).name}"
+
+
 @dataclass
 class TruthKind:
     """One kind of ``truth.model``: its parameter table (None: a bare name, no parameters) and
@@ -283,13 +310,15 @@ TRUTH_KINDS: dict[str, TruthKind] = {
     "playback": TruthKind(PlaybackSpec),
     "lbm": TruthKind(LbmSpec),
     "lbm3d": TruthKind(Lbm3dSpec),
+    "gaden": TruthKind(GadenSpec),
 }
 """The one registry of truth kinds, by the ``kind`` of ``truth.model`` (``"isotropic"`` for the
 plain string): the scenario schema validates against the specs, :func:`dcee.simulation.make_truth`
 builds with the factories. A new truth adds its spec class here and registers its factory in its
 own module under :mod:`dcee.simulation`."""
 TruthModelSpec = Annotated[
-    FilamentSpec | PuffsSpec | PlaybackSpec | LbmSpec | Lbm3dSpec, Field(discriminator="kind")
+    FilamentSpec | PuffsSpec | PlaybackSpec | LbmSpec | Lbm3dSpec | GadenSpec,
+    Field(discriminator="kind"),
 ]
 
 
@@ -362,7 +391,7 @@ class Truth(BaseModel):
                 f"{FIELD_MARK}truth.extra_sources: {len(extra) + 1} releases in all; at most "
                 f"{MAX_SOURCES} (the one at truth.x, y, z and {MAX_SOURCES - 1} more)"
             )
-        if isinstance(self.model, PlaybackSpec | LbmSpec | Lbm3dSpec):
+        if isinstance(self.model, PlaybackSpec | LbmSpec | Lbm3dSpec | GadenSpec):
             raise ValueError(
                 f"{FIELD_MARK}truth.extra_sources: a {self.model.kind} truth holds its own "
                 "releases; further ones need truth.model isotropic, filament or puffs"
