@@ -44,7 +44,8 @@ def likelihood_names() -> list[str]:
 TRUTH_OPTION = click.option(
     "--truth",
     help="What the sensor sees: isotropic | filament | puffs | lbm (a fluid solver's planar "
-    "plume) | lbm3d (its 3-D surface-layer plume) | PATH of a recording "
+    "plume) | lbm3d (its 3-D surface-layer plume) | PATH of a recording | a GADEN simulation "
+    "folder (with `dcee run`, no --scenario needed: the room's own) "
     "[default: the scenario's truth.model].",
 )
 LIKELIHOOD_OPTION = click.option(

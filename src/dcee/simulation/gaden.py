@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.recordings.gaden import GAS_MOLAR_MASS, GadenSimulation
+from dcee.recordings.gaden import FREE, GAS_MOLAR_MASS, GadenSimulation
 from dcee.simulation.truth import TruthModel, register_truth
 
 if TYPE_CHECKING:
@@ -111,6 +111,13 @@ def _gaden(scenario: Scenario, seed: int) -> GadenTruth:
             "search.budget",
             f"{budget:g} s but the GADEN files last {truth.duration:g} s from "
             f"truth.model.start (set truth.model.loop = true or shorten the budget)",
+        )
+    start = np.asarray(scenario.agent.start, dtype=np.float64)
+    idx, inside = truth.simulation.grid.cells(start[None, :])
+    if inside[0] and truth.simulation.occupancy[tuple(idx[0])] != FREE:
+        raise DceeInputError(
+            "agent.start",
+            f"{tuple(float(v) for v in start)} m lies in a wall or door cell of the GADEN room",
         )
     low, high = np.array(scenario.volume.low), np.array(scenario.volume.high)
     grid = truth.simulation.grid

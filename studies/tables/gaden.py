@@ -1,0 +1,59 @@
+"""dcee-cl and infotaxis in GADEN's two sample rooms (recipe gaden, issue 84)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from studies.tables.common import RESULTS, table
+
+FOLDER = RESULTS / "gaden"
+ROOMS = (("empty-room", "uniform draught"), ("empty-room-cfd", "solver wind (lbmpy D3Q27)"))
+
+
+def _searches() -> list[dict]:
+    return json.loads((FOLDER / "searches.json").read_text(encoding="utf-8"))["searches"]
+
+
+def gaden_rooms_table() -> str:
+    """Per room and planner: acquired (final RMSE < 1 m) of the ten starts, the median final
+    RMSE with its range, the median error of the posterior mean and the truth in the 95 %
+    region."""
+    rows = []
+    searches = _searches()
+    for room, wind in ROOMS:
+        for strategy in ("dcee-cl", "infotaxis"):
+            runs = [r for r in searches if r["room"] == room and r["strategy"] == strategy]
+            if not runs:
+                continue
+            rmse = np.array([r["final_rmse"] for r in runs])
+            err = np.array([r["final_mean_error"] for r in runs])
+            rows.append(
+                [
+                    f"{room} ({wind})",
+                    strategy,
+                    f"{sum(r['source_acquired'] for r in runs)}/{len(runs)}",
+                    f"{np.median(rmse):.2f} ({rmse.min():.2f}-{rmse.max():.2f})",
+                    f"{np.median(err):.2f}",
+                    f"{sum(r['truth_in_95'] for r in runs)}/{len(runs)}",
+                ]
+            )
+    header = ["room", "planner", "acquired", "median final RMSE, m (range)", "mean error, m",
+              "truth in 95 %"]  # fmt: skip
+    return table(header, rows)
+
+
+def gaden_starts_table() -> str:
+    """Every search: the start, and each planner's final RMSE (m) and detections."""
+    by_key = {(r["room"], tuple(r["start"]), r["strategy"]): r for r in _searches()}
+    rows = []
+    for room, _ in ROOMS:
+        starts = sorted({k[1] for k in by_key if k[0] == room}, key=lambda s: (s[1], s[0]))
+        for start in starts:
+            cells = [room, f"({start[0]:g}, {start[1]:g})"]
+            for strategy in ("dcee-cl", "infotaxis"):
+                r = by_key.get((room, start, strategy))
+                cells.append("—" if r is None else f"{r['final_rmse']:.2f} ({r['detections']})")
+            rows.append(cells)
+    return table(["room", "start (x, y) m", "dcee-cl: RMSE (detections)", "infotaxis"], rows)
