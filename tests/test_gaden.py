@@ -43,6 +43,26 @@ def test_the_reader_reproduces_gaden_s_player_at_every_reference_point(room):
     assert sim.iteration_at(150.0) == 150 and sim.iteration_at(150.7) == 150
 
 
+@pytest.mark.parametrize("room", ROOMS)
+def test_the_compiled_kernel_equals_its_numpy_reference(room):
+    """At 4,000 points around the filaments (each a filament's position moved by up to 1 m:
+    within, at and beyond the cut-off, through the walls and doors) and 1,000 over and beyond
+    the grid, at four times: the same zero pattern and values to 1e-12."""
+    sim = GadenSimulation.open(DATA / room)
+    rng = np.random.default_rng(3)
+    for t in (5.0, 60.0, 150.0, 300.0):
+        res = sim.result(sim.iteration_at(t))
+        near = res.filaments[rng.integers(0, len(res.filaments), 4000), :3].astype(np.float64)
+        near += rng.uniform(-1.0, 1.0, near.shape)
+        far = rng.uniform([-0.5, -0.5, -0.2], [10.5, 6.5, 2.7], (1000, 3))
+        pts = np.vstack([near, far])
+        got = gaden.filament_concentration(pts, res, sim.occupancy, sim.grid)
+        want = gaden.filament_concentration_reference(pts, res, sim.occupancy, sim.grid)
+        np.testing.assert_array_equal(got > 0, want > 0)
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=0)
+        assert (want > 0).sum() > 300  # the points meet the gas
+
+
 def test_times_from_the_simulation_settings_match_gaden_s_table(tmp_path):
     """Without times.csv the times come from sim.yaml (a save every ⌊0.95 / 0.1⌋ + 1 = 10 steps
     of 0.1 s): the same as GADEN's table; a whole ratio is refused rather than guessed."""

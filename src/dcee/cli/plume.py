@@ -23,7 +23,7 @@ def _spec(settings: tuple[str, ...], model: str = "lbm") -> Any:
     from pydantic import ValidationError
 
     from dcee.scenarios import parse_setting
-    from dcee.scenarios.schema.truth import TRUTH_KINDS
+    from dcee.scenarios.schema.truth_models import TRUTH_KINDS
 
     spec_class = TRUTH_KINDS[model].spec
     assert spec_class is not None

@@ -42,6 +42,7 @@ __all__ = [
     "GadenResult",
     "GadenSimulation",
     "filament_concentration",
+    "filament_concentration_reference",
     "read_occupancy",
     "read_result",
     "read_wind",
@@ -92,7 +93,44 @@ def filament_concentration(
 ) -> np.ndarray:
     """(M,) ppm at ``points`` (M, 3) m from one result's filaments, as GADEN's player computes
     it (module docstring): 0 outside the grid, each filament within 3 σ and in line of sight
-    through free cells of ``occupancy`` (nx, ny, nz) adding its Gaussian."""
+    through free cells of ``occupancy`` (nx, ny, nz) adding its Gaussian. The compiled kernel
+    (:mod:`dcee.recordings.gaden_kernel`); :func:`filament_concentration_reference` is its NumPy
+    reference."""
+    grid = grid or result.grid
+    return _compiled(points, result, np.ascontiguousarray(occupancy == FREE), grid)
+
+
+def _compiled(
+    points: np.ndarray, result: GadenResult, free: np.ndarray, grid: GadenGrid
+) -> np.ndarray:
+    """:func:`filament_concentration` with the free cells (nx, ny, nz) bool given."""
+    from dcee.recordings.gaden_kernel import filament_ppm
+
+    points = np.atleast_2d(np.asarray(points, dtype=np.float64))
+    out = np.zeros(len(points))
+    if len(points) == 0:
+        return out
+    _, inside = grid.cells(points)
+    filament_ppm(
+        points.astype(np.float32),
+        result.filaments,
+        free,
+        grid.low.astype(np.float32),
+        np.float32(grid.cell),
+        inside,
+        1e6 * result.moles_per_filament / result.moles_per_cm3,
+        out,
+    )
+    return out
+
+
+def filament_concentration_reference(
+    points: np.ndarray,
+    result: GadenResult,
+    occupancy: np.ndarray,
+    grid: GadenGrid | None = None,
+) -> np.ndarray:
+    """NumPy reference of :func:`filament_concentration` (the same arguments and result)."""
     grid = grid or result.grid
     points = np.atleast_2d(np.asarray(points, dtype=np.float64))
     out = np.zeros(len(points))
@@ -133,6 +171,7 @@ class GadenSimulation:
     iterations: np.ndarray
     times: np.ndarray
     _results: dict
+    _free: np.ndarray | None = None
 
     @classmethod
     def open(cls, folder: str | Path) -> GadenSimulation:
@@ -189,9 +228,9 @@ class GadenSimulation:
     def concentration(self, points: np.ndarray, time: float) -> np.ndarray:
         """(M,) ppm at ``points`` (M, 3) m at simulated time ``time`` s (the result saved last
         at or before it)."""
-        return filament_concentration(
-            points, self.result(self.iteration_at(time)), self.occupancy, self.grid
-        )
+        if self._free is None:
+            self._free = np.ascontiguousarray(self.occupancy == FREE)
+        return _compiled(points, self.result(self.iteration_at(time)), self._free, self.grid)
 
 
 def _iteration_times(folder: Path, iterations: np.ndarray) -> np.ndarray:

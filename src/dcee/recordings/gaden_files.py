@@ -206,7 +206,7 @@ def read_result(path: str | Path) -> GadenResult:
         )
     records = np.frombuffer(reader.data, dtype=_FILAMENT, count=count, offset=reader.pos)
     filaments = np.column_stack([records["xyz"], records["sigma"]]).astype(np.float32)
-    filaments = filaments[records["active"] != 0]
+    filaments = np.ascontiguousarray(filaments[records["active"] != 0])
     if not np.all(np.isfinite(filaments)) or np.any(filaments[:, 3] <= 0):
         raise gaden_error(path, "a filament with a non-finite position or σ ≤ 0: corrupt")
     return GadenResult(

@@ -11,7 +11,7 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.models.plume import IsotropicPlume
-from dcee.scenarios.schema.truth import TRUTH_KINDS
+from dcee.scenarios.schema.truth_models import TRUTH_KINDS
 
 if TYPE_CHECKING:
     from dcee.scenarios import Scenario

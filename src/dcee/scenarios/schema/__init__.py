@@ -32,15 +32,14 @@ from dcee.scenarios.schema.estimator import (
 )
 from dcee.scenarios.schema.learn import default_learn, default_learn_prior
 from dcee.scenarios.schema.scenario import FIELD_MARK, Scenario, validate_scenario
-from dcee.scenarios.schema.truth import (
+from dcee.scenarios.schema.truth import TURBULENT_HOLD, Truth, Volume
+from dcee.scenarios.schema.truth_models import (
     TRUTH_KINDS,
-    TURBULENT_HOLD,
     FilamentSpec,
+    GadenSpec,
     PlaybackSpec,
     PuffsSpec,
-    Truth,
     TruthKind,
-    Volume,
 )
 
 __all__ = [
@@ -65,6 +64,7 @@ __all__ = [
     "EstimatorSpec",
     "FilamentSpec",
     "Finite",
+    "GadenSpec",
     "Likelihood",
     "PlaybackSpec",
     "Positive",

@@ -11,7 +11,7 @@ from pydantic import BaseModel, ValidationError
 
 from dcee.errors import DceeInputError
 from dcee.scenarios.schema.common import FIELD_MARK
-from dcee.scenarios.schema.truth import TRUTH_KINDS
+from dcee.scenarios.schema.truth_models import TRUTH_KINDS
 
 
 def one_line_error(exc: ValidationError, root: type[BaseModel]) -> DceeInputError:
