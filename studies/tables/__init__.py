@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from dcee.scenarios import REGION_FLOOR_DEFAULT
-from studies.tables.gaden import gaden_rooms_table, gaden_starts_table
+from studies.tables.gaden import gaden_rooms_table, gaden_starts_table, gaden_timing_table
 from studies.tables.headline import headline_table
 from studies.tables.held_out import held_out_table, others_table, paired_table
 from studies.tables.lbm import (
@@ -57,6 +57,7 @@ from studies.tables.turbulent import cross_truth_table, turbulent_table
 TABLES: dict[str, Callable[[], str]] = {
     "gaden-rooms": gaden_rooms_table,
     "gaden-starts": gaden_starts_table,
+    "gaden-timing": gaden_timing_table,
     "lbm3d-plume": lbm3d_plume_table,
     "lbm3d-search": lbm3d_search_table,
     "lbm3d-altitudes": lbm3d_altitude_table,

@@ -57,3 +57,22 @@ def gaden_starts_table() -> str:
                 cells.append("—" if r is None else f"{r['final_rmse']:.2f} ({r['detections']})")
             rows.append(cells)
     return table(["room", "start (x, y) m", "dcee-cl: RMSE (detections)", "infotaxis"], rows)
+
+
+def gaden_timing_table() -> str:
+    """The GADEN playback's query against the lbm plume's, µs per reading, same run
+    (``studies/gaden_timing.py``)."""
+    doc = json.loads((FOLDER / "timing.json").read_text(encoding="utf-8"))
+    machine = doc["machine"]
+    rows = [
+        [
+            f"{doc['gaden_us_per_reading']:.2f}",
+            f"{doc['lbm_us_per_reading']:.2f}",
+            f"{doc['ratio_gaden_to_lbm']:.2f}",
+            f"{doc['gaden_first_read_ms_per_file']:.2f}",
+            f"{machine['processor'] or machine['machine']}, {machine['cpus']} CPUs",
+        ]
+    ]
+    header = ["GADEN, µs per reading", "lbm plume, µs per reading", "ratio",
+              "GADEN file's first read, ms", "machine"]  # fmt: skip
+    return table(header, rows)
