@@ -135,7 +135,8 @@ def test_truth_choice_rejects_what_is_neither_a_model_nor_a_recording(tmp_path):
     assert truth_choice("filament") == "filament"
     assert truth_choice("puffs") == "puffs"
     with pytest.raises(
-        DceeInputError, match=r"isotropic, filament, puffs, lbm, lbm3d or a \.npy/\.h5"
+        DceeInputError,
+        match=r"isotropic, filament, puffs, lbm, lbm3d, a \.npy/\.h5/\.nc recording or a GADEN",
     ):
         truth_choice("gaussian")
     with pytest.raises(DceeInputError, match="no such recording"):
