@@ -187,6 +187,8 @@ def _bearing_comment(phi: Any) -> str:
         if phi.get("mean") is not None:
             return f"# ^ centred on {wind_from_words(phi['mean'])} (compass bearing)"
         lo, hi = phi.get("low"), phi.get("high")
+        if lo is not None and hi is not None and hi - lo >= 360.0:
+            return "# ^ wind from any direction (a uniform prior over the full circle)"
         if lo is not None and hi is not None:
             return (
                 f"# ^ wind from bearings {bearing_from_phi(hi):g}° to {bearing_from_phi(lo):g}° "
