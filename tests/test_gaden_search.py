@@ -3,6 +3,7 @@ built from its folder (dcee.scenarios.gaden_room, ``dcee run --truth DIR``)."""
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import shutil
@@ -118,3 +119,45 @@ def test_a_gas_without_a_known_molar_mass_must_be_given_one(tmp_path):
     with pytest.raises(DceeInputError, match="gas type 3; give its molar mass"):
         gaden_truth(room, 60.0, True, None)
     assert gaden_truth(room, 60.0, True, 58.08).grams_per_ppm > 0
+
+
+def _with_block(room: Path) -> None:
+    """Obstacle cells x 5.0-6.0 m, y 1.0-2.0 m at every height (a cabinet) in ``room``'s grid."""
+    from dcee.recordings.gaden import read_occupancy
+
+    _, cells = read_occupancy(room / "OccupancyGrid3D.csv")
+    cells[52:62, 12:22, :] = 1
+    head = (room / "OccupancyGrid3D.csv").read_text().splitlines()[:4]
+    body = []
+    for k in range(cells.shape[2]):
+        body += [" ".join(str(v) for v in cells[i, :, k]) + " " for i in range(cells.shape[0])]
+        body.append(";")
+    (room / "OccupancyGrid3D.csv").write_text("\n".join(head + body) + "\n")
+
+
+def test_a_room_with_an_obstacle_gets_its_map_and_no_path_crosses_it(tmp_path, monkeypatch):
+    """An obstacle inside the room becomes the scenario's map (the empty samples get none): a
+    start in it is refused, and a search started beside it never enters or crosses it."""
+    from dcee.runs import run_episode
+
+    monkeypatch.setenv("DCEE_CACHE", str(tmp_path / "cache"))
+    assert load_scenario(str(ROOM)).world.map is None
+    room = tmp_path / "room"
+    shutil.copytree(ROOM, room)
+    _with_block(room)
+    scenario = load_scenario(str(room))
+    assert scenario.world.map is not None and Path(scenario.world.map).exists()
+    with pytest.raises(DceeInputError, match=r"agent\.start"):
+        scenario.with_overrides(**{"agent.start": [5.5, 1.5, 0.5]})
+    flown = scenario.with_overrides(
+        **{"agent.start": [7.0, 1.5, 0.5], "search.particles": 500, "search.hypotheses": 4,
+           "search.budget": 60.0}
+    )  # fmt: skip
+    records = run_episode(flown, "dcee", 0).records
+    path = np.array([[r["x"], r["y"]] for r in records])
+    # every leg sampled every 5 cm stays outside the block
+    for a, b in itertools.pairwise(path):
+        for f in np.linspace(0.0, 1.0, 21):
+            x, y = a + f * (b - a)
+            assert not (5.0 <= x <= 6.0 and 1.0 <= y <= 2.0), (a, b)
+    assert len(path) > 5

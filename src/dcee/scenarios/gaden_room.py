@@ -8,6 +8,11 @@ two sample rooms beyond what is said there.
   ``numFilaments_sec`` × the files' moles per filament × the gas's molar mass (for the record:
   the estimator does not read it); u and φ the wind of the source's cell. The source height is
   estimated (``dimensions = 3``).
+* **Obstacles**: where an obstacle cell lies inside the area at the sensor's height (furniture,
+  an inner wall; the area's outermost ring of cells, the walls beside the doors, left out), the
+  occupancy grid's obstacle cells at that height become the scenario's ``world.map``
+  (a ROS map file in ``$DCEE_CACHE`` or ``~/.cache/dcee``, ``maps/``): the robot never enters
+  or crosses a blocked cell. An empty room (the samples) gets none.
 * **Robot**: a ground robot with its sensor at :data:`SENSOR_HEIGHT` (0.5 m), 0.5 m steps at
   0.5 m/s (the lab's 0.3 m in a 4.5 m room scaled to a 10 m one), a 4 s hold per reading (the
   default on a time-varying truth); it starts at the free cell at sensor height farthest from
@@ -42,6 +47,7 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.recordings.gaden import FREE, GAS_MOLAR_MASS, GadenSimulation
+from dcee.recordings.gaden_files import OBSTACLE
 
 SENSOR_HEIGHT = 0.5
 """m: the ground robot's sensor above the floor."""
@@ -91,6 +97,7 @@ def gaden_room_configuration(folder: str | Path) -> dict[str, Any]:
     start = np.array([*np.round(start_xy, 6), SENSOR_HEIGHT])
     at_source, at_start = wind_at(source), wind_at(start)
     speed = float(np.hypot(*at_start[:2]))
+    room_map = _room_map(sim, k, free.min(axis=0), free.max(axis=0), folder.name)
     if first.gas_type not in GAS_MOLAR_MASS:
         raise DceeInputError(
             f"GADEN {folder}",
@@ -99,7 +106,8 @@ def gaden_room_configuration(folder: str | Path) -> dict[str, Any]:
         )
     molar_mass = GAS_MOLAR_MASS[first.gas_type]
     rate = _release_rate(folder, first.moles_per_filament, molar_mass)
-    return {
+    extra = {"world": {"map": room_map}} if room_map is not None else {}
+    return extra | {
         "name": f"gaden:{folder.name}",
         "description": (
             f"GADEN simulation {folder.name}: a room {high[0] - low[0]:g} m x "
@@ -141,6 +149,45 @@ def gaden_room_configuration(folder: str | Path) -> dict[str, Any]:
         "agent": {"start": start.tolist(), "step": 0.5, "speed": 0.5, "climb": 0.0},
         "search": {"particles": 20_000, "hypotheses": 40, "budget": 450.0, "acquired_rmse": 1.0},
     }
+
+
+def _room_map(
+    sim: GadenSimulation, k: int, first: np.ndarray, last: np.ndarray, name: str
+) -> str | None:
+    """The ROS map file of the occupancy grid's layer ``k`` (its obstacle cells blocked; an
+    outlet, a door, is not), or None where no obstacle lies inside the free box ``first`` …
+    ``last`` (cell indices, its outermost ring left out); written once per layer's content."""
+    import hashlib
+    import os
+    import tempfile
+
+    from dcee.models.ros_map import write_ros_map
+    from dcee.models.site import SiteMap
+
+    layer = sim.occupancy[:, :, k] == OBSTACLE  # (nx, ny); a door (outlet) can be driven into
+    # the box's outermost cells hold the walls beside the doors: only an obstacle further in
+    # calls for a map
+    if not layer[first[0] + 1 : last[0], first[1] + 1 : last[1]].any():
+        return None
+    grid = sim.grid
+    key = hashlib.sha256(
+        layer.tobytes() + repr((layer.shape, grid.low.tolist(), grid.cell)).encode()
+    ).hexdigest()[:16]
+    root = Path(os.environ.get("DCEE_CACHE") or Path.home() / ".cache" / "dcee") / "maps"
+    path = root / f"gaden-{key}.yaml"
+    if not path.exists():
+        root.mkdir(parents=True, exist_ok=True)
+        site = SiteMap(
+            layer.T.copy(),
+            (float(grid.low[0]), float(grid.low[1])),
+            float(grid.cell),
+            name=f"GADEN {name} at {SENSOR_HEIGHT:g} m",
+        )
+        with tempfile.TemporaryDirectory(dir=root) as tmp:
+            written = write_ros_map(site, Path(tmp) / path.name)
+            os.replace(written.with_suffix(".pgm"), path.with_suffix(".pgm"))
+            os.replace(written, path)
+    return str(path)
 
 
 def _release_rate(folder: Path, moles: float, molar_mass: float) -> float:
