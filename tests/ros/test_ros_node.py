@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -67,6 +68,26 @@ def test_demo_finds_the_source_over_topics_and_replay_reprocesses_its_bag(tmp_pa
     for a, b in zip(live, rec, strict=True):
         assert math.hypot(a["x"] - b["x"], a["y"] - b["y"]) < 0.02
     assert replay.summary["strategy"] == "replay"
+
+
+def test_demo_searches_a_gaden_room_over_topics() -> None:
+    """The node and the simulated robot on a GADEN simulation folder (its room's scenario, the
+    robot reading GADEN's filaments): readings arrive, goals go out, the search closes in."""
+    room = Path(__file__).resolve().parents[1] / "data" / "gaden" / "empty-room"
+    summary = run_demo(
+        str(room),
+        "dcee",
+        seed=0,
+        particles=1000,
+        budget=90.0,
+        speedup=100.0,
+        timeout=300.0,
+        domain_id=_domain(),
+    )
+    live = summary["records"]
+    assert summary["transport"] == "ros2" and summary["scenario"] == "gaden:empty-room"
+    assert len(live) >= 10 and summary["plume_acquired"]
+    assert live[-1]["rmse"] < live[0]["rmse"]
 
 
 def test_node_refuses_a_bad_pose_type() -> None:
