@@ -7,6 +7,7 @@ Gaussian plume's spreads."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -193,3 +194,26 @@ def test_plume_command_reports_the_3d_comparison(monkeypatch, tmp_path, capsys) 
     assert doc["release_height"] == 1.25 and [round(s["x"]) for s in doc["sections"]] == [5]
     code, _, err = run_cli(["plume", "--model", "lbm3d", "--set", "bar_spacing=3"], capsys)
     assert code == 2 and err.startswith("dcee: error: bar_spacing: not a setting of the lbm3d")
+
+
+def test_a_plume_not_yet_cached_is_announced_before_it_is_computed(tmp_path, monkeypatch, capsys):
+    """`dcee run` says, once, that a solver plume is about to be computed and where it will be
+    cached (minutes of silence otherwise); nothing once it is cached, nothing with -q."""
+    from dcee.console import plume_notice
+    from dcee.scenarios import load_scenario
+
+    monkeypatch.setenv("DCEE_CACHE", str(tmp_path))
+    three_d = load_scenario("random:9").with_overrides(**{"truth.model": "lbm3d"})
+    planar = load_scenario("paper:1").with_overrides(**{"truth.model": "lbm", "truth.z": 4.0})
+    for scenario, what in ((three_d, "the 3-D plume"), (planar, "the planar solver plume")):
+        plume_notice(scenario, True)
+        assert capsys.readouterr().err == ""
+        plume_notice(scenario, False)
+        err = capsys.readouterr().err
+        assert err.startswith(f"dcee: computing {what}") and err.count("\n") == 1
+        cached = Path(err.split("cached as ")[1].strip())
+        assert cached.parent == tmp_path / "plumes"
+        cached.parent.mkdir(exist_ok=True)
+        cached.touch()
+        plume_notice(scenario, False)
+        assert capsys.readouterr().err == ""

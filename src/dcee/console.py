@@ -101,6 +101,29 @@ def compile_notice(quiet: bool) -> None:
         )
 
 
+def plume_notice(scenario: Any, quiet: bool) -> None:
+    """Say so when the scenario's fluid-solver plume is not cached yet and is about to be
+    computed (minutes of no visible progress otherwise): the 3-D plume of its release cell, or
+    the planar plume in open terrain."""
+    if quiet:
+        return
+    model = scenario.truth.model
+    kind = getattr(model, "kind", None)
+    if kind == "lbm3d":
+        from dcee.simulation.lbm3d import cache_path
+
+        height = float(scenario.truth_theta()[2]) - float(scenario.volume.low[2])
+        path, what = cache_path(model, height), "the 3-D plume of this release cell (about 4 min)"
+    elif kind == "lbm" and not scenario.world.obstacles and scenario.world.map is None:
+        from dcee.simulation.lbm import cache_path
+
+        path, what = cache_path(model), "the planar solver plume (about a minute)"
+    else:
+        return
+    if not path.exists():
+        click.echo(f"dcee: computing {what}, once: it is cached as {path}", err=True)
+
+
 def _why_climb(scenario: Any) -> str:
     """Why an unset climb resolved to a climbing UAV (:func:`dcee.scenarios.unset_climb`)."""
     if scenario.estimator.likelihood == "fluctuation":

@@ -7,7 +7,13 @@ from pathlib import Path
 import click
 
 from dcee.cli.options import LIKELIHOOD_OPTION, SET_OPTION, TRUTH_OPTION, overrides
-from dcee.console import climb_notice, compile_notice, print_summary, run_with_progress
+from dcee.console import (
+    climb_notice,
+    compile_notice,
+    plume_notice,
+    print_summary,
+    run_with_progress,
+)
 from dcee.errors import DceeInputError
 from dcee.io import (
     check_writable_dir,
@@ -127,6 +133,7 @@ def run(
         check_same_run(out_dir, scenario, strategy, seed)
         if json_file is not None:
             check_writable_file(json_file, "json")
+        plume_notice(scenario, quiet)
         truth_model = make_truth(scenario, seed)  # a bad recording fails here, before the search
         tune_allocator()  # this process is the command line's own (see dcee.allocator)
         compile_notice(quiet)
