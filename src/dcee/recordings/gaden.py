@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -172,6 +172,7 @@ class GadenSimulation:
     times: np.ndarray
     _results: dict
     _free: np.ndarray | None = None
+    _winds: dict = field(default_factory=dict)
 
     @classmethod
     def open(cls, folder: str | Path) -> GadenSimulation:
@@ -213,12 +214,10 @@ class GadenSimulation:
     def wind(self, index: int = 0) -> np.ndarray:
         """(nx, ny, nz, 3) float32 m/s: GADEN's preprocessed wind state ``index``
         (``wind/wind_iteration_<index>``; a result file names the one it used)."""
-        key = ("wind", index)
-        if key not in self._results:
-            self._results[key] = read_wind(
-                self.folder / "wind" / f"wind_iteration_{index}", self.grid
-            )
-        return self._results[key]
+        if index not in self._winds:
+            path = self.folder / "wind" / f"wind_iteration_{index}"
+            self._winds[index] = read_wind(path, self.grid)
+        return self._winds[index]
 
     def iteration_at(self, time: float) -> int:
         """The latest iteration saved at or before ``time`` s (the first before it)."""

@@ -17,13 +17,11 @@ _NORM = 1.0 / math.sqrt(8.0 * math.pi**3)
 @njit(cache=True, inline="always")
 def _free_cell(x, y, z, low, cell, free) -> bool:
     """Whether the float32 point (x, y, z) lies in a free cell of ``free`` (nx, ny, nz)."""
-    i = int((x - low[0]) / cell)
-    j = int((y - low[1]) / cell)
-    k = int((z - low[2]) / cell)
-    # int() truncates toward zero, as GADEN's cast: (low - cell, low) maps to 0
     rx, ry, rz = (x - low[0]) / cell, (y - low[1]) / cell, (z - low[2]) / cell
     if rx <= -1.0 or ry <= -1.0 or rz <= -1.0:
         return False
+    # int() truncates toward zero, as GADEN's cast: (low - cell, low) maps to 0
+    i, j, k = int(rx), int(ry), int(rz)
     if i >= free.shape[0] or j >= free.shape[1] or k >= free.shape[2]:
         return False
     return free[i, j, k]

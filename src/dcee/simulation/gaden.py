@@ -46,14 +46,16 @@ class GadenTruth(TruthModel):
             )
         self.first_time = float(times[np.searchsorted(times, self.start + 1e-9, "right") - 1])
         self.end = float(times[-1])
+        steps = np.diff(times)
+        # s between files: read at every sample of every hold, so worked out once
+        self._time_step = float(steps.min()) if len(steps) else None
         first = simulation.result(int(simulation.iterations[0]))
         # g/m³ per ppm: 1e-6 mole fraction × n_air (mol/cm³ → mol/m³) × M (g/mol)
         self.grams_per_ppm = 1e-6 * first.moles_per_cm3 * 1e6 * molar_mass
 
     @property
     def time_step(self) -> float | None:
-        steps = np.diff(self.simulation.times)
-        return float(steps.min()) if len(steps) else None
+        return self._time_step
 
     @property
     def duration(self) -> float:
