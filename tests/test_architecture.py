@@ -31,6 +31,7 @@ LAYERS = {
     "dcee.blas": 0,
     "dcee.kernel_cache": 0,  # where numba keeps compiled kernels (set before numba loads)
     "dcee.kernel_locator": 0,  # how numba files them there (numba imports it by name)
+    "dcee.state_file": 0,  # state files that are data, not code (checkpoints)
     "dcee.models": 1,
     "dcee.recordings": 1,  # plume recordings on disk: CF reader, header layout, statistics
     "dcee.estimation": 2,

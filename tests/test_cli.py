@@ -397,7 +397,7 @@ def test_help_lists_every_command_without_truncating(capsys, monkeypatch):
     monkeypatch.setenv("COLUMNS", "80")
     code, out, _ = run_cli(["--help"], capsys)
     commands = out.split("Commands:")[1].strip().splitlines()
-    assert code == 0 and len(commands) == 10
+    assert code == 0 and len(commands) == 11
     assert not any(line.rstrip().endswith("...") for line in commands), commands
 
 

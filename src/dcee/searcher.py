@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import pickle
 import time as _time
 from dataclasses import dataclass
 from pathlib import Path
@@ -73,8 +72,9 @@ class LeavingAgent(RestrictedAgent):
         return away
 
 
-CHECKPOINT_FORMAT = "dcee-searcher-checkpoint-1"
-"""Identifies a :meth:`Searcher.save` file (and its layout version)."""
+CHECKPOINT_FORMAT = "dcee-searcher-checkpoint-2"
+"""Identifies a :meth:`Searcher.save` file and its layout version (1 was a Python pickle, no
+longer read: reading a pickle runs whatever code its author put in it)."""
 
 
 class Searcher:
@@ -156,6 +156,10 @@ class Searcher:
         self.planning_cache = ParticleTerms()
         self.checkpoint_code: dict[str, Any] | None = None
         """the code version that wrote the checkpoint this searcher was loaded from"""
+        self.scenario_key: dict[str, str] | None = None
+        """the scenario this search belongs to (name and identity digest,
+        :func:`dcee.runs.scenario_key`): saved with a checkpoint and checked when one is
+        resumed"""
 
     def tell(self, position: np.ndarray, reading: float, time: float | None = None) -> UpdateInfo:
         """Assimilate a reading (g/m³) taken at ``position`` (m) at ``time`` (s)."""
@@ -327,37 +331,52 @@ class Searcher:
         """Checkpoint the whole search to ``path`` (one file, written atomically): the filter
         (particles, weights, reading history, its random state), the planner and its options,
         the agent, the planner's random state, the last position and time. :meth:`load` gives a
-        searcher that makes exactly the decisions this one would have made (tested). The file
-        is a Python pickle: load only checkpoints you wrote yourself."""
+        searcher that makes exactly the decisions this one would have made (tested).
+
+        The file is data, not code (:mod:`dcee.state_file`: NumPy arrays and a JSON header with
+        a checksum, read without pickle); its layout is :data:`CHECKPOINT_FORMAT`, documented
+        in docs/robot.md."""
         from dcee.provenance import code_version
+        from dcee.state_file import write_state
 
         path = Path(path)
-        state = {"format": CHECKPOINT_FORMAT, "code": code_version(), "searcher": self}
+        meta = {"scenario": self.scenario_key}
         try:
-            write_atomic(path, lambda p: p.write_bytes(pickle.dumps(state, protocol=5)))
+            write_atomic(
+                path, lambda p: write_state(p, CHECKPOINT_FORMAT, self, meta, code_version())
+            )
         except OSError as exc:
             raise DceeInputError("path", f"cannot write checkpoint {path}: {exc}") from None
         return path
 
     @classmethod
-    def load(cls, path: str | Path) -> Searcher:
+    def load(cls, path: str | Path, scenario_key: dict[str, str] | None = None) -> Searcher:
         """Restore a searcher from a :meth:`save` checkpoint (the code version that wrote it is
-        in :attr:`checkpoint_code`)."""
+        in :attr:`checkpoint_code`). With ``scenario_key`` (:func:`dcee.runs.scenario_key` of
+        the scenario it is to resume) a checkpoint of another scenario is refused. Any file
+        that is not an intact checkpoint of this dcee version: one
+        :class:`~dcee.errors.DceeInputError` naming what is wrong."""
+        from dcee.state_file import read_state
+
         path = Path(path)
-        try:
-            state = pickle.loads(path.read_bytes())
-        except FileNotFoundError:
-            raise DceeInputError("path", f"no checkpoint at {path}") from None
-        except Exception as exc:
-            raise DceeInputError("path", f"{path} is not a dcee checkpoint ({exc})") from None
-        if not (
-            isinstance(state, dict)
-            and state.get("format") == CHECKPOINT_FORMAT
-            and isinstance(state.get("searcher"), cls)
-        ):
-            raise DceeInputError("path", f"{path} is not a dcee searcher checkpoint")
-        searcher: Searcher = state["searcher"]
-        searcher.checkpoint_code = state.get("code")
+        header, searcher = read_state(path, CHECKPOINT_FORMAT)
+        if not isinstance(searcher, cls):
+            raise DceeInputError("checkpoint", f"{path}: holds no searcher")
+        for name, role in (("filter", Estimator), ("agent", GridAgent)):
+            if not isinstance(getattr(searcher, name, None), role):
+                raise DceeInputError("checkpoint", f"{path}: its searcher has no valid {name}")
+        if searcher.planner is not None and not isinstance(searcher.planner, Planner):
+            raise DceeInputError("checkpoint", f"{path}: its searcher has no valid planner")
+        saved = (header.get("meta") or {}).get("scenario")
+        if scenario_key is not None and saved != scenario_key:
+            name = saved.get("name") if isinstance(saved, dict) else None
+            now = scenario_key.get("name")
+            what = f"not of {now!r}" if name != now else f"not of {now!r} with other settings"
+            raise DceeInputError(
+                "checkpoint",
+                f"{path}: saved by a search of {name!r}, {what}: start a new search",
+            )
+        searcher.checkpoint_code = header.get("code")
         return searcher
 
     def belief(self) -> Belief:

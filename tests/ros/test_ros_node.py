@@ -486,3 +486,55 @@ def test_the_node_filter_has_the_outlier_safety() -> None:
         node.destroy_node()
     finally:
         rclpy.try_shutdown(context=context)
+
+
+def test_node_resumes_its_own_checkpoint_and_refuses_a_tampered_or_foreign_one(tmp_path) -> None:
+    """The ``checkpoint`` parameter: the node's own file resumes the search; a file with one byte
+    changed, or saved under other settings, starts no search: ERROR in the diagnostics, the
+    reason logged, dcee/start refused while the file is there (issue 80)."""
+    import rclpy
+    from diagnostic_msgs.msg import DiagnosticStatus
+    from rclpy.parameter import Parameter
+    from std_srvs.srv import Trigger
+
+    from dcee.ros.node import SearchNode
+
+    path = tmp_path / "search.ckpt"
+    context = rclpy.Context()
+    rclpy.init(context=context, args=[], domain_id=_domain())
+
+    def node(particles: int = 300) -> SearchNode:
+        return SearchNode(
+            context=context,
+            parameter_overrides=[
+                Parameter("particles", value=particles),
+                Parameter("checkpoint", value=str(path)),
+            ],
+        )
+
+    try:
+        first = node()
+        assert first.searcher is not None and first.checkpoint_error == ""
+        first.searcher.tell(np.array(first.scenario.agent.start), 0.0, time=1.0)
+        first.searcher.save(path)
+        resumed = node()
+        assert resumed.searcher is not None and resumed.searcher.checkpoint_code is not None
+        assert resumed.searcher.filter.n_readings == 1
+        assert resumed.diagnostics().level == DiagnosticStatus.OK
+
+        foreign = node(particles=400)  # the same scenario name, other settings
+        assert foreign.searcher is None and "with other settings" in foreign.checkpoint_error
+        status = foreign.diagnostics()
+        assert status.level == DiagnosticStatus.ERROR and "checkpoint refused" in status.message
+
+        data = path.read_bytes()
+        path.write_bytes(data[:1000] + bytes([data[1000] ^ 1]) + data[1001:])
+        tampered = node()
+        assert tampered.searcher is None and "digest does not match" in tampered.checkpoint_error
+        answer = tampered._on_start(Trigger.Request(), Trigger.Response())
+        assert not answer.success and "digest" in answer.message
+        path.unlink()  # the operator removes the file: a fresh search starts
+        answer = tampered._on_start(Trigger.Request(), Trigger.Response())
+        assert answer.success and tampered.searcher is not None
+    finally:
+        rclpy.try_shutdown(context=context)

@@ -12,6 +12,7 @@ import click
 
 from dcee.cli.bench import bench, report
 from dcee.cli.catalogue import scenarios, schema, show, strategies
+from dcee.cli.checkpoint import checkpoint
 from dcee.cli.perf import perf
 from dcee.cli.plume import plume
 from dcee.cli.replay import replay
@@ -28,7 +29,19 @@ def cli(ctx: click.Context) -> None:
         click.echo(ctx.get_help())
 
 
-for _command in (run, replay, scenarios, strategies, show, schema, perf, bench, report, plume):
+for _command in (
+    run,
+    replay,
+    checkpoint,
+    scenarios,
+    strategies,
+    show,
+    schema,
+    perf,
+    bench,
+    report,
+    plume,
+):
     cli.add_command(_command)
 
 

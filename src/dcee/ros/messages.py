@@ -194,12 +194,19 @@ def diagnostic_status(
     active: bool,
     callback_errors: int,
     finish_reason: str,
+    checkpoint_error: str = "",
 ) -> DiagnosticStatus:
     """The search's state and its input health as one DiagnosticStatus: WARN once input
-    messages were dropped, ERROR once a callback failed."""
+    messages were dropped, ERROR once a callback failed or while a checkpoint file was refused
+    (``checkpoint_error``: no search started from it)."""
     status = DiagnosticStatus()
     status.name = name
     status.hardware_id = "dcee"
+    if cycle is None and checkpoint_error:
+        status.level = DiagnosticStatus.ERROR
+        status.message = f"checkpoint refused: {checkpoint_error}"
+        status.values = [KeyValue(key="state", value="checkpoint refused")]
+        return status
     if cycle is None:
         status.level = DiagnosticStatus.OK
         status.message = "configured, no search yet" if active else "inactive"

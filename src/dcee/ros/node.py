@@ -80,6 +80,7 @@ from dcee.ros.parameters import (
     new_searcher,
     scenario_from_parameters,
 )
+from dcee.runs import scenario_key
 from dcee.scenarios import Scenario
 from dcee.searcher import Searcher
 
@@ -140,6 +141,8 @@ class SearchNode(NodeOutputs, LifecycleNode):
         """occupancy grids applied from the ``map`` topic"""
         self.configure_error: str | None = None
         """why the last configure transition failed (one line)"""
+        self.checkpoint_error = ""
+        """why the checkpoint file was refused (one line; empty once a search started)"""
         self._errors_in_a_row = 0
         self._rejected_reported = 0
         self._wind_warned = False
@@ -232,11 +235,22 @@ class SearchNode(NodeOutputs, LifecycleNode):
             callback = functools.partial(self._guarded, what, handler)
             self.create_subscription(kind, str(p[topic]), callback, qos)
 
-    def _new_search(self) -> None:
-        """A fresh search (resumed from the checkpoint file when there is one, the first time)."""
+    def _new_search(self) -> bool:
+        """A fresh search (resumed from the checkpoint file when there is one, the first time).
+        False, with :attr:`checkpoint_error` set, logged and in the diagnostics, when that file
+        is not an intact checkpoint of this scenario: no search starts from it."""
         p, scenario = self.params, self.scenario
+        key = scenario_key(scenario)  # the configured scenario's (before a map's walls)
         if self.searches_started == 0 and self.checkpoint is not None and self.checkpoint.exists():
-            searcher = Searcher.load(self.checkpoint)
+            try:
+                searcher = Searcher.load(self.checkpoint, key)
+            except DceeInputError as exc:
+                self.checkpoint_error = exc.message
+                self.get_logger().error(
+                    f"no search started: {exc.message} (remove the file to start afresh)"
+                )
+                self._publish_diagnostics()
+                return False
             self.get_logger().info(f"resumed the search from {self.checkpoint}")
         else:
             scenario, line = self.map_gas.scenario(scenario, bool(p["gas_walls"]))
@@ -244,6 +258,8 @@ class SearchNode(NodeOutputs, LifecycleNode):
                 walls = scenario.estimator.plume == "walls"
                 (self.get_logger().info if walls else self.get_logger().warning)(line)
             searcher = new_searcher(p, scenario, self.searches_started)
+            searcher.scenario_key = key
+        self.checkpoint_error = ""
         self.gas_model = scenario.estimator.plume
         if self._map_site is not None:  # the map topic's obstacles outlive a search
             searcher.agent = dataclasses.replace(searcher.agent, site=self._map_site)
@@ -262,14 +278,16 @@ class SearchNode(NodeOutputs, LifecycleNode):
             self._last_pose = None
             self._rejected_reported = 0
         self.searches_started += 1
+        return True
 
     def _on_start(self, request: Any, response: Any) -> Any:
         if not self.active:
             response.success, response.message = False, "not active (configure and activate)"
         elif self.cycle is not None and not self.done.is_set():
             response.success, response.message = False, "a search is running (cancel it first)"
+        elif not self._new_search():
+            response.success, response.message = False, self.checkpoint_error
         else:
-            self._new_search()
             response.success, response.message = True, f"search {self.searches_started} started"
         return response
 

@@ -48,6 +48,7 @@ class NodeOutputs:
             self.active,
             self.callback_errors,
             self.finish_reason,
+            self.checkpoint_error,
         )
 
     def _publish_diagnostics(self) -> None:

@@ -7,7 +7,7 @@ against live in :mod:`dcee.simulation`; campaigns of runs in :mod:`dcee.campaign
 
 from dcee.runs.assemble import make_searcher, planner_defaults
 from dcee.runs.episode import run_episode
-from dcee.runs.identity import scenario_identity
+from dcee.runs.identity import scenario_identity, scenario_key
 from dcee.runs.metrics import longest_stall, search_stall, search_summary, summarise
 from dcee.runs.records import reading_record
 from dcee.runs.result import (
@@ -34,6 +34,7 @@ __all__ = [
     "reading_record",
     "run_episode",
     "scenario_identity",
+    "scenario_key",
     "search_stall",
     "search_summary",
     "snapshot_times",

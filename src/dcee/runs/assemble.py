@@ -15,6 +15,7 @@ from dcee.estimation.multi_source import MultiSourceFilter
 from dcee.estimation.particle_filter import ParticleFilter
 from dcee.estimation.source_count import FOUND_SHARE, SourceCountBank
 from dcee.planning.base import Planner, planner_class
+from dcee.runs.identity import scenario_key
 from dcee.scenarios import Scenario
 from dcee.scenarios.schema.truth import MIN_SOURCE_SEPARATION
 from dcee.searcher import Searcher
@@ -91,7 +92,7 @@ def make_searcher(
         )
     else:
         estimator = filters[0]
-    return Searcher(
+    searcher = Searcher(
         estimator,
         planner,
         scenario.make_agent(on_robot=on_robot),
@@ -101,6 +102,8 @@ def make_searcher(
         stop_rule=scenario.stop_rule(on_robot),
         explore_guard=scenario.explore_guard,
     )
+    searcher.scenario_key = scenario_key(scenario)
+    return searcher
 
 
 def planner_defaults(

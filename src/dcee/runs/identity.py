@@ -167,6 +167,18 @@ def _with_resolved(scenario: dict[str, Any], resolved: Any) -> dict[str, Any]:
     return out
 
 
+def scenario_key(scenario: Any) -> dict[str, str]:
+    """{"name", "identity"}: a :class:`~dcee.scenarios.Scenario`'s name and the SHA-256 of its
+    :func:`scenario_identity` (what a checkpoint records, so that a search is resumed only
+    under the scenario it belongs to)."""
+    import hashlib
+    import json
+
+    ident = scenario_identity(scenario.model_dump(mode="json"))
+    digest = hashlib.sha256(json.dumps(ident, sort_keys=True, default=str).encode()).hexdigest()
+    return {"name": str(scenario.name), "identity": digest}
+
+
 def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
     """A stored scenario (its JSON dump) reduced to what decides the results: without its
     free-text description and without later-added settings at their defaults."""
