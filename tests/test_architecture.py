@@ -32,6 +32,7 @@ LAYERS = {
     "dcee.kernel_cache": 0,  # where numba keeps compiled kernels (set before numba loads)
     "dcee.kernel_locator": 0,  # how numba files them there (numba imports it by name)
     "dcee.state_file": 0,  # state files that are data, not code (checkpoints)
+    "dcee.limits": 0,  # what a reader of others' files will allocate
     "dcee.models": 1,
     "dcee.recordings": 1,  # plume recordings on disk: CF reader, header layout, statistics
     "dcee.estimation": 2,

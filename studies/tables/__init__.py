@@ -28,6 +28,7 @@ from studies.tables.performance import (
     search_speed_table,
     speed_table,
 )
+from studies.tables.robustness import fuzz_readers_table
 from studies.tables.sites import (
     sites_table,
     sites_walls_table,
@@ -58,6 +59,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "gaden-rooms": gaden_rooms_table,
     "gaden-starts": gaden_starts_table,
     "gaden-timing": gaden_timing_table,
+    "fuzz-readers": fuzz_readers_table,
     "lbm3d-plume": lbm3d_plume_table,
     "lbm3d-search": lbm3d_search_table,
     "lbm3d-altitudes": lbm3d_altitude_table,

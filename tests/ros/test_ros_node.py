@@ -538,3 +538,103 @@ def test_node_resumes_its_own_checkpoint_and_refuses_a_tampered_or_foreign_one(t
         assert answer.success and tampered.searcher is not None
     finally:
         rclpy.try_shutdown(context=context)
+
+
+def _drive_until(executor, node, pose_pub, conc_pub, goals, count, t0, start) -> float:
+    """Publish a robot's odometry (at ``start``, then standing at the latest goal: it gets
+    there at once) and zero readings until ``count`` goals arrived."""
+    import time
+
+    from nav_msgs.msg import Odometry
+    from std_msgs.msg import Float32
+
+    from dcee.ros.sim_node import stamp_of
+
+    t, deadline = t0, time.monotonic() + 60
+    while len(goals) < count and time.monotonic() < deadline:
+        msg = Odometry()
+        msg.header.stamp = stamp_of(t)
+        msg.header.frame_id = "map"
+        at = (goals[-1].pose.position.x, goals[-1].pose.position.y) if goals else start[:2]
+        msg.pose.pose.position.x, msg.pose.pose.position.y = at[0], at[1]
+        msg.pose.pose.orientation.w = 1.0
+        conc_pub.publish(Float32(data=0.0))
+        pose_pub.publish(msg)
+        for _ in range(4):
+            executor.spin_once(timeout_sec=0.01)
+        t += 0.1
+    assert len(goals) >= count, f"{len(goals)} goals of {count}"
+    return t
+
+
+def test_a_full_disk_costs_the_checkpoint_not_the_search_and_a_restart_resumes(tmp_path) -> None:
+    """Checkpoints that cannot be written (the disk full): the goal is still published, the
+    failure counted, logged and WARN in the diagnostics, the search goes on. The node killed
+    and started again on the same file resumes with every reading written and goes on
+    (issue 80)."""
+    import rclpy
+    from diagnostic_msgs.msg import DiagnosticStatus
+    from geometry_msgs.msg import PoseStamped
+    from nav_msgs.msg import Odometry
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    from std_msgs.msg import Float32
+
+    import dcee.searcher
+    from dcee.errors import DceeInputError
+    from dcee.ros.node import SearchNode
+    from dcee.ros.parameters import LATCHED, RELIABLE
+
+    path = tmp_path / "search.ckpt"
+    context = rclpy.Context()
+    rclpy.init(context=context, args=[], domain_id=_domain())
+    real_save = dcee.searcher.Searcher.save
+
+    def full_disk(self, p):
+        raise DceeInputError("path", f"cannot write checkpoint {p}: [Errno 28] No space left")
+
+    def node() -> SearchNode:
+        return SearchNode(
+            context=context,
+            parameter_overrides=[
+                Parameter("particles", value=300),
+                Parameter("strategy", value="mpc"),
+                Parameter("checkpoint", value=str(path)),
+            ],
+        )
+
+    try:
+        dcee.searcher.Searcher.save = full_disk
+        first = node()
+        robot = rclpy.create_node("robot", context=context)
+        pose_pub = robot.create_publisher(Odometry, "odom", RELIABLE)
+        conc_pub = robot.create_publisher(Float32, "concentration", RELIABLE)
+        goals: list = []
+        robot.create_subscription(PoseStamped, "goal_pose", goals.append, LATCHED)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(first)
+        executor.add_node(robot)
+        start = first.scenario.agent.start
+        t = _drive_until(executor, first, pose_pub, conc_pub, goals, 2, 1.0, start)
+        assert first.checkpoint_failures >= 2 and not path.exists()
+        status = first.diagnostics()
+        assert status.level == DiagnosticStatus.WARN and "No space left" in status.message
+        assert first.callback_errors == 0 and first.cycle.state != "done"
+
+        dcee.searcher.Searcher.save = real_save  # space again: the next reading is written
+        t = _drive_until(executor, first, pose_pub, conc_pub, goals, 3, t, start)
+        assert path.exists() and first.checkpoint_failure == ""
+        written = first.searcher.filter.n_readings
+        executor.remove_node(first)
+        first.destroy_node()  # killed: only the file is left
+
+        goals.clear()
+        second = node()
+        executor.add_node(second)
+        assert second.searcher.filter.n_readings == written
+        _drive_until(executor, second, pose_pub, conc_pub, goals, 2, t, start)
+        assert second.searcher.filter.n_readings > written
+        assert second.callback_errors == 0
+    finally:
+        dcee.searcher.Searcher.save = real_save
+        rclpy.try_shutdown(context=context)

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from dcee.errors import DceeInputError
+from dcee.limits import MAX_IMAGE_PIXELS, read_text
 from dcee.models.site import SiteMap
 
 
@@ -26,10 +27,10 @@ def load_ros_map(path: str | Path, clearance: float = 0.0) -> SiteMap:
     path = Path(path)
     field_name = "world.map"
     try:
-        meta = yaml.safe_load(path.read_text(encoding="utf-8"))
+        meta = yaml.safe_load(read_text(path, field_name))
     except FileNotFoundError:
         raise DceeInputError(field_name, f"no map file {path}") from None
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
+    except (OSError, UnicodeDecodeError, yaml.YAMLError, RecursionError) as exc:
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise DceeInputError(field_name, f"{path} is not a readable map YAML ({first})") from None
     if not isinstance(meta, dict):
@@ -72,10 +73,22 @@ def load_ros_map(path: str | Path, clearance: float = 0.0) -> SiteMap:
     image = path.parent / str(meta["image"])
     try:
         with Image.open(image) as img:
+            if img.width * img.height > MAX_IMAGE_PIXELS:  # the header's size, nothing decoded
+                raise DceeInputError(
+                    field_name,
+                    f"{path}: its image declares {img.width} x {img.height} pixels, over the "
+                    f"{MAX_IMAGE_PIXELS:,} a map may have",
+                )
             pixels = np.asarray(img.convert("L"), dtype=float)
     except FileNotFoundError:
         raise DceeInputError(field_name, f"{path}: its image {image} does not exist") from None
-    except (OSError, UnidentifiedImageError) as exc:
+    except (
+        OSError,
+        UnidentifiedImageError,
+        ValueError,
+        SyntaxError,
+        Image.DecompressionBombError,
+    ) as exc:
         raise DceeInputError(
             field_name, f"{path}: its image {image} cannot be read ({exc})"
         ) from None

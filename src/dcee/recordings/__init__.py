@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from dcee.errors import DceeInputError
+from dcee.limits import check_npy, read_text
 from dcee.recordings.cf import SUFFIXES, cf_layout
 
 FIELD = "truth.model.file"
@@ -43,16 +44,16 @@ def recording_layout(
     plane: object = None
     try:
         if suffix == ".npy":
-            ndim = np.load(path, mmap_mode="r", allow_pickle=False).ndim
+            ndim = len(check_npy(path, FIELD))  # the header alone
             meta_path = path.with_suffix(".json")
             if meta_path.is_file():
-                meta = json.loads(meta_path.read_text(encoding="utf-8"))
+                meta = json.loads(read_text(meta_path, FIELD))
                 plane = meta.get("z") if isinstance(meta, dict) else None
         elif suffix in (".h5", ".hdf5"):
             import h5py
 
             with h5py.File(path, "r") as h5:
-                if "concentration" not in h5:
+                if not isinstance(h5.get("concentration"), h5py.Dataset):
                     raise DceeInputError(FIELD, f"{path.name} has no 'concentration' dataset")
                 ndim = h5["concentration"].ndim
                 plane = h5.attrs.get("z")
@@ -68,8 +69,10 @@ def recording_layout(
         raise DceeInputError(
             FIELD, "HDF5 recordings need h5py: pip install 'dcee[hdf5]' (or use .npy)"
         ) from None
-    except (OSError, ValueError) as exc:
-        raise DceeInputError(FIELD, f"cannot read {path.name}: {exc}") from None
+    except (OSError, ValueError, TypeError, KeyError, RuntimeError, RecursionError) as exc:
+        # h5py reports a corrupt file as any of these; JSON nested too deep: RecursionError
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise DceeInputError(FIELD, f"cannot read {path.name}: {first}") from None
     if ndim != 3:
         return False, None
     try:

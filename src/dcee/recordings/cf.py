@@ -32,13 +32,16 @@ naming the field, raised before any search starts.
 
 from __future__ import annotations
 
+import gc
 import re
+import sys
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from dcee.errors import DceeInputError
+from dcee.limits import check_declared
 
 FIELD = "truth.model.file"
 SUFFIXES = (".nc", ".nc4", ".netcdf", ".cdf")
@@ -119,11 +122,24 @@ def _open(path: Path) -> Any:
         import xarray as xr
     except ImportError:
         raise _fail("NetCDF recordings need xarray: pip install 'dcee[netcdf]'") from None
+    # a file h5netcdf fails to open leaves a half-made object whose finaliser prints a traceback
+    # of its own ("Exception ignored in ... close") when the failure's frames are let go: not
+    # the user's to read, so that finaliser runs, silenced, before the one-line error
+    hook = sys.unraisablehook
+    sys.unraisablehook = _ignore
     try:
-        return xr.open_dataset(path, decode_times=False, mask_and_scale=True)
-    except Exception as exc:  # xarray raises many kinds (ValueError, OSError, engine errors)
-        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise _fail(f"cannot read {path.name} as NetCDF: {first}") from None
+        try:
+            return xr.open_dataset(path, decode_times=False, mask_and_scale=True)
+        except Exception as exc:  # xarray raises many kinds (ValueError, OSError, engine errors)
+            first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        gc.collect()
+    finally:
+        sys.unraisablehook = hook
+    raise _fail(f"cannot read {path.name} as NetCDF: {first}")
+
+
+def _ignore(unraisable: object) -> None:
+    """An unraisable-exception hook that prints nothing (:func:`_open`)."""
 
 
 def _is_concentration(units: object) -> bool:
@@ -195,7 +211,7 @@ def cf_layout(
             if coord.ndim != 0 or _axis_of(ds, str(name), {}) != "z":
                 continue
             scale = _scale(coord.attrs.get("units"), LENGTH_METRES, "length", str(name))
-            height = float(coord.values) * scale
+            height = float(np.asarray(coord.values, dtype=np.float64)) * scale
             if np.isfinite(height):
                 return True, height
         return True, None
@@ -240,6 +256,10 @@ def read_cf_recording(
                 f"(dimensions {', '.join(map(str, var.dims))})"
             )
         order = ["t", "y", "x"] + (["z"] if "z" in found else [])
+        check_declared(FIELD, f"{path.name}: variable {var.name!r}", var.shape)  # before reading
+        for a in order:
+            if found[a] in ds.variables:
+                check_declared(FIELD, f"{path.name}: axis {found[a]!r}", ds[found[a]].shape)
         arr = np.asarray(var.transpose(*[found[a] for a in order]).values, dtype=np.float64)
         coords = {}
         for a in order:

@@ -16,6 +16,7 @@ float64 (GADEN's float32 sum differs from it by under 4e-7 relative on the sampl
 
 from __future__ import annotations
 
+import io
 import math
 import re
 from dataclasses import dataclass, field
@@ -23,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from dcee.limits import read_text
 from dcee.recordings.gaden_files import (
     FREE,
     GAS_MOLAR_MASS,
@@ -240,23 +242,27 @@ def _iteration_times(folder: Path, iterations: np.ndarray) -> np.ndarray:
         import pandas as pd
 
         try:
-            frame = pd.read_csv(table)
+            frame = pd.read_csv(io.StringIO(read_text(table, "GADEN")))
             by_file = dict(zip(frame["file"], frame["t_s"].astype(float), strict=True))
-        except (ValueError, KeyError) as exc:
-            raise gaden_error(table, f"needs columns file and t_s ({exc})") from None
+        except (ValueError, KeyError, TypeError) as exc:
+            first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise gaden_error(table, f"needs columns file and t_s ({first})") from None
         try:
-            return np.array([by_file[f"iteration_{k}"] for k in iterations])
+            times = np.array([by_file[f"iteration_{k}"] for k in iterations], dtype=np.float64)
         except KeyError as exc:
             raise gaden_error(table, f"no time for {exc.args[0]}") from None
+        if not (np.all(np.isfinite(times)) and np.all(np.diff(times) > 0)):
+            raise gaden_error(table, "the times must be finite and increase with the iteration")
+        return times
     sim = folder / "sim.yaml"
     if not sim.exists():
         raise gaden_error(folder, "neither times.csv nor sim.yaml: the result files carry no time")
     import yaml
 
     try:
-        settings = yaml.safe_load(sim.read_text()) or {}
+        settings = yaml.safe_load(read_text(sim, "GADEN")) or {}
         dt, save = float(settings["deltaTime"]), float(settings["saveDeltaTime"])
-    except (yaml.YAMLError, KeyError, TypeError, ValueError) as exc:
+    except (yaml.YAMLError, KeyError, TypeError, ValueError, RecursionError) as exc:
         raise gaden_error(sim, f"needs numbers deltaTime and saveDeltaTime ({exc})") from None
     if not (dt > 0 and save >= 0):
         raise gaden_error(sim, f"deltaTime {dt} must be > 0 and saveDeltaTime {save} ≥ 0")

@@ -28,6 +28,8 @@ and a grid that does not match the occupancy grid's.
 
 from __future__ import annotations
 
+import gzip
+import io
 import math
 import struct
 import zlib
@@ -37,6 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from dcee.errors import DceeInputError
+from dcee.limits import CappedStream, read_text
 
 SUPPORTED_VERSIONS = ((3, 0),)
 """(major, minor) versions of GADEN's result and wind files that this reader knows."""
@@ -219,7 +222,7 @@ def read_occupancy(path: str | Path) -> tuple[GadenGrid, np.ndarray]:
     1 obstacle, 2 outlet)."""
     path = Path(path)
     try:
-        lines = path.read_text(encoding="ascii").splitlines()
+        lines = read_text(path, "GADEN", encoding="ascii").splitlines()
     except FileNotFoundError:
         raise gaden_error(path, "no such file: a GADEN folder needs its occupancy grid") from None
     except (OSError, UnicodeDecodeError) as exc:
@@ -243,12 +246,12 @@ def read_occupancy(path: str | Path) -> tuple[GadenGrid, np.ndarray]:
     rows = [ln for ln in lines[4:] if ln.strip() and ln.strip() != ";"]
     if len(rows) != nx * nz:
         raise gaden_error(path, f"{len(rows)} rows of cells; the header's grid needs {nx * nz}")
-    try:
-        cells = np.array([r.split() for r in rows], dtype=np.uint8)
-    except ValueError:
-        raise gaden_error(path, f"every row needs {ny} cell values 0, 1 or 2") from None
-    if cells.shape != (nx * nz, ny) or cells.max(initial=0) > OUTLET:
-        raise gaden_error(path, f"every row needs {ny} cell values 0, 1 or 2")
+    cells = np.empty((nx * nz, ny), dtype=np.uint8)
+    for k, row in enumerate(rows):  # row by row: no list of every cell's text at once
+        values = row.split()
+        if len(values) != ny or not all(v in ("0", "1", "2") for v in values):
+            raise gaden_error(path, f"row {k + 5}: every row needs {ny} cell values 0, 1 or 2")
+        cells[k] = np.array(values, dtype=np.uint8)
     return grid, cells.reshape(nz, nx, ny).transpose(1, 2, 0).copy()
 
 
@@ -278,12 +281,21 @@ def read_wind_csv(path: str | Path, grid: GadenGrid) -> np.ndarray:
 
     path = Path(path)
     columns = ["U:0", "U:1", "U:2", "Points:0", "Points:1", "Points:2"]
+    cells = math.prod(grid.shape)
+    # a row of six numbers as GADEN's export writes them is under 128 bytes: a file that
+    # expands (gzip) to more than that per cell is refused before pandas holds it
+    limit = 128 * (cells + 1)
     try:
-        frame = pd.read_csv(path, usecols=columns, dtype=np.float64)
+        raw = gzip.open(path) if path.suffix == ".gz" else path.open("rb")
+        with io.BufferedReader(CappedStream(raw, limit, "GADEN", str(path))) as stream:
+            frame = pd.read_csv(stream, usecols=columns, dtype=np.float64, nrows=cells + 1)
     except FileNotFoundError:
         raise gaden_error(path, "no such file") from None
-    except (ValueError, OSError, EOFError, zlib.error) as exc:
-        raise gaden_error(path, f"needs numeric columns {', '.join(columns)} ({exc})") from None
+    except DceeInputError:
+        raise
+    except (ValueError, OSError, EOFError, zlib.error, pd.errors.ParserError) as exc:
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise gaden_error(path, f"needs numeric columns {', '.join(columns)} ({first})") from None
     if len(frame) > math.prod(grid.shape) or not np.all(np.isfinite(frame.to_numpy())):
         raise gaden_error(path, "more rows than the grid has cells, or a value that is not finite")
     idx, inside = grid.cells(frame[columns[3:]].to_numpy())

@@ -178,8 +178,10 @@ def read_events(path: str | Path, topics: dict[str, str] | None = None) -> list[
                 events.extend(_event(by_topic[conn.topic], msg, stamp_seconds(log_ns)))
     except DceeInputError:
         raise
-    except Exception as exc:
-        raise DceeInputError("bag", f"cannot read {path} as a ROS 2 bag ({exc})") from None
+    except Exception as exc:  # rosbags raises many kinds for a corrupt bag
+        first = str(exc).strip().splitlines()[0][:200] if str(exc).strip() else ""
+        why = f"{type(exc).__name__}: {first}" if first else type(exc).__name__
+        raise DceeInputError("bag", f"cannot read {path} as a ROS 2 bag ({why})") from None
     kinds = {e.kind for e in events}
     for kind in ("pose", "reading", "goal"):
         if kind not in kinds:

@@ -9,6 +9,7 @@ own clock starts at the first pose, so ``search.budget`` counts from there.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from numbers import Real
@@ -144,6 +145,11 @@ class SearchCycle:
     _pending_goal: np.ndarray | None = None
     _wind: list[tuple[float, float]] = field(default_factory=list)
     _wind_since: float | None = None
+    clock_offset: float = 0.0
+    """s added to every stamp since the clock jumped back (:data:`CLOCK_JUMP`)"""
+    clock_jumps: int = 0
+    """how many times the clock jumped back and the search's clock carried on"""
+    _behind: list[float] = field(default_factory=list)
 
     @property
     def search_time(self) -> float:
@@ -219,7 +225,8 @@ class SearchCycle:
         if self.state == "holding":
             # arrived while holding: part of this hold, even when its stamp lags the pose's
             # (a subscriber's clock behind the odometry's)
-            self._samples.append((max(float(t), self._since), float(value)))
+            t = float(t) + self.clock_offset
+            self._samples.append((max(t, self._since), float(value)))
 
     def on_wind(self, t: float, vx: float, vy: float) -> bool:
         """A wind sample received at ``t`` s: the air's velocity (vx, vy) m/s in the map frame.
@@ -234,6 +241,7 @@ class SearchCycle:
         if math.hypot(vx, vy) > MAX_WIND:
             self._reject("wind above 100 m/s")
             return False
+        t = float(t) + self.clock_offset
         if self._wind_since is None or t < self._wind_since:
             self._wind_since, self._wind = float(t), []
         self._wind.append((float(vx), float(vy)))
@@ -249,16 +257,25 @@ class SearchCycle:
     def on_pose(self, pose: Pose) -> CycleOutput:
         """A pose sample: advances the cycle; returns what to publish. A pose that cannot be
         the robot's (:meth:`pose_problem`) is dropped and counted (:attr:`rejected`)."""
+        pose = dataclasses.replace(pose, t=pose.t + self.clock_offset)
         problem = self.pose_problem(pose)
+        if problem == "pose stamp went backwards":
+            jump = self._clock_jump(pose)
+            if jump is not None:
+                pose = dataclasses.replace(pose, t=pose.t + jump)
+                problem = self.pose_problem(pose)
         if problem is not None:
             self._reject(problem)
             return CycleOutput()
+        self._behind = []
         out = CycleOutput()
         if self._pose is not None:
             self.path_length += math.hypot(pose.x - self._pose.x, pose.y - self._pose.y)
         self._pose = pose
         if self.start_time is None:
-            self.start_time = pose.t
+            # a searcher resumed from a checkpoint: the search's time carries on from its last
+            # reading (the estimator takes no reading from before it, and the budget counts on)
+            self.start_time = pose.t - self.searcher.time
             self._drive_started = pose.t
         s = self.settings
         if self.state != "done" and self.search_time > s.budget + 1e-9:
@@ -279,6 +296,26 @@ class SearchCycle:
         if self.state == "holding" and pose.t - self._since >= s.hold - 1e-9 and self._samples:
             out = self._complete(pose)
         return out
+
+    def _clock_jump(self, pose: Pose) -> float | None:
+        """The jump (s) when ``pose``, its stamp behind the last accepted one, is the
+        :data:`CLOCK_JUMP_POSES`-th in a row each more than :data:`CLOCK_JUMP` s behind and each
+        later than the one before: the clock jumped back (a time source reset, a simulation
+        restarted); it did not merely deliver a pose late. Then the search's clock carries on
+        from the last accepted pose (:attr:`clock_offset` grows by the jump, which is counted)
+        instead of dropping every pose until the new clock catches up. None otherwise."""
+        assert self._pose is not None
+        if self._pose.t - pose.t <= CLOCK_JUMP or (self._behind and pose.t <= self._behind[-1]):
+            self._behind = []
+            return None
+        self._behind.append(pose.t)
+        if len(self._behind) < CLOCK_JUMP_POSES:
+            return None
+        jump = self._pose.t - self._behind[0]
+        self.clock_offset += jump
+        self.clock_jumps += 1
+        self._behind = []
+        return jump
 
     def _complete(self, pose: Pose) -> CycleOutput:
         s = self.settings
@@ -330,6 +367,13 @@ class SearchCycle:
             self.goal, self.state = None, "waiting"
         return out
 
+
+CLOCK_JUMP = 1.0
+"""s: a pose stamp further than this behind the last accepted one is not a late message; three
+such in a row, each later than the one before, are a clock that jumped back
+(:meth:`SearchCycle.on_pose`)."""
+
+CLOCK_JUMP_POSES = 3
 
 MAX_WIND = 100.0
 """m/s: a faster wind sample is a sensor fault."""

@@ -195,10 +195,13 @@ def diagnostic_status(
     callback_errors: int,
     finish_reason: str,
     checkpoint_error: str = "",
+    checkpoint_failure: str = "",
+    health: dict[str, str] | None = None,
 ) -> DiagnosticStatus:
     """The search's state and its input health as one DiagnosticStatus: WARN once input
     messages were dropped, ERROR once a callback failed or while a checkpoint file was refused
-    (``checkpoint_error``: no search started from it)."""
+    (``checkpoint_error``: no search started from it); WARN while checkpoints cannot be written
+    (``checkpoint_failure``: the search goes on). ``health``: more key-values (latency)."""
     status = DiagnosticStatus()
     status.name = name
     status.hardware_id = "dcee"
@@ -216,6 +219,9 @@ def diagnostic_status(
     if callback_errors:
         status.level = DiagnosticStatus.ERROR
         status.message = f"{callback_errors} callback errors (messages ignored)"
+    elif checkpoint_failure:
+        status.level = DiagnosticStatus.WARN
+        status.message = f"checkpoint not written: {checkpoint_failure}"
     elif rejected:
         status.level = DiagnosticStatus.WARN
         status.message = f"{sum(rejected.values())} input messages dropped"
@@ -228,6 +234,7 @@ def diagnostic_status(
         "readings used": str(len(cycle.records)),
         "callback errors": str(callback_errors),
         **{f"dropped: {k}": str(v) for k, v in sorted(rejected.items())},
+        **(health or {}),
     }
     status.values = [KeyValue(key=k, value=v) for k, v in values.items()]
     return status

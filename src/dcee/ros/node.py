@@ -37,10 +37,12 @@ concentrations are g/m³.
 
 from __future__ import annotations
 
+import collections
 import dataclasses
 import functools
 import json
 import threading
+import time
 from pathlib import Path
 from typing import Any
 
@@ -143,6 +145,13 @@ class SearchNode(NodeOutputs, LifecycleNode):
         """why the last configure transition failed (one line)"""
         self.checkpoint_error = ""
         """why the checkpoint file was refused (one line; empty once a search started)"""
+        self.checkpoint_failures = 0
+        """checkpoints that could not be written (a full or read-only disk)"""
+        self.checkpoint_failure = ""
+        """why the last checkpoint could not be written (empty once one was)"""
+        self.step_latency: collections.deque[tuple[float, float]] = collections.deque(maxlen=1000)
+        """(pose time s, wall s) of the last 1,000 goals: from the pose that completed a hold
+        to the goal's publication (the reading's update, the decision, the messages)"""
         self._errors_in_a_row = 0
         self._rejected_reported = 0
         self._wind_warned = False
@@ -377,6 +386,7 @@ class SearchNode(NodeOutputs, LifecycleNode):
         self._step(pose_from_pose_cov(msg, self._now(), self._last_pose))
 
     def _step(self, pose: Pose) -> None:
+        started = time.perf_counter()
         with self._lock:
             if not self.active or self.cycle is None or self.done.is_set():
                 return
@@ -394,12 +404,29 @@ class SearchNode(NodeOutputs, LifecycleNode):
         if out.record is not None:
             self._publish_belief(out.record)
             self._publish_feedback(out.record)
-            if self.checkpoint is not None:
-                self.searcher.save(self.checkpoint)
         if out.goal is not None:
             self._publish_goal(out.goal, pose)
+            self.step_latency.append((pose.t, time.perf_counter() - started))
+        if out.record is not None and self.checkpoint is not None:
+            self._save_checkpoint()  # after the goal: the robot does not wait for the disk
         if out.finished:
             self._finish(out.reason)
+
+    def _save_checkpoint(self) -> None:
+        """Write the checkpoint; a disk that is full or read-only costs the checkpoint, not the
+        search: the failure is logged (throttled), counted and in the diagnostics (WARN), and
+        the search goes on; the previous checkpoint stays whole (written atomically)."""
+        try:
+            self.searcher.save(self.checkpoint)
+        except DceeInputError as exc:
+            self.checkpoint_failures += 1
+            self.checkpoint_failure = exc.message
+            self.get_logger().error(
+                f"checkpoint not written ({exc.message}); the search goes on",
+                throttle_duration_sec=10.0,
+            )
+        else:
+            self.checkpoint_failure = ""
 
     def _finish(self, reason: str) -> None:
         """End the search: log why and the estimate, publish the result and the diagnostics,

@@ -49,7 +49,18 @@ class NodeOutputs:
             self.callback_errors,
             self.finish_reason,
             self.checkpoint_error,
+            self.checkpoint_failure,
+            self._health(),
         )
+
+    def _health(self) -> dict[str, str]:
+        """The decision latency over the last goals and the checkpoints not written."""
+        out = {"checkpoints not written": str(self.checkpoint_failures)}
+        if self.step_latency:
+            wall = [w for _, w in self.step_latency]
+            out["latency to goal: last, s"] = f"{wall[-1]:.3f}"
+            out["latency to goal: max of last 1000, s"] = f"{max(wall):.3f}"
+        return out
 
     def _publish_diagnostics(self) -> None:
         msg = DiagnosticArray()

@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 
 from dcee.errors import DceeInputError
+from dcee.limits import read_text
 from dcee.recordings.gaden import FREE, GAS_MOLAR_MASS, GadenSimulation
 from dcee.recordings.gaden_files import OBSTACLE
 
@@ -196,8 +197,10 @@ def _release_rate(folder: Path, moles: float, molar_mass: float) -> float:
     import yaml
 
     try:
-        settings = yaml.safe_load((folder / "sim.yaml").read_text()) or {}
+        settings = yaml.safe_load(read_text(folder / "sim.yaml", "GADEN")) or {}
         per_second = float(settings["numFilaments_sec"])
-    except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError):
+    except DceeInputError:
+        raise  # larger than a settings file may be
+    except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError, RecursionError):
         return 0.003
     return per_second * moles * molar_mass

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from dcee.errors import DceeInputError
+from dcee.limits import check_declared, check_npy, read_text
 from dcee.recordings import is_cf
 from dcee.recordings.cf import read_cf_recording
 from dcee.simulation.truth import TruthModel, register_truth
@@ -209,9 +210,12 @@ def load_recording(
         if not meta_path.is_file():
             raise _fail(f"{path.name} needs its metadata in {meta_path.name} (t, x, y, optional z)")
         try:
+            check_npy(path, "truth.model.file")  # its declared shape, before it is read
             arr = np.load(path, allow_pickle=False)
-            meta = json.loads(meta_path.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
+            meta = json.loads(read_text(meta_path, "truth.model.file"))
+        except DceeInputError:
+            raise
+        except (OSError, ValueError, RecursionError) as exc:
             raise _fail(f"cannot read {path.name} or {meta_path.name}: {exc}") from None
         if not isinstance(meta, dict):
             raise _fail(f"{meta_path.name} must hold a JSON object")
@@ -219,14 +223,23 @@ def load_recording(
         h5py = _h5py(_fail)
         try:
             with h5py.File(path, "r") as h5:
-                if "concentration" not in h5:
+                if not isinstance(h5.get("concentration"), h5py.Dataset):
                     raise _fail(f"{path.name} has no 'concentration' dataset")
+                names = [k for k in ("concentration", "t", "x", "y", "z") if k in h5]
+                for k in names:  # declared shapes, before anything is read
+                    if not isinstance(h5[k], h5py.Dataset):
+                        raise _fail(f"{path.name}: {k!r} is not a dataset")
+                    check_declared("truth.model.file", f"{path.name}: dataset {k!r}", h5[k].shape)
                 arr = np.asarray(h5["concentration"][...])
-                meta = {k: np.asarray(h5[k][...]) for k in ("t", "x", "y", "z") if k in h5}
+                meta = {k: np.asarray(h5[k][...]) for k in names[1:]}
                 if "source" in h5.attrs:
                     meta["source"] = np.asarray(h5.attrs["source"])
-        except OSError as exc:
-            raise _fail(f"cannot read {path.name} as HDF5: {exc}") from None
+        except DceeInputError:
+            raise
+        except (OSError, ValueError, TypeError, KeyError, RuntimeError) as exc:
+            # h5py reports a corrupt file as any of these
+            first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise _fail(f"cannot read {path.name} as HDF5: {first}") from None
     else:
         raise _fail(
             f"unsupported recording {path.name!r}: use .npy (with .json), .h5 or CF NetCDF (.nc)"

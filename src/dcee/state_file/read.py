@@ -89,7 +89,7 @@ class _Decoder:
 
     def _pairs(self, value: Any, size: int, tag: str) -> list:
         if not (isinstance(value, list) and len(value) == size):
-            raise self.fail(f"a {tag!r} entry must be a list of {size}")
+            raise self.fail(f"an entry tagged {tag!r} must be a list of {size}")
         return value
 
     def _tagged(self, tag: str, value: Any, depth: int) -> Any:
@@ -142,8 +142,9 @@ class _Decoder:
             if kind not in BIT_GENERATORS:
                 raise self.fail(f"bit generator {str(kind)[:30]!r} is not one of NumPy's")
             bit = getattr(np.random, kind)()
+            state = self.decode(state, depth + 1)
             try:
-                bit.state = self.decode(state, depth + 1)
+                bit.state = state
             except (TypeError, ValueError, KeyError, OverflowError) as exc:
                 raise self.fail(f"bad {kind} state ({exc})") from None
             rng = np.random.Generator(bit)
