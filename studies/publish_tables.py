@@ -40,6 +40,7 @@ PAGES = (
     "docs/performance.md",
     "docs/multi-source.md",
     "docs/three-d.md",
+    "docs/guide/robot.md",
 )
 MARKER = re.compile(
     r"(<!-- generated: (?P<name>[a-z0-9-]+) \(studies/publish_tables\.py\) -->\n)"

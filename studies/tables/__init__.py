@@ -28,7 +28,12 @@ from studies.tables.performance import (
     search_speed_table,
     speed_table,
 )
-from studies.tables.robustness import fuzz_readers_table
+from studies.tables.robustness import (
+    fuzz_readers_table,
+    soak_faults_table,
+    soak_run_table,
+    soak_table,
+)
 from studies.tables.sites import (
     sites_table,
     sites_walls_table,
@@ -60,6 +65,9 @@ TABLES: dict[str, Callable[[], str]] = {
     "gaden-starts": gaden_starts_table,
     "gaden-timing": gaden_timing_table,
     "fuzz-readers": fuzz_readers_table,
+    "soak": soak_table,
+    "soak-faults": soak_faults_table,
+    "soak-run": soak_run_table,
     "lbm3d-plume": lbm3d_plume_table,
     "lbm3d-search": lbm3d_search_table,
     "lbm3d-altitudes": lbm3d_altitude_table,

@@ -37,3 +37,106 @@ def fuzz_readers_table() -> str:
         ]
     )
     return table(["format", "cases", "read", "refused (one line)", "failed", "seconds"], rows)
+
+
+SOAK_BOUNDS = {"rss_mb": 200.0, "decision": 2.0, "latency": 2.0}
+"""Stated before the soak was run (2026-12-04): resident memory at the end at most 200 MB above
+its value after the first 100 readings; the mean decision time and the mean latency over the
+last 100 readings at most twice their mean over readings 100-200 (the first 100 warm up the
+compiled kernels and the caches)."""
+
+
+def _soak() -> dict:
+    return json.loads((RESULTS / "soak" / "soak.json").read_text(encoding="utf-8"))
+
+
+def _window(samples: list[dict], lo: int, hi: int, key: str) -> float | None:
+    vals = [s[key] for s in samples if lo <= s["readings"] < hi and s.get(key) is not None]
+    return sum(vals) / len(vals) if vals else None
+
+
+def soak_table() -> str:
+    """Memory, decision time and latency early in the soak and at its end, against the bounds
+    (:data:`SOAK_BOUNDS`)."""
+    doc = _soak()
+    samples = doc["soak"]["samples"]
+    last = max(s["readings"] for s in samples)
+    rows = []
+    for key, label, unit, scale, bound in (
+        ("rss_mb", "resident memory", "MB", 1.0, ("+", SOAK_BOUNDS["rss_mb"])),
+        ("decision_s_last20", "decision time (mean of the last 20)", "ms", 1e3,
+         ("x", SOAK_BOUNDS["decision"])),
+        ("latency_s_mean", "latency, pose to goal (mean)", "ms", 1e3,
+         ("x", SOAK_BOUNDS["latency"])),
+        ("latency_s_max", "latency, pose to goal (max in a sample)", "ms", 1e3, None),
+    ):  # fmt: skip
+        early = _window(samples, 100, 200, key)
+        late = _window(samples, last - 100, last + 1, key)
+        if early is None or late is None:
+            continue
+        if bound is None:
+            verdict = "—"
+        elif bound[0] == "+":
+            verdict = ("within" if late - early <= bound[1] else "BEYOND") + f" +{bound[1]:g} MB"
+        else:
+            verdict = ("within" if late <= bound[1] * early else "BEYOND") + f" {bound[1]:g}×"
+        rows.append([label, f"{early * scale:.1f} {unit}", f"{late * scale:.1f} {unit}", verdict])
+    head = ["", "readings 100-200", f"last 100 (of {last})", "bound"]
+    return table(head, rows)
+
+
+def soak_faults_table() -> str:
+    """Each injected fault: the readings, dropped poses, clock jumps and unwritten checkpoints
+    before and after it, and whether the search went on."""
+    doc = _soak()
+    rows = []
+    for f in doc["soak"]["faults"]:
+        b, a = f["before"], f["after"]
+        dropped = sum(a["rejected"].values()) - sum(b["rejected"].values())
+        rows.append(
+            [
+                f["fault"],
+                f"{b['sim_time']:.0f}",
+                f"{b['readings']} → {a['readings']}",
+                str(dropped),
+                str(a["clock_jumps"] - b["clock_jumps"]),
+                str(a["checkpoint_failures"] - b["checkpoint_failures"]),
+                str(a["callback_errors"] - b["callback_errors"]),
+            ]
+        )
+    kill = doc["kill"]
+    rows.append(
+        [
+            "SIGKILL, started again on the checkpoint",
+            f"{kill['time_in_checkpoint_at_kill_s']:.0f}",
+            f"{kill['readings_in_checkpoint_at_kill']} → {kill['second_readings_written']}",
+            "—",
+            "—",
+            "—",
+            "history kept" if kill["history_before_kill_kept"] else "HISTORY LOST",
+        ]
+    )
+    head = ["fault", "at s (simulated)", "readings before → after", "messages dropped",
+            "clock jumps", "checkpoints not written", "callback errors"]  # fmt: skip
+    return table(head, rows)
+
+
+def soak_run_table() -> str:
+    """The run itself: simulated hours, readings, wall time, machine and code."""
+    doc = _soak()
+    s = doc["soak"]
+    machine = doc["machine"]
+    return table(
+        ["scenario, planner", "particles", "simulated", "readings", "wall", "machine", "code"],
+        [
+            [
+                f"{doc['scenario']}, {doc['strategy']}",
+                f"{doc['particles']:,}",
+                f"{doc['hours']:g} h",
+                str(s["readings"]),
+                f"{s['wall_seconds'] / 60:.1f} min",
+                f"{machine['processor'] or machine['machine']}, {machine['cpus']} CPUs",
+                str(doc["code_version"].get("commit", ""))[:9],
+            ]
+        ],
+    )

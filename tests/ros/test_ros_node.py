@@ -638,3 +638,26 @@ def test_a_full_disk_costs_the_checkpoint_not_the_search_and_a_restart_resumes(t
     finally:
         dcee.searcher.Searcher.save = real_save
         rclpy.try_shutdown(context=context)
+
+
+def test_the_path_message_keeps_the_last_readings_only() -> None:
+    """``dcee/path`` holds the last PATH_POSES readings: on a day's mission the whole path made
+    each reading's messages cost more than the last (the soak benchmark, issue 80)."""
+    import rclpy
+    from rclpy.parameter import Parameter
+
+    from dcee.ros.node import SearchNode
+    from dcee.ros.outputs import PATH_POSES
+
+    context = rclpy.Context()
+    rclpy.init(context=context, args=[], domain_id=_domain())
+    try:
+        node = SearchNode(context=context, parameter_overrides=[Parameter("particles", value=200)])
+        node.params["marker_particles"] = 0
+        for k in range(PATH_POSES + 5):
+            node._publish_belief({"x": float(k), "y": 1.0, "z": 0.0})
+        poses = node.path_msg.poses
+        assert len(poses) == PATH_POSES and poses[-1].pose.position.x == PATH_POSES + 4
+        assert poses[0].pose.position.x == 5.0
+    finally:
+        rclpy.try_shutdown(context=context)

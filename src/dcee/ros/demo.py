@@ -49,10 +49,15 @@ def run_demo(
     truth: str | None = None,
     likelihood: str | None = None,
     overrides: dict[str, Any] | None = None,
+    checkpoint: Path | None = None,
+    observer: Any = None,
 ) -> dict[str, Any]:
     """Run the search node against the simulated robot until the budget is spent; returns the
     summary (:func:`dcee.runs.metrics.summarise` plus the message counts, the driven
-    path and ``records``, the node's per-reading records)."""
+    path and ``records``, the node's per-reading records). ``checkpoint``: the node's
+    ``checkpoint`` parameter (written after every reading, resumed from when it exists);
+    ``observer(search_node, sim_node, context)``: called once both nodes exist, before the
+    search starts (the soak benchmark samples and injects faults from it)."""
     os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
     import rclpy
     from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
@@ -94,6 +99,7 @@ def run_demo(
                 Parameter("strategy", value=strategy),
                 Parameter("seed", value=seed),
                 Parameter("autostart", value=False),
+                Parameter("checkpoint", value=str(checkpoint) if checkpoint else ""),
             ],
             true_location=scenario.truth_theta()[:3],
             scenario=scenario.with_overrides(world={}),
@@ -128,6 +134,8 @@ def run_demo(
                     raise
 
         spinner = threading.Thread(target=spin, daemon=True)
+        if observer is not None:
+            observer(search, sim, context)
         spinner.start()
         mission.start(timeout=min(timeout, 60.0))  # configure, activate, map, dcee/start
         sim.paused = False

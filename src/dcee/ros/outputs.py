@@ -87,8 +87,17 @@ class NodeOutputs:
             particle_markers(self.searcher.filter, self._marker_rng, n, self.frame_id, stamp)
         )
         self.path_msg.header.stamp = stamp
-        self.path_msg.poses.append(path_pose(record, self.frame_id, stamp))
+        poses = self.path_msg.poses
+        poses.append(path_pose(record, self.frame_id, stamp))
+        if len(poses) > PATH_POSES:  # a day's mission: the message would grow without end
+            del poses[0]
         self.path_pub.publish(self.path_msg)
 
 
-__all__ = ["NodeOutputs"]
+PATH_POSES = 1000
+"""Readings the ``dcee/path`` message holds: the last 1,000 (every reading's position is in the
+``dcee/feedback`` stream and a recorded bag). The whole path made every reading cost more than
+the last: in an 8-hour soak the latency from a pose to its goal grew from 10.5 to 26.3 ms
+(docs/guide/robot.md)."""
+
+__all__ = ["PATH_POSES", "NodeOutputs"]

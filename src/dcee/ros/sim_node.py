@@ -70,6 +70,9 @@ class SimRobotNode(Node):
         self._stopped = False
         self.paused = paused
         """while True the robot's clock stands still and nothing is published"""
+        self.clock_offset = 0.0
+        """s added to the robot's time in every stamp and on ``/clock``: lowering it is a clock
+        that jumps back (fault injection, ``studies/soak_node.py``)"""
         if not paused:
             self._publish()
         self.timer = self.create_timer(self.robot.control_dt / speedup, self._tick)
@@ -95,7 +98,7 @@ class SimRobotNode(Node):
 
     def _publish(self) -> None:
         r = self.robot
-        stamp = stamp_of(r.time)
+        stamp = stamp_of(r.time + self.clock_offset)
         self.clock_pub.publish(Clock(clock=stamp))
         s = r.odometry()
         odom = Odometry()

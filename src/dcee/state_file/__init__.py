@@ -29,7 +29,7 @@ pickle runs whatever code its author put in it; reading a state file runs none:
   (:data:`MAX_ARRAY_BYTES`), the graph's nesting (:data:`MAX_DEPTH`).
 
 Every failure to read is one :class:`dcee.errors.DceeInputError` naming the file and what is
-wrong (missing, not a zip, truncated, a member's CRC, the checksum, the format, the version).
+wrong (missing, not a zip, truncated, a member's CRC, the checksum, the format, the release).
 """
 
 from __future__ import annotations

@@ -9,6 +9,7 @@ import importlib
 import io
 import json
 import math
+import re
 import zipfile
 from collections.abc import Callable
 from pathlib import Path
@@ -215,6 +216,14 @@ def _set_plain_state(obj: Any, state: Any) -> None:
         object.__setattr__(obj, key, value)
 
 
+def release(version: str) -> str:
+    """The release a version string names: ``0.1.1`` of ``0.1.1.dev741+g1d53b98de`` (two
+    installs of one release, a development checkout's venvs among them, read each other's
+    files; the code version that wrote one is in its header)."""
+    match = re.match(r"\d+(?:\.\d+)*", version)
+    return match.group(0) if match else version
+
+
 def read_state(path: Path, format_name: str) -> tuple[dict[str, Any], Any]:
     """(header, object) of the state file ``path`` written with ``format_name`` (module doc);
     one :class:`DceeInputError` for any file that is not one, or not intact."""
@@ -275,10 +284,11 @@ def read_state(path: Path, format_name: str) -> tuple[dict[str, Any], Any]:
         raise fail(f"not an intact dcee state file ({type(exc).__name__}: {exc})") from None
     if header.get("checksum") != checksum(header, arrays):
         raise fail("its checksum does not match its content (corrupt or edited)")
-    if header.get("dcee_version") != package_version():
+    written = str(header.get("dcee_version"))
+    if release(written) != release(package_version()):
         raise fail(
-            f"written by dcee {str(header.get('dcee_version'))[:40]}, this is dcee "
-            f"{package_version()} (a state file is read by the version that wrote it)"
+            f"written by dcee {written[:40]}, this is dcee {package_version()} (a state file "
+            "is read by the release that wrote it)"
         )
     try:
         obj = _Decoder(arrays, fail).decode(header.get("state"))
