@@ -224,3 +224,16 @@ def test_the_command_line_reads_a_checkpoint_as_a_node_would(saved, tmp_path, ca
         assert err.startswith("dcee: error: checkpoint: ")
     code, _, err = run_cli(["checkpoint", str(saved), "--scenario", "paper:1"], capsys)
     assert code == 2 and "with other settings" in err and err.count("\n") == 1
+
+
+def test_no_reader_in_the_package_unpickles() -> None:
+    """No pickle anywhere in a path that reads a file (issue 80): the package neither imports
+    pickle nor lets NumPy load pickled objects."""
+    from pathlib import Path
+
+    import dcee
+
+    for path in Path(dcee.__file__).parent.rglob("*.py"):
+        text = path.read_text(encoding="utf-8")
+        for banned in ("import pickle", "pickle.load", "allow_pickle=True", "import dill"):
+            assert banned not in text, f"{path.name}: {banned}"

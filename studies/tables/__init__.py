@@ -33,6 +33,7 @@ from studies.tables.robustness import (
     soak_faults_table,
     soak_run_table,
     soak_table,
+    soak_worst_table,
 )
 from studies.tables.sites import (
     sites_table,
@@ -68,6 +69,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "soak": soak_table,
     "soak-faults": soak_faults_table,
     "soak-run": soak_run_table,
+    "soak-worst": soak_worst_table,
     "lbm3d-plume": lbm3d_plume_table,
     "lbm3d-search": lbm3d_search_table,
     "lbm3d-altitudes": lbm3d_altitude_table,

@@ -568,10 +568,10 @@ def _drive_until(executor, node, pose_pub, conc_pub, goals, count, t0, start) ->
 
 
 def test_a_full_disk_costs_the_checkpoint_not_the_search_and_a_restart_resumes(tmp_path) -> None:
-    """Checkpoints that cannot be written (the disk full): the goal is still published, the
-    failure counted, logged and WARN in the diagnostics, the search goes on. The node killed
-    and started again on the same file resumes with every reading written and goes on
-    (issue 80)."""
+    """Checkpoints that cannot be written (the disk full, then read-only): the goal is still
+    published, the failure counted, logged and WARN in the diagnostics, the search goes on. The
+    node killed and started again on the same file resumes with every reading written and goes
+    on (issue 80)."""
     import rclpy
     from diagnostic_msgs.msg import DiagnosticStatus
     from geometry_msgs.msg import PoseStamped
@@ -621,8 +621,17 @@ def test_a_full_disk_costs_the_checkpoint_not_the_search_and_a_restart_resumes(t
         assert status.level == DiagnosticStatus.WARN and "No space left" in status.message
         assert first.callback_errors == 0 and first.cycle.state != "done"
 
-        dcee.searcher.Searcher.save = real_save  # space again: the next reading is written
+        def read_only(self, p):
+            raise DceeInputError("path", f"cannot write checkpoint {p}: [Errno 30] Read-only")
+
+        dcee.searcher.Searcher.save = read_only  # then mounted read-only: the same
+        failures = first.checkpoint_failures
         t = _drive_until(executor, first, pose_pub, conc_pub, goals, 3, t, start)
+        assert first.checkpoint_failures > failures and "Read-only" in first.checkpoint_failure
+        assert first.callback_errors == 0 and not path.exists()
+
+        dcee.searcher.Searcher.save = real_save  # writable again: the next reading is written
+        t = _drive_until(executor, first, pose_pub, conc_pub, goals, 4, t, start)
         assert path.exists() and first.checkpoint_failure == ""
         written = first.searcher.filter.n_readings
         executor.remove_node(first)
