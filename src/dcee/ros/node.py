@@ -412,22 +412,6 @@ class SearchNode(NodeOutputs, LifecycleNode):
         if out.finished:
             self._finish(out.reason)
 
-    def _save_checkpoint(self) -> None:
-        """Write the checkpoint; a disk that is full or read-only costs the checkpoint, not the
-        search: the failure is logged (throttled), counted and in the diagnostics (WARN), and
-        the search goes on; the previous checkpoint stays whole (written atomically)."""
-        try:
-            self.searcher.save(self.checkpoint)
-        except DceeInputError as exc:
-            self.checkpoint_failures += 1
-            self.checkpoint_failure = exc.message
-            self.get_logger().error(
-                f"checkpoint not written ({exc.message}); the search goes on",
-                throttle_duration_sec=10.0,
-            )
-        else:
-            self.checkpoint_failure = ""
-
     def _finish(self, reason: str) -> None:
         """End the search: log why and the estimate, publish the result and the diagnostics,
         set :attr:`done`."""

@@ -1,5 +1,6 @@
-"""What the search node publishes (a mixin of :class:`dcee.ros.node.SearchNode`): the goal, the
-belief (estimate, covariance, particles, path), feedback, the result and the diagnostics. Every
+"""What the search node publishes and writes (a mixin of :class:`dcee.ros.node.SearchNode`): the
+goal, the belief (estimate, covariance, particles, path), feedback, the result, the diagnostics
+and the checkpoint. Every
 attribute it reads (publishers, ``searcher``, ``cycle``, ``params``) is the node's."""
 
 from __future__ import annotations
@@ -11,6 +12,7 @@ import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from std_msgs.msg import String
 
+from dcee.errors import DceeInputError
 from dcee.robot.cycle import Pose
 from dcee.ros.messages import (
     diagnostic_status,
@@ -61,6 +63,22 @@ class NodeOutputs:
             out["latency to goal: last, s"] = f"{wall[-1]:.3f}"
             out["latency to goal: max of last 1000, s"] = f"{max(wall):.3f}"
         return out
+
+    def _save_checkpoint(self) -> None:
+        """Write the checkpoint; a disk that is full or read-only costs the checkpoint, not the
+        search: the failure is logged (throttled), counted and in the diagnostics (WARN), and
+        the search goes on; the previous checkpoint stays whole (written atomically)."""
+        try:
+            self.searcher.save(self.checkpoint)
+        except DceeInputError as exc:
+            self.checkpoint_failures += 1
+            self.checkpoint_failure = exc.message
+            self.get_logger().error(
+                f"checkpoint not written ({exc.message}); the search goes on",
+                throttle_duration_sec=10.0,
+            )
+        else:
+            self.checkpoint_failure = ""
 
     def _publish_diagnostics(self) -> None:
         msg = DiagnosticArray()
