@@ -52,6 +52,21 @@ class Soak:
         self.samples: list[dict[str, Any]] = []
         self.faults: list[dict[str, Any]] = []
         self.stop = threading.Event()
+        self.gc_pauses: list[tuple[float, float]] = []  # (wall end, seconds) of full collections
+        self._gc_started = 0.0
+        import gc
+
+        gc.callbacks.append(self._gc)
+
+    def _gc(self, phase: str, info: dict) -> None:
+        """Times Python's full (generation 2) garbage collections: a suspect of the rare long
+        waits for a goal (docs/guide/robot.md)."""
+        if info.get("generation") != 2:
+            return
+        if phase == "start":
+            self._gc_started = time.perf_counter()
+        else:
+            self.gc_pauses.append((time.perf_counter(), time.perf_counter() - self._gc_started))
 
     def observe(self, search: Any, sim: Any, context: Any) -> None:
         import rclpy
@@ -155,6 +170,7 @@ class Soak:
             (0.75, "disk back", self._disk_back, 0.0),
         ]  # fmt: skip
         last_pose = -1e300
+        seen_gc = 0
         started = time.monotonic()
         while not self.stop.is_set():
             t = self.sim.robot.time
@@ -170,6 +186,8 @@ class Soak:
             fresh = [w for t_pose, w in latency if t_pose > last_pose]
             if latency:
                 last_pose = max(last_pose, latency[-1][0])
+            pauses = [p for _, p in self.gc_pauses[seen_gc:]]
+            seen_gc = len(self.gc_pauses)
             decisions = [r.get("decision_seconds") for r in records[-20:]]
             decisions = [d for d in decisions if d is not None]
             self.samples.append(
@@ -183,6 +201,7 @@ class Soak:
                     else None,
                     "latency_s_max": round(max(fresh), 4) if fresh else None,
                     "latency_s_mean": round(sum(fresh) / len(fresh), 4) if fresh else None,
+                    "full_gc_s_max": round(max(pauses), 4) if pauses else None,
                 }
             )
             time.sleep(self.interval)

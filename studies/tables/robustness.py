@@ -150,15 +150,22 @@ def soak_worst_table() -> str:
     rows = []
     for q in range(4):
         lo, hi = q * last // 4, (q + 1) * last // 4 + (1 if q == 3 else 0)
-        worst = [s["latency_s_max"] for s in samples
-                 if lo <= s["readings"] < hi and s.get("latency_s_max") is not None]  # fmt: skip
+        part = [s for s in samples if lo <= s["readings"] < hi]
+        worst = [s["latency_s_max"] for s in part if s.get("latency_s_max") is not None]
         if not worst:
             continue
+        gcs = [s["full_gc_s_max"] for s in part if s.get("full_gc_s_max") is not None]
+        slow = [s for s in part if (s.get("latency_s_max") or 0) > 0.1]
+        with_gc = sum(1 for s in slow if (s.get("full_gc_s_max") or 0) > 0.05)
         rows.append(
             [
                 f"{lo}-{hi - (1 if q == 3 else 0)}",
                 f"{max(worst) * 1e3:.0f} ms",
-                f"{sum(w > 0.1 for w in worst)} of {len(worst)}",
+                f"{len(slow)} of {len(worst)}",
+                f"{max(gcs) * 1e3:.0f} ms ({len(gcs)})" if gcs else "none",
+                f"{with_gc} of {len(slow)}",
             ]
         )
-    return table(["readings", "worst latency", "samples with one over 100 ms"], rows)
+    head = ["readings", "worst latency", "samples with one over 100 ms",
+            "longest full collection (count)", "slow samples with a collection > 50 ms"]  # fmt: skip
+    return table(head, rows)
