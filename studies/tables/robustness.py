@@ -167,5 +167,5 @@ def soak_worst_table() -> str:
             ]
         )
     head = ["readings", "worst latency", "samples with one over 100 ms",
-            "longest full collection (count)", "slow samples with a collection > 50 ms"]  # fmt: skip
+            "longest full collection (count)", "slow ones with a collection > 50 ms"]  # fmt: skip
     return table(head, rows)
