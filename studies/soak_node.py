@@ -47,8 +47,8 @@ def _rss_mb() -> float:
 class Soak:
     """Samples the node and injects the faults (module doc) from a thread of its own."""
 
-    def __init__(self, budget: float, checkpoint: Path, interval: float) -> None:
-        self.budget, self.checkpoint, self.interval = budget, checkpoint, interval
+    def __init__(self, budget: float, interval: float) -> None:
+        self.budget, self.interval = budget, interval
         self.samples: list[dict[str, Any]] = []
         self.faults: list[dict[str, Any]] = []
         self.stop = threading.Event()
@@ -214,7 +214,7 @@ def soak(args: argparse.Namespace) -> dict[str, Any]:
     budget = args.hours * 3600.0
     checkpoint = Path(args.scratch) / "soak.ckpt"
     checkpoint.unlink(missing_ok=True)
-    watcher = Soak(budget, checkpoint, args.sample)
+    watcher = Soak(budget, args.sample)
     summary = run_demo(
         SCENARIO,
         STRATEGY,

@@ -27,7 +27,7 @@ import signal
 import zipfile
 import zlib
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -355,10 +355,7 @@ def corrupt(data: bytes, rng: np.random.Generator) -> bytes:
 class Outcome:
     read: int = 0
     refused: int = 0
-    failures: list[str] | None = None
-
-    def __post_init__(self) -> None:
-        self.failures = [] if self.failures is None else self.failures
+    failures: list[str] = field(default_factory=list)
 
 
 class _Timeout(Exception):

@@ -153,8 +153,6 @@ def test_node_command_line_errors_are_one_line_exit_2() -> None:
 def test_node_with_pose_with_covariance_input_takes_readings_and_publishes_a_goal() -> None:
     """A robot that reports PoseWithCovarianceStamped (AMCL-style): speeds come from successive
     poses; standing still, it gets a reading after the hold and a goal one step away."""
-    import time
-
     import rclpy
     from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
     from rclpy.executors import SingleThreadedExecutor
@@ -163,7 +161,6 @@ def test_node_with_pose_with_covariance_input_takes_readings_and_publishes_a_goa
 
     from dcee.ros.node import SearchNode
     from dcee.ros.parameters import LATCHED, RELIABLE
-    from dcee.ros.sim_node import stamp_of
 
     context = rclpy.Context()
     rclpy.init(context=context, args=[], domain_id=_domain())
@@ -186,20 +183,9 @@ def test_node_with_pose_with_covariance_input_takes_readings_and_publishes_a_goa
         executor.add_node(node)
         executor.add_node(robot)
         start = node.scenario.agent.start
-        deadline = time.monotonic() + 60
-        t = 1.0  # a zero stamp means "unstamped": the node would use its own clock
-        while not goals and time.monotonic() < deadline:
-            msg = PoseWithCovarianceStamped()
-            msg.header.stamp = stamp_of(t)
-            msg.header.frame_id = "map"
-            msg.pose.pose.position.x, msg.pose.pose.position.y = start[0], start[1]
-            msg.pose.pose.orientation.w = 1.0
-            conc_pub.publish(Float32(data=0.0))
-            pose_pub.publish(msg)
-            for _ in range(4):
-                executor.spin_once(timeout_sec=0.01)
-            t += 0.1
-        assert goals, "no goal published"
+        # from 1 s: a zero stamp means "unstamped" (the node would use its own clock)
+        _drive_until(executor, node, pose_pub, conc_pub, goals, 1, 1.0, start,
+                     PoseWithCovarianceStamped)  # fmt: skip
         g = goals[0].pose.position
         assert math.hypot(g.x - start[0], g.y - start[1]) == pytest.approx(0.3)
         rec = node.cycle.records[0]
@@ -540,9 +526,10 @@ def test_node_resumes_its_own_checkpoint_and_refuses_a_tampered_or_foreign_one(t
         rclpy.try_shutdown(context=context)
 
 
-def _drive_until(executor, node, pose_pub, conc_pub, goals, count, t0, start) -> float:
-    """Publish a robot's odometry (at ``start``, then standing at the latest goal: it gets
-    there at once) and zero readings until ``count`` goals arrived."""
+def _drive_until(executor, node, pose_pub, conc_pub, goals, count, t0, start, kind=None) -> float:
+    """Publish a robot's pose (``kind``: nav_msgs/Odometry unless given; at ``start``, then
+    standing at the latest goal: it gets there at once) and zero readings until ``count``
+    goals arrived; returns the next stamp."""
     import time
 
     from nav_msgs.msg import Odometry
@@ -552,7 +539,7 @@ def _drive_until(executor, node, pose_pub, conc_pub, goals, count, t0, start) ->
 
     t, deadline = t0, time.monotonic() + 60
     while len(goals) < count and time.monotonic() < deadline:
-        msg = Odometry()
+        msg = (kind or Odometry)()
         msg.header.stamp = stamp_of(t)
         msg.header.frame_id = "map"
         at = (goals[-1].pose.position.x, goals[-1].pose.position.y) if goals else start[:2]

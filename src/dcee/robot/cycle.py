@@ -257,7 +257,8 @@ class SearchCycle:
     def on_pose(self, pose: Pose) -> CycleOutput:
         """A pose sample: advances the cycle; returns what to publish. A pose that cannot be
         the robot's (:meth:`pose_problem`) is dropped and counted (:attr:`rejected`)."""
-        pose = dataclasses.replace(pose, t=pose.t + self.clock_offset)
+        if self.clock_offset:
+            pose = dataclasses.replace(pose, t=pose.t + self.clock_offset)
         problem = self.pose_problem(pose)
         if problem == "pose stamp went backwards":
             jump = self._clock_jump(pose)
