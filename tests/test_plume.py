@@ -141,3 +141,48 @@ def test_disc_source_against_a_dense_disc_integral_and_the_point_limit():
     point = np.trapezoid(isotropic_concentration(theta, line)[0], ys)
     disc = np.trapezoid(IsotropicPlume(radius=radius).concentration(theta, line)[0], ys)
     assert disc == pytest.approx(point, rel=0.02)
+
+
+def test_ground_image_and_vertical_ratio_by_hand():
+    """The ground adds the release's mirror image below z = 0; the vertical ratio a divides
+    every height (and the release rate) by a: hand formulas of the paper's plume."""
+    from dcee.models.plume import IsotropicPlume
+
+    q, u, phi, z1, z2 = 2.0, 3.0, math.radians(30), 0.5, 40.0
+    sx, sy, sz = 1.0, 2.0, 1.5
+    p = np.array([-3.0, 0.5, 2.5])
+    lam = math.sqrt(z1 * z2 / (1 + u * u * z2 / (4 * z1)))
+
+    def paper(height_offset: float, a: float) -> float:
+        dx, dy = p[0] - sx, p[1] - sy
+        r = math.sqrt(dx * dx + dy * dy + (height_offset / a) ** 2)
+        adv = (dx * u * math.cos(phi) + dy * u * math.sin(phi)) / (2 * z1)
+        return q / a / (4 * math.pi * z1 * r) * math.exp(-r / lam - adv)
+
+    theta = np.array([[sx, sy, sz, q, u, phi, z1, z2]])
+    for a, g in ((1.0, 1.0), (0.66, 0.0), (0.66, 1.0), (1.5, 0.5)):
+        expected = paper(p[2] - sz, a) + g * paper(p[2] + sz, a)
+        got = IsotropicPlume(vertical=a, ground=g).concentration(theta, p[None])[0, 0]
+        assert got == pytest.approx(expected, rel=1e-12)
+        ref = isotropic_concentration_reference(theta, p[None], vertical=a, ground=g)[0, 0]
+        assert ref == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize("a", [1.0, 0.66])
+def test_ground_keeps_the_flux_above_it(a):
+    """Mass conservation, a limiting case: far downwind of a release on the ground, with no
+    decay (ζ2 → ∞), the flux u ∫∫ C dy dz through a crosswind half-plane above the ground is
+    the release rate, whatever the vertical ratio, when the ground reflects; half of it when
+    it does not (the other half passes below z = 0)."""
+    from dcee.models.plume import IsotropicPlume
+
+    q, u = 3.0, 4.0
+    theta = np.array([[0.0, 0.0, 0.0, q, u, math.pi, 0.4, 1e9]])  # wind towards +x
+    ys = np.linspace(-12.0, 12.0, 241)
+    zs = np.linspace(0.0, 12.0, 601)
+    yy, zz = np.meshgrid(ys, zs, indexing="ij")
+    plane = np.column_stack([np.full(yy.size, 40.0), yy.ravel(), zz.ravel()])
+    for ground, share in ((1.0, 1.0), (0.0, 0.5)):
+        c = IsotropicPlume(vertical=a, ground=ground).concentration(theta, plane)[0]
+        flux = u * np.trapezoid(np.trapezoid(c.reshape(yy.shape), zs, axis=1), ys)
+        assert flux == pytest.approx(share * q, rel=0.02)

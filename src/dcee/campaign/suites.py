@@ -20,7 +20,8 @@
   ``random:1`` … ``random:40``; a range never flown before, ``random:7000`` … ``random:7099``;
   and a horizontal slice of the plume at 4 m (``truth.model.plane = 4``) replayed as a planar
   recording, over the first 50 configurations from ``random:8000`` whose source is 2-4 m below
-  it (at most 2 m above the ground).
+  it (at most 2 m above the ground); ``lbm3d-slice-tune``, the same slice over the first 20
+  such configurations of the tuning range (choose here, never report).
 * ``smoke``: two of them at toy scale (1,000 particles, 10 hypothesised readings, 60 s) so a
   campaign with every strategy finishes in well under a minute; for CI and for trying options.
 """
@@ -172,6 +173,10 @@ SUITES: dict[str, dict] = {
     "lbm3d-held-out-100": {
         "configs": [f"random:{k}" for k in range(LBM3D_HELD_OUT_FROM, LBM3D_HELD_OUT_FROM + 100)],
         "overrides": LBM3D,
+    },
+    "lbm3d-slice-tune": {
+        "configs": _sources_below(1, SLICE_PLANE, 2.0, 20),
+        "overrides": {**LBM3D, "truth.model": {"kind": "lbm3d", "plane": SLICE_PLANE}},
     },
     "lbm3d-slice-held-out-50": {
         "configs": _sources_below(SLICE_FROM, SLICE_PLANE, 2.0, SLICE_COUNT),

@@ -114,6 +114,8 @@ def _history_kernel(
     decay: float,
     backflow: float,
     radius: float,
+    vertical: float,
+    ground: float,
     sp: SensorParams,
     threshold: np.ndarray,
     remaining_bound: np.ndarray,
@@ -160,11 +162,19 @@ def _history_kernel(
             px = positions[k, 0]
             py = positions[k, 1]
             pz = positions[k, 2]
-            if meander > 0.0 or decay != 1.0 or backflow > 0.0 or radius > 0.0:
+            if (
+                meander > 0.0
+                or decay != 1.0
+                or backflow > 0.0
+                or radius > 0.0
+                or vertical != 1.0
+                or ground > 0.0
+            ):
                 for q in range(nb):
                     conc[q], dist[q] = plume_at(
-                        constants_at(pc, q), px, py, pz, rmin, meander, decay, backflow, radius
-                    )
+                        constants_at(pc, q), px, py, pz, rmin, meander, decay, backflow, radius,
+                        vertical, ground,
+                    )  # fmt: skip
             else:
                 _plume_block(pc, nb, px, py, pz, rmin, conc, dist)
             zk = readings[k]
@@ -257,6 +267,8 @@ def history_log_likelihood(
     decay: float,
     backflow: float,
     radius: float,
+    vertical: float,
+    ground: float,
     sp: SensorParams,
     out: np.ndarray,
     threshold: np.ndarray | None = None,
@@ -283,6 +295,8 @@ def history_log_likelihood(
         decay,
         backflow,
         radius,
+        vertical,
+        ground,
         sp,
         np.ascontiguousarray(threshold, dtype=np.float64),
         remaining,

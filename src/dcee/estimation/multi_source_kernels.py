@@ -63,6 +63,8 @@ def _multi_history_kernel(
     decay: float,
     backflow: float,
     radius: float,
+    vertical: float,
+    ground: float,
     sp: SensorParams,
     threshold: np.ndarray,
     remaining_bound: np.ndarray,
@@ -107,6 +109,8 @@ def _multi_history_kernel(
                         decay,
                         backflow,
                         radius,
+                        vertical,
+                        ground,
                     )
                     conc += c
                     dist = min(dist, r)
@@ -129,6 +133,8 @@ def multi_history_log_likelihood(
     decay: float,
     backflow: float,
     radius: float,
+    vertical: float,
+    ground: float,
     sp: SensorParams,
     out: np.ndarray,
     threshold: np.ndarray | None = None,
@@ -151,6 +157,8 @@ def multi_history_log_likelihood(
         decay,
         backflow,
         radius,
+        vertical,
+        ground,
         sp,
         np.ascontiguousarray(threshold, dtype=np.float64),
         remaining,

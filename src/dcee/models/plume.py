@@ -64,6 +64,16 @@ so the model stays smooth inside the disc. The distance the reading model's near
 use is to the disc's centre. The reading model can weigh it (``estimator.learn =
 {source_radius = [0, 1]}``).
 
+Vertical ratio (``vertical`` = a, 1 by default) and ground (``ground`` = g, 0 by default): the
+paper's plume spreads as fast vertically as horizontally in unbounded air. Near the ground the
+eddies are flatter (in a neutral surface layer σ_w / σ_v ≈ 1.25 / 1.9 ≈ 0.66; Panofsky &
+Dutton 1984), and the ground turns back the gas that reaches it. With a vertical diffusivity
+a² ζ1, the solution is the isotropic one with every height divided by a and the release rate
+too (substitute z = a z' in the advection-diffusion equation: the point source's δ(z) becomes
+δ(z') / a); a ground that reflects adds the mirror image of the release at −z (the image
+method for a zero-flux boundary), weighted by g. Both together keep the flux through a
+crosswind plane above the ground equal to the release rate (tests/test_plume.py).
+
 The distance is clamped at :data:`MIN_DISTANCE` = 0.1 m, the scale of a sensor inlet, so the
 model stays finite when a hypothesised source sits on the sensor (the authors' MATLAB code uses
 1e-5 m, Stone Soup 0.1 m; a tiny clamp makes a particle at the sensor predict absurd
@@ -120,12 +130,30 @@ def isotropic_concentration_reference(
     decay: float = 1.0,
     backflow: float = 0.0,
     radius: float = 0.0,
+    vertical: float = 1.0,
+    ground: float = 0.0,
 ) -> np.ndarray:
     """Plain NumPy implementation of the plume; the compiled kernel is tested against it.
 
     theta: (N, 8); positions: (M, 3) in m. Returns (N, M) concentrations in g/m³.
     """
     theta, positions = _check_shapes(theta, positions)
+    if vertical != 1.0 or ground != 0.0:
+        # heights divided by a (and the release rate with them), plus the image below z = 0
+        scaled = theta.copy()
+        scaled[:, 2] /= vertical
+        scaled[:, 3] /= vertical
+        pos = positions.copy()
+        pos[:, 2] /= vertical
+        total = isotropic_concentration_reference(
+            scaled, pos, min_distance, meander, decay, backflow, radius
+        )
+        if ground > 0:
+            scaled[:, 2] *= -1.0
+            total = total + ground * isotropic_concentration_reference(
+                scaled, pos, min_distance, meander, decay, backflow, radius
+            )
+        return total
     if radius > 0:
         # the disc rule: the centre weighs 1/4, six points on a ring of radius R √(2/3) 1/8
         # each (one straight upwind), every sub-source's distance clamped at half the ring
@@ -179,6 +207,8 @@ def isotropic_concentration(
     decay: float = 1.0,
     backflow: float = 0.0,
     radius: float = 0.0,
+    vertical: float = 1.0,
+    ground: float = 0.0,
 ) -> np.ndarray:
     """Expected concentration (g/m³) of the isotropic plume, compiled.
 
@@ -188,7 +218,7 @@ def isotropic_concentration(
     theta, positions = _check_shapes(theta, positions)
     out = np.empty((theta.shape[0], positions.shape[0]))
     plume_kernels.concentration_matrix(
-        theta, positions, min_distance, meander, decay, backflow, radius, out
+        theta, positions, min_distance, meander, decay, backflow, radius, vertical, ground, out
     )
     return out
 
@@ -209,6 +239,11 @@ class IsotropicPlume:
     radius: float = 0.0
     """m, the release spread evenly over a horizontal disc of this radius about the source
     location (module doc); 0: a point source"""
+    vertical: float = 1.0
+    """ratio a of the plume's vertical to its horizontal spread (module doc); 1: isotropic"""
+    ground: float = 0.0
+    """weight of the release's image below the ground z = 0 (module doc): 1 a ground that
+    reflects all gas, 0 none (the paper's unbounded air)"""
 
     def __post_init__(self) -> None:
         if not (0.0 <= self.meander <= 2.0):
@@ -219,12 +254,16 @@ class IsotropicPlume:
             raise DceeInputError("backflow", f"must be in [0, 0.5], got {self.backflow}")
         if not (0.0 <= self.radius <= 10.0):
             raise DceeInputError("source_radius", f"must be in [0, 10] m, got {self.radius}")
+        if not (0.1 <= self.vertical <= 10.0):
+            raise DceeInputError("vertical_ratio", f"must be in [0.1, 10], got {self.vertical}")
+        if not (0.0 <= self.ground <= 1.0):
+            raise DceeInputError("ground", f"must be in [0, 1], got {self.ground}")
 
     @property
-    def shape(self) -> tuple[float, float, float, float]:
-        """(meander, decay, backflow, radius): the plume's shape settings, in the order the
-        kernels take them."""
-        return (self.meander, self.decay, self.backflow, self.radius)
+    def shape(self) -> tuple[float, float, float, float, float, float]:
+        """(meander, decay, backflow, radius, vertical, ground): the plume's shape settings, in
+        the order the kernels take them."""
+        return (self.meander, self.decay, self.backflow, self.radius, self.vertical, self.ground)
 
     def concentration(self, theta: np.ndarray, positions: np.ndarray) -> np.ndarray:
         """(N, 8) source terms × (M, 3) positions → (N, M) concentrations in g/m³."""

@@ -86,33 +86,13 @@ _RING_SIN = tuple(math.sin(j * math.pi / 3.0) for j in range(6))
 
 
 @njit(cache=True, inline="always")
-def plume_at(
-    terms,
-    px: float,
-    py: float,
-    pz: float,
-    rmin: float,
-    meander: float,
-    decay: float,
-    backflow: float,
-    radius: float,
+def _point_or_disc(
+    dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow, radius
 ):
-    """(concentration, clamped distance r) at (px, py, pz) from one particle's
-    :func:`plume_terms`; see :mod:`dcee.models.plume` for ``meander``, ``decay``, ``backflow``
-    (w: (1 − w) · the plume + w · the plume of the reversed wind) and ``radius`` (the release
-    spread over a horizontal disc: seven sub-sources, :data:`DISC_RING`). r is the distance to
-    the source location (the disc's centre)."""
-    sx, sy, sz, pref, inv_lam, ax, ay, c, s, k = terms
-    dx = px - sx
-    dy = py - sy
-    dz = pz - sz
-    r0 = math.sqrt(dx * dx + dy * dy + dz * dz)
-    if r0 < rmin:
-        r0 = rmin
+    """The plume at offset (dx, dy, dz) from the source location of a point release
+    (``radius`` 0) or of one spread over a horizontal disc (:data:`DISC_RING`)."""
     if radius <= 0.0:
-        return _mixed(
-            dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow
-        ), r0
+        return _mixed(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow)
     ring = radius * DISC_RING
     # a sub-source's distance clamped at half the spacing of the rule's points
     rsub = max(rmin, 0.5 * ring)
@@ -128,6 +108,52 @@ def plume_at(
         value += 0.125 * _mixed(
             dx - ox, dy - oy, dz, pref, inv_lam, ax, ay, c, s, k, rsub, meander, decay, backflow
         )
+    return value
+
+
+@njit(cache=True, inline="always")
+def plume_at(
+    terms,
+    px: float,
+    py: float,
+    pz: float,
+    rmin: float,
+    meander: float,
+    decay: float,
+    backflow: float,
+    radius: float,
+    vertical: float,
+    ground: float,
+):
+    """(concentration, clamped distance r) at (px, py, pz) from one particle's
+    :func:`plume_terms`; see :mod:`dcee.models.plume` for ``meander``, ``decay``, ``backflow``
+    (w: (1 − w) · the plume + w · the plume of the reversed wind), ``radius`` (the release
+    spread over a horizontal disc: seven sub-sources, :data:`DISC_RING`), ``vertical`` (the
+    ratio a of the vertical to the horizontal spread: heights divided by a, the release rate
+    too) and ``ground`` (the weight of the release's image below the ground z = 0). r is the
+    distance to the source location (the disc's centre)."""
+    sx, sy, sz, pref, inv_lam, ax, ay, c, s, k = terms
+    dx = px - sx
+    dy = py - sy
+    dz = pz - sz
+    r0 = math.sqrt(dx * dx + dy * dy + dz * dz)
+    if r0 < rmin:
+        r0 = rmin
+    if vertical == 1.0 and ground == 0.0:
+        return _point_or_disc(
+            dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow, radius
+        ), r0
+    inv_a = 1.0 / vertical
+    pref_a = pref * inv_a
+    value = _point_or_disc(
+        dx, dy, dz * inv_a, pref_a, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow,
+        radius,
+    )  # fmt: skip
+    if ground > 0.0:
+        value += ground * _point_or_disc(
+            dx, dy, (pz + sz) * inv_a, pref_a, inv_lam, ax, ay, c, s, k, rmin, meander, decay,
+            backflow, radius,
+        )  # fmt: skip
     return value, r0
 
 
@@ -190,6 +216,8 @@ def concentration_distance_grid(
     decay: float,
     backflow: float,
     radius: float,
+    vertical: float,
+    ground: float,
     conc: np.ndarray,
     dist: np.ndarray,
 ):
@@ -209,6 +237,8 @@ def concentration_distance_grid(
                 decay,
                 backflow,
                 radius,
+                vertical,
+                ground,
             )
             conc[m, i] = c
             dist[m, i] = r
@@ -222,12 +252,16 @@ def concentration_matrix(
     decay: float,
     backflow: float,
     radius: float,
+    vertical: float,
+    ground: float,
     out: np.ndarray,
 ):
     """out[i, m] = C(positions[m]; theta[i]); out (N, M) C-contiguous."""
     tmp = np.empty((positions.shape[0], theta.shape[0]))
     dist = np.empty_like(tmp)
-    concentration_distance_grid(theta, positions, rmin, meander, decay, backflow, radius, tmp, dist)
+    concentration_distance_grid(
+        theta, positions, rmin, meander, decay, backflow, radius, vertical, ground, tmp, dist
+    )
     out[...] = tmp.T
 
 

@@ -73,7 +73,13 @@ def plume_constants(theta: np.ndarray, out: np.ndarray) -> None:
 
 @njit(cache=True)
 def vectorised_case(
-    sp: SensorParams, meander: float, decay: float, backflow: float, radius: float
+    sp: SensorParams,
+    meander: float,
+    decay: float,
+    backflow: float,
+    radius: float,
+    vertical: float,
+    ground: float,
 ) -> bool:
     """True for the paper's sensor and plume (Gaussian family, constant Pd < 1; no meander,
     backflow or area release; decay 1), which the branch-free loops with the vectorisable
@@ -87,6 +93,8 @@ def vectorised_case(
         and decay == 1.0
         and backflow == 0.0
         and radius == 0.0
+        and vertical == 1.0
+        and ground == 0.0
         and sp.sigma_min >= 2.0**-60  # σ within the range of the vectorised log
     )
 
@@ -217,6 +225,8 @@ def position_rows(
     decay: float,
     backflow: float,
     radius: float,
+    vertical: float,
+    ground: float,
     sp: SensorParams,
     conc: np.ndarray,
     dist: np.ndarray,
@@ -244,7 +254,7 @@ def position_rows(
     """
     n = plume.shape[1]
     n_blocks = (n + _ROW_BLOCK - 1) // _ROW_BLOCK
-    fast = vectorised_case(sp, meander, decay, backflow, radius)
+    fast = vectorised_case(sp, meander, decay, backflow, radius, vertical, ground)
     for b in prange(n_blocks):
         i0 = b * _ROW_BLOCK
         i1 = min(n, i0 + _ROW_BLOCK)
@@ -261,8 +271,9 @@ def position_rows(
                 continue
             for i in range(i0, i1):
                 c, r = plume_at(
-                    constants_at(plume, i), px, py, pz, rmin, meander, decay, backflow, radius
-                )
+                    constants_at(plume, i), px, py, pz, rmin, meander, decay, backflow, radius,
+                    vertical, ground,
+                )  # fmt: skip
                 _store_terms(c, r, sp, row, i, conc, dist, loc, log_nd, inv_sigma, det_offset)
 
 

@@ -212,16 +212,23 @@ class ScenarioBuilders:
                 float(self.site_resolution),
             )
             return _wall_plume(site, (u, phi, k, zeta2), (self.wall_wind, self.wall_viscosity))
-        if self.estimator.likelihood == "paper":
-            return IsotropicPlume(meander=self.meander)
+        e = self.estimator
+        learned = dict(self.reading_model_variants).get(model, {})
+        # the ground and the vertical spread are the air's, not a member's shape: every member
+        world = {
+            "vertical": learned.get("vertical_ratio", e.vertical_ratio),
+            "ground": learned.get("ground", e.ground),
+        }
+        if e.likelihood == "paper":
+            return IsotropicPlume(meander=self.meander, **world)
         if model == "paper":
-            return IsotropicPlume(meander=0.0)  # the fluctuation likelihood's calm member
-        learned = dict(self.reading_model_variants)[model]
+            return IsotropicPlume(meander=0.0, **world)  # the fluctuation likelihood's calm member
         return IsotropicPlume(
             meander=learned.get("meander", self.meander),
-            decay=learned.get("decay", self.estimator.decay),
-            backflow=learned.get("backflow", self.estimator.backflow),
-            radius=learned.get("source_radius", self.estimator.source_radius),
+            decay=learned.get("decay", e.decay),
+            backflow=learned.get("backflow", e.backflow),
+            radius=learned.get("source_radius", e.source_radius),
+            **world,
         )
 
     def _reading_model(self, model: str | None) -> str:

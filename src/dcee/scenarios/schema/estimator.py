@@ -186,10 +186,12 @@ LearnedName = Literal[
     "decay",
     "backflow",
     "source_radius",
+    "vertical_ratio",
+    "ground",
     "wall_diffusivity",
 ]
 """The reading model's nuisance parameters ``estimator.learn`` may weigh."""
-PLUME_SHAPE_SETTINGS = ("meander", "decay", "backflow", "source_radius")
+PLUME_SHAPE_SETTINGS = ("meander", "decay", "backflow", "source_radius", "vertical_ratio", "ground")
 """The open plume's shape settings (:class:`~dcee.models.plume.IsotropicPlume`): the wall-aware
 plume has none of them, so ``estimator.plume = "walls"`` learns none."""
 LEARN_RANGES: dict[str, tuple[float, float]] = {
@@ -201,6 +203,8 @@ LEARN_RANGES: dict[str, tuple[float, float]] = {
     "decay": (0.25, 2.0),
     "backflow": (0.0, 0.5),
     "source_radius": (0.0, 10.0),
+    "vertical_ratio": (0.1, 10.0),
+    "ground": (0.0, 1.0),
     "wall_diffusivity": (1e-3, 1000.0),
 }
 """Allowed values of each learned setting (as for the fixed setting)."""
@@ -309,6 +313,16 @@ class EstimatorSpec(BaseModel):
     radius about the source location (:mod:`dcee.models.plume`): a pool, a vent, or a point
     release recorded on a coarse grid. 0: a point source (the paper's model). The paper's
     likelihood and the calm member always use 0"""
+    vertical_ratio: Annotated[float, Field(ge=0.1, le=10.0, allow_inf_nan=False)] = 1.0
+    """the plume model's vertical spread over its horizontal spread, a = √(K_z / K_h)
+    (:mod:`dcee.models.plume`): 1, isotropic (the paper's model); about 0.66 in a neutral
+    surface layer, where σ_w / σ_v = 1.25 / 1.9 (Panofsky & Dutton 1984). Every member of the
+    bank, the calm one included"""
+    ground: Annotated[float, Field(ge=0.0, le=1.0, allow_inf_nan=False)] = 0.0
+    """the weight of the release's mirror image below the ground z = 0 in the plume model
+    (:mod:`dcee.models.plume`): 1, a ground that reflects the gas (a release near the ground
+    doubles its concentration there); 0, the paper's unbounded air. Every member of the bank,
+    the calm one included"""
     meander: Annotated[float | None, Field(ge=0, le=2)] = None
     """crosswind turbulence intensity of the plume model's time-mean meander broadening
     (:mod:`dcee.models.plume`); None: the likelihood's default, :data:`MEANDER_DEFAULT`"""
