@@ -205,7 +205,7 @@ def test_history_kernel_matches_reference(sensor):
     mult = rng.integers(1, 4, 30).astype(float)
     out = np.empty(500)
     history_log_likelihood(
-        theta, np.ones(500, bool), pos, z, mult, 0.1, 0.0, 1.0, 0.0, 0.0, sensor.params, out
+        theta, np.ones(500, bool), pos, z, mult, 0.1, *IsotropicPlume().shape, sensor.params, out
     )
     ref = history_log_likelihood_reference(theta, pos, z, mult, sensor, IsotropicPlume())
     np.testing.assert_allclose(out, ref, rtol=1e-9)
@@ -316,7 +316,7 @@ def test_history_likelihood_and_reading_bounds_against_numpy(sensor):
     out = np.empty(700)
     active = rng.random(700) < 0.9
     history_log_likelihood(
-        theta, active, pos, z, mult, 1e-3, 0.0, 1.0, 0.0, 0.0, sensor.params, out
+        theta, active, pos, z, mult, 1e-3, *IsotropicPlume().shape, sensor.params, out
     )
     ref = history_log_likelihood_reference(theta, pos, z, mult, sensor, plume)
     np.testing.assert_allclose(out[active], ref[active], rtol=1e-9)
@@ -340,10 +340,7 @@ def test_history_likelihood_and_reading_bounds_against_numpy(sensor):
         z,
         mult,
         1e-3,
-        0.0,
-        1.0,
-        0.0,
-        0.0,
+        *IsotropicPlume().shape,
         sensor.params,
         early,
         threshold,
@@ -380,11 +377,11 @@ def test_mcmc_move_is_unchanged_by_early_rejection(monkeypatch):
 
     def no_exit(*args):
         calls.append(len(args))
-        return plain(*args[:12])
+        return plain(*args[:14])
 
     monkeypatch.setattr(rmm, "history_log_likelihood", no_exit)
     np.testing.assert_array_equal(run(), with_exit)
-    assert 14 in calls  # the move's calls, with a threshold and bounds, ran without them
+    assert 16 in calls  # the move's calls, with a threshold and bounds, ran without them
 
 
 def test_both_estimators_implement_the_estimator_interface_and_resample_on_demand():
@@ -450,3 +447,45 @@ def test_compiled_summaries_match_numpy_and_a_hand_calculation():
     assert log_ev == pytest.approx(logsumexp(logw + ll) - logsumexp(logw), rel=1e-12)
     scaled = np.exp(new - new.max())
     assert ess == pytest.approx(effective_sample_size(scaled / scaled.sum()), rel=1e-12)
+
+
+def test_a_move_budget_keeps_the_exact_grid_posterior(sensor):
+    """search.move_history: with a history longer than the budget a sweep moves a random share
+    budget / entries of the particles. Each particle is still a draw of the posterior: the
+    filter with a budget of 2 entries (a share of 1/3 once all six readings are in) matches the
+    exact grid posterior as the full sweep does, and proposes only that share each sweep."""
+    data = _readings(sensor)
+    grid_mean, grid_sd = _grid_posterior(sensor, data)
+    pf = ParticleFilter(
+        planar_prior(u=2.0),
+        sensor,
+        n_particles=20_000,
+        seed=7,
+        resample_threshold=1.0,
+        mcmc_steps=3,
+        move_history=2,
+    )
+    for pos, z in data:
+        pf.update(pos, z)
+    assert pf._move_share() == pytest.approx(2 / 6)
+    np.testing.assert_array_less(np.abs(pf.mean() - grid_mean), 0.2 * grid_sd)
+    np.testing.assert_allclose(np.sqrt(np.diag(pf.cov())), grid_sd, rtol=0.2)
+    _, proposed = pf._mh_sweep(pf._move_share())
+    assert abs(proposed - pf.n / 3) < 5 * np.sqrt(pf.n * (1 / 3) * (2 / 3))
+
+
+def test_a_move_budget_above_the_history_changes_nothing(sensor):
+    """Below the budget the sweeps and the random stream are the unbudgeted filter's, draw for
+    draw: no study's search (at most a few hundred readings) changes with the default."""
+    data = _readings(sensor)
+    runs = []
+    for budget in (None, len(data), 10_000):
+        pf = ParticleFilter(planar_prior(u=2.0), sensor, n_particles=2_000, seed=3,
+                            resample_threshold=1.0, move_history=budget)  # fmt: skip
+        for pos, z in data:
+            pf.update(pos, z)
+        runs.append(pf.theta.copy())
+    for theta in runs[1:]:
+        np.testing.assert_array_equal(theta, runs[0])
+    with pytest.raises(DceeInputError, match="search.move_history"):
+        ParticleFilter(planar_prior(u=2.0), sensor, n_particles=100, move_history=0)

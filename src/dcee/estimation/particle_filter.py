@@ -62,9 +62,12 @@ class ParticleFilter(ResampleMove):
     global_share: share of particles proposing a location from the prior in each sweep.
     diversify: sweep until this share of the particles has moved since the resampling.
     max_sweeps: most sweeps after one resampling.
+    move_history: most history entries a sweep may read per particle (``search.move_history``;
+        None: no limit).
     """
 
-    # checkpoints written before the anemometer existed restore with these
+    # checkpoints written before these existed restore with them
+    move_history: int | None = None
     anemometer: Anemometer | None = None
     wind: WindEvidence = WindEvidence()
     wind_log_evidence: float = 0.0
@@ -87,7 +90,16 @@ class ParticleFilter(ResampleMove):
         anemometer: Anemometer | None = None,
         repeat_radius: float = 0.0,
         repeat_power: float = 1.0,
+        move_history: int | None = None,
     ) -> None:
+        if move_history is not None and not (
+            isinstance(move_history, int)
+            and not isinstance(move_history, bool)
+            and move_history >= 1
+        ):
+            raise DceeInputError(
+                "search.move_history", f"must be an integer >= 1 or None, got {move_history!r}"
+            )
         if not (isinstance(reading_weight, int | float) and 0 < reading_weight <= 1):
             raise DceeInputError(
                 "estimator.reading_weight", f"must be in (0, 1], got {reading_weight!r}"
@@ -129,6 +141,7 @@ class ParticleFilter(ResampleMove):
         self.global_share = global_share
         self.diversify = diversify
         self.max_sweeps = int(max_sweeps)
+        self.move_history = move_history
         self.reading_weight = float(reading_weight)
         self.repeat_radius = float(repeat_radius)
         self.repeat_power = float(repeat_power)

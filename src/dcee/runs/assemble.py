@@ -48,6 +48,7 @@ def make_searcher(
         "global_share": search.global_share,
         "diversify": search.diversify,
         "max_sweeps": search.max_sweeps,
+        "move_history": search.move_history,
         "reading_weight": scenario.reading_weight,
         "repeat_radius": scenario.repeat_radius,
         "repeat_power": scenario.repeat_power,

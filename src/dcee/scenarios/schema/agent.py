@@ -239,3 +239,10 @@ class SearchSpec(BaseModel):
     """sweep until this share of the particles has moved since the resampling"""
     max_sweeps: Annotated[int, Field(ge=1, le=100)] = 8
     """most sweeps after one resampling"""
+    move_history: Annotated[int | None, Field(ge=1, le=10**9)] = 1000
+    """most history entries a rejuvenating sweep reads per particle: beyond it a sweep moves a
+    random share move_history / entries of the particles (each still a draw of the posterior),
+    so a resampling costs the same after an hour of flight as after 1,000 readings. None: every
+    particle every sweep (a cost that grows with the mission). 1,000: above every study's search
+    (at most 180 readings a robot, 540 for a team of three), so no stored result changes; the
+    cost it bounds is measured in docs/guide/robot.md ("A day on a robot")"""
