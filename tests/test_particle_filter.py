@@ -487,5 +487,5 @@ def test_a_move_budget_above_the_history_changes_nothing(sensor):
         runs.append(pf.theta.copy())
     for theta in runs[1:]:
         np.testing.assert_array_equal(theta, runs[0])
-    with pytest.raises(DceeInputError, match="search.move_history"):
+    with pytest.raises(DceeInputError, match=r"search\.move_history"):
         ParticleFilter(planar_prior(u=2.0), sensor, n_particles=100, move_history=0)
