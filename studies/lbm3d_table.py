@@ -12,6 +12,7 @@ searches. Written as CSV and JSON under ``--out`` (docs/results/lbm3d/ in the re
 from __future__ import annotations
 
 import argparse
+import math
 import json
 from pathlib import Path
 
@@ -66,6 +67,28 @@ def _rare(part: pd.DataFrame) -> dict[str, float]:
     }
 
 
+def _errors(run_dirs: list[str]) -> dict[str, float]:
+    """Median error of the final posterior mean along the wind (m, + downwind of the release),
+    across it (m, absolute) and in height (m, + above), from each search's summary and its
+    scenario (the wind comes from φ, the plume runs towards −(cos φ, sin φ))."""
+    down, cross, height = [], [], []
+    for d in run_dirs:
+        summary = json.loads((Path(d) / "summary.json").read_text(encoding="utf-8"))
+        truth = json.loads((Path(d) / "config.json").read_text(encoding="utf-8"))["scenario"]
+        truth = truth["truth"]
+        err = np.asarray(summary["final_mean"], dtype=float) - [truth["x"], truth["y"], truth["z"]]
+        phi = math.radians(truth["phi"])
+        along = -np.array([math.cos(phi), math.sin(phi)])
+        down.append(float(err[:2] @ along))
+        cross.append(abs(float(err[0] * -along[1] + err[1] * along[0])))
+        height.append(float(err[2]))
+    return {
+        "median_downwind_error": float(np.median(down)),
+        "median_crosswind_error": float(np.median(cross)),
+        "median_height_error": float(np.median(height)),
+    }
+
+
 def campaign_table(folder: Path) -> tuple[list[dict], list[dict], list[dict]]:
     """(rows per strategy, paired differences, worst searches) of one campaign."""
     _, runs = load_campaign(folder)
@@ -87,6 +110,7 @@ def campaign_table(folder: Path) -> tuple[list[dict], list[dict], list[dict]]:
                 # precision where detections are rare: the searches with fewer than 60
                 "rare": _rare(part),
                 "altitude_share": share,
+                **_errors(list(part["run_dir"])),
                 "lowest_altitude": z_min,
                 "highest_altitude": z_max,
             }
@@ -144,7 +168,9 @@ def main(argv: list[str] | None = None) -> None:
                 f"{folder.name} {r['strategy']}: acquired {r['acquired']}/{r['searches']}, "
                 f"median RMSE {r['median_final_rmse']:.2f} m [{lo:.2f}, {hi:.2f}], region "
                 f"{r['truth_in_95']}/{r['searches']}, detections {r['median_detections']:.0f}, "
-                f"altitudes {r['lowest_altitude']:g}-{r['highest_altitude']:g} m; under "
+                f"altitudes {r['lowest_altitude']:g}-{r['highest_altitude']:g} m, error downwind "
+                f"{r['median_downwind_error']:+.2f} m, across {r['median_crosswind_error']:.2f} m, "
+                f"in height {r['median_height_error']:+.2f} m; under "
                 f"{RARE} detections: {r['rare']['searches']} searches, median RMSE "
                 f"{r['rare']['median_final_rmse']:.2f} m (others "
                 f"{r['rare']['others_median_final_rmse']:.2f} m), Spearman ρ(detections, RMSE) "
