@@ -12,8 +12,8 @@ searches. Written as CSV and JSON under ``--out`` (docs/results/lbm3d/ in the re
 from __future__ import annotations
 
 import argparse
-import math
 import json
+import math
 from pathlib import Path
 
 import numpy as np
