@@ -132,17 +132,31 @@ class ResampleMove:
         log_u = np.log(self.rng.random(self.n))
         # accepted iff ll_prop > threshold: lets the kernel abandon hopeless proposals early
         with np.errstate(invalid="ignore"):
-            threshold = log_u - lp_prop + self._hist_loglik + lp_cur - log_q_ratio
-        self._history_ll(
-            proposal,
-            active,
-            pos,
-            z,
-            mult,
-            ll_prop,
-            np.nan_to_num(threshold, nan=-np.inf, posinf=np.inf),
-            reading_upper_bounds(z, self.sensor),
-        )
+            threshold = np.nan_to_num(
+                log_u - lp_prop + self._hist_loglik + lp_cur - log_q_ratio,
+                nan=-np.inf,
+                posinf=np.inf,
+            )
+        bounds = reading_upper_bounds(z, self.sensor)
+        if share < 1.0:
+            # only the particles proposed to move go to the kernel, so that the sweep's cost
+            # is that share of the full one (the kernel's blocks would compute the others)
+            moving = np.flatnonzero(active)
+            ll_moving = np.empty(moving.size)
+            self._history_ll(
+                np.ascontiguousarray(proposal[moving]),
+                np.ones(moving.size, dtype=np.bool_),
+                pos,
+                z,
+                mult,
+                ll_moving,
+                np.ascontiguousarray(threshold[moving]),
+                bounds,
+            )
+            ll_prop.fill(-np.inf)
+            ll_prop[moving] = ll_moving
+        else:
+            self._history_ll(proposal, active, pos, z, mult, ll_prop, threshold, bounds)
         with np.errstate(invalid="ignore"):
             log_ratio = (ll_prop + lp_prop) - (self._hist_loglik + lp_cur) + log_q_ratio
             accept = active & (log_u < log_ratio)
