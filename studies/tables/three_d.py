@@ -136,3 +136,57 @@ __all__ = [
     "lbm3d_search_table",
     "lbm3d_timing_table",
 ]
+
+
+SURFACE_PROBE = (
+    ("lbm3d-tune", "3-D plume", "random:1-40", "today's"),
+    ("lbm3d-tune-surface", "3-D plume", "random:1-40", "surface layer"),
+    ("lbm3d-slice-tune", "4 m slice", "lbm3d-slice-tune (20)", "today's"),
+    ("lbm3d-slice-tune-surface", "4 m slice", "lbm3d-slice-tune (20)", "surface layer"),
+)
+
+
+def lbm3d_surface_tune_table() -> str:
+    """The surface-layer reading model beside today's on the tuning ranges (recipe
+    lbm3d-surface-tune; studies/lbm3d_table.py and studies/pair_campaigns.py)."""
+    import csv
+
+    folder = RESULTS / "lbm3d-surface-tune"
+    with (folder / "pairs.csv").open(encoding="utf-8") as f:
+        pairs = {r["truth"]: r for r in csv.DictReader(f)}
+    rows = []
+    for name, truth, range_, model in SURFACE_PROBE:
+        r = json.loads((folder / f"{name}.json").read_text(encoding="utf-8"))["rows"][0]
+        n = r["searches"]
+        lo, hi = r["median_final_rmse_ci95"]
+        paired = ""
+        if model != "today's":
+            p = pairs["3-D" if truth == "3-D plume" else "slice"]
+            paired = (
+                f"{float(p['median_rmse_b_minus_a']):+.2f} m (p = {float(p['rmse_wilcoxon_p']):.2g})"
+            )
+        rows.append(
+            [
+                truth,
+                range_,
+                model,
+                f"{r['acquired']}/{n}",
+                f"{r['median_final_rmse']:.2f} [{lo:.2f}, {hi:.2f}]",
+                f"{r['truth_in_95']}/{n}",
+                f"{r['median_downwind_error']:+.2f}",
+                f"{r['median_height_error']:+.2f}",
+                paired,
+            ]
+        )
+    header = [
+        "truth",
+        "configurations (tuning)",
+        "reading model",
+        "acquired",
+        "median final RMSE (m) [95 % CI]",
+        "truth in 95 % region",
+        "error downwind (m, median)",
+        "error in height (m, median)",
+        "paired RMSE change (Wilcoxon)",
+    ]
+    return table(header, rows)
