@@ -162,9 +162,8 @@ def lbm3d_surface_tune_table() -> str:
         paired = ""
         if model != "today's":
             p = pairs["3-D" if truth == "3-D plume" else "slice"]
-            paired = (
-                f"{float(p['median_rmse_b_minus_a']):+.2f} m (p = {float(p['rmse_wilcoxon_p']):.2g})"
-            )
+            change, p_value = float(p["median_rmse_b_minus_a"]), float(p["rmse_wilcoxon_p"])
+            paired = f"{change:+.2f} m (p = {p_value:.2g})"
         rows.append(
             [
                 truth,
