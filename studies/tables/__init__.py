@@ -45,6 +45,7 @@ from studies.tables.three_d import (
     lbm3d_altitude_table,
     lbm3d_plume_table,
     lbm3d_search_table,
+    lbm3d_store_tune_table,
     lbm3d_surface_tune_table,
     lbm3d_timing_table,
 )
@@ -76,6 +77,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "lbm3d-altitudes": lbm3d_altitude_table,
     "lbm3d-timing": lbm3d_timing_table,
     "lbm3d-surface-tune": lbm3d_surface_tune_table,
+    "lbm3d-store-tune": lbm3d_store_tune_table,
     "source-count": lambda: _source_count("table"),
     "source-count-latest": lambda: _source_count("table_latest"),
     "source-count-worst": lambda: _source_count("worst"),

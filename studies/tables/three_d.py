@@ -12,8 +12,12 @@ FOLDER = RESULTS / "lbm3d"
 HEIGHTS = ("0.25", "0.75", "1.25", "1.75", "2.25", "2.75")
 DISTANCES = (10.0, 20.0, 40.0)
 CAMPAIGNS = (
-    ("lbm3d-held-out-100", "3-D plume", "random:7000-7099"),
-    ("lbm3d-slice-held-out-50", "its 4 m slice, as a planar recording", "50 from random:8000"),
+    ("lbm3d-held-out-100", "3-D plume, stored in 1 m blocks", "random:7000-7099"),
+    (
+        "lbm3d-slice-held-out-50",
+        "its 4 m slice (1 m blocks), as a planar recording",
+        "50 from random:8000",
+    ),
 )
 LOOKS = {"lbm3d-held-out-100": 1, "lbm3d-slice-held-out-50": 1}
 """How many times each published range was looked at (flown and read) before these rows: the
@@ -187,5 +191,42 @@ def lbm3d_surface_tune_table() -> str:
         "error downwind (m, median)",
         "error in height (m, median)",
         "paired RMSE change (Wilcoxon)",
+    ]
+    return table(header, rows)
+
+
+def lbm3d_store_tune_table() -> str:
+    """The 3-D plume stored in 1 m blocks against every 0.5 m cell, 17 searches of the tuning
+    range (docs/results/lbm3d-store-tune/pairs.csv)."""
+    import numpy as np
+    import pandas as pd
+    from scipy.stats import wilcoxon
+
+    pairs = pd.read_csv(RESULTS / "lbm3d-store-tune" / "pairs.csv")
+    n = len(pairs)
+    diff = pairs["rmse_cells_05m"] - pairs["rmse_blocks_1m"]
+    p_value = float(wilcoxon(diff).pvalue)
+    rows = []
+    for label, key in (
+        ("1 m blocks (until 2026-12-05)", "blocks_1m"),
+        ("every 0.5 m cell", "cells_05m"),
+    ):
+        rows.append(
+            [
+                label,
+                str(n),
+                f"{np.median(pairs[f'rmse_{key}']):.2f}",
+                f"{np.median(pairs[f'downwind_{key}']):+.2f}",
+                f"{int(pairs[f'in95_{key}'].sum())}/{n}",
+                "" if key == "blocks_1m" else f"{np.median(diff):+.2f} m (p = {p_value:.1g})",
+            ]
+        )
+    header = [
+        "truth's recording",
+        "searches (tuning)",
+        "median final RMSE (m)",
+        "error downwind (m, median)",
+        "truth in 95 % region",
+        "paired change (Wilcoxon)",
     ]
     return table(header, rows)
