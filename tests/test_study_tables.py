@@ -447,3 +447,24 @@ def test_region_floor_reads_a_campaigns_nested_summaries(tmp_path: Path, capsys)
     row = table[table["floor"] == 0.25].iloc[0]
     assert (row["inside"], row["n"]) == (1, 2)
     assert row["median_radius"] == pytest.approx(math.sqrt(0.04 + 2 * 0.0625))
+
+
+def test_lbm3d_errors_along_and_across_the_wind_by_hand(tmp_path: Path) -> None:
+    """studies/lbm3d_table.py: the final mean's error along the wind is + downwind of the
+    release (the wind comes from φ, the plume runs towards −(cos φ, sin φ)), across it absolute,
+    in height + above: two searches laid out by hand."""
+    table = _script("lbm3d_table")
+    dirs = []
+    # wind from φ = 0 (from +x): downwind is −x. Mean 1 m upwind (+x), 0.5 m across, 0.2 m up
+    # wind from φ = 90° (from +y): downwind is −y. Mean 3 m downwind (−y), 0.25 m across
+    for k, (phi, mean) in enumerate(((0.0, (11.0, 20.5, 1.2)), (90.0, (10.25, 17.0, 0.8)))):
+        d = tmp_path / f"run{k}"
+        d.mkdir()
+        truth = {"x": 10.0, "y": 20.0, "z": 1.0, "phi": phi}
+        (d / "config.json").write_text(json.dumps({"scenario": {"truth": truth}}))
+        (d / "summary.json").write_text(json.dumps({"final_mean": list(mean)}))
+        dirs.append(str(d))
+    errors = table._errors(dirs)
+    assert errors["median_downwind_error"] == pytest.approx((-1.0 + 3.0) / 2)
+    assert errors["median_crosswind_error"] == pytest.approx((0.5 + 0.25) / 2)
+    assert errors["median_height_error"] == pytest.approx((0.2 - 0.2) / 2)
