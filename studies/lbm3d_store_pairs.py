@@ -14,16 +14,18 @@ from __future__ import annotations
 import argparse
 import csv
 import json
-import math
+import sys
 from pathlib import Path
 
-import numpy as np
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT) not in sys.path:  # run as a script: the studies package sits beside it
+    sys.path.insert(0, str(ROOT))
+
+from studies.lbm3d_table import mean_error  # noqa: E402
 
 
 def _downwind(mean: list[float], truth: dict) -> float:
-    phi = math.radians(truth["phi"])
-    along = -np.array([math.cos(phi), math.sin(phi)])
-    return float((np.asarray(mean[:2]) - [truth["x"], truth["y"]]) @ along)
+    return mean_error(mean, truth)[0]
 
 
 def _code(summary: dict) -> str:

@@ -67,25 +67,28 @@ def _rare(part: pd.DataFrame) -> dict[str, float]:
     }
 
 
+def mean_error(final_mean: list[float], truth: dict) -> tuple[float, float, float]:
+    """The final posterior mean's error (m) along the wind (+ downwind of the release), across
+    it (absolute) and in height (+ above); ``truth`` a scenario's truth (x, y, z, φ in degrees:
+    the wind comes from φ, the plume runs towards −(cos φ, sin φ))."""
+    err = np.asarray(final_mean, dtype=float) - [truth["x"], truth["y"], truth["z"]]
+    phi = math.radians(truth["phi"])
+    along = -np.array([math.cos(phi), math.sin(phi)])
+    return float(err[:2] @ along), abs(float(err[0] * -along[1] + err[1] * along[0])), float(err[2])
+
+
 def _errors(run_dirs: list[str]) -> dict[str, float]:
-    """Median error of the final posterior mean along the wind (m, + downwind of the release),
-    across it (m, absolute) and in height (m, + above), from each search's summary and its
-    scenario (the wind comes from φ, the plume runs towards −(cos φ, sin φ))."""
-    down, cross, height = [], [], []
+    """Median :func:`mean_error` over searches, from each one's summary and its scenario."""
+    errors = []
     for d in run_dirs:
         summary = json.loads((Path(d) / "summary.json").read_text(encoding="utf-8"))
-        truth = json.loads((Path(d) / "config.json").read_text(encoding="utf-8"))["scenario"]
-        truth = truth["truth"]
-        err = np.asarray(summary["final_mean"], dtype=float) - [truth["x"], truth["y"], truth["z"]]
-        phi = math.radians(truth["phi"])
-        along = -np.array([math.cos(phi), math.sin(phi)])
-        down.append(float(err[:2] @ along))
-        cross.append(abs(float(err[0] * -along[1] + err[1] * along[0])))
-        height.append(float(err[2]))
+        config = json.loads((Path(d) / "config.json").read_text(encoding="utf-8"))
+        errors.append(mean_error(summary["final_mean"], config["scenario"]["truth"]))
+    down, cross, height = np.median(np.asarray(errors), axis=0)
     return {
-        "median_downwind_error": float(np.median(down)),
-        "median_crosswind_error": float(np.median(cross)),
-        "median_height_error": float(np.median(height)),
+        "median_downwind_error": float(down),
+        "median_crosswind_error": float(cross),
+        "median_height_error": float(height),
     }
 
 

@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
+import csv
 import json
+
+import numpy as np
+import pandas as pd
+from scipy.stats import wilcoxon
 
 from dcee.recordings.statistics import briggs_sigma_y, briggs_sigma_z
 from dcee.simulation.lbm3d_solver import SURFACE_LAYER_SIGMAS
@@ -153,8 +158,6 @@ SURFACE_PROBE = (
 def lbm3d_surface_tune_table() -> str:
     """The surface-layer reading model beside today's on the tuning ranges (recipe
     lbm3d-surface-tune; studies/lbm3d_table.py and studies/pair_campaigns.py)."""
-    import csv
-
     folder = RESULTS / "lbm3d-surface-tune"
     with (folder / "pairs.csv").open(encoding="utf-8") as f:
         pairs = {r["truth"]: r for r in csv.DictReader(f)}
@@ -198,10 +201,6 @@ def lbm3d_surface_tune_table() -> str:
 def lbm3d_store_tune_table() -> str:
     """The 3-D plume stored in 1 m blocks against every 0.5 m cell, 17 searches of the tuning
     range (docs/results/lbm3d-store-tune/pairs.csv)."""
-    import numpy as np
-    import pandas as pd
-    from scipy.stats import wilcoxon
-
     pairs = pd.read_csv(RESULTS / "lbm3d-store-tune" / "pairs.csv")
     n = len(pairs)
     diff = pairs["rmse_cells_05m"] - pairs["rmse_blocks_1m"]
