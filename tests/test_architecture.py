@@ -35,6 +35,7 @@ LAYERS = {
     "dcee.limits": 0,  # what a reader of others' files will allocate
     "dcee.models": 1,
     "dcee.recordings": 1,  # plume recordings on disk: CF reader, header layout, statistics
+    "dcee.geo": 1,  # geographic coordinates: the local frame, site files, answers on a map
     "dcee.estimation": 2,
     "dcee.stopping": 2,  # when the posterior is narrow enough to end a search
     "dcee.planning": 3,

@@ -193,6 +193,20 @@ def print_summary(summary: dict[str, Any], out_dir: Path | None, where: str = "r
             if summary.get("true_sources", 1) > 1
             else []
         ),
+        *(
+            [
+                (
+                    "estimate (latitude, longitude; height)",
+                    f"{geo['latitude']:.7f}°, {geo['longitude']:.7f}°; {geo['height_m']:.1f} m",
+                ),
+                (
+                    "estimate (local x, y, z m)",
+                    ", ".join(f"{v:.2f}" for v in summary["final_mean"]),
+                ),
+            ]
+            if (geo := summary.get("final_mean_geo"))
+            else []
+        ),
         ("plume acquired", str(summary["plume_acquired"])),
         ("time to RMSE < 1 m (s)", _seconds(summary["time_to_rmse_1m"])),
         ("time to RMSE < 0.5 m (s)", _seconds(summary["time_to_rmse_0_5m"])),

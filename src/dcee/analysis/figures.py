@@ -161,6 +161,8 @@ def _draw_map(
     ax.set_ylabel("y (m)")
     ax.set_title(f"t = {until:.0f} s, RMSE {last['rmse']:.2f} m", loc="left")
     _draw_compass(ax, scenario.truth.phi)
+    if scenario.world.frame is not None:
+        _draw_map_frame(ax, scenario)
     plt.colorbar(
         mesh,
         ax=ax,
@@ -193,6 +195,30 @@ def _draw_compass(ax: plt.Axes, phi_deg: float) -> None:
     ax.text(
         0.84, 1.065, wind_from_words(phi_deg), transform=ax.transAxes, ha="right",
         va="center", fontsize=7, color="tab:blue",
+    )  # fmt: skip
+
+
+def _draw_map_frame(ax: plt.Axes, scenario: Scenario) -> None:
+    """A site in geographic coordinates: a scale bar in the map's lower-right corner and the
+    local frame's origin in degrees under the map."""
+    from mpl_toolkits.axes_grid1.anchored_artists import AnchoredSizeBar
+
+    width = scenario.volume.high[0] - scenario.volume.low[0]
+    nice = [1, 2, 5, 10, 20, 25, 50, 100, 200, 250, 500, 1000, 2000, 5000, 10000]
+    length = max((n for n in nice if n <= width / 4), default=nice[0])
+    ax.add_artist(
+        AnchoredSizeBar(
+            ax.transData, length, f"{length:g} m", "lower right", pad=0.4, frameon=True,
+            size_vertical=width / 200, fontproperties={"size": 7},
+        )
+    )  # fmt: skip
+    frame = scenario.world.frame
+    assert frame is not None
+    lon, lat = frame.local_frame().to_geo(np.array([0.0]), np.array([0.0]))
+    ax.text(
+        0.0, -0.16, f"(0, 0) = {abs(lat[0]):.6f}° {'N' if lat[0] >= 0 else 'S'}, "
+        f"{abs(lon[0]):.6f}° {'E' if lon[0] >= 0 else 'W'}; x east, y north (transverse "
+        "Mercator about the site)", transform=ax.transAxes, fontsize=7, va="top",
     )  # fmt: skip
 
 

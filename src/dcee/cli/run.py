@@ -37,6 +37,14 @@ from dcee.io import (
     show_default=True,
     help="Planner NAME[:KEY=VALUE]..., e.g. dcee-cl:reach=6 (`dcee strategies` lists them).",
 )
+@click.option(
+    "--area",
+    "area_file",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="A site in geographic coordinates: a GeoJSON file with the search area, buildings, "
+    "no-go zones, the start and the release (docs/guide/on-a-map.md); with --scenario, that "
+    "scenario's settings on this site. Writes estimate.geojson and estimate.kml too.",
+)
 @click.option("--seed", default=0, show_default=True, type=int, help="Run seed.")
 @click.option("--particles", type=int, help="Override search.particles.")
 @click.option("--hypotheses", type=int, help="Override search.hypotheses (per candidate move).")
@@ -69,6 +77,7 @@ from dcee.io import (
 def run(
     scenario_name: str | None,
     strategy: str,
+    area_file: Path | None,
     seed: int,
     particles: int | None,
     hypotheses: int | None,
@@ -99,6 +108,8 @@ def run(
     get_planner(strategy)  # fail fast on an unknown name or a bad option
     if truth is not None:
         truth = truth_choice(truth)
+    if scenario_name is None and area_file is not None:
+        scenario_name, area_file = str(area_file), None  # the site's own scenario
     if scenario_name is None:
         if not (isinstance(truth, dict) and truth.get("kind") == "gaden"):
             raise DceeInputError(
@@ -108,6 +119,11 @@ def run(
             )
         scenario_name = truth["folder"]
     base = load_scenario(scenario_name)
+    if area_file is not None:
+        from dcee.scenarios.geo_area import with_area
+        from dcee.scenarios.schema import validate_scenario
+
+        base = validate_scenario(with_area(base, area_file))
     changes = {
         "search.particles": particles,
         "search.hypotheses": hypotheses,

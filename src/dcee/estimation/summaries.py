@@ -106,20 +106,20 @@ REGION_SEED = 20261202
 answer (the region is a summary, not part of the search)."""
 
 
-def in_credible_ellipsoid(
+def credible_ellipsoid(
     points: np.ndarray,
     weights: np.ndarray,
-    truth: np.ndarray,
     level: float = 0.95,
     floor: float = 0.0,
-) -> bool:
-    """Whether ``truth`` (D,) lies in the ``level`` credible region of the weighted points
-    (N, D), weights (N,) normalised.
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """The ``level`` credible region of the weighted points (N, D), weights (N,) normalised, as
+    (mean (D,), inverse covariance (D, D), cutoff): the points x with
+    (x − mean)ᵀ inv (x − mean) ≤ cutoff.
 
     The region is the ellipsoid, shaped by the weighted covariance, that holds ``level`` of the
-    mass: the truth is inside when its Mahalanobis distance is at most the weighted ``level``
-    quantile of the points' distances (no Gaussian assumption on the radial profile). Over many
-    searches a calibrated filter contains the truth ``level`` of the time.
+    mass: the cutoff is the weighted ``level`` quantile of the points' Mahalanobis distances (no
+    Gaussian assumption on the radial profile). Over many searches a calibrated filter contains
+    the truth ``level`` of the time.
 
     ``floor`` σ (m, ≥ 0) is a model-discrepancy scale: the region is that of the posterior
     convolved with an isotropic normal N(0, σ² I), the source's location as the points place it
@@ -137,16 +137,51 @@ def in_credible_ellipsoid(
     inv = np.linalg.pinv(cov)
     d = points - mean
     dist = np.einsum("ij,jk,ik->i", d, inv, d)
-    t = np.asarray(truth, dtype=np.float64) - mean
     order = np.argsort(dist)
     cum = np.cumsum(weights[order])
     cutoff = dist[order][min(int(np.searchsorted(cum, level)), len(cum) - 1)]
+    return mean, inv, float(cutoff)
+
+
+def in_credible_ellipsoid(
+    points: np.ndarray,
+    weights: np.ndarray,
+    truth: np.ndarray,
+    level: float = 0.95,
+    floor: float = 0.0,
+) -> bool:
+    """Whether ``truth`` (D,) lies in the ``level`` credible region of the weighted points
+    (:func:`credible_ellipsoid`)."""
+    mean, inv, cutoff = credible_ellipsoid(points, weights, level, floor)
+    t = np.asarray(truth, dtype=np.float64) - mean
     return bool(t @ inv @ t <= cutoff)
+
+
+def credible_ellipse_boundary(
+    points: np.ndarray,
+    weights: np.ndarray,
+    level: float = 0.95,
+    floor: float = 0.0,
+    vertices: int = 72,
+) -> np.ndarray:
+    """(vertices, 2) points on the boundary of the ``level`` credible region of the weighted 2-D
+    points (N, 2) (:func:`credible_ellipsoid`), counter-clockwise, not closed."""
+    mean, inv, cutoff = credible_ellipsoid(points, weights, level, floor)
+    values, vectors = np.linalg.eigh(inv)
+    radii = np.sqrt(cutoff / np.maximum(values, 1e-300))
+    angle = np.linspace(0.0, 2.0 * np.pi, vertices, endpoint=False)
+    unit = np.stack([np.cos(angle), np.sin(angle)], axis=1) * radii
+    boundary = mean + unit @ vectors.T
+    if np.linalg.det(vectors) < 0:  # a reflection turns the order clockwise
+        boundary = boundary[::-1]
+    return boundary
 
 
 __all__ = [
     "REGION_DRAWS",
     "REGION_SEED",
+    "credible_ellipse_boundary",
+    "credible_ellipsoid",
     "in_credible_ellipsoid",
     "weighted_moments",
     "weighted_rmse",

@@ -81,6 +81,12 @@ class EpisodeResult:
         write_json(folder / "config.json", config)
         summary = {"code": code_version(), **self.summary}  # run_episode already set it
         summary.update(record_rows=len(records), final_sample=len(idx))
+        frame = ((config.get("scenario") or {}).get("world") or {}).get("frame")
+        if frame is not None:  # a site in geographic coordinates: the answer on a map too
+            from dcee.runs.map_answer import write_map_answer
+
+            summary["final_mean_geo"] = write_map_answer(folder, self, frame)
+            self.summary["final_mean_geo"] = summary["final_mean_geo"]
         write_json(folder / "summary.json", summary)
         return folder
 

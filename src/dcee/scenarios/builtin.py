@@ -90,6 +90,11 @@ def _paper(k: int, scale: float = 1.0) -> dict[str, Any]:
     }
 
 
+def paper_configuration(k: int) -> dict[str, Any]:
+    """The raw scenario ``paper:K`` (a fresh copy: callers may change it)."""
+    return _paper(k)
+
+
 # Indoor experiment (section 6) in simulation. The area, step, wind speed and the seven unknowns
 # are the paper's; the source position, the plume's release rate and dispersion, the robot's
 # speed and dwell and the budget are chosen (docs/scenarios.md). Wind blows along +x (φ = 180°).

@@ -17,6 +17,7 @@ from dcee.scenarios.builtin import (
 )
 from dcee.scenarios.defaults import DEFAULTS
 from dcee.scenarios.gaden_room import gaden_room_configuration, is_gaden_folder
+from dcee.scenarios.geo_area import area_configuration, expand_area
 from dcee.scenarios.schema import Scenario, validate_scenario
 from dcee.stopping import DEFAULT_STOP_SHARE
 
@@ -49,6 +50,8 @@ def load_scenario(name_or_path: str) -> Scenario:
     path = Path(name_or_path)
     if is_gaden_folder(path):
         return validate_scenario(gaden_room_configuration(path))
+    if path.suffix.lower() in (".geojson", ".json") and path.is_file():
+        return validate_scenario(area_configuration(path))
     if not path.suffix == ".toml" and ":" in name_or_path:
         raise DceeInputError(
             "scenario",
@@ -65,7 +68,7 @@ def load_scenario(name_or_path: str) -> Scenario:
         raise DceeInputError("scenario", f"cannot read {path}: {exc}") from None
     data.setdefault("name", path.stem)
     _resolve_recording(data, path.parent)
-    return validate_scenario(data)
+    return validate_scenario(expand_area(data, path.parent))
 
 
 def _resolve_recording(data: dict, base: Path) -> None:
@@ -145,6 +148,8 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
             f"{DEFAULT_STOP_SHARE * scenario.search.acquired_rmse:g} m, in a simulation never"
         ),
         ("world", "map"): "unset: no occupancy-grid map",
+        ("world", "area"): "unset: a local frame only, no map in geographic coordinates",
+        ("world", "frame"): "unset: written when world.area is read",
         ("agent", "min_altitude"): (
             f"unset: the area's floor, {scenario.volume.low[2]:g} m; the agent flies no lower"
         ),

@@ -4,7 +4,7 @@ shapes or as an occupancy-grid map in the ROS map-server format (:mod:`dcee.mode
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, Field, model_validator
 
@@ -66,6 +66,24 @@ class ShapeSpec(BaseModel):
         return Polygon(tuple(self.points))  # type: ignore[arg-type]
 
 
+class FrameSpec(BaseModel):
+    """The local frame of a site given in geographic coordinates (:mod:`dcee.geo.frame`):
+    transverse Mercator about (``latitude``, ``longitude``) degrees on WGS 84, shifted by
+    (``x0``, ``y0``) m. Written when ``world.area`` is read; never given by hand."""
+
+    model_config = FROZEN
+    latitude: Annotated[float, Field(gt=-90, lt=90, allow_inf_nan=False)]
+    longitude: Annotated[float, Field(ge=-180, le=180, allow_inf_nan=False)]
+    x0: Finite = 0.0
+    y0: Finite = 0.0
+
+    def local_frame(self) -> Any:
+        """The :class:`dcee.geo.frame.LocalFrame` it describes."""
+        from dcee.geo.frame import LocalFrame
+
+        return LocalFrame(self.latitude, self.longitude, self.x0, self.y0)
+
+
 class WorldSpec(BaseModel):
     """Obstacles and no-go zones. The robot never enters or crosses either (every planner
     chooses among the moves that stay clear; distance costs are travel distances around
@@ -95,6 +113,22 @@ class WorldSpec(BaseModel):
     ``agent.step`` (0.5 m at the paper's 2 m steps, 0.075 m in the lab)"""
     clearance: Annotated[float, Field(ge=0, le=100, allow_inf_nan=False)] = 0.0
     """m: every obstacle and zone grown by this much (the robot's radius plus a margin)"""
+    area: str | None = None
+    """a site in geographic coordinates: a GeoJSON file with the search area, buildings and
+    no-go zones (:mod:`dcee.scenarios.geo_area`, docs/guide/on-a-map.md), read when the scenario
+    is loaded into the local frame (``frame``) and these shapes; a relative path is taken from
+    the scenario file's folder"""
+    frame: FrameSpec | None = None
+    """the local frame of ``area`` (written when it is read)"""
+
+    @model_validator(mode="after")
+    def _area_read(self) -> WorldSpec:
+        if self.area is not None and self.frame is None:
+            raise ValueError(
+                "area: a map is read when the scenario is loaded: give it as [world] area in a "
+                "scenario file or with dcee run --area FILE, not with --set"
+            )
+        return self
 
     @property
     def empty(self) -> bool:
@@ -105,4 +139,4 @@ def shapes_of(specs: tuple[ShapeSpec, ...]) -> list[Shape]:
     return [s.shape() for s in specs]
 
 
-__all__ = ["ShapeSpec", "WorldSpec", "shapes_of"]
+__all__ = ["FrameSpec", "ShapeSpec", "WorldSpec", "shapes_of"]
