@@ -41,6 +41,7 @@ PAGES = (
     "docs/multi-source.md",
     "docs/three-d.md",
     "docs/guide/robot.md",
+    "docs/guide/on-a-map.md",
 )
 MARKER = re.compile(
     r"(<!-- generated: (?P<name>[a-z0-9-]+) \(studies/publish_tables\.py\) -->\n)"

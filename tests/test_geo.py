@@ -17,7 +17,7 @@ from dcee.scenarios import load_scenario
 from dcee.scenarios.schema import validate_scenario
 from tests.helpers import run_cli
 
-SITE = Path(__file__).parents[1] / "examples" / "sites" / "example-works.geojson"
+SITE = Path(__file__).parents[1] / "src" / "dcee" / "scenarios" / "sites" / "example-works.geojson"
 
 
 def test_frame_round_trip_and_distances_match_the_geodesic() -> None:
@@ -237,3 +237,51 @@ def test_bad_site_files_are_refused_in_one_line(
     lines = [line for line in err.strip().splitlines() if line.strip()]
     assert len(lines) == 1 and field in lines[0] and words in lines[0], err
     assert "Traceback" not in err and not out.exists() and not stdout
+
+
+def test_a_declared_crs_gives_the_same_site(tmp_path: Path) -> None:
+    """The example site written in UTM zone 31N (EPSG:32631, as GeoJSON 2008's ``crs``
+    member names it) is the same scenario to the millimetre."""
+    from pyproj import Transformer
+
+    to_utm = Transformer.from_crs("EPSG:4326", "EPSG:32631", always_xy=True)
+    doc = json.loads(SITE.read_text())
+
+    def utm(p: list[float]) -> list[float]:
+        return list(to_utm.transform(p[0], p[1]))
+
+    for f in doc["features"]:
+        g = f["geometry"]
+        if g["type"] == "Polygon":
+            g["coordinates"] = [[utm(p) for p in ring] for ring in g["coordinates"]]
+        elif g["type"] == "Point":
+            g["coordinates"] = utm(g["coordinates"])
+        elif g["type"] == "LineString":
+            g["coordinates"] = [utm(p) for p in g["coordinates"]]
+    doc["crs"] = {"type": "name", "properties": {"name": "EPSG:32631"}}
+    path = tmp_path / "utm.geojson"
+    path.write_text(json.dumps(doc))
+    a, b = load_scenario(str(SITE)), load_scenario(str(path))
+    assert np.allclose(a.agent.start, b.agent.start, atol=2e-3)
+    assert np.allclose(
+        [a.truth.x, a.truth.y, a.truth.z], [b.truth.x, b.truth.y, b.truth.z], atol=2e-3
+    )
+    for sa, sb in zip(a.world.obstacles, b.world.obstacles, strict=True):
+        assert np.allclose(sa.points, sb.points, atol=2e-3)
+
+
+def test_the_site_check_finds_a_position_inside_a_building(tmp_path: Path, capsys) -> None:  # noqa: ANN001
+    """studies/geo_site_check.py, the check behind the published 'never entered' count, flags
+    a path moved into the hall (so its zero can fail)."""
+    from studies.geo_site_check import check
+
+    out = _search(["--area", str(SITE)], tmp_path / "campaign", "run", capsys)
+    assert all(not r["entered"] for r in check(tmp_path / "campaign")["searches"])
+    doc = json.loads((out / "estimate.geojson").read_text())
+    hall = np.array(_feature(json.loads(SITE.read_text()), "Hall A")["geometry"]["coordinates"][0])
+    path = next(f for f in doc["features"] if f["properties"]["kind"] == "path")
+    path["geometry"]["coordinates"][3] = hall[:-1].mean(axis=0).tolist()
+    (out / "estimate.geojson").write_text(json.dumps(doc))
+    entered = check(tmp_path / "campaign")["searches"][0]["entered"]
+    assert "position 3 in features[1] (building 'Hall A')" in entered
+    assert any("crosses features[1]" in e for e in entered)

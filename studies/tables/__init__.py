@@ -7,6 +7,7 @@ from collections.abc import Callable
 
 from dcee.scenarios import REGION_FLOOR_DEFAULT
 from studies.tables.gaden import gaden_rooms_table, gaden_starts_table, gaden_timing_table
+from studies.tables.geo import geo_site_table
 from studies.tables.headline import headline_table
 from studies.tables.held_out import held_out_table, others_table, paired_table
 from studies.tables.lbm import (
@@ -65,6 +66,7 @@ from studies.tables.turbulent import cross_truth_table, turbulent_table
 
 TABLES: dict[str, Callable[[], str]] = {
     "gaden-rooms": gaden_rooms_table,
+    "geo-site": geo_site_table,
     "gaden-starts": gaden_starts_table,
     "gaden-timing": gaden_timing_table,
     "fuzz-readers": fuzz_readers_table,

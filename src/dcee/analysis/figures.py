@@ -215,11 +215,12 @@ def _draw_map_frame(ax: plt.Axes, scenario: Scenario) -> None:
     frame = scenario.world.frame
     assert frame is not None
     lon, lat = frame.local_frame().to_geo(np.array([0.0]), np.array([0.0]))
-    ax.text(
-        0.0, -0.16, f"(0, 0) = {abs(lat[0]):.6f}° {'N' if lat[0] >= 0 else 'S'}, "
-        f"{abs(lon[0]):.6f}° {'E' if lon[0] >= 0 else 'W'}; x east, y north (transverse "
-        "Mercator about the site)", transform=ax.transAxes, fontsize=7, va="top",
-    )  # fmt: skip
+    ax.set_xlabel(
+        f"x (m east; (0, 0) = {abs(lat[0]):.6f}° {'N' if lat[0] >= 0 else 'S'}, "
+        f"{abs(lon[0]):.6f}° {'E' if lon[0] >= 0 else 'W'}, transverse Mercator about the site)",
+        fontsize=8,
+    )
+    ax.set_ylabel("y (m north)")
 
 
 def _draw_rmse(ax: plt.Axes, result: EpisodeResult, scenario: Scenario, until: float) -> None:

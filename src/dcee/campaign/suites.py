@@ -24,6 +24,7 @@
   configurations from ``random:8000`` whose source is 2-4 m below it (at most 2 m above the
   ground); ``lbm3d-slice-tune``, the same slice over the first 20 such configurations of the
   tuning range (choose here, never report).
+* ``geo-example``: the site on a map that ships with dcee (``area:example-works``, issue 81).
 * ``smoke``: two of them at toy scale (1,000 particles, 10 hypothesised readings, 60 s) so a
   campaign with every strategy finishes in well under a minute; for CI and for trying options.
 """
@@ -192,6 +193,8 @@ SUITES: dict[str, dict] = {
         "configs": _sources_below(SLICE_FROM, SLICE_PLANE, 2.0, SLICE_COUNT),
         "overrides": {**LBM3D, "truth.model": {"kind": "lbm3d", "plane": SLICE_PLANE}},
     },
+    # a site on a map in geographic coordinates (issue 81): the example site that ships with dcee
+    "geo-example": {"configs": ["area:example-works"], "overrides": {}},
     # tuning configurations for slow studies (never report them)
     "random-tune-12": {"configs": [f"random:{k}" for k in range(1, 13)], "overrides": {}},
     "smoke": {

@@ -24,6 +24,13 @@ def scenarios() -> None:
         f"{'random-site:K':14s} A random site: 3-6 buildings, a release among them, the wind "
         "from anywhere; for tuning the gas round buildings (--truth lbm), never reported."
     )
+    from dcee.scenarios.geo_area import SITES
+
+    for path in sorted(SITES.glob("*.geojson")):
+        click.echo(
+            f"{'area:' + path.stem:14s} A site on a map in geographic coordinates "
+            f"({path.name}; docs/guide/on-a-map.md); any GeoJSON site: --area FILE."
+        )
 
 
 @click.command(short_help="List the planners and their options.")

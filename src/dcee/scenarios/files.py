@@ -17,7 +17,7 @@ from dcee.scenarios.builtin import (
 )
 from dcee.scenarios.defaults import DEFAULTS
 from dcee.scenarios.gaden_room import gaden_room_configuration, is_gaden_folder
-from dcee.scenarios.geo_area import area_configuration, expand_area
+from dcee.scenarios.geo_area import area_configuration, expand_area, packaged_site
 from dcee.scenarios.schema import Scenario, validate_scenario
 from dcee.stopping import DEFAULT_STOP_SHARE
 
@@ -47,6 +47,8 @@ def load_scenario(name_or_path: str) -> Scenario:
         raise DceeInputError("scenario", str(exc)) from None
     if family is not None:
         return validate_scenario(random_family_configuration(*family))
+    if name_or_path.startswith("area:"):
+        return validate_scenario(area_configuration(packaged_site(name_or_path[5:])))
     path = Path(name_or_path)
     if is_gaden_folder(path):
         return validate_scenario(gaden_room_configuration(path))

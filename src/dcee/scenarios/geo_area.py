@@ -34,6 +34,8 @@ from dcee.errors import DceeInputError
 from dcee.geo.frame import MAX_EXTENT, LocalFrame, frame_for_bounds
 from dcee.geo.site_file import GeoPoint, GeoSite, read_site
 
+SITES = Path(__file__).parent / "sites"
+"""The site files that ship with dcee (``area:NAME`` is ``sites/NAME.geojson``)."""
 MIN_CEILING = 5.0
 """m: the volume's least top (the random scenarios' 0-5 m)."""
 
@@ -82,7 +84,8 @@ def _place(frame: LocalFrame, point: GeoPoint, area: Any, what: str) -> list[flo
         )
         raise DceeInputError(
             what,
-            f"({point.lat:.6f}°, {point.lon:.6f}°) lies outside the area, {km / 1000.0:,.2f} km "
+            f"latitude {point.lat:.6f}°, longitude {point.lon:.6f}° lies outside the area, "
+            f"{km / 1000.0:,.2f} km "
             f"from its centre{hint}",
         )
     return [round(float(x[0]), 3), round(float(y[0]), 3), point.height]
@@ -214,6 +217,15 @@ def _simple_pieces(geometry: Any) -> list[Any]:
     return out
 
 
+def packaged_site(name: str) -> Path:
+    """The site file of ``area:NAME``."""
+    path = SITES / f"{name}.geojson"
+    if not path.is_file():
+        names = ", ".join(f"area:{p.stem}" for p in sorted(SITES.glob("*.geojson")))
+        raise DceeInputError("scenario", f"no site area:{name}; dcee ships {names}")
+    return path
+
+
 def area_configuration(path: str | Path) -> dict[str, Any]:
     """The scenario of a site file alone (``--scenario FILE.geojson``, ``--area FILE`` without
     a scenario): the paper's sensor, agent and priors (configuration 1 of its study) on the
@@ -258,4 +270,11 @@ def with_area(scenario: Any, path: str | Path) -> dict[str, Any]:
     return expand_area(data)
 
 
-__all__ = ["MIN_CEILING", "area_configuration", "expand_area", "with_area"]
+__all__ = [
+    "MIN_CEILING",
+    "SITES",
+    "area_configuration",
+    "expand_area",
+    "packaged_site",
+    "with_area",
+]
