@@ -270,7 +270,7 @@ def test_a_declared_crs_gives_the_same_site(tmp_path: Path) -> None:
         assert np.allclose(sa.points, sb.points, atol=2e-3)
 
 
-def test_the_site_check_finds_a_position_inside_a_building(tmp_path: Path, capsys) -> None:  # noqa: ANN001
+def test_the_site_check_finds_a_position_inside_a_building(tmp_path: Path, capsys) -> None:
     """studies/geo_site_check.py, the check behind the published 'never entered' count, flags
     a path moved into the hall (so its zero can fail)."""
     from studies.geo_site_check import check
