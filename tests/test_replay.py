@@ -3,12 +3,15 @@ through the same cycle give the same readings and the same posterior."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
 pytest.importorskip("rosbags")
 
 from dcee.cli import main
+from dcee.errors import DceeInputError
 from dcee.planning import get as get_planner
 from dcee.robot.bag import BagWriter, read_events, stamp_seconds
 from dcee.robot.cycle import CycleSettings, Pose, SearchCycle
@@ -81,3 +84,50 @@ def test_replay_cli(tmp_path, capsys) -> None:
     assert err[-1].startswith("dcee: error: bag: no bag at")
     assert _replay(bag, *lab, "--calibration", "-1") == 2
     assert "calibration" in capsys.readouterr().err
+
+
+def test_replay_places_gnss_fixes_on_the_sites_map(tmp_path) -> None:
+    """A robot that logs latitude and longitude (sensor_msgs/NavSatFix on its pose topic) is
+    replayed in the site's local frame: it reads at the odometry's positions (within 5 cm: its
+    speeds come from successive fixes, so it may settle a control step apart) and ends near the
+    same estimate."""
+    pytest.importorskip("pyproj")
+    sc = load_scenario("area:example-works").with_overrides(**SCENARIO)
+    frame = sc.world.frame.local_frame()
+    robot = SimulatedRobot(sc, 0)
+    _, filter_rng, planner_rng, _ = streams(0)
+    planner = get_planner("infotaxis", **planner_defaults("infotaxis", sc, None))
+    cycle = SearchCycle(
+        make_searcher(sc, planner, filter_rng, planner_rng),
+        CycleSettings.from_scenario(sc),
+        true_location=sc.truth_theta()[:3],
+    )
+    with BagWriter(tmp_path / "odom") as odom, BagWriter(tmp_path / "gnss") as gnss:
+        while True:
+            s = robot.odometry()
+            value = float(np.float32(robot.sample()))
+            t = stamp_seconds(round(robot.time * 1e9))
+            odom.write_search_step(t, pose=(s.x, s.y, s.heading, s.v, s.omega), reading=value)
+            lon, lat = frame.to_geo(np.array([s.x]), np.array([s.y]))
+            gnss.write_fix(t, float(lat[0]), float(lon[0]), topic="odom")
+            gnss.write_search_step(t, reading=value)
+            cycle.on_reading(t, value)
+            out = cycle.on_pose(Pose(t, s.x, s.y, s.heading, s.v, s.omega))
+            if out.goal is not None:
+                odom.write_search_step(t, goal=tuple(out.goal))
+                gnss.write_search_step(t, goal=tuple(out.goal))
+                robot.set_goal(out.goal)
+            if out.finished:
+                break
+            robot.step()
+    a = replay_bag(tmp_path / "odom", sc, seed=0)
+    b = replay_bag(tmp_path / "gnss", sc, seed=0)
+    assert {e.kind for e in read_events(tmp_path / "gnss")} == {"fix", "reading", "goal"}
+    assert len(b.records) >= 5 and abs(len(a.records) - len(b.records)) <= 1
+    for ra, rb in zip(a.records, b.records, strict=False):
+        assert math.hypot(ra["x"] - rb["x"], ra["y"] - rb["y"]) < 0.05  # the settle may differ
+    est_a = np.array(a.summary["final_mean"])
+    est_b = np.array(b.summary["final_mean"])
+    assert np.linalg.norm(est_a - est_b) < 0.5
+    with pytest.raises(DceeInputError, match="geographic coordinates"):
+        replay_bag(tmp_path / "gnss", load_scenario("lab:upwind"), seed=0)

@@ -114,6 +114,37 @@ class BagWriter:
             )
             self.write_message(names["goal"], ns, msg, "geometry_msgs/msg/PoseStamped")
 
+    def write_fix(
+        self,
+        t: float,
+        latitude: float,
+        longitude: float,
+        topic: str = "fix",
+        status: int = 0,
+        frame_id: str = "gps",
+    ) -> None:
+        """Write a GNSS fix (sensor_msgs/NavSatFix; altitude NaN, covariance unknown) at ``t``
+        s: how a robot that reports latitude and longitude is logged (:mod:`dcee.robot.gps`)."""
+        types = self._typestore.types
+        ns = round(t * 1e9)
+        header = types["std_msgs/msg/Header"](
+            stamp=types["builtin_interfaces/msg/Time"](
+                sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000
+            ),
+            frame_id=frame_id,
+        )
+        status_type = types["sensor_msgs/msg/NavSatStatus"]
+        msg = types["sensor_msgs/msg/NavSatFix"](
+            header=header,
+            status=status_type(status=status, service=1),
+            latitude=float(latitude),
+            longitude=float(longitude),
+            altitude=math.nan,
+            position_covariance=np.zeros(9),
+            position_covariance_type=0,
+        )
+        self.write_message(topic, ns, msg, "sensor_msgs/msg/NavSatFix")
+
     def close(self) -> None:
         self._writer.close()
 
@@ -157,7 +188,8 @@ def _stamp(header: Any, fallback: float) -> float:
 
 
 def read_events(path: str | Path, topics: dict[str, str] | None = None) -> list[BagEvent]:
-    """The poses (nav_msgs/Odometry), readings (std_msgs/Float32) and goals
+    """The poses (nav_msgs/Odometry, or GNSS fixes: sensor_msgs/NavSatFix as events of kind
+    "fix", value (latitude, longitude, status)), readings (std_msgs/Float32) and goals
     (geometry_msgs/PoseStamped) of a bag, in time order. ``topics`` maps "concentration",
     "pose" and "goal" to topic names (:data:`DEFAULT_TOPICS`)."""
     try:
@@ -182,14 +214,14 @@ def read_events(path: str | Path, topics: dict[str, str] | None = None) -> list[
         first = str(exc).strip().splitlines()[0][:200] if str(exc).strip() else ""
         why = f"{type(exc).__name__}: {first}" if first else type(exc).__name__
         raise DceeInputError("bag", f"cannot read {path} as a ROS 2 bag ({why})") from None
-    kinds = {e.kind for e in events}
+    kinds = {"pose" if e.kind == "fix" else e.kind for e in events}
     for kind in ("pose", "reading", "goal"):
         if kind not in kinds:
             topic = names["concentration" if kind == "reading" else kind]
             raise DceeInputError("bag", f"{path} has no {kind} messages on topic {topic!r}")
     # at equal times: the reading, then the pose it completes a hold with, then the goal the
     # node published in answer (the order the simulated robot and the node produce them)
-    order = {"reading": 0, "pose": 1, "goal": 2}
+    order = {"reading": 0, "pose": 1, "fix": 1, "goal": 2}
     events.sort(key=lambda e: (e.t, order[e.kind]))
     return events
 
@@ -197,6 +229,12 @@ def read_events(path: str | Path, topics: dict[str, str] | None = None) -> list[
 def _event(kind: str, msg: Any, log_t: float) -> Iterator[BagEvent]:
     if kind == "concentration":
         yield BagEvent(log_t, "reading", float(msg.data))
+    elif kind == "pose" and hasattr(msg, "latitude"):  # sensor_msgs/NavSatFix (dcee.robot.gps)
+        yield BagEvent(
+            _stamp(msg.header, log_t),
+            "fix",
+            (float(msg.latitude), float(msg.longitude), int(msg.status.status)),
+        )
     elif kind == "pose":
         p = msg.pose.pose
         twist = getattr(msg, "twist", None)

@@ -13,6 +13,7 @@ from dcee.errors import DceeInputError
 from dcee.provenance import code_version
 from dcee.robot.bag import read_events
 from dcee.robot.cycle import CycleSettings, Pose, SearchCycle
+from dcee.robot.gps import FixToPose
 from dcee.runs import EpisodeResult, make_searcher, search_summary, streams
 from dcee.scenarios import Scenario
 
@@ -27,18 +28,28 @@ def replay_bag(
     """Replay ``bag`` into ``scenario``'s estimator (its filter built from ``seed``'s filter
     stream): the same search cycle as the node (settle, hold, average, tell), with the goals
     the bag recorded. The scenario's truth is the reference for the RMSE (for a field run:
-    where the source really was, when known). Returns the search as :func:`run_episode` does
+    where the source really was, when known). A bag whose pose topic carries GNSS fixes
+    (sensor_msgs/NavSatFix) is placed in the scenario's map frame (:mod:`dcee.robot.gps`).
+    Returns the search as :func:`run_episode` does
     (strategy ``"replay"``)."""
     events = read_events(bag, topics)
     _, filter_rng, planner_rng, _ = streams(seed)
     searcher = make_searcher(scenario, None, filter_rng, planner_rng)
     settings = CycleSettings.from_scenario(scenario, calibration=calibration)
     cycle = SearchCycle(searcher, settings, plan=False, true_location=scenario.truth_theta()[:3])
+    fixes = (
+        FixToPose.for_scenario(scenario, "bag") if any(e.kind == "fix" for e in events) else None
+    )
     for e in events:
         if e.kind == "reading":
             cycle.on_reading(e.t, e.value)
         elif e.kind == "goal":
             cycle.on_goal(np.asarray(e.value))
+        elif e.kind == "fix":
+            assert fixes is not None
+            pose = fixes.pose(e.t, *e.value)
+            if pose is not None:
+                cycle.on_pose(pose)
         else:
             x, y, heading, v, omega = e.value
             cycle.on_pose(Pose(e.t, x, y, heading, v, omega))
@@ -48,6 +59,8 @@ def replay_bag(
         raise DceeInputError("bag", f"{bag}: the robot never settled for a whole hold")
     summary = search_summary(cycle.records, scenario, "replay", seed, cycle.path_length, searcher)
     summary.update(bag=str(bag), dropped_readings=cycle.dropped_readings)
+    if fixes is not None:
+        summary["dropped_fixes"] = fixes.dropped
     pf = searcher.filter
     config: dict[str, Any] = {
         "scenario": scenario.model_dump(mode="json"),
