@@ -11,4 +11,4 @@ if [ "${DCEE_SETUP_DONE:-0}" = 1 ]; then exit 0; fi
 source scripts/venv.sh
 # the ROS 2 extra and pytest only: the ROS 2 tests (tests/ros) need nothing else, and the rest of
 # the development tools live in .venv
-install_into .venv-ros -e ".[ros]" "pytest>=8.0"
+install_into .venv-ros -e ".[ros,geo]" "pytest>=8.0"

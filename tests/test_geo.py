@@ -285,3 +285,28 @@ def test_the_site_check_finds_a_position_inside_a_building(tmp_path: Path, capsy
     entered = check(tmp_path / "campaign")["searches"][0]["entered"]
     assert "position 3 in features[1] (building 'Hall A')" in entered
     assert any("crosses features[1]" in e for e in entered)
+
+
+def test_gnss_fixes_become_poses_with_course_and_speed() -> None:
+    """dcee.robot.gps: a fix 3 m east then 4 m north of the last, 1 s apart, gives heading 0
+    then 90°, speed 3 then 4 m/s; NO_FIX, NaN and a stamp not after the last are dropped."""
+    from dcee.robot.gps import NO_FIX, FixToPose
+
+    frame = load_scenario(str(SITE)).world.frame.local_frame()
+    fixes = FixToPose(frame)
+
+    def at(x: float, y: float) -> tuple[float, float]:
+        lon, lat = frame.to_geo(np.array([x]), np.array([y]))
+        return float(lat[0]), float(lon[0])
+
+    p0 = fixes.pose(1.0, *at(10.0, 10.0))
+    p1 = fixes.pose(2.0, *at(13.0, 10.0))
+    assert fixes.pose(2.5, *at(50.0, 50.0), status=NO_FIX) is None
+    assert fixes.pose(2.6, math.nan, 0.1) is None
+    assert fixes.pose(2.0, *at(13.0, 14.0)) is None  # not after the last
+    p2 = fixes.pose(3.0, *at(13.0, 14.0), status=-2)  # STATUS_UNKNOWN: taken
+    assert p0 is not None and p1 is not None and p2 is not None and fixes.dropped == 3
+    assert abs(p0.x - 10.0) < 1e-6 and abs(p2.y - 14.0) < 1e-6
+    assert abs(p1.heading) < 1e-6 and abs(p1.v - 3.0) < 1e-6
+    assert abs(p2.heading - math.pi / 2) < 1e-6 and abs(p2.v - 4.0) < 1e-6
+    assert abs(p2.omega - math.pi / 2) < 1e-6

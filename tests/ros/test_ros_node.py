@@ -657,3 +657,77 @@ def test_the_path_message_keeps_the_last_readings_only() -> None:
         assert poses[0].pose.position.x == 5.0
     finally:
         rclpy.try_shutdown(context=context)
+
+
+def test_node_on_a_map_takes_gnss_fixes_and_publishes_the_estimate_in_degrees() -> None:
+    """A robot that reports sensor_msgs/NavSatFix (``pose_type:=navsatfix``) on the example
+    site on a map: its fixes are placed in the site's frame, it gets goals one step away, and
+    the estimate comes back in degrees (``dcee/estimate_fix``) where ``dcee/estimate`` puts it
+    in metres (issue 81). Without a map the parameter is refused."""
+    import time
+
+    import rclpy
+    from geometry_msgs.msg import PointStamped, PoseStamped
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    from sensor_msgs.msg import NavSatFix
+    from std_msgs.msg import Float32
+
+    from dcee.ros.node import SearchNode
+    from dcee.ros.parameters import LATCHED, RELIABLE
+    from dcee.ros.sim_node import stamp_of
+
+    context = rclpy.Context()
+    rclpy.init(context=context, args=[], domain_id=_domain())
+    try:
+        node = SearchNode(
+            context=context,
+            parameter_overrides=[
+                Parameter("scenario", value="area:example-works"),
+                Parameter("pose_type", value="navsatfix"),
+                Parameter("pose_topic", value="fix"),
+                Parameter("particles", value=500),
+                Parameter("strategy", value="infotaxis"),
+            ],
+        )
+        frame = node.scenario.world.frame.local_frame()
+        robot = rclpy.create_node("robot", context=context)
+        fix_pub = robot.create_publisher(NavSatFix, "fix", RELIABLE)
+        conc_pub = robot.create_publisher(Float32, "concentration", RELIABLE)
+        goals, fixes, points = [], [], []
+        robot.create_subscription(PoseStamped, "goal_pose", goals.append, LATCHED)
+        robot.create_subscription(NavSatFix, "dcee/estimate_fix", fixes.append, RELIABLE)
+        robot.create_subscription(PointStamped, "dcee/estimate", points.append, RELIABLE)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+        executor.add_node(robot)
+        start = node.scenario.agent.start
+        t, deadline = 1.0, time.monotonic() + 60
+        while len(goals) < 2 and time.monotonic() < deadline:
+            at = (goals[-1].pose.position.x, goals[-1].pose.position.y) if goals else start[:2]
+            lon, lat = frame.to_geo(np.array([at[0]]), np.array([at[1]]))
+            msg = NavSatFix()
+            msg.header.stamp = stamp_of(t)
+            msg.latitude, msg.longitude, msg.altitude = float(lat[0]), float(lon[0]), math.nan
+            conc_pub.publish(Float32(data=0.0))
+            fix_pub.publish(msg)
+            for _ in range(4):
+                executor.spin_once(timeout_sec=0.01)
+            t += 0.1
+        for _ in range(20):
+            executor.spin_once(timeout_sec=0.01)
+        assert len(goals) >= 2, f"{len(goals)} goals"
+        rec = node.cycle.records[0]
+        assert math.hypot(rec["x"] - start[0], rec["y"] - start[1]) < 1e-6
+        g = goals[0].pose.position
+        assert math.hypot(g.x - start[0], g.y - start[1]) == pytest.approx(node.scenario.agent.step)
+        assert fixes and points
+        x, y = frame.to_local(np.array([fixes[-1].longitude]), np.array([fixes[-1].latitude]))
+        assert math.hypot(x[0] - points[-1].point.x, y[0] - points[-1].point.y) < 1e-3
+        assert fixes[-1].position_covariance_type == NavSatFix.COVARIANCE_TYPE_KNOWN
+    finally:
+        rclpy.try_shutdown(context=context)
+    with pytest.raises(DceeInputError, match="navsatfix"):
+        from dcee.ros.parameters import PARAMETERS, scenario_from_parameters
+
+        scenario_from_parameters({**PARAMETERS, "pose_type": "navsatfix"}, None)

@@ -9,8 +9,9 @@ heading kept while the robot moves less than :data:`COURSE_MIN_STEP` between two
 heading from a few centimetres of motion is noise). The cycle's "settled" test then reads the
 speed the fixes show: a receiver whose fixes wander at rest by more than ``settle_speed`` × the
 interval needs odometry for the speeds (give ``pose_type = "odometry"`` in the site's frame) or a
-larger ``settle_speed``. A fix without a position (``status.status`` < 0, NO_FIX) or with a
-latitude or longitude that is not finite is dropped.
+larger ``settle_speed``. A fix the receiver marks as none (``status.status`` = -1, NO_FIX) or
+with a latitude or longitude that is not finite is dropped; an unknown status (-2, the message's
+default since ROS 2 Jazzy) is taken as a fix.
 """
 
 from __future__ import annotations
@@ -51,7 +52,7 @@ class FixToPose:
 
     def pose(self, t: float, latitude: float, longitude: float, status: int = 0) -> Pose | None:
         """The pose of a fix at ``t`` s, or None (no fix; a time not after the last fix)."""
-        if status <= NO_FIX or not (math.isfinite(latitude) and math.isfinite(longitude)):
+        if status == NO_FIX or not (math.isfinite(latitude) and math.isfinite(longitude)):
             self.dropped += 1
             return None
         x, y = self.frame.to_local(np.array([longitude]), np.array([latitude]))  # type: ignore[attr-defined]
@@ -65,7 +66,9 @@ class FixToPose:
                 self.dropped += 1
                 return None
             step = math.hypot(x0 - last.x, y0 - last.y)
-            heading = math.atan2(y0 - last.y, x0 - last.x) if step >= COURSE_MIN_STEP else last.heading
+            heading = (
+                math.atan2(y0 - last.y, x0 - last.x) if step >= COURSE_MIN_STEP else last.heading
+            )
             turn = math.remainder(heading - last.heading, 2.0 * math.pi)
             pose = Pose(t, x0, y0, heading, step / dt, turn / dt)
         self._last = pose

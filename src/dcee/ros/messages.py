@@ -63,6 +63,24 @@ def pose_from_pose_cov(msg: PoseWithCovarianceStamped, now: float, last: Pose | 
     return Pose(t, x, y, yaw, v, w)
 
 
+def estimate_fix(mean: np.ndarray, cov: np.ndarray, frame: Any, stamp: Any) -> Any:
+    """The source estimate on the map (sensor_msgs/NavSatFix): its latitude and longitude
+    through the scenario's frame (a :class:`dcee.geo.frame.LocalFrame`), the location covariance
+    (m², east-north-up) as a known covariance. The altitude is NaN: NavSatFix's is the height
+    above the ellipsoid, which a search does not know (the height above the ground is the z of
+    ``dcee/estimate``)."""
+    from sensor_msgs.msg import NavSatFix, NavSatStatus
+
+    lon, lat = frame.to_geo(np.array([mean[0]]), np.array([mean[1]]))
+    msg = NavSatFix()
+    msg.header.stamp, msg.header.frame_id = stamp, "wgs84"
+    msg.status.status, msg.status.service = NavSatStatus.STATUS_FIX, 0
+    msg.latitude, msg.longitude, msg.altitude = float(lat[0]), float(lon[0]), math.nan
+    msg.position_covariance = [float(v) for v in np.asarray(cov, dtype=float)[:3, :3].ravel()]
+    msg.position_covariance_type = NavSatFix.COVARIANCE_TYPE_KNOWN
+    return msg
+
+
 def grid_from_map(msg: OccupancyGrid) -> SiteMap:
     """The occupancy grid as it is (occupied and unknown cells blocked); a grid that cannot be
     used (malformed, rotated) raises :class:`DceeInputError`."""

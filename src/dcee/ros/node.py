@@ -4,7 +4,9 @@ Subscribes
     ``concentration`` (std_msgs/Float32, sensor units × ``calibration`` = g/m³), stamped on
     arrival with the node's clock (set ``use_sim_time`` to follow ``/clock``);
     ``odom`` (nav_msgs/Odometry; or geometry_msgs/PoseWithCovarianceStamped with
-    ``pose_type:=pose_with_covariance``, speeds then from successive poses);
+    ``pose_type:=pose_with_covariance``, speeds then from successive poses; or GNSS fixes,
+    sensor_msgs/NavSatFix with ``pose_type:=navsatfix`` on a scenario on a map, placed in its
+    frame, :mod:`dcee.robot.gps`);
     ``wind`` (geometry_msgs/Vector3Stamped, the air's velocity in m/s in the map frame, from
     the robot's anemometer; averaged over ``anemometer.period`` s into one reading; used when
     the scenario's ``[anemometer]`` is enabled, else ignored with one warning);
@@ -15,7 +17,9 @@ Publishes
     ``goal_pose`` (geometry_msgs/PoseStamped, what Nav2's bt_navigator accepts; its
     orientation faces the move), ``dcee/estimate`` (geometry_msgs/PointStamped, posterior mean
     of the source), ``dcee/estimate_covariance`` (geometry_msgs/PoseWithCovarianceStamped, the
-    same mean with the 3 × 3 location covariance in the position block), ``dcee/particles``
+    same mean with the 3 × 3 location covariance in the position block), on a scenario on a map
+    ``dcee/estimate_fix`` (sensor_msgs/NavSatFix: the mean's latitude and longitude with the
+    covariance), ``dcee/particles``
     (visualization_msgs/MarkerArray, a weighted sample of source hypotheses), ``dcee/path``
     (nav_msgs/Path, where the readings were taken), ``/diagnostics``
     (diagnostic_msgs/DiagnosticArray, once a second: the search's state, readings used and every
@@ -58,20 +62,16 @@ from nav_msgs.msg import OccupancyGrid, Odometry
 from nav_msgs.msg import Path as PathMsg
 from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.parameter import Parameter
+from sensor_msgs.msg import NavSatFix
 from std_msgs.msg import Float32, String
 from std_srvs.srv import Trigger
 from visualization_msgs.msg import MarkerArray
 
 from dcee.errors import DceeInputError
 from dcee.robot.cycle import Pose, SearchCycle
+from dcee.robot.gps import FixToPose
 from dcee.robot.map_gas import MapGas
-from dcee.ros.messages import (
-    grid_from_map,
-    pose_from_odometry,
-    pose_from_pose_cov,
-    seconds,
-    site_from_map,
-)
+from dcee.ros.inputs import NodeInputs
 from dcee.ros.outputs import NodeOutputs
 from dcee.ros.parameters import (
     LATCHED,
@@ -87,7 +87,7 @@ from dcee.scenarios import Scenario
 from dcee.searcher import Searcher
 
 
-class SearchNode(NodeOutputs, LifecycleNode):
+class SearchNode(NodeInputs, NodeOutputs, LifecycleNode):
     """The search cycle as a managed (lifecycle) ROS 2 node.
 
     Lifecycle: *configure* reads the parameters and the scenario (a bad value fails the
@@ -231,14 +231,22 @@ class SearchNode(NodeOutputs, LifecycleNode):
         self.result_pub = self.create_publisher(String, "dcee/result", LATCHED)
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE)
         self.create_timer(1.0, lambda: self._guarded("diagnostics", self._publish_diagnostics))
-        odometry = p["pose_type"] == "odometry"
-        pose_handler = self._odometry if odometry else self._pose_cov
+        self.map_frame = (
+            None if scenario.world.frame is None else scenario.world.frame.local_frame()
+        )
+        self.fix_pub = None if self.map_frame is None else self.create_publisher(
+            NavSatFix, "dcee/estimate_fix", RELIABLE
+        )  # fmt: skip
+        pose_input = {
+            "odometry": (Odometry, "odometry", self._odometry),
+            "pose_with_covariance": (PoseWithCovarianceStamped, "pose", self._pose_cov),
+            "navsatfix": (NavSatFix, "fix", self._fix),
+        }[p["pose_type"]]
         inputs = (
             (Float32, "concentration_topic", "concentration", self._reading, RELIABLE),
             (OccupancyGrid, "map_topic", "map", self._map, LATCHED),
             (Vector3Stamped, "wind_topic", "wind", self._wind, RELIABLE),
-            (Odometry if odometry else PoseWithCovarianceStamped, "pose_topic",
-             "odometry" if odometry else "pose", pose_handler, RELIABLE),
+            (pose_input[0], "pose_topic", pose_input[1], pose_input[2], RELIABLE),
         )  # fmt: skip
         for kind, topic, what, handler, qos in inputs:  # every callback guarded (_guarded)
             callback = functools.partial(self._guarded, what, handler)
@@ -285,6 +293,7 @@ class SearchNode(NodeOutputs, LifecycleNode):
             self.finish_reason = ""
             self.done.clear()
             self._last_pose = None
+            self._fixes = None if self.map_frame is None else FixToPose(self.map_frame)
             self._rejected_reported = 0
         self.searches_started += 1
         return True
@@ -341,49 +350,6 @@ class SearchNode(NodeOutputs, LifecycleNode):
             self.get_logger().warning(
                 f"dropped {total} input messages so far ({counts})", throttle_duration_sec=5.0
             )
-
-    def _reading(self, msg: Float32) -> None:
-        with self._lock:
-            if self.active and self.cycle is not None:
-                self.cycle.on_reading(self._now(), float(msg.data))
-
-    def _wind(self, msg: Vector3Stamped) -> None:
-        if not self.scenario.anemometer.enabled:
-            if not self._wind_warned:
-                self._wind_warned = True
-                self.get_logger().warning(
-                    "wind readings ignored: the scenario has no [anemometer] (enabled = true)"
-                )
-            return
-        t = seconds(msg.header.stamp) or self._now()
-        with self._lock:
-            if self.active and self.cycle is not None:
-                self.cycle.on_wind(t, msg.vector.x, msg.vector.y)
-
-    def _map(self, msg: OccupancyGrid) -> None:
-        """Apply an occupancy grid: a map that cannot be used (rotated, not covering the
-        search area, malformed) is logged and ignored; the search goes on with the last map."""
-        grid = grid_from_map(msg)
-        site = site_from_map(grid, self.scenario)
-        with self._lock:
-            self._map_site = site
-            self.map_gas.update(grid)
-            searching = self.searcher is not None
-            if searching:
-                self.searcher.agent = dataclasses.replace(self.searcher.agent, site=site)
-        self.maps_received += 1
-        info = msg.info
-        later = " (the gas model follows it from the next search)" if searching else ""
-        self.get_logger().info(
-            f"map applied: {info.width} x {info.height} cells of {info.resolution:g} m, "
-            f"{int(site.blocked.sum())} of {site.blocked.size} planning cells blocked{later}"
-        )
-
-    def _odometry(self, msg: Odometry) -> None:
-        self._step(pose_from_odometry(msg, self._now()))
-
-    def _pose_cov(self, msg: PoseWithCovarianceStamped) -> None:
-        self._step(pose_from_pose_cov(msg, self._now(), self._last_pose))
 
     def _step(self, pose: Pose) -> None:
         started = time.perf_counter()

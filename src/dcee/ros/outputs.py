@@ -16,6 +16,7 @@ from dcee.errors import DceeInputError
 from dcee.robot.cycle import Pose
 from dcee.ros.messages import (
     diagnostic_status,
+    estimate_fix,
     estimate_messages,
     goal_message,
     particle_markers,
@@ -100,6 +101,8 @@ class NodeOutputs:
         point, cov = estimate_messages(est.mean, est.cov, self.frame_id, stamp)
         self.estimate_pub.publish(point)
         self.cov_pub.publish(cov)
+        if self.fix_pub is not None:  # a site on a map: the estimate in degrees too
+            self.fix_pub.publish(estimate_fix(est.mean, est.cov, self.map_frame, stamp))
         n = int(self.params["marker_particles"])
         self.particles_pub.publish(
             particle_markers(self.searcher.filter, self._marker_rng, n, self.frame_id, stamp)

@@ -6,7 +6,7 @@ profiles the dcee nodes share (:mod:`dcee.ros.node`, :mod:`dcee.ros.sim_node`,
 Parameters
     ``scenario`` (name or TOML path), ``strategy``, ``seed``, ``particles`` (0: the
     scenario's), ``frame_id`` ("map"), ``calibration`` (1.0), ``concentration_topic``,
-    ``pose_topic``, ``goal_topic``, ``pose_type`` ("odometry" | "pose_with_covariance"),
+    ``pose_topic``, ``goal_topic``, ``pose_type`` (:data:`POSE_TYPES`),
     ``checkpoint`` (a file: the searcher is saved there after every reading and resumed from
     it at start), ``marker_particles`` (500); when the robot has settled for a reading:
     ``goal_tolerance`` (0.05 m), ``settle_speed`` (0.02 m/s), ``settle_turn_rate`` (5 °/s),
@@ -38,6 +38,11 @@ LATCHED = QoSProfile(
     reliability=QoSReliabilityPolicy.RELIABLE,
     durability=QoSDurabilityPolicy.TRANSIENT_LOCAL,
 )
+
+POSE_TYPES = ("odometry", "pose_with_covariance", "navsatfix")
+"""What the pose topic carries: nav_msgs/Odometry, geometry_msgs/PoseWithCovarianceStamped
+(speeds from successive poses) or sensor_msgs/NavSatFix (GNSS fixes placed in the scenario's map
+frame, heading and speeds from successive fixes: :mod:`dcee.robot.gps`)."""
 
 PARAMETERS: dict[str, Any] = {
     "scenario": "lab:upwind",
@@ -83,8 +88,14 @@ def scenario_from_parameters(p: dict[str, Any], given: Scenario | None = None) -
     for key in ("stop_spread", "stop_hold"):
         if float(p[key]) >= 0:
             scenario = scenario.with_overrides(**{f"search.{key}": float(p[key])})
-    if p["pose_type"] not in ("odometry", "pose_with_covariance"):
-        raise DceeInputError("pose_type", "must be odometry or pose_with_covariance")
+    if p["pose_type"] not in POSE_TYPES:
+        raise DceeInputError("pose_type", f"must be one of {', '.join(POSE_TYPES)}")
+    if p["pose_type"] == "navsatfix" and scenario.world.frame is None:
+        raise DceeInputError(
+            "pose_type",
+            "navsatfix (GNSS fixes) needs a scenario on a map in geographic coordinates "
+            "(world.area, docs/guide/on-a-map.md) to place them",
+        )
     return scenario
 
 
@@ -115,6 +126,7 @@ __all__ = [
     "LATCHED",
     "MAX_CONSECUTIVE_ERRORS",
     "PARAMETERS",
+    "POSE_TYPES",
     "RELIABLE",
     "cycle_settings",
     "new_searcher",
