@@ -110,6 +110,11 @@ def test_estimate_geojson_is_rfc7946_and_its_point_round_trips(tmp_path: Path, c
     x, y = frame.to_local(np.array([lon]), np.array([lat]))
     assert math.hypot(x[0] - summary["final_mean"][0], y[0] - summary["final_mean"][1]) < 1.0
     assert math.hypot(x[0] - summary["final_mean"][0], y[0] - summary["final_mean"][1]) < 0.01
+    code, _, err = run_cli(["report", str(out), "--out", str(tmp_path / "report")], capsys)
+    assert code == 0, err
+    table = (tmp_path / "report" / "map_estimates.md").read_text()
+    assert f"{summary['final_mean_geo']['latitude']:.7f}" in table
+    assert "estimates on the map" in (tmp_path / "report" / "report.html").read_text()
     kml = (out / "estimate.kml").read_text()
     assert kml.startswith("<?xml") and "<Polygon>" in kml and "<LineString>" in kml
     import xml.etree.ElementTree as ET

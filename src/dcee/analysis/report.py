@@ -60,6 +60,29 @@ def model_selection_markdown(runs: pd.DataFrame) -> str | None:
     return "\n".join(lines) + "\n"
 
 
+def map_estimates_markdown(runs: pd.DataFrame) -> str | None:
+    """Searches on a site in geographic coordinates (issue 81): each estimate in degrees and in
+    the site's local frame, with the file that holds it on a map; None when no search has one."""
+    if "final_mean_geo" not in runs:
+        return None
+    rows = [
+        "| configuration | strategy | seed | latitude (°) | longitude (°) | height (m) | local "
+        "x, y (m) | final RMSE (m) | on a map |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for _, r in runs.sort_values(["scenario", "strategy", "seed"]).iterrows():
+        geo = r["final_mean_geo"]
+        if not isinstance(geo, dict):
+            continue
+        x, y = r["final_mean"][:2]
+        rows.append(
+            f"| {r['scenario']} | {r['strategy']} | {r['seed']} | {geo['latitude']:.7f} | "
+            f"{geo['longitude']:.7f} | {geo['height_m']:.2f} | {x:.2f}, {y:.2f} | "
+            f"{r['final_rmse']:.2f} | {'/'.join(Path(r['run_dir']).parts[-3:])}/estimate.geojson |"
+        )
+    return "\n".join(rows) + "\n" if len(rows) > 2 else None
+
+
 def per_configuration_markdown(table: pd.DataFrame) -> str:
     cols = list(table.columns)
     lines = [
@@ -212,6 +235,9 @@ def write_report(results_dir: Path, out_dir: Path) -> list[Path]:
     models_md = model_selection_markdown(runs)
     if models_md is not None:
         tables["model_selection.md"] = lambda p: p.write_text(models_md)
+    map_md = map_estimates_markdown(runs)
+    if map_md is not None:
+        tables["map_estimates.md"] = lambda p: p.write_text(map_md)
     for name, writer in tables.items():
         write_atomic(out_dir / name, writer)
     failed = len(list(results_dir.rglob("error.json")))
@@ -256,6 +282,9 @@ def write_report(results_dir: Path, out_dir: Path) -> list[Path]:
             "<h2>reading model selected by the readings (turbulence level)</h2>",
             _md_to_html(models_md),
         ]
+    if map_md is not None:
+        html += ["<h2>estimates on the map (WGS 84 and the site's local frame)</h2>",
+                 _md_to_html(map_md)]  # fmt: skip
     for name, data in figures.items():
         b64 = base64.b64encode(data).decode()
         title = name[:-4].replace("_", " ")
