@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from dcee.errors import DceeInputError
 from dcee.geo.frame import LocalFrame, frame_for_bounds
 from dcee.scenarios import load_scenario
 from dcee.scenarios.schema import validate_scenario
@@ -315,3 +316,28 @@ def test_gnss_fixes_become_poses_with_course_and_speed() -> None:
     assert abs(p1.heading) < 1e-6 and abs(p1.v - 3.0) < 1e-6
     assert abs(p2.heading - math.pi / 2) < 1e-6 and abs(p2.v - 4.0) < 1e-6
     assert abs(p2.omega - math.pi / 2) < 1e-6
+
+
+def test_a_scenario_file_names_the_area_and_places_start_and_release_in_degrees(
+    tmp_path: Path,
+) -> None:
+    """[world] area (relative to the scenario file) with agent.start_geo and truth.source_geo:
+    the same site, the start and release where the degrees put them (the frame's inverse)."""
+    (tmp_path / "site.geojson").write_text(SITE.read_text())
+    (tmp_path / "s.toml").write_text(
+        'name = "my-site"\n[world]\narea = "site.geojson"\n'
+        "[agent]\nstart_geo = {latitude = 52.20505, longitude = 0.11815, height = 4.0}\n"
+        "step = 2.0\nspeed = 2.0\n"
+        "[truth]\nsource_geo = {latitude = 52.2053, longitude = 0.11905, height = 1.0}\n"
+        "q = 3.0\nu = 4.0\nwind_from = 250.0\nzeta1 = 1.0\nzeta2 = 8.0\n"
+    )
+    s = load_scenario(str(tmp_path / "s.toml"))
+    frame = s.world.frame.local_frame()
+    lon, lat = frame.to_geo(
+        np.array([s.agent.start[0], s.truth.x]), np.array([s.agent.start[1], s.truth.y])
+    )
+    assert np.allclose(lat, [52.20505, 52.2053], atol=1e-7)
+    assert np.allclose(lon, [0.11815, 0.11905], atol=1e-7)
+    assert s.truth.q == 3.0 and len(s.world.obstacles) == 3
+    with pytest.raises(DceeInputError, match="agent.start_geo"):
+        load_scenario("paper:1").with_overrides(**{"agent.start_geo": {"latitude": 1.0}})

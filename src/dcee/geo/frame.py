@@ -8,8 +8,8 @@ the area's bounding box is (0, 0). Why this one and not a tangent plane (ENU):
 
 * it is conformal: angles are kept, so a wind bearing, a heading and a crosswind offset mean
   the same in both frames; its grid north differs from true north by the meridian convergence
-  γ ≈ Δλ sin φ, which is zero on the central meridian and below 0.01° anywhere within 1 km of
-  it at any latitude below 80°;
+  γ ≈ (d / R) tan φ at d east or west of the central meridian: zero on it, 0.009° at 1 km at
+  latitude 45°, 0.05° at 80° (far below a wind vane's error);
 * its scale error grows as k − 1 ≈ d² / (2 R²) with the distance d from the central meridian
   (R ≈ 6,371 km): 1.2e-8 at 1 km, 3.1e-6 at 10 km. :data:`MAX_EXTENT` bounds an area so that
   every local distance is within 1e-5 of the true one (1 cm per km, well below a GNSS fix's
