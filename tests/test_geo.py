@@ -339,5 +339,5 @@ def test_a_scenario_file_names_the_area_and_places_start_and_release_in_degrees(
     assert np.allclose(lat, [52.20505, 52.2053], atol=1e-7)
     assert np.allclose(lon, [0.11815, 0.11905], atol=1e-7)
     assert s.truth.q == 3.0 and len(s.world.obstacles) == 3
-    with pytest.raises(DceeInputError, match="agent.start_geo"):
+    with pytest.raises(DceeInputError, match=r"agent\.start_geo"):
         load_scenario("paper:1").with_overrides(**{"agent.start_geo": {"latitude": 1.0}})

@@ -42,6 +42,7 @@ from studies.tables.sites import (
     sites_walls_timing_table,
 )
 from studies.tables.source_count import _source_count, source_count_timing_table
+from studies.tables.sparse import sparse_table
 from studies.tables.three_d import (
     lbm3d_altitude_table,
     lbm3d_plume_table,
@@ -67,6 +68,7 @@ from studies.tables.turbulent import cross_truth_table, turbulent_table
 TABLES: dict[str, Callable[[], str]] = {
     "gaden-rooms": gaden_rooms_table,
     "geo-site": geo_site_table,
+    "lbm3d-sparse-tune": sparse_table,
     "gaden-starts": gaden_starts_table,
     "gaden-timing": gaden_timing_table,
     "fuzz-readers": fuzz_readers_table,
