@@ -41,14 +41,22 @@ MAX_EXTENT = 2.0 * EARTH_RADIUS * math.sqrt(2.0 * MAX_SCALE_ERROR)
 lies at most half of it from the central meridian."""
 
 
-def _pyproj():  # an optional dependency: the ``geo`` extra
+def require_geo() -> None:
+    """Refuse in one line where the ``geo`` extra (pyproj, shapely) is missing."""
     try:
-        import pyproj
+        import pyproj  # noqa: F401
+        import shapely  # noqa: F401
     except ImportError:  # pragma: no cover - the extra is installed in CI
         raise DceeInputError(
             "area",
             "maps in geographic coordinates need pyproj and shapely: pip install 'dcee[geo]'",
         ) from None
+
+
+def _pyproj():  # an optional dependency: the ``geo`` extra
+    require_geo()
+    import pyproj
+
     return pyproj
 
 
@@ -128,4 +136,4 @@ def frame_for_bounds(lon_min: float, lat_min: float, lon_max: float, lat_max: fl
     return LocalFrame(centre.latitude, centre.longitude, x0, y0)
 
 
-__all__ = ["MAX_EXTENT", "MAX_SCALE_ERROR", "LocalFrame", "frame_for_bounds"]
+__all__ = ["MAX_EXTENT", "MAX_SCALE_ERROR", "LocalFrame", "frame_for_bounds", "require_geo"]

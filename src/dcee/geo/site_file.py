@@ -225,8 +225,10 @@ def _point(
 
 def read_site(path: str | Path) -> GeoSite:
     """The site in ``path`` (module doc); one-line errors naming the feature."""
+    from dcee.geo.frame import require_geo
     from dcee.limits import read_text
 
+    require_geo()
     path = Path(path).expanduser()
     if not path.is_file():
         raise DceeInputError(FIELD, f"no such file {str(path)!r}")
