@@ -11,7 +11,7 @@ the area's bounding box is (0, 0). Why this one and not a tangent plane (ENU):
   γ ≈ (d / R) tan φ at d east or west of the central meridian: zero on it, 0.009° at 1 km at
   latitude 45°, 0.05° at 80° (far below a wind vane's error);
 * its scale error grows as k − 1 ≈ d² / (2 R²) with the distance d from the central meridian
-  (R ≈ 6,371 km): 1.2e-8 at 1 km, 3.1e-6 at 10 km. :data:`MAX_EXTENT` bounds an area so that
+  (R ≈ 6,371 km): 1.2e-8 at 1 km, 1.2e-6 at 10 km. :data:`MAX_EXTENT` bounds an area so that
   every local distance is within 1e-5 of the true one (1 cm per km, well below a GNSS fix's
   error);
 * an ENU tangent plane drops away from the ground as d² / (2 R) (8 cm at 1 km), which a
