@@ -104,6 +104,7 @@ def test_estimate_geojson_is_rfc7946_and_its_point_round_trips(tmp_path: Path, c
         pts = np.array(f["geometry"]["coordinates"], dtype=float).reshape(-1, 2)
         assert np.all(np.abs(pts[:, 0]) <= 180) and np.all(np.abs(pts[:, 1]) <= 90)
     summary = json.loads((out / "summary.json").read_text())
+    assert "scale error at most" in summary["final_mean_geo"]["frame_description"]
     frame = LocalFrame(
         **json.loads((out / "config.json").read_text())["scenario"]["world"]["frame"]
     )

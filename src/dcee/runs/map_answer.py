@@ -45,11 +45,15 @@ def write_map_answer(folder: Path, result: Any, frame_spec: dict[str, Any]) -> d
         unit=unit,
         name=f"dcee: {summary.get('scenario', '')} {summary.get('strategy', '')}".strip(),
     )
+    # the frame's largest scale error over the area: at the east or west edge of the volume
+    high_x = float((scenario.get("volume") or {}).get("high", [0.0])[0])
+    half_width = max(abs(frame.x0), abs(high_x - frame.x0))
     extra = {
         "scenario": summary.get("scenario"),
         "strategy": summary.get("strategy"),
         "code": summary.get("code"),
         "frame": frame.proj,
+        "frame_description": frame.describe(half_width),
     }
     write_json(folder / "estimate.geojson", estimate_geojson(frame, answer, extra))
     write_atomic(
@@ -62,6 +66,7 @@ def write_map_answer(folder: Path, result: Any, frame_spec: dict[str, Any]) -> d
         "latitude": round(float(lat[0]), 8),
         "height_m": round(float(mean[2]), 3),
         "frame": frame.proj,
+        "frame_description": extra["frame_description"],
     }
 
 
