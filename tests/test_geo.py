@@ -296,27 +296,27 @@ def test_the_site_check_finds_a_position_inside_a_building(tmp_path: Path, capsy
 
 def test_gnss_fixes_become_poses_with_course_and_speed() -> None:
     """dcee.robot.gps: a fix 3 m east then 4 m north of the last, 1 s apart, gives heading 0
-    then 90°, speed 3 then 4 m/s; NO_FIX, NaN and a stamp not after the last are dropped."""
-    from dcee.robot.gps import NO_FIX, FixToPose
+    then 90°, speed 3 then 4 m/s; NO_FIX and NaN become poses the cycle drops (not finite), a
+    stamp not after the last one it drops as going back; STATUS_UNKNOWN (-2) is a fix."""
+    from dcee.robot.gps import NO_FIX, pose_from_fix
 
     frame = load_scenario(str(SITE)).world.frame.local_frame()
-    fixes = FixToPose(frame)
 
-    def at(x: float, y: float) -> tuple[float, float]:
+    def fix(t: float, x: float, y: float, last, status: int = 0):
         lon, lat = frame.to_geo(np.array([x]), np.array([y]))
-        return float(lat[0]), float(lon[0])
+        return pose_from_fix(frame, t, float(lat[0]), float(lon[0]), status, last)
 
-    p0 = fixes.pose(1.0, *at(10.0, 10.0))
-    p1 = fixes.pose(2.0, *at(13.0, 10.0))
-    assert fixes.pose(2.5, *at(50.0, 50.0), status=NO_FIX) is None
-    assert fixes.pose(2.6, math.nan, 0.1) is None
-    assert fixes.pose(2.0, *at(13.0, 14.0)) is None  # not after the last
-    p2 = fixes.pose(3.0, *at(13.0, 14.0), status=-2)  # STATUS_UNKNOWN: taken
-    assert p0 is not None and p1 is not None and p2 is not None and fixes.dropped == 3
-    assert abs(p0.x - 10.0) < 1e-6 and abs(p2.y - 14.0) < 1e-6
+    p0 = fix(1.0, 10.0, 10.0, None)
+    p1 = fix(2.0, 13.0, 10.0, p0)
+    p2 = fix(3.0, 13.0, 14.0, p1, status=-2)
+    assert abs(p0.x - 10.0) < 1e-6 and abs(p2.y - 14.0) < 1e-6 and p0.v == 0.0
     assert abs(p1.heading) < 1e-6 and abs(p1.v - 3.0) < 1e-6
     assert abs(p2.heading - math.pi / 2) < 1e-6 and abs(p2.v - 4.0) < 1e-6
     assert abs(p2.omega - math.pi / 2) < 1e-6
+    assert math.isnan(fix(4.0, 50.0, 50.0, p2, status=NO_FIX).x)
+    assert not math.isfinite(pose_from_fix(frame, 4.0, math.nan, 0.1, 0, p2).x)
+    stale = fix(2.5, 13.0, 20.0, p2)  # not after the last: the cycle drops it as going back
+    assert stale.t < p2.t and stale.v == 0.0
 
 
 def test_a_scenario_file_names_the_area_and_places_start_and_release_in_degrees(

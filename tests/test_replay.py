@@ -23,9 +23,11 @@ from dcee.scenarios import load_scenario
 SCENARIO = {"search.particles": 800, "search.hypotheses": 8, "search.budget": 60.0}
 
 
-def _record_search(bag) -> SearchCycle:
-    """A live search (simulated robot + cycle), every message also written to ``bag``."""
-    sc = load_scenario("lab:upwind").with_overrides(**SCENARIO)
+def _record_search(bag, scenario: str = "lab:upwind", fixes=None) -> SearchCycle:
+    """A live search (simulated robot + cycle) of ``scenario``, every message also written to
+    ``bag``; with ``fixes`` (a second bag), the same search logged by a robot that reports
+    GNSS fixes on its pose topic instead of odometry (the scenario's map frame)."""
+    sc = load_scenario(scenario).with_overrides(**SCENARIO)
     robot = SimulatedRobot(sc, 0)
     _, filter_rng, planner_rng, _ = streams(0)
     planner = get_planner("infotaxis", **planner_defaults("infotaxis", sc, None))
@@ -34,22 +36,31 @@ def _record_search(bag) -> SearchCycle:
         CycleSettings.from_scenario(sc),
         true_location=sc.truth_theta()[:3],
     )
-    with BagWriter(bag) as writer:
+    writers = [BagWriter(bag)] + ([BagWriter(fixes)] if fixes is not None else [])
+    try:
         while True:
             s = robot.odometry()
             # what a node receives: a float32 reading, a stamp in whole nanoseconds
             value = float(np.float32(robot.sample()))
             t = stamp_seconds(round(robot.time * 1e9))
             pose = (s.x, s.y, s.heading, s.v, s.omega)
-            writer.write_search_step(t, pose=pose, reading=value)
+            writers[0].write_search_step(t, pose=pose, reading=value)
+            if fixes is not None:
+                lon, lat = sc.world.frame.local_frame().to_geo(np.array([s.x]), np.array([s.y]))
+                writers[1].write_fix(t, float(lat[0]), float(lon[0]), topic="odom")
+                writers[1].write_search_step(t, reading=value)
             cycle.on_reading(t, value)
             out = cycle.on_pose(Pose(t, *pose))
             if out.goal is not None:
-                writer.write_search_step(t, goal=tuple(out.goal))
+                for writer in writers:
+                    writer.write_search_step(t, goal=tuple(out.goal))
                 robot.set_goal(out.goal)
             if out.finished:
                 return cycle
             robot.step()
+    finally:
+        for writer in writers:
+            writer.close()
 
 
 def test_replay_reproduces_the_search_it_recorded(tmp_path) -> None:
@@ -92,34 +103,8 @@ def test_replay_places_gnss_fixes_on_the_sites_map(tmp_path) -> None:
     speeds come from successive fixes, so it may settle a control step apart) and ends near the
     same estimate."""
     pytest.importorskip("pyproj")
+    _record_search(tmp_path / "odom", "area:example-works", fixes=tmp_path / "gnss")
     sc = load_scenario("area:example-works").with_overrides(**SCENARIO)
-    frame = sc.world.frame.local_frame()
-    robot = SimulatedRobot(sc, 0)
-    _, filter_rng, planner_rng, _ = streams(0)
-    planner = get_planner("infotaxis", **planner_defaults("infotaxis", sc, None))
-    cycle = SearchCycle(
-        make_searcher(sc, planner, filter_rng, planner_rng),
-        CycleSettings.from_scenario(sc),
-        true_location=sc.truth_theta()[:3],
-    )
-    with BagWriter(tmp_path / "odom") as odom, BagWriter(tmp_path / "gnss") as gnss:
-        while True:
-            s = robot.odometry()
-            value = float(np.float32(robot.sample()))
-            t = stamp_seconds(round(robot.time * 1e9))
-            odom.write_search_step(t, pose=(s.x, s.y, s.heading, s.v, s.omega), reading=value)
-            lon, lat = frame.to_geo(np.array([s.x]), np.array([s.y]))
-            gnss.write_fix(t, float(lat[0]), float(lon[0]), topic="odom")
-            gnss.write_search_step(t, reading=value)
-            cycle.on_reading(t, value)
-            out = cycle.on_pose(Pose(t, s.x, s.y, s.heading, s.v, s.omega))
-            if out.goal is not None:
-                odom.write_search_step(t, goal=tuple(out.goal))
-                gnss.write_search_step(t, goal=tuple(out.goal))
-                robot.set_goal(out.goal)
-            if out.finished:
-                break
-            robot.step()
     a = replay_bag(tmp_path / "odom", sc, seed=0)
     b = replay_bag(tmp_path / "gnss", sc, seed=0)
     assert {e.kind for e in read_events(tmp_path / "gnss")} == {"fix", "reading", "goal"}

@@ -727,7 +727,7 @@ def test_node_on_a_map_takes_gnss_fixes_and_publishes_the_estimate_in_degrees() 
         assert fixes[-1].position_covariance_type == NavSatFix.COVARIANCE_TYPE_KNOWN
     finally:
         rclpy.try_shutdown(context=context)
-    with pytest.raises(DceeInputError, match="navsatfix"):
+    with pytest.raises(DceeInputError, match="pose_type: GNSS fixes"):
         from dcee.ros.parameters import PARAMETERS, scenario_from_parameters
 
         scenario_from_parameters({**PARAMETERS, "pose_type": "navsatfix"}, None)

@@ -57,6 +57,16 @@ class BagWriter:
         self.add_topic(topic, msgtype)
         self.write(topic, stamp_ns, bytes(self._typestore.serialize_cdr(message, msgtype)))
 
+    def _header(self, ns: int, frame_id: str) -> Any:
+        """A std_msgs/Header stamped ``ns`` (integer nanoseconds) in ``frame_id``."""
+        types = self._typestore.types
+        return types["std_msgs/msg/Header"](
+            stamp=types["builtin_interfaces/msg/Time"](
+                sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000
+            ),
+            frame_id=frame_id,
+        )
+
     def write_search_step(
         self,
         t: float,
@@ -73,12 +83,7 @@ class BagWriter:
         names = {**DEFAULT_TOPICS, **(topics or {})}
         types = self._typestore.types
         ns = round(t * 1e9)
-        header = types["std_msgs/msg/Header"](
-            stamp=types["builtin_interfaces/msg/Time"](
-                sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000
-            ),
-            frame_id=frame_id,
-        )
+        header = self._header(ns, frame_id)
         vec3, point = types["geometry_msgs/msg/Vector3"], types["geometry_msgs/msg/Point"]
         quat = types["geometry_msgs/msg/Quaternion"]
         if reading is not None:
@@ -127,12 +132,7 @@ class BagWriter:
         s: how a robot that reports latitude and longitude is logged (:mod:`dcee.robot.gps`)."""
         types = self._typestore.types
         ns = round(t * 1e9)
-        header = types["std_msgs/msg/Header"](
-            stamp=types["builtin_interfaces/msg/Time"](
-                sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000
-            ),
-            frame_id=frame_id,
-        )
+        header = self._header(ns, frame_id)
         status_type = types["sensor_msgs/msg/NavSatStatus"]
         msg = types["sensor_msgs/msg/NavSatFix"](
             header=header,

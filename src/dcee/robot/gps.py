@@ -10,19 +10,24 @@ heading from a few centimetres of motion is noise). The cycle's "settled" test t
 speed the fixes show: a receiver whose fixes wander at rest by more than ``settle_speed`` × the
 interval needs odometry for the speeds (give ``pose_type = "odometry"`` in the site's frame) or a
 larger ``settle_speed``. A fix the receiver marks as none (``status.status`` = -1, NO_FIX) or
-with a latitude or longitude that is not finite is dropped; an unknown status (-2, the message's
-default since ROS 2 Jazzy) is taken as a fix.
+with a latitude or longitude that is not finite is dropped and counted by the cycle like any
+impossible pose; an unknown status (-2, the message's default since ROS 2 Jazzy) is taken as a
+fix.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.robot.cycle import Pose
+
+if TYPE_CHECKING:
+    from dcee.geo.frame import LocalFrame
+    from dcee.scenarios import Scenario
 
 NO_FIX = -1
 """``sensor_msgs/NavSatStatus.STATUS_NO_FIX``."""
@@ -30,49 +35,41 @@ COURSE_MIN_STEP = 0.05
 """m: the least motion between two fixes that updates the heading (the course over ground)."""
 
 
-@dataclass
-class FixToPose:
-    """Turns fixes into poses in ``frame`` (a :class:`dcee.geo.frame.LocalFrame`)."""
-
-    frame: object
-    _last: Pose | None = field(default=None, init=False)
-    dropped: int = field(default=0, init=False)
-
-    @classmethod
-    def for_scenario(cls, scenario: object, field_name: str) -> FixToPose:
-        """The converter of ``scenario``'s map; refused where it has none."""
-        frame = getattr(getattr(scenario, "world", None), "frame", None)
-        if frame is None:
-            raise DceeInputError(
-                field_name,
-                "GNSS fixes (sensor_msgs/NavSatFix) need a scenario on a map in geographic "
-                "coordinates (world.area, docs/guide/on-a-map.md) to place them",
-            )
-        return cls(frame.local_frame())
-
-    def pose(self, t: float, latitude: float, longitude: float, status: int = 0) -> Pose | None:
-        """The pose of a fix at ``t`` s, or None (no fix; a time not after the last fix)."""
-        if status == NO_FIX or not (math.isfinite(latitude) and math.isfinite(longitude)):
-            self.dropped += 1
-            return None
-        x, y = self.frame.to_local(np.array([longitude]), np.array([latitude]))  # type: ignore[attr-defined]
-        x0, y0 = float(x[0]), float(y[0])
-        last = self._last
-        if last is None:
-            pose = Pose(t, x0, y0)
-        else:
-            dt = t - last.t
-            if dt <= 0:
-                self.dropped += 1
-                return None
-            step = math.hypot(x0 - last.x, y0 - last.y)
-            heading = (
-                math.atan2(y0 - last.y, x0 - last.x) if step >= COURSE_MIN_STEP else last.heading
-            )
-            turn = math.remainder(heading - last.heading, 2.0 * math.pi)
-            pose = Pose(t, x0, y0, heading, step / dt, turn / dt)
-        self._last = pose
-        return pose
+def map_frame(scenario: Scenario, field_name: str) -> LocalFrame:
+    """The local frame of ``scenario``'s map; refused in one line where it has none."""
+    if scenario.world.frame is None:
+        raise DceeInputError(
+            field_name,
+            "GNSS fixes (sensor_msgs/NavSatFix) need a scenario on a map in geographic "
+            "coordinates (world.area, docs/guide/on-a-map.md) to place them",
+        )
+    return scenario.world.frame.local_frame()
 
 
-__all__ = ["COURSE_MIN_STEP", "NO_FIX", "FixToPose"]
+def pose_from_fix(
+    frame: LocalFrame,
+    t: float,
+    latitude: float,
+    longitude: float,
+    status: int,
+    last: Pose | None,
+) -> Pose:
+    """The pose of a fix at ``t`` s in ``frame``, its heading and speeds from the ``last``
+    accepted pose (as :func:`dcee.ros.messages.pose_from_pose_cov` takes them from successive
+    poses). A fix marked NO_FIX, or without a finite latitude and longitude, becomes a pose
+    that is not finite, which the cycle drops and counts (``pose not finite``) as it does any
+    other impossible pose; so does a stamp not after the last (``pose stamp went backwards``)."""
+    if status == NO_FIX:
+        return Pose(t, math.nan, math.nan)
+    x, y = frame.to_local(np.array([longitude]), np.array([latitude]))
+    x0, y0 = float(x[0]), float(y[0])
+    if last is None or not t > last.t:
+        return Pose(t, x0, y0, last.heading if last is not None else 0.0)
+    dt = t - last.t
+    step = math.hypot(x0 - last.x, y0 - last.y)
+    heading = math.atan2(y0 - last.y, x0 - last.x) if step >= COURSE_MIN_STEP else last.heading
+    turn = math.remainder(heading - last.heading, 2.0 * math.pi)
+    return Pose(t, x0, y0, heading, step / dt, turn / dt)
+
+
+__all__ = ["COURSE_MIN_STEP", "NO_FIX", "map_frame", "pose_from_fix"]

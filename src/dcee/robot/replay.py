@@ -13,7 +13,7 @@ from dcee.errors import DceeInputError
 from dcee.provenance import code_version
 from dcee.robot.bag import read_events
 from dcee.robot.cycle import CycleSettings, Pose, SearchCycle
-from dcee.robot.gps import FixToPose
+from dcee.robot.gps import map_frame, pose_from_fix
 from dcee.runs import EpisodeResult, make_searcher, search_summary, streams
 from dcee.scenarios import Scenario
 
@@ -37,19 +37,20 @@ def replay_bag(
     searcher = make_searcher(scenario, None, filter_rng, planner_rng)
     settings = CycleSettings.from_scenario(scenario, calibration=calibration)
     cycle = SearchCycle(searcher, settings, plan=False, true_location=scenario.truth_theta()[:3])
-    fixes = (
-        FixToPose.for_scenario(scenario, "bag") if any(e.kind == "fix" for e in events) else None
-    )
+    frame = map_frame(scenario, "bag") if any(e.kind == "fix" for e in events) else None
+    last: Pose | None = None  # the last accepted pose: a fix's speeds start from it
     for e in events:
         if e.kind == "reading":
             cycle.on_reading(e.t, e.value)
         elif e.kind == "goal":
             cycle.on_goal(np.asarray(e.value))
         elif e.kind == "fix":
-            assert fixes is not None
-            pose = fixes.pose(e.t, *e.value)
-            if pose is not None:
-                cycle.on_pose(pose)
+            assert frame is not None
+            dropped = sum(cycle.rejected.values())
+            pose = pose_from_fix(frame, e.t, *e.value, last)
+            cycle.on_pose(pose)
+            if sum(cycle.rejected.values()) == dropped:
+                last = pose
         else:
             x, y, heading, v, omega = e.value
             cycle.on_pose(Pose(e.t, x, y, heading, v, omega))
@@ -59,8 +60,6 @@ def replay_bag(
         raise DceeInputError("bag", f"{bag}: the robot never settled for a whole hold")
     summary = search_summary(cycle.records, scenario, "replay", seed, cycle.path_length, searcher)
     summary.update(bag=str(bag), dropped_readings=cycle.dropped_readings)
-    if fixes is not None:
-        summary["dropped_fixes"] = fixes.dropped
     pf = searcher.filter
     config: dict[str, Any] = {
         "scenario": scenario.model_dump(mode="json"),

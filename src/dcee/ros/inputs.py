@@ -12,6 +12,7 @@ from nav_msgs.msg import OccupancyGrid, Odometry
 from sensor_msgs.msg import NavSatFix
 from std_msgs.msg import Float32
 
+from dcee.robot.gps import pose_from_fix
 from dcee.ros.messages import (
     grid_from_map,
     pose_from_odometry,
@@ -68,11 +69,9 @@ class NodeInputs:
         self._step(pose_from_pose_cov(msg, self._now(), self._last_pose))
 
     def _fix(self, msg: NavSatFix) -> None:
-        fixes = self._fixes  # new per search: speeds start from its first fix
-        pose = fixes.pose(seconds(msg.header.stamp) or self._now(), msg.latitude, msg.longitude,
-                          msg.status.status)  # fmt: skip
-        if pose is not None:
-            self._step(pose)
+        t = seconds(msg.header.stamp) or self._now()
+        self._step(pose_from_fix(self.map_frame, t, msg.latitude, msg.longitude,
+                                 msg.status.status, self._last_pose))  # fmt: skip
 
 
 __all__ = ["NodeInputs"]

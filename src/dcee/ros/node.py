@@ -69,7 +69,6 @@ from visualization_msgs.msg import MarkerArray
 
 from dcee.errors import DceeInputError
 from dcee.robot.cycle import Pose, SearchCycle
-from dcee.robot.gps import FixToPose
 from dcee.robot.map_gas import MapGas
 from dcee.ros.inputs import NodeInputs
 from dcee.ros.outputs import NodeOutputs
@@ -293,7 +292,6 @@ class SearchNode(NodeInputs, NodeOutputs, LifecycleNode):
             self.finish_reason = ""
             self.done.clear()
             self._last_pose = None
-            self._fixes = None if self.map_frame is None else FixToPose(self.map_frame)
             self._rejected_reported = 0
         self.searches_started += 1
         return True

@@ -28,6 +28,7 @@ from rclpy.qos import QoSDurabilityPolicy, QoSProfile, QoSReliabilityPolicy
 
 from dcee.errors import DceeInputError
 from dcee.robot.cycle import CycleSettings
+from dcee.robot.gps import map_frame
 from dcee.runs import make_searcher, planner_defaults, streams
 from dcee.scenarios import Scenario, load_scenario
 from dcee.searcher import Searcher
@@ -90,12 +91,8 @@ def scenario_from_parameters(p: dict[str, Any], given: Scenario | None = None) -
             scenario = scenario.with_overrides(**{f"search.{key}": float(p[key])})
     if p["pose_type"] not in POSE_TYPES:
         raise DceeInputError("pose_type", f"must be one of {', '.join(POSE_TYPES)}")
-    if p["pose_type"] == "navsatfix" and scenario.world.frame is None:
-        raise DceeInputError(
-            "pose_type",
-            "navsatfix (GNSS fixes) needs a scenario on a map in geographic coordinates "
-            "(world.area, docs/guide/on-a-map.md) to place them",
-        )
+    if p["pose_type"] == "navsatfix":
+        map_frame(scenario, "pose_type")  # refused where the scenario has no map
     return scenario
 
 
