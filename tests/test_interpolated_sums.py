@@ -166,7 +166,7 @@ def test_node_terms_are_the_position_rows_formulas_bit_for_bit(sensor):
     constants = np.empty((10, len(theta)))
     plume_constants(theta, constants)
     out = [np.empty((1, len(theta))) for _ in range(6)]
-    shape = (0.0, 1.0, 0.0, 0.0, 1.0, 0.0)  # the paper's plume: IsotropicPlume().shape
+    shape = (0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0)  # the paper's plume: IsotropicPlume().shape
     position_rows(constants, np.array([[20.0, 15.0, 1.0]]), np.array([0]), 1e-3, *shape,
                   sensor.params, *out)  # fmt: skip
     conc, _, loc, log_nd, inv_sigma, det_offset = (a[0] for a in out)

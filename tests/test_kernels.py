@@ -185,15 +185,16 @@ def test_vectorised_log1p_matches_math_log1p():
 
 
 @pytest.mark.parametrize(
-    ("meander", "decay", "backflow", "radius", "vertical", "ground"),
+    ("meander", "decay", "backflow", "radius", "vertical", "ground", "meander_z"),
     [
-        (0.0, 1.0, 0.0, 0.0, 1.0, 0.0),
-        (0.6, 1.0, 0.0, 0.0, 1.0, 0.0),
-        (0.0, 0.5, 0.0, 0.0, 1.0, 0.0),
-        (0.0, 1.0, 0.1, 0.0, 1.0, 0.0),
-        (0.15, 1.0, 0.05, 1.0, 1.0, 0.0),
-        (0.0, 1.0, 0.0, 0.0, 0.66, 1.0),
-        (0.0, 1.0, 0.05, 1.0, 0.66, 0.5),
+        (0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0),
+        (0.6, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0),
+        (0.0, 0.5, 0.0, 0.0, 1.0, 0.0, 0.0),
+        (0.0, 1.0, 0.1, 0.0, 1.0, 0.0, 0.0),
+        (0.15, 1.0, 0.05, 1.0, 1.0, 0.0, 0.0),
+        (0.0, 1.0, 0.0, 0.0, 0.66, 1.0, 0.0),
+        (0.0, 1.0, 0.05, 1.0, 0.66, 0.5, 0.0),
+        (0.15, 1.0, 0.0, 0.0, 1.0, 0.0, 0.1),
     ],
 )
 @pytest.mark.parametrize(
@@ -209,7 +210,7 @@ def test_vectorised_log1p_matches_math_log1p():
     ids=["gauss", "gauss-pd1", "ln", "ln+near", "ln+spread", "ln+conserve"],
 )
 def test_position_rows_match_the_numpy_plume_and_likelihood(
-    sensor, meander, decay, backflow, radius, vertical, ground
+    sensor, meander, decay, backflow, radius, vertical, ground, meander_z
 ):
     """The planners' per-position terms, written into chosen rows, against the NumPy plume and
     the NumPy likelihood of a non-detection and of a reading (which fixes loc, σ and Pd); the
@@ -248,12 +249,13 @@ def test_position_rows_match_the_numpy_plume_and_likelihood(
         radius,
         vertical,
         ground,
+        meander_z,
         sensor.params,
         *out,
     )
     conc, dist, loc, log_nd, inv_sigma, det_offset = (a[rows] for a in out)
     ref_c = isotropic_concentration_reference(
-        theta, positions, 1e-3, meander, decay, backflow, radius, vertical, ground
+        theta, positions, 1e-3, meander, decay, backflow, radius, vertical, ground, meander_z
     ).T
     np.testing.assert_allclose(conc, ref_c, rtol=1e-10, atol=1e-300)
     ref_r = np.linalg.norm(theta[None, :, :3] - positions[:, None, :], axis=2)

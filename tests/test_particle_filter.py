@@ -377,11 +377,11 @@ def test_mcmc_move_is_unchanged_by_early_rejection(monkeypatch):
 
     def no_exit(*args):
         calls.append(len(args))
-        return plain(*args[:14])
+        return plain(*args[:15])
 
     monkeypatch.setattr(rmm, "history_log_likelihood", no_exit)
     np.testing.assert_array_equal(run(), with_exit)
-    assert 16 in calls  # the move's calls, with a threshold and bounds, ran without them
+    assert 17 in calls  # the move's calls, with a threshold and bounds, ran without them
 
 
 def test_both_estimators_implement_the_estimator_interface_and_resample_on_demand():

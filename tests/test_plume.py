@@ -186,3 +186,63 @@ def test_ground_keeps_the_flux_above_it(a):
         c = IsotropicPlume(vertical=a, ground=ground).concentration(theta, plane)[0]
         flux = u * np.trapezoid(np.trapezoid(c.reshape(yy.shape), zs, axis=1), ys)
         assert flux == pytest.approx(share * q, rel=0.02)
+
+
+@pytest.mark.parametrize(
+    "shape",
+    [
+        {"meander_z": 0.1},
+        {"meander": 0.15, "meander_z": 0.1, "ground": 1.0, "vertical": 0.66},
+        {"meander": 0.15, "meander_z": 0.3, "backflow": 0.05, "radius": 1.0, "decay": 0.5},
+    ],
+)
+def test_compiled_matches_reference_with_vertical_meander(shape):
+    from dcee.models.plume import IsotropicPlume
+
+    rng = np.random.default_rng(5)
+    theta = random_theta(200, rng)
+    theta[:, 2] = rng.uniform(0.0, 3.0, len(theta))
+    pos = rng.uniform([0, 0, 0], [50, 50, 6], size=(23, 3))
+    fast = IsotropicPlume(**shape).concentration(theta, pos)
+    ref = isotropic_concentration_reference(theta, pos, **shape)
+    np.testing.assert_allclose(fast, ref, rtol=1e-9, atol=1e-300)
+
+
+def test_vertical_meander_by_hand():
+    """Downwind of the source the height offset is compressed by f_z = 1/√(1 + i_z² d u/(2ζ1))
+    and the concentration multiplied by it; upwind nothing changes."""
+    from dcee.models.plume import IsotropicPlume
+
+    q, u, z1, z2, iz = 2.0, 3.0, 0.5, 40.0, 0.2
+    theta = np.array([[0.0, 0.0, 1.0, q, u, math.pi, z1, z2]])  # wind towards +x
+    lam = math.sqrt(z1 * z2 / (1 + u * u * z2 / (4 * z1)))
+
+    def by_hand(x: float, y: float, z: float, fz: float) -> float:
+        dz = (z - 1.0) * fz
+        r = math.sqrt(x * x + y * y + dz * dz)
+        return fz * q / (4 * math.pi * z1 * r) * math.exp(-r / lam + x * u / (2 * z1))
+
+    for x, y, z in ((12.0, 0.5, 3.0), (3.0, -1.0, 0.2), (-4.0, 1.0, 2.5)):
+        fz = 1.0 / math.sqrt(1.0 + iz * iz * max(x, 0.0) * u / (2 * z1))
+        got = IsotropicPlume(meander_z=iz).concentration(theta, np.array([[x, y, z]]))[0, 0]
+        assert got == pytest.approx(by_hand(x, y, z, fz), rel=1e-12)
+
+
+@pytest.mark.parametrize("iz", [0.0, 0.1, 0.3])
+def test_vertical_meander_grows_the_plume_ballistically_and_keeps_its_flux(iz):
+    """Far downwind the vertical profile is Gaussian with variance 2 ζ1 d / u + i_z² d² (the
+    diffusive spread plus Taylor's ballistic one), and the flux u ∫∫ C dy dz is the release
+    rate whatever i_z: statistics of the profile against the closed form."""
+    from dcee.models.plume import IsotropicPlume
+
+    q, u, z1, d = 3.0, 4.0, 0.4, 40.0
+    theta = np.array([[0.0, 0.0, 0.0, q, u, math.pi, z1, 1e9]])
+    ys = np.linspace(-15.0, 15.0, 301)
+    zs = np.linspace(-70.0, 70.0, 2801)  # ±5 σ_z at i_z = 0.3
+    yy, zz = np.meshgrid(ys, zs, indexing="ij")
+    plane = np.column_stack([np.full(yy.size, d), yy.ravel(), zz.ravel()])
+    c = IsotropicPlume(meander_z=iz).concentration(theta, plane)[0].reshape(yy.shape)
+    profile = np.trapezoid(c, ys, axis=0)
+    assert u * np.trapezoid(profile, zs) == pytest.approx(q, rel=0.02)
+    variance = np.trapezoid(profile * zs**2, zs) / np.trapezoid(profile, zs)
+    assert variance == pytest.approx(2 * z1 * d / u + iz**2 * d**2, rel=0.03)

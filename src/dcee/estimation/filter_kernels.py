@@ -116,6 +116,7 @@ def _history_kernel(
     radius: float,
     vertical: float,
     ground: float,
+    meander_z: float,
     sp: SensorParams,
     threshold: np.ndarray,
     remaining_bound: np.ndarray,
@@ -169,11 +170,12 @@ def _history_kernel(
                 or radius > 0.0
                 or vertical != 1.0
                 or ground > 0.0
+                or meander_z > 0.0
             ):
                 for q in range(nb):
                     conc[q], dist[q] = plume_at(
                         constants_at(pc, q), px, py, pz, rmin, meander, decay, backflow, radius,
-                        vertical, ground,
+                        vertical, ground, meander_z,
                     )  # fmt: skip
             else:
                 _plume_block(pc, nb, px, py, pz, rmin, conc, dist)
@@ -269,6 +271,7 @@ def history_log_likelihood(
     radius: float,
     vertical: float,
     ground: float,
+    meander_z: float,
     sp: SensorParams,
     out: np.ndarray,
     threshold: np.ndarray | None = None,
@@ -297,6 +300,7 @@ def history_log_likelihood(
         radius,
         vertical,
         ground,
+        meander_z,
         sp,
         np.ascontiguousarray(threshold, dtype=np.float64),
         remaining,

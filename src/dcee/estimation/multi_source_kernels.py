@@ -65,6 +65,7 @@ def _multi_history_kernel(
     radius: float,
     vertical: float,
     ground: float,
+    meander_z: float,
     sp: SensorParams,
     threshold: np.ndarray,
     remaining_bound: np.ndarray,
@@ -111,6 +112,7 @@ def _multi_history_kernel(
                         radius,
                         vertical,
                         ground,
+                        meander_z,
                     )
                     conc += c
                     dist = min(dist, r)
@@ -135,6 +137,7 @@ def multi_history_log_likelihood(
     radius: float,
     vertical: float,
     ground: float,
+    meander_z: float,
     sp: SensorParams,
     out: np.ndarray,
     threshold: np.ndarray | None = None,
@@ -159,6 +162,7 @@ def multi_history_log_likelihood(
         radius,
         vertical,
         ground,
+        meander_z,
         sp,
         np.ascontiguousarray(threshold, dtype=np.float64),
         remaining,

@@ -30,6 +30,15 @@ is the isotropic one at the crosswind offset compressed by f = σ_d / √(σ_d²
 1/√(1 + i² d u / (2 ζ1)), times f (mass conserved across the plume). Exact for the far field's
 Gaussian profile, f → 1 at the source and upwind.
 
+Vertical meander (``meander_z`` = i_z > 0, off by default): the same broadening across the
+wind in the vertical, at its own intensity (Taylor: σ_z = i_z · d with i_z = σ_w / u): the
+height offset compressed by f_z = 1/√(1 + i_z² d u / (2 ζ1)), the concentration times f_z.
+Near the ground the vertical eddies are weaker than the horizontal ones (σ_w / σ_v ≈ 0.66 in a
+neutral surface layer; Panofsky & Dutton 1984). Without it the plume grows upwards
+diffusively (σ_z² = 2 ζ1 d / u), so a reading model fitted to gas met some way above a
+release makes the height it must climb depend on ζ1; with it the climb is ballistic, as the
+near field of a real plume's is.
+
 Decay (``decay`` = p, 1 by default): the prefactor falls with distance as 1/r^p. p = 1 is the
 paper's point source in three dimensions; p = 1/2 is the far field of the same equation in two
 dimensions, a planar plume (the 2-D solution q'/(2π ζ1) · K0(r/λ) · exp(advection), with
@@ -132,6 +141,7 @@ def isotropic_concentration_reference(
     radius: float = 0.0,
     vertical: float = 1.0,
     ground: float = 0.0,
+    meander_z: float = 0.0,
 ) -> np.ndarray:
     """Plain NumPy implementation of the plume; the compiled kernel is tested against it.
 
@@ -146,12 +156,12 @@ def isotropic_concentration_reference(
         pos = positions.copy()
         pos[:, 2] /= vertical
         total = isotropic_concentration_reference(
-            scaled, pos, min_distance, meander, decay, backflow, radius
+            scaled, pos, min_distance, meander, decay, backflow, radius, meander_z=meander_z
         )
         if ground > 0:
             scaled[:, 2] *= -1.0
             total = total + ground * isotropic_concentration_reference(
-                scaled, pos, min_distance, meander, decay, backflow, radius
+                scaled, pos, min_distance, meander, decay, backflow, radius, meander_z=meander_z
             )
         return total
     if radius > 0:
@@ -160,7 +170,7 @@ def isotropic_concentration_reference(
         ring = radius * math.sqrt(2.0 / 3.0)
         clamp = max(min_distance, ring / 2.0)
         total = 0.25 * isotropic_concentration_reference(
-            theta, positions, clamp, meander, decay, backflow
+            theta, positions, clamp, meander, decay, backflow, meander_z=meander_z
         )
         for j in range(6):
             angle = theta[:, 5] + j * math.pi / 3.0
@@ -168,7 +178,7 @@ def isotropic_concentration_reference(
             moved[:, 0] += ring * np.cos(angle)
             moved[:, 1] += ring * np.sin(angle)
             total += 0.125 * isotropic_concentration_reference(
-                moved, positions, clamp, meander, decay, backflow
+                moved, positions, clamp, meander, decay, backflow, meander_z=meander_z
             )
         return total
     if backflow > 0:
@@ -176,16 +186,16 @@ def isotropic_concentration_reference(
         reversed_wind = theta.copy()
         reversed_wind[:, 5] += np.pi
         return (1.0 - backflow) * isotropic_concentration_reference(
-            theta, positions, min_distance, meander, decay
+            theta, positions, min_distance, meander, decay, meander_z=meander_z
         ) + backflow * isotropic_concentration_reference(
-            reversed_wind, positions, min_distance, meander, decay
+            reversed_wind, positions, min_distance, meander, decay, meander_z=meander_z
         )
     x, y, z, q, u, phi, z1, z2 = (theta[:, k : k + 1] for k in range(8))
     dx = positions[None, :, 0] - x
     dy = positions[None, :, 1] - y
     factor = np.ones_like(dx)
+    down = np.maximum(-(dx * np.cos(phi) + dy * np.sin(phi)), 0.0)
     if meander > 0:
-        down = np.maximum(-(dx * np.cos(phi) + dy * np.sin(phi)), 0.0)
         factor = 1.0 / np.sqrt(1.0 + meander**2 * down * u / (2.0 * z1))
         cross = -dx * np.sin(phi) + dy * np.cos(phi)
         along = dx * np.cos(phi) + dy * np.sin(phi)
@@ -193,6 +203,10 @@ def isotropic_concentration_reference(
         dx = along * np.cos(phi) - cross * np.sin(phi)
         dy = along * np.sin(phi) + cross * np.cos(phi)
     dz = positions[None, :, 2] - z
+    if meander_z > 0:
+        factor_z = 1.0 / np.sqrt(1.0 + meander_z**2 * down * u / (2.0 * z1))
+        dz = dz * factor_z
+        factor = factor * factor_z
     r = np.maximum(np.sqrt(dx * dx + dy * dy + dz * dz), min_distance)
     lam = np.sqrt(z1 * z2 / (1.0 + u * u * z2 / (4.0 * z1)))
     advection = (dx * u * np.cos(phi) + dy * u * np.sin(phi)) / (2.0 * z1)
@@ -209,6 +223,7 @@ def isotropic_concentration(
     radius: float = 0.0,
     vertical: float = 1.0,
     ground: float = 0.0,
+    meander_z: float = 0.0,
 ) -> np.ndarray:
     """Expected concentration (g/m³) of the isotropic plume, compiled.
 
@@ -218,8 +233,9 @@ def isotropic_concentration(
     theta, positions = _check_shapes(theta, positions)
     out = np.empty((theta.shape[0], positions.shape[0]))
     plume_kernels.concentration_matrix(
-        theta, positions, min_distance, meander, decay, backflow, radius, vertical, ground, out
-    )
+        theta, positions, min_distance, meander, decay, backflow, radius, vertical, ground,
+        meander_z, out,
+    )  # fmt: skip
     return out
 
 
@@ -244,6 +260,8 @@ class IsotropicPlume:
     ground: float = 0.0
     """weight of the release's image below the ground z = 0 (module doc): 1 a ground that
     reflects all gas, 0 none (the paper's unbounded air)"""
+    meander_z: float = 0.0
+    """vertical turbulence intensity i_z of the meander broadening (module doc); 0: none"""
 
     def __post_init__(self) -> None:
         if not (0.0 <= self.meander <= 2.0):
@@ -258,12 +276,22 @@ class IsotropicPlume:
             raise DceeInputError("vertical_ratio", f"must be in [0.1, 10], got {self.vertical}")
         if not (0.0 <= self.ground <= 1.0):
             raise DceeInputError("ground", f"must be in [0, 1], got {self.ground}")
+        if not (0.0 <= self.meander_z <= 2.0):
+            raise DceeInputError("vertical_meander", f"must be in [0, 2], got {self.meander_z}")
 
     @property
-    def shape(self) -> tuple[float, float, float, float, float, float]:
-        """(meander, decay, backflow, radius, vertical, ground): the plume's shape settings, in
-        the order the kernels take them."""
-        return (self.meander, self.decay, self.backflow, self.radius, self.vertical, self.ground)
+    def shape(self) -> tuple[float, float, float, float, float, float, float]:
+        """(meander, decay, backflow, radius, vertical, ground, meander_z): the plume's shape
+        settings, in the order the kernels take them."""
+        return (
+            self.meander,
+            self.decay,
+            self.backflow,
+            self.radius,
+            self.vertical,
+            self.ground,
+            self.meander_z,
+        )
 
     def concentration(self, theta: np.ndarray, positions: np.ndarray) -> np.ndarray:
         """(N, 8) source terms × (M, 3) positions → (N, M) concentrations in g/m³."""

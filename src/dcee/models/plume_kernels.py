@@ -47,17 +47,23 @@ def plume_terms(theta: np.ndarray, i: int):
 
 
 @njit(cache=True, inline="always")
-def _advected(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay):
+def _advected(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, meander_z):
     """The advected plume at offset (dx, dy, dz) from the source, wind terms (ax, ay, c, s, k)
     as :func:`plume_terms` gives them (negated: the plume of the reversed wind)."""
     factor = 1.0
-    if meander > 0.0:
+    if meander > 0.0 or meander_z > 0.0:
         down = -(dx * c + dy * s)  # distance downwind of the source
         if down > 0.0:
-            factor = 1.0 / math.sqrt(1.0 + meander * meander * down * k)
-            cross = (factor - 1.0) * (-dx * s + dy * c)  # compress the crosswind offset
-            dx -= cross * s
-            dy += cross * c
+            if meander > 0.0:
+                factor = 1.0 / math.sqrt(1.0 + meander * meander * down * k)
+                cross = (factor - 1.0) * (-dx * s + dy * c)  # compress the crosswind offset
+                dx -= cross * s
+                dy += cross * c
+            if meander_z > 0.0:
+                # the same broadening in the vertical, at its own intensity
+                factor_z = 1.0 / math.sqrt(1.0 + meander_z * meander_z * down * k)
+                dz *= factor_z
+                factor *= factor_z
     r = math.sqrt(dx * dx + dy * dy + dz * dz)
     if r < rmin:
         r = rmin
@@ -66,11 +72,14 @@ def _advected(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay):
 
 
 @njit(cache=True, inline="always")
-def _mixed(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow):
-    """The point source's plume at offset (dx, dy, dz), with ``backflow`` w mixed in."""
-    value = _advected(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay)
+def _mixed(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow, mz):
+    """The point source's plume at offset (dx, dy, dz), with ``backflow`` w mixed in (``mz``:
+    the vertical meander)."""
+    value = _advected(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, mz)
     if backflow > 0.0:
-        reverse = _advected(dx, dy, dz, pref, inv_lam, -ax, -ay, -c, -s, k, rmin, meander, decay)
+        reverse = _advected(
+            dx, dy, dz, pref, inv_lam, -ax, -ay, -c, -s, k, rmin, meander, decay, mz
+        )
         value = (1.0 - backflow) * value + backflow * reverse
     return value
 
@@ -87,17 +96,19 @@ _RING_SIN = tuple(math.sin(j * math.pi / 3.0) for j in range(6))
 
 @njit(cache=True, inline="always")
 def _point_or_disc(
-    dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow, radius
+    dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow, radius, mz
 ):
     """The plume at offset (dx, dy, dz) from the source location of a point release
     (``radius`` 0) or of one spread over a horizontal disc (:data:`DISC_RING`)."""
     if radius <= 0.0:
-        return _mixed(dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow)
+        return _mixed(
+            dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow, mz
+        )
     ring = radius * DISC_RING
     # a sub-source's distance clamped at half the spacing of the rule's points
     rsub = max(rmin, 0.5 * ring)
     value = 0.25 * _mixed(
-        dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rsub, meander, decay, backflow
+        dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rsub, meander, decay, backflow, mz
     )
     for j in range(6):
         # one ring point straight upwind (c, s), the others every 60°
@@ -106,8 +117,9 @@ def _point_or_disc(
         ox = ring * (c * cj - s * sj)
         oy = ring * (s * cj + c * sj)
         value += 0.125 * _mixed(
-            dx - ox, dy - oy, dz, pref, inv_lam, ax, ay, c, s, k, rsub, meander, decay, backflow
-        )
+            dx - ox, dy - oy, dz, pref, inv_lam, ax, ay, c, s, k, rsub, meander, decay, backflow,
+            mz,
+        )  # fmt: skip
     return value
 
 
@@ -124,14 +136,16 @@ def plume_at(
     radius: float,
     vertical: float,
     ground: float,
+    meander_z: float,
 ):
     """(concentration, clamped distance r) at (px, py, pz) from one particle's
     :func:`plume_terms`; see :mod:`dcee.models.plume` for ``meander``, ``decay``, ``backflow``
     (w: (1 − w) · the plume + w · the plume of the reversed wind), ``radius`` (the release
     spread over a horizontal disc: seven sub-sources, :data:`DISC_RING`), ``vertical`` (the
     ratio a of the vertical to the horizontal spread: heights divided by a, the release rate
-    too) and ``ground`` (the weight of the release's image below the ground z = 0). r is the
-    distance to the source location (the disc's centre)."""
+    too), ``ground`` (the weight of the release's image below the ground z = 0) and
+    ``meander_z`` (the meander's vertical intensity). r is the distance to the source location
+    (the disc's centre)."""
     sx, sy, sz, pref, inv_lam, ax, ay, c, s, k = terms
     dx = px - sx
     dy = py - sy
@@ -141,18 +155,19 @@ def plume_at(
         r0 = rmin
     if vertical == 1.0 and ground == 0.0:
         return _point_or_disc(
-            dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow, radius
-        ), r0
+            dx, dy, dz, pref, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow, radius,
+            meander_z,
+        ), r0  # fmt: skip
     inv_a = 1.0 / vertical
     pref_a = pref * inv_a
     value = _point_or_disc(
         dx, dy, dz * inv_a, pref_a, inv_lam, ax, ay, c, s, k, rmin, meander, decay, backflow,
-        radius,
+        radius, meander_z,
     )  # fmt: skip
     if ground > 0.0:
         value += ground * _point_or_disc(
             dx, dy, (pz + sz) * inv_a, pref_a, inv_lam, ax, ay, c, s, k, rmin, meander, decay,
-            backflow, radius,
+            backflow, radius, meander_z,
         )  # fmt: skip
     return value, r0
 
@@ -218,6 +233,7 @@ def concentration_distance_grid(
     radius: float,
     vertical: float,
     ground: float,
+    meander_z: float,
     conc: np.ndarray,
     dist: np.ndarray,
 ):
@@ -239,6 +255,7 @@ def concentration_distance_grid(
                 radius,
                 vertical,
                 ground,
+                meander_z,
             )
             conc[m, i] = c
             dist[m, i] = r
@@ -254,14 +271,16 @@ def concentration_matrix(
     radius: float,
     vertical: float,
     ground: float,
+    meander_z: float,
     out: np.ndarray,
 ):
     """out[i, m] = C(positions[m]; theta[i]); out (N, M) C-contiguous."""
     tmp = np.empty((positions.shape[0], theta.shape[0]))
     dist = np.empty_like(tmp)
     concentration_distance_grid(
-        theta, positions, rmin, meander, decay, backflow, radius, vertical, ground, tmp, dist
-    )
+        theta, positions, rmin, meander, decay, backflow, radius, vertical, ground, meander_z,
+        tmp, dist,
+    )  # fmt: skip
     out[...] = tmp.T
 
 

@@ -80,6 +80,7 @@ def vectorised_case(
     radius: float,
     vertical: float,
     ground: float,
+    meander_z: float,
 ) -> bool:
     """True for the paper's sensor and plume (Gaussian family, constant Pd < 1; no meander,
     backflow or area release; decay 1), which the branch-free loops with the vectorisable
@@ -95,6 +96,7 @@ def vectorised_case(
         and radius == 0.0
         and vertical == 1.0
         and ground == 0.0
+        and meander_z == 0.0
         and sp.sigma_min >= 2.0**-60  # σ within the range of the vectorised log
     )
 
@@ -227,6 +229,7 @@ def position_rows(
     radius: float,
     vertical: float,
     ground: float,
+    meander_z: float,
     sp: SensorParams,
     conc: np.ndarray,
     dist: np.ndarray,
@@ -254,7 +257,7 @@ def position_rows(
     """
     n = plume.shape[1]
     n_blocks = (n + _ROW_BLOCK - 1) // _ROW_BLOCK
-    fast = vectorised_case(sp, meander, decay, backflow, radius, vertical, ground)
+    fast = vectorised_case(sp, meander, decay, backflow, radius, vertical, ground, meander_z)
     for b in prange(n_blocks):
         i0 = b * _ROW_BLOCK
         i1 = min(n, i0 + _ROW_BLOCK)
@@ -272,7 +275,7 @@ def position_rows(
             for i in range(i0, i1):
                 c, r = plume_at(
                     constants_at(plume, i), px, py, pz, rmin, meander, decay, backflow, radius,
-                    vertical, ground,
+                    vertical, ground, meander_z,
                 )  # fmt: skip
                 _store_terms(c, r, sp, row, i, conc, dist, loc, log_nd, inv_sigma, det_offset)
 

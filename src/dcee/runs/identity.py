@@ -64,6 +64,8 @@ LATER_DEFAULTS: dict[tuple[str, ...], Any] = {
     ("estimator", "backflow"): 0.0,
     # a point source before issue 42's source_radius setting
     ("estimator", "source_radius"): 0.0,
+    # the plume grew upwards by diffusion alone before issue 78's vertical meander
+    ("estimator", "vertical_meander"): 0.0,
     # every learned value equally likely before issue 42's learn_prior setting
     ("estimator", "learn_prior"): {},
     # input only (a compass bearing converted to phi), always unset once validated
@@ -93,6 +95,7 @@ FLUCTUATION_ONLY = (
     "decay",
     "backflow",
     "source_radius",
+    "vertical_meander",
     "learn",
 )
 """Estimator settings that only the fluctuation likelihood reads: under the paper's likelihood

@@ -228,6 +228,7 @@ class ScenarioBuilders:
             decay=learned.get("decay", e.decay),
             backflow=learned.get("backflow", e.backflow),
             radius=learned.get("source_radius", e.source_radius),
+            meander_z=learned.get("vertical_meander", e.vertical_meander),
             **world,
         )
 

@@ -188,10 +188,19 @@ LearnedName = Literal[
     "source_radius",
     "vertical_ratio",
     "ground",
+    "vertical_meander",
     "wall_diffusivity",
 ]
 """The reading model's nuisance parameters ``estimator.learn`` may weigh."""
-PLUME_SHAPE_SETTINGS = ("meander", "decay", "backflow", "source_radius", "vertical_ratio", "ground")
+PLUME_SHAPE_SETTINGS = (
+    "meander",
+    "decay",
+    "backflow",
+    "source_radius",
+    "vertical_ratio",
+    "ground",
+    "vertical_meander",
+)
 """The open plume's shape settings (:class:`~dcee.models.plume.IsotropicPlume`): the wall-aware
 plume has none of them, so ``estimator.plume = "walls"`` learns none."""
 LEARN_RANGES: dict[str, tuple[float, float]] = {
@@ -205,6 +214,7 @@ LEARN_RANGES: dict[str, tuple[float, float]] = {
     "source_radius": (0.0, 10.0),
     "vertical_ratio": (0.1, 10.0),
     "ground": (0.0, 1.0),
+    "vertical_meander": (0.0, 2.0),
     "wall_diffusivity": (1e-3, 1000.0),
 }
 """Allowed values of each learned setting (as for the fixed setting)."""
@@ -323,6 +333,11 @@ class EstimatorSpec(BaseModel):
     (:mod:`dcee.models.plume`): 1, a ground that reflects the gas (a release near the ground
     doubles its concentration there); 0, the paper's unbounded air. Every member of the bank,
     the calm one included"""
+    vertical_meander: Annotated[float, Field(ge=0.0, le=2.0, allow_inf_nan=False)] = 0.0
+    """fluctuation: the vertical turbulence intensity i_z = σ_w / u of the plume model's
+    meander broadening (:mod:`dcee.models.plume`): the plume grows upwards by i_z · d at d m
+    downwind, as a real plume's near field does. 0: none, the plume grows upwards by diffusion
+    alone (the paper's model). The paper's likelihood and the calm member always use 0"""
     meander: Annotated[float | None, Field(ge=0, le=2)] = None
     """crosswind turbulence intensity of the plume model's time-mean meander broadening
     (:mod:`dcee.models.plume`); None: the likelihood's default, :data:`MEANDER_DEFAULT`"""
