@@ -110,6 +110,8 @@ def campaign_table(folder: Path) -> tuple[list[dict], list[dict], list[dict]]:
                 "median_final_rmse_ci95": [lo, hi],
                 "truth_in_95": int(part["truth_in_95"].astype(bool).sum()),
                 "median_detections": float(part["detections"].median()),
+                # m, the final particles' RMS distance from their mean (the posterior's spread)
+                "median_final_spread": float(part["final_spread"].median()),
                 # precision where detections are rare: the searches with fewer than 60
                 "rare": _rare(part),
                 "altitude_share": share,

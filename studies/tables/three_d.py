@@ -234,3 +234,57 @@ def lbm3d_store_tune_table() -> str:
         "paired change (Wilcoxon)",
     ]
     return table(header, rows)
+
+
+SLICE_PROBES = (
+    ("lbm3d-slice-tune-cells", "today's defaults"),
+    ("lbm3d-slice-tune-height-known", "the source height declared known (a diagnostic)"),
+    ("lbm3d-slice-tune-decay", "the fall learned: 1/r or 1/r^(1/2)"),
+    ("lbm3d-slice-tune-decay-surface", "that, with the ground and vertical ratio 0.66"),
+    ("lbm3d-slice-tune-vmeander", "a vertical meander, i_z = 0.1"),
+)
+"""The slice's tuning probes, one change of the reading model at a time (recipes
+lbm3d-store-tune and lbm3d-slice-probes)."""
+
+
+def lbm3d_slice_probes_table() -> str:
+    """The slice's tuning range under each probe of the reading model (recipe
+    lbm3d-slice-probes; studies/lbm3d_table.py and studies/pair_campaigns.py)."""
+    folder = RESULTS / "lbm3d-slice-probes"
+    with (folder / "pairs.csv").open(encoding="utf-8") as f:
+        pairs = {r["arm"]: r for r in csv.DictReader(f)}
+    rows = []
+    for name, change in SLICE_PROBES:
+        r = json.loads((folder / f"{name}.json").read_text(encoding="utf-8"))["rows"][0]
+        n = r["searches"]
+        lo, hi = r["median_final_rmse_ci95"]
+        paired = ""
+        if name in pairs:
+            p = pairs[name]
+            change_m, p_value = float(p["median_rmse_b_minus_a"]), float(p["rmse_wilcoxon_p"])
+            paired = f"{change_m:+.2f} m (p = {p_value:.2g})"
+        rows.append(
+            [
+                change,
+                f"{r['acquired']}/{n}",
+                f"{r['median_final_rmse']:.2f} [{lo:.2f}, {hi:.2f}]",
+                f"{r['median_downwind_error']:+.2f}",
+                f"{r['median_height_error']:+.2f}",
+                f"{r['median_final_spread']:.2f}",
+                f"{r['truth_in_95']}/{n}",
+                f"{r['median_detections']:.0f}",
+                paired,
+            ]
+        )
+    header = [
+        "reading model (lbm3d-slice-tune, 20 searches)",
+        "acquired",
+        "median final RMSE (m) [95 % CI]",
+        "error downwind (m, median)",
+        "error in height (m, median)",
+        "final spread (m, median)",
+        "truth in 95 % region",
+        "median detections",
+        "paired RMSE change (Wilcoxon)",
+    ]
+    return table(header, rows)
