@@ -242,6 +242,7 @@ SLICE_PROBES = (
     ("lbm3d-slice-tune-decay", "the fall learned: 1/r or 1/r^(1/2)"),
     ("lbm3d-slice-tune-decay-surface", "that, with the ground and vertical ratio 0.66"),
     ("lbm3d-slice-tune-vmeander", "a vertical meander, i_z = 0.1"),
+    ("lbm3d-slice-tune-anemometer", "a measured wind (the anemometer on)"),
 )
 """The slice's tuning probes, one change of the reading model at a time (recipes
 lbm3d-store-tune and lbm3d-slice-probes)."""

@@ -271,12 +271,12 @@ class SearchNode(NodeInputs, NodeOutputs, LifecycleNode):
         else:
             scenario, line = self.map_gas.scenario(scenario, bool(p["gas_walls"]))
             if line is not None:
-                walls = scenario.estimator.plume == "walls"
+                walls = scenario.plume_model == "walls"
                 (self.get_logger().info if walls else self.get_logger().warning)(line)
             searcher = new_searcher(p, scenario, self.searches_started)
             searcher.scenario_key = key
         self.checkpoint_error = ""
-        self.gas_model = scenario.estimator.plume
+        self.gas_model = scenario.plume_model
         if self._map_site is not None:  # the map topic's obstacles outlive a search
             searcher.agent = dataclasses.replace(searcher.agent, site=self._map_site)
         with self._lock:

@@ -19,6 +19,7 @@ from dcee.scenarios import (
     unset_lookahead,
     unset_region_floor,
 )
+from dcee.scenarios.schema.estimator import unset_plume
 from dcee.scenarios.schema.world import WorldSpec
 
 
@@ -187,6 +188,15 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
     free-text description and without later-added settings at their defaults."""
     out = copy.deepcopy({k: v for k, v in scenario.items() if k != "description"})
     estimator = out.get("estimator")
+    if isinstance(estimator, dict) and "plume" in estimator and estimator["plume"] is None:
+        # unset: the plume it resolved to (Scenario.plume_model), compared as that model
+        world_dump = out.get("world") or {}
+        estimator["plume"] = unset_plume(
+            bool(world_dump.get("obstacles")) or world_dump.get("map") is not None,
+            str(out.get("unknown", "source")),
+            int(estimator.get("max_sources", 1)),
+            estimator.get("learn"),
+        )
     if isinstance(estimator, dict):
         likelihood = estimator.get("likelihood", "paper")
         if likelihood == "paper":

@@ -132,6 +132,7 @@ class ScenarioBuilders:
             ("world", "resolution"): self.site_resolution,
             ("search", "lookahead"): self.lookahead,
             ("search", "explore_guard"): self.explore_guard,
+            ("estimator", "plume"): self.plume_model,
             ("estimator", "wall_diffusivity"): self.wall_diffusivity,
             ("estimator", "wall_wind"): self.wall_wind,
             ("estimator", "wall_viscosity"): self.wall_viscosity,
@@ -197,7 +198,7 @@ class ScenarioBuilders:
         site's wall-aware plume at the member's diffusivity (members of one diffusivity share
         it: it has no open-plume shape setting to learn)."""
         model = self._reading_model(model)
-        if self.estimator.plume == "walls":
+        if self.plume_model == "walls":
             u, phi = (float(v) for v in self.truth_theta()[4:6])
             lifetime = self.estimator.wall_lifetime
             zeta2 = math.inf if lifetime is None else float(lifetime)

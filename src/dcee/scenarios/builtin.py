@@ -256,6 +256,10 @@ def random_sources_configuration(k: int, n_sources: int) -> dict[str, Any]:
     return scenario
 
 
+SITE_FLIGHT_HEIGHT = 4.0
+"""m: the release height of a built-in site with walls, the UAV's flight height (the fluid
+solver's plume that flows round the walls is planar, its source in the flight plane)."""
+
 SITE_BUILDINGS = (3, 6)
 """``random-site:K``: how many buildings (inclusive range)."""
 
@@ -297,10 +301,18 @@ def random_site_configuration(k: int) -> dict[str, Any]:
     scenario.update(
         name=f"random-site:{k}",
         description=(
-            f"Random site {k} (tuning range): {len(boxes)} buildings; source ({x}, {y}, 1) m, "
-            f"q {q} g/s, {wind_from_words(phi)} at 4 m/s; UAV at 4 m from (2, 2)."
+            f"Random site {k} (tuning range): {len(boxes)} buildings; source ({x}, {y}, "
+            f"{SITE_FLIGHT_HEIGHT:g}) m, q {q} g/s, {wind_from_words(phi)} at 4 m/s; UAV at 4 m "
+            "from (2, 2); the gas flows round the buildings."
         ),
-        truth={**scenario["truth"], "x": x, "y": y, "q": q, "phi": phi},
+        truth={
+            **scenario["truth"],
+            "x": x,
+            "y": y,
+            "z": SITE_FLIGHT_HEIGHT,
+            "q": q,
+            "phi": phi,
+        },
         world={
             "obstacles": [
                 {"kind": "rectangle", "low": [b[0], b[1]], "high": [b[2], b[3]]} for b in boxes
@@ -388,11 +400,16 @@ def _site(kind: str) -> dict[str, Any]:
     x, y, phi = spec["source"]
     base = _paper(1)
     base["name"] = f"site:{kind}"
+    walls = "obstacles" in spec["world"] or "map" in spec["world"]
+    # where there are walls the gas flows round them (the fluid solver's plume, planar: its
+    # source in the flight plane, issue 84); a no-go zone is nothing to the gas
+    z = SITE_FLIGHT_HEIGHT if walls else base["truth"]["z"]
+    gas = "the gas flows round the walls" if walls else "the gas passes through the zone"
     base["description"] = (
-        f"Site with obstacles, {spec['description']}: source ({x}, {y}, 1) m, "
-        f"{wind_from_words(phi)} at 4 m/s; UAV at 4 m from (2, 2)."
+        f"Site with obstacles, {spec['description']}: source ({x}, {y}, {z:g}) m, "
+        f"{wind_from_words(phi)} at 4 m/s; UAV at 4 m from (2, 2); {gas}."
     )
-    base["truth"] = {**base["truth"], "x": x, "y": y, "phi": phi}
+    base["truth"] = {**base["truth"], "x": x, "y": y, "z": z, "phi": phi}
     base["prior"] = {**base["prior"], "phi": {**base["prior"]["phi"], "mean": phi}}
     base["world"] = spec["world"]
     return base

@@ -7,12 +7,13 @@ combination, and each member's prior probability (a mixin of
 from __future__ import annotations
 
 import itertools
+from typing import Literal
 
 import numpy as np
 
 from dcee.models.site_flow import WAKE_VISCOSITY, WALL_WIND_DEFAULT
 from dcee.scenarios.schema.common import FIELD_MARK
-from dcee.scenarios.schema.estimator import LEARN_RANGES, PLUME_SHAPE_SETTINGS
+from dcee.scenarios.schema.estimator import LEARN_RANGES, PLUME_SHAPE_SETTINGS, unset_plume
 from dcee.scenarios.schema.learn import (
     LEARN_MEMBERS_MAX,
     default_learn,
@@ -47,7 +48,7 @@ class ReadingModelSettings:
         """``estimator.plume = "walls"``: buildings to flow round, one known flow, one release,
         no open-plume shape learned."""
         e = self.estimator
-        if e.plume != "walls":
+        if self.plume_model != "walls":
             walls_only = (e.wall_diffusivity, e.wall_lifetime, e.wall_wind, e.wall_viscosity)
             if walls_only != (None,) * 4 or "wall_diffusivity" in (e.learn or {}):
                 raise ValueError(
@@ -138,8 +139,23 @@ class ReadingModelSettings:
         return default_learn_prior(e.likelihood, self._learn_fixed(), e.learn)
 
     def _learn_fixed(self) -> dict:
-        """The estimator's settings by name, the wall-aware plume's diffusivity resolved."""
-        return {**dict(self.estimator), "wall_diffusivity": self.wall_diffusivity}
+        """The estimator's settings by name, the plume and the wall-aware plume's diffusivity
+        resolved."""
+        return {
+            **dict(self.estimator),
+            "plume": self.plume_model,
+            "wall_diffusivity": self.wall_diffusivity,
+        }
+
+    @property
+    def plume_model(self) -> Literal["open", "walls"]:
+        """``estimator.plume`` resolved: as given, or ``walls`` wherever there are walls and the
+        wall-aware plume applies, else ``open`` (:func:`unset_plume`)."""
+        e = self.estimator
+        if e.plume is not None:
+            return e.plume
+        walls = bool(self.world.obstacles) or self.world.map is not None
+        return unset_plume(walls, self.unknown, e.max_sources, e.learn)
 
     @property
     def wall_wind(self) -> str:

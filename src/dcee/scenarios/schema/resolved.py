@@ -52,7 +52,11 @@ class ResolvedSettings:
             return self.search.lookahead
         e = self.estimator
         return unset_lookahead(
-            e.likelihood, self.agent.model, e.max_sources, self.world.empty, e.plume == "walls"
+            e.likelihood,
+            self.agent.model,
+            e.max_sources,
+            self.world.empty,
+            self.plume_model == "walls",
         )
 
     @property
@@ -106,7 +110,7 @@ class ResolvedSettings:
     def region_floor(self) -> float:
         """m, the reported region's floor (``estimator.region_floor`` or its default)."""
         e = self.estimator
-        floor = unset_region_floor(e.likelihood, e.plume)
+        floor = unset_region_floor(e.likelihood, self.plume_model)
         return floor if e.region_floor is None else e.region_floor
 
     def resolved_settings(self) -> dict[str, Any]:
@@ -126,7 +130,7 @@ class ResolvedSettings:
             "climb": self.climb,
             "lookahead": self.lookahead,
             "explore_guard": self.explore_guard,
-            "estimator_plume": self.estimator.plume,
+            "estimator_plume": self.plume_model,
         }
 
 

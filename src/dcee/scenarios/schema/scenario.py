@@ -36,6 +36,22 @@ GAS_MAP_MAX_CELL = 1.0
 """m: the coarsest map cell the gas round buildings is computed on (the lbm truth, the
 wall-aware estimator): a 2 m street is then two cells wide at least."""
 
+SITE_TRUTH = "lbm"
+"""The truth of a site with walls when ``truth.model`` is unset (issue 84): the fluid solver's
+plume, whose gas flows round the walls (planar, its source in the flight plane); elsewhere the
+unset truth is the paper's isotropic plume."""
+
+
+def site_has_walls(world: Any) -> bool:
+    """Whether a ``[world]`` (a mapping or a :class:`WorldSpec`) holds walls the gas flows round:
+    obstacles or an occupancy-grid map (a no-go zone is nothing to the gas)."""
+    if isinstance(world, WorldSpec):
+        return bool(world.obstacles) or world.map is not None
+    if not isinstance(world, dict):
+        return False
+    return bool(world.get("obstacles")) or world.get("map") is not None
+
+
 GAS_SOURCE_CLEARANCE = 2.0
 """m round the source within which a map may leave no cell unknown where the gas flows round
 walls (what the gas meets first must be known)."""
@@ -86,6 +102,27 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, ResolvedSettings, BaseMod
         prior = {k: v for k, v in prior.items() if k != "wind_from"}
         prior["phi"] = phi_prior_from_bearing(data["prior"]["wind_from"])
         return {**data, "prior": prior}
+
+    @model_validator(mode="before")
+    @classmethod
+    def _gas_round_walls(cls, data: Any) -> Any:
+        # at a site with walls the gas goes round them: an unset truth model is the fluid
+        # solver's plume, and an unset likelihood follows that turbulent truth (issue 84)
+        if not isinstance(data, dict) or not site_has_walls(data.get("world")):
+            return data
+        truth = data.get("truth")
+        if not isinstance(truth, dict):
+            return data
+        out = dict(data)
+        if truth.get("model") is None:
+            out["truth"] = truth = {**truth, "model": SITE_TRUTH}
+        estimator = out.get("estimator")
+        if isinstance(estimator, EstimatorSpec):
+            return out
+        estimator = dict(estimator or {})
+        if truth.get("model") == SITE_TRUTH and estimator.get("likelihood") is None:
+            out["estimator"] = {**estimator, "likelihood": "fluctuation"}
+        return out
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario:
@@ -201,9 +238,10 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, ResolvedSettings, BaseMod
         if self.truth.model_name == "lbm" and abs(self.truth.z - start[2]) > 1e-6:
             raise ValueError(
                 f"{FIELD_MARK}truth.z: {self.truth.z:g} m is off the flight plane: the lbm plume "
-                f"is planar, its source in the plane the agent flies (z = {start[2]:g} m), so "
-                f'set truth.z = {start[2]:g}, or use truth.model = "lbm3d" (a 3-D plume) for '
-                "a source below the UAV"
+                f"(a site's truth where there are walls) is planar, its source in the plane the "
+                f"agent flies (z = {start[2]:g} m), so set truth.z = {start[2]:g}, or for a "
+                'source below the UAV truth.model = "lbm3d" (a 3-D plume, open terrain) or '
+                '"isotropic" (gas that passes through walls)'
             )
         if plane is None:
             plane = float(start[2])
@@ -287,7 +325,7 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, ResolvedSettings, BaseMod
                 f"{FIELD_MARK}world: the source area around ({src[0]:g}, {src[1]:g}) cannot be "
                 f"reached from agent.start {tuple(self.agent.start)}: obstacles enclose it"
             )
-        if self.truth.model_name == "lbm" or self.estimator.plume == "walls":
+        if self.truth.model_name == "lbm" or self.plume_model == "walls":
             self._checked_gas_walls(src)
         return site
 
