@@ -113,7 +113,7 @@ def test_an_unset_climb_follows_the_expected_plume_and_the_platform():
     assert several.with_overrides(**{"agent.model": "unicycle"}).climb == 0.0
     assert paper.with_overrides(**{"estimator.max_sources": 1}).climb == 0.0
     # not measured at a site: the paper's fixed altitude there
-    assert load_scenario("site:block").with_overrides(**{"estimator.max_sources": 2}).climb == 0.0
+    assert load_scenario("site:nogo").with_overrides(**{"estimator.max_sources": 2}).climb == 0.0
     stored = several.model_dump(mode="json")
     assert scenario_identity(stored) == scenario_identity(
         several.with_overrides(**{"agent.climb": 1.0}).model_dump(mode="json")

@@ -32,10 +32,12 @@ def test_an_unset_lookahead_is_three_only_where_it_was_chosen():
     several = {"estimator.max_sources": 2, "estimator.calm_prior": 0.0, "estimator.learn": {}}
     assert turbulent.with_overrides(**several).lookahead == 1
     assert turbulent.with_overrides(**{"agent.model": "unicycle"}).lookahead == 1
-    site = load_scenario("site:wall").with_overrides(**{"estimator.likelihood": "fluctuation"})
+    site = load_scenario("site:wall").with_overrides(**{"estimator.plume": "open"})
     assert site.lookahead == 1  # the wall-blind estimator at a site: not measured there
-    # the wall-aware estimator at a site: chosen on the tuning sites (SITE_LOOKAHEAD)
-    aware = site.with_overrides(**{"estimator.plume": "walls"})
+    # the wall-aware estimator at a site (its default there since issue 84): chosen on the
+    # tuning sites (SITE_LOOKAHEAD)
+    aware = load_scenario("site:wall")
+    assert aware.plume_model == "walls" and aware.estimator.likelihood == "fluctuation"
     assert aware.lookahead == SITE_LOOKAHEAD
     assert aware.with_overrides(**{"agent.model": "unicycle"}).lookahead == 1
     # a value set is kept everywhere

@@ -21,13 +21,18 @@ from dcee.runs import make_searcher, planner_defaults, streams
 from dcee.scenarios import load_scenario
 
 SCENARIO = {"search.particles": 800, "search.hypotheses": 8, "search.budget": 60.0}
+SITE = {**SCENARIO, "truth.model": "isotropic", "estimator.plume": "open"}
+"""At a site, the geography, not the gas: the paper's plume as the truth and the estimator's (the
+site's defaults, the fluid solver's plume and the wall-aware one, cost minutes)."""
 
 
-def _record_search(bag, scenario: str = "lab:upwind", fixes=None) -> SearchCycle:
+def _record_search(
+    bag, scenario: str = "lab:upwind", fixes=None, overrides: dict = SCENARIO
+) -> SearchCycle:
     """A live search (simulated robot + cycle) of ``scenario``, every message also written to
     ``bag``; with ``fixes`` (a second bag), the same search logged by a robot that reports
     GNSS fixes on its pose topic instead of odometry (the scenario's map frame)."""
-    sc = load_scenario(scenario).with_overrides(**SCENARIO)
+    sc = load_scenario(scenario).with_overrides(**overrides)
     robot = SimulatedRobot(sc, 0)
     _, filter_rng, planner_rng, _ = streams(0)
     planner = get_planner("infotaxis", **planner_defaults("infotaxis", sc, None))
@@ -103,8 +108,8 @@ def test_replay_places_gnss_fixes_on_the_sites_map(tmp_path) -> None:
     speeds come from successive fixes, so it may settle a control step apart) and ends near the
     same estimate."""
     pytest.importorskip("pyproj")
-    _record_search(tmp_path / "odom", "area:example-works", fixes=tmp_path / "gnss")
-    sc = load_scenario("area:example-works").with_overrides(**SCENARIO)
+    _record_search(tmp_path / "odom", "area:example-works", tmp_path / "gnss", SITE)
+    sc = load_scenario("area:example-works").with_overrides(**SITE)
     a = replay_bag(tmp_path / "odom", sc, seed=0)
     b = replay_bag(tmp_path / "gnss", sc, seed=0)
     assert {e.kind for e in read_events(tmp_path / "gnss")} == {"fix", "reading", "goal"}

@@ -94,7 +94,8 @@ def test_exploration_information_of_a_plume_by_its_own_method_is_the_compiled_on
     [
         ({"scenario": "paper:1"}, "needs buildings or walls"),
         ({"unknown": "full"}, 'needs unknown = "source"'),
-        ({"estimator.max_sources": 2}, "max_sources = 1"),
+        # the paper's likelihood: one reading model, so the count's own check passes
+        ({"estimator.likelihood": "paper", "estimator.max_sources": 2}, "max_sources = 1"),
         (
             {"scenario": "site:wall", "estimator.plume": "open", "estimator.wall_lifetime": 8.0},
             "wall_lifetime",
@@ -145,7 +146,7 @@ def test_the_fluctuation_likelihood_learns_no_open_plume_shape_round_walls() -> 
 def test_a_search_round_a_wall_with_the_wall_aware_estimator() -> None:
     sc = load_scenario("site:wall").with_overrides(
         **{
-            "estimator.plume": "walls",
+            "truth.model": "isotropic",  # not the site's default: minutes to compute the first time
             "search.particles": 600,
             "search.hypotheses": 8,
             "search.budget": 200.0,

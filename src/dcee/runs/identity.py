@@ -19,7 +19,7 @@ from dcee.scenarios import (
     unset_lookahead,
     unset_region_floor,
 )
-from dcee.scenarios.schema.estimator import unset_plume
+from dcee.scenarios.schema.reading_models import unset_plume
 from dcee.scenarios.schema.world import WorldSpec
 
 

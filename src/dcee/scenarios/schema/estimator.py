@@ -4,7 +4,7 @@ the instrument, and the reading model of the filter and the planners."""
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any, Literal, get_args
+from typing import Annotated, Literal, get_args
 
 from pydantic import BaseModel, Field, field_validator, model_validator
 
@@ -131,22 +131,6 @@ smallest floor of the grid 0-0.5 m at which the truth lies in the 95 % region in
 each truth's searches (filament 25/28 up to 0.2 m, 27/28 at 0.25 m; puffs 28/28 from 0); the
 region's median RMS radius 0.33 → 0.55 m. The wall-aware plume (``plume = "walls"``), on which
 no floor was chosen, keeps 0."""
-
-
-def unset_plume(
-    walls: bool, unknown: str, max_sources: int, learn: dict[str, Any] | None
-) -> Literal["open", "walls"]:
-    """What an unset ``estimator.plume`` resolves to: ``walls`` wherever there are walls
-    (``walls``: a ``[world]`` with obstacles or a map; no-go zones are nothing to the gas) and
-    the wall-aware plume applies (one known flow, ``unknown = "source"``; one release; none of
-    the open plume's shape settings learned by hand), else ``open``. Chosen by the held-out
-    sites (issue 44, docs/scenarios.md): the wall-aware estimator against the wall-blind one
-    19 / 0 searches acquired by one and not the other, 40/40 against 21/40; the default since
-    issue 84 (before it: ``open`` everywhere)."""
-    shaped = set(learn or {}) & set(PLUME_SHAPE_SETTINGS)
-    if walls and unknown == "source" and max_sources == 1 and not shaped:
-        return "walls"
-    return "open"
 
 
 def unset_region_floor(likelihood: str, plume: str = "open") -> float:
@@ -417,7 +401,8 @@ class EstimatorSpec(BaseModel):
     them, source-receptor fields per sensor position). ``walls`` needs a ``[world]`` with
     obstacles or a map, the wind and ζ known (``unknown = "source"``: one flow), one release,
     and none of the open plume's shape settings learned (:data:`PLUME_SHAPE_SETTINGS`). None:
-    ``walls`` wherever it applies, else ``open`` (:func:`unset_plume`)"""
+    ``walls`` wherever it applies, else ``open``
+    (:func:`~dcee.scenarios.schema.reading_models.unset_plume`)"""
     wall_diffusivity: Annotated[float | None, Field(gt=0, le=1000, allow_inf_nan=False)] = None
     """m²/s: the wall-aware plume's diffusivity K (``plume = "walls"``); None: the scenario's
     ζ1. The fluctuation likelihood weighs it and 3 and 10 times it
