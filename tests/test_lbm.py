@@ -215,3 +215,22 @@ def test_a_site_grows_the_domain_round_the_search_area_and_walls_off_its_buildin
         lambda xy: np.zeros(len(xy), bool),
     )  # fmt: skip
     assert none is None and open_spec == spec
+
+
+def test_a_run_that_diverges_but_stays_finite_is_refused() -> None:
+    """A conserved scalar obeys a maximum principle: a cell of the air far above the most the
+    release cell has held is a diverged run (site:passage's plume of 2026-12-05 reached 6.6e34
+    of it, finite), refused in one line; a bounded field passes and the peak is kept."""
+    from dcee.simulation.lbm_solver import BLOW_UP, bounded
+
+    field = np.zeros((20, 10))
+    field[10, 5] = 0.8  # the release cell
+    field[15, 5] = 0.5  # gas downwind, below it
+    assert bounded(field, 0.8, 1.0, 12.0) == 1.0  # the earlier peak kept
+    assert bounded(field, 0.8, 0.0, 12.0) == 0.8
+    field[3, 2] = 2.0 * BLOW_UP
+    with pytest.raises(DceeInputError, match=r"became unstable 12 s into the run \(it diverged\)"):
+        bounded(field, 0.8, 1.0, 12.0)
+    field[3, 2] = 1e25  # finite, as the diverged run's
+    with pytest.raises(DceeInputError, match="unstable"):
+        bounded(field, 0.8, 1.0, 12.0)

@@ -46,8 +46,10 @@ from dcee.simulation.truth import TruthModel, register_truth
 if TYPE_CHECKING:
     from dcee.scenarios import Scenario
 
-FORMAT = 2
-"""Bumped when the stored file's layout or the solver setup changes (part of the cache key)."""
+FORMAT = 3
+"""Bumped when the stored file's layout or the solver setup changes (part of the cache key).
+3 (2026-12-05): a run that diverged is refused (:data:`dcee.simulation.lbm_solver.BLOW_UP`), so
+a recording cached before that holds a diverged run (``site:passage``'s did) is not read."""
 
 
 def cache_folder() -> Path:
