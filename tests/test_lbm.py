@@ -234,3 +234,34 @@ def test_a_run_that_diverges_but_stays_finite_is_refused() -> None:
     field[3, 2] = 1e25  # finite, as the diverged run's
     with pytest.raises(DceeInputError, match="unstable"):
         bounded(field, 0.8, 1.0, 12.0)
+
+
+def test_a_site_whose_run_diverges_is_computed_once_more_slower(tmp_path, monkeypatch) -> None:
+    """A site's run that diverges at the site's lattice speed is run once more at the slower
+    one, and remembered: the next request goes to the slower run at once; in open terrain (no
+    walls) a diverged run is refused."""
+    from dcee.simulation import lbm
+    from dcee.simulation.lbm_solver import unstable
+
+    monkeypatch.setenv("DCEE_CACHE", str(tmp_path))
+    calls: list[float] = []
+
+    def fake_solve(spec, progress=None, solids=None):
+        calls.append(spec.lattice_speed)
+        if spec.lattice_speed > lbm.SITE_FALLBACK_SPEED:
+            raise unstable(1465.0)
+        t = np.arange(3.0)
+        x, y = np.arange(4.0), np.arange(-1.0, 2.0)
+        field = np.full((3, 3, 4), 0.5, np.float32)
+        return {"concentration": field, "t": t, "x": x, "y": y, "attrs": {"flux_lattice": 1.0}}
+
+    monkeypatch.setattr(lbm, "solve", fake_solve)
+    spec = LbmSpec(lattice_speed=lbm.SITE_LATTICE_SPEED)
+    walls = np.zeros((8, 6), dtype=bool)
+    walls[3, 2] = True
+    first = lbm.cached_recording(spec, solids=walls)
+    assert calls == [lbm.SITE_LATTICE_SPEED, lbm.SITE_FALLBACK_SPEED]
+    assert first == lbm.cache_path(spec.model_copy(update={"lattice_speed": 0.02}), walls)
+    assert lbm.cached_recording(spec, solids=walls) == first and len(calls) == 2  # remembered
+    with pytest.raises(DceeInputError, match="became unstable 1465 s into the run"):
+        lbm.cached_recording(spec)  # open terrain: no slower run

@@ -312,10 +312,14 @@ def bounded(field: np.ndarray, at_source: float, source_peak: float, time: float
     return peak
 
 
-def unstable(at: float | None = None) -> DceeInputError:
+class LatticeDiverged(DceeInputError):
+    """A lattice Boltzmann run that went NaN or diverged (:func:`unstable`)."""
+
+
+def unstable(at: float | None = None) -> LatticeDiverged:
     """The one-line error of a run that went NaN or diverged (``at``: s into the run)."""
     when = "" if at is None else f" {at:.0f} s into the run"
-    return DceeInputError(
+    return LatticeDiverged(
         FIELD,
         f"the lattice Boltzmann run became unstable{when} (it diverged); lower lattice_speed or "
         "raise smagorinsky",
@@ -349,6 +353,7 @@ __all__ = [
     "FLUX_DISTANCE",
     "MAGIC",
     "REFERENCE_SPEED",
+    "LatticeDiverged",
     "Solid",
     "bounded",
     "solid_cells",
