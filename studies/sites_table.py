@@ -4,10 +4,7 @@ the obstacles, and whether any search touched an obstacle or no-go zone (every r
 position and every drive, against the shapes themselves).
 
     python studies/sites_table.py results/sites results/sites-mcts results/sites-robot \\
-        [--csv docs/results/sites/sites.csv] [--skip site:passage]
-
-``--skip NAME`` leaves a scenario's searches out of the table (say why where the table is
-published: since 2026-12-05 ``site:passage``, whose fluid-solver truth diverged).
+        [--csv docs/results/sites/sites.csv]
 """
 
 from __future__ import annotations
@@ -71,10 +68,8 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("folders", nargs="+", type=Path)
     ap.add_argument("--csv", type=Path)
-    ap.add_argument("--skip", action="append", default=[], help="leave this scenario out")
     args = ap.parse_args(argv)
     runs = pd.DataFrame([r for f in args.folders for r in rows_of(f)])
-    runs = runs[~runs["scenario"].isin(args.skip)]
     table = []
     for (scenario, strategy, motion), g in runs.groupby(["scenario", "strategy", "motion"]):
         n = len(g)
