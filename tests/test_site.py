@@ -210,11 +210,14 @@ SITE_NAMES = ["site:wall", "site:passage", "site:canyon", "site:block", "site:no
 @pytest.mark.parametrize("name", SITE_NAMES)
 @pytest.mark.parametrize("strategy", ["dcee-cl", "infotaxis", "mpc", "dcee", "entrotaxis"])
 def test_no_search_enters_or_crosses_a_blocked_cell(name, strategy):
-    # the geometry, not the gas: the paper's plume as the truth (a site's default, the fluid
-    # solver's plume, takes minutes per site to compute the first time)
+    # the geometry, not the gas: the paper's plume as the truth and the estimator's (a site's
+    # defaults, the fluid solver's plume and the wall-aware estimator, cost minutes per site to
+    # compute the first time and seconds a search; tests/test_wall_aware_estimator.py flies them)
     sc = load_scenario(name).with_overrides(
         **{
             "truth.model": "isotropic",
+            "estimator.likelihood": "paper",
+            "estimator.plume": "open",
             "search.particles": 400,
             "search.hypotheses": 8,
             "search.budget": 120.0,
