@@ -197,17 +197,26 @@ def test_collapse_is_recovered_by_tempering_and_still_matches_the_posterior(sens
     np.testing.assert_array_less(np.abs(pf.mean() - grid_mean), 0.25 * grid_sd)
 
 
-def test_history_kernel_matches_reference(sensor):
+@pytest.mark.parametrize(
+    "plume",
+    [
+        IsotropicPlume(),
+        IsotropicPlume(meander_z=0.3),  # alone: the kernel must leave its fast path
+        IsotropicPlume(meander=0.15, meander_z=0.1, ground=1.0),
+    ],
+)
+def test_history_kernel_matches_reference(sensor, plume):
     rng = np.random.default_rng(0)
     theta = theta_at(np.column_stack([rng.uniform(0, 10, (500, 2)), np.zeros(500)]), q=2.0, u=2.0)
     pos = np.column_stack([rng.uniform(0, 10, (30, 2)), np.zeros(30)])
+    pos[:, 2] = rng.uniform(0.0, 3.0, 30)  # off the sources' height: the vertical terms count
     z = np.where(rng.random(30) < 0.5, 0.0, rng.gamma(1.0, 5e-3, 30))
     mult = rng.integers(1, 4, 30).astype(float)
     out = np.empty(500)
     history_log_likelihood(
-        theta, np.ones(500, bool), pos, z, mult, 0.1, *IsotropicPlume().shape, sensor.params, out
+        theta, np.ones(500, bool), pos, z, mult, 0.1, *plume.shape, sensor.params, out
     )
-    ref = history_log_likelihood_reference(theta, pos, z, mult, sensor, IsotropicPlume())
+    ref = history_log_likelihood_reference(theta, pos, z, mult, sensor, plume)
     np.testing.assert_allclose(out, ref, rtol=1e-9)
 
 

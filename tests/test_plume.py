@@ -246,3 +246,17 @@ def test_vertical_meander_grows_the_plume_ballistically_and_keeps_its_flux(iz):
     assert u * np.trapezoid(profile, zs) == pytest.approx(q, rel=0.02)
     variance = np.trapezoid(profile * zs**2, zs) / np.trapezoid(profile, zs)
     assert variance == pytest.approx(2 * z1 * d / u + iz**2 * d**2, rel=0.03)
+
+
+def test_the_vertical_meander_setting_reaches_the_turbulent_members_only() -> None:
+    """``estimator.vertical_meander`` is the turbulent members' (the calm member, the paper's
+    model, has none), and the paper's likelihood ignores it."""
+    from dcee.scenarios import load_scenario
+
+    sc = load_scenario("random:1").with_overrides(
+        **{"estimator.likelihood": "fluctuation", "estimator.vertical_meander": 0.1}
+    )
+    assert sc.make_plume().meander_z == 0.1
+    assert sc.make_plume("paper").meander_z == 0.0
+    paper = sc.with_overrides(**{"estimator.likelihood": "paper"})
+    assert paper.make_plume().meander_z == 0.0

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -160,22 +161,36 @@ SURFACE_PROBE = (
 )
 
 
+def _pairs(folder: Path, key: str) -> dict[str, dict]:
+    """The rows of ``folder``/pairs.csv (studies/pair_campaigns.py) by their ``key`` column."""
+    with (folder / "pairs.csv").open(encoding="utf-8") as f:
+        return {r[key]: r for r in csv.DictReader(f)}
+
+
+def _campaign_row(folder: Path, name: str) -> dict:
+    """The first strategy's row of ``folder``/``name``.json (studies/lbm3d_table.py)."""
+    return json.loads((folder / f"{name}.json").read_text(encoding="utf-8"))["rows"][0]
+
+
+def _paired(p: dict) -> str:
+    """A pairs.csv row's median paired RMSE change with its Wilcoxon p."""
+    change, p_value = float(p["median_rmse_b_minus_a"]), float(p["rmse_wilcoxon_p"])
+    return f"{change:+.2f} m (p = {p_value:.2g})"
+
+
 def lbm3d_surface_tune_table() -> str:
     """The surface-layer reading model beside today's on the tuning ranges (recipe
     lbm3d-surface-tune; studies/lbm3d_table.py and studies/pair_campaigns.py)."""
     folder = RESULTS / "lbm3d-surface-tune"
-    with (folder / "pairs.csv").open(encoding="utf-8") as f:
-        pairs = {r["truth"]: r for r in csv.DictReader(f)}
+    pairs = _pairs(folder, "truth")
     rows = []
     for name, truth, range_, model in SURFACE_PROBE:
-        r = json.loads((folder / f"{name}.json").read_text(encoding="utf-8"))["rows"][0]
+        r = _campaign_row(folder, name)
         n = r["searches"]
         lo, hi = r["median_final_rmse_ci95"]
         paired = ""
         if model != "today's":
-            p = pairs["3-D" if truth == "3-D plume" else "slice"]
-            change, p_value = float(p["median_rmse_b_minus_a"]), float(p["rmse_wilcoxon_p"])
-            paired = f"{change:+.2f} m (p = {p_value:.2g})"
+            paired = _paired(pairs["3-D" if truth == "3-D plume" else "slice"])
         rows.append(
             [
                 truth,
@@ -252,18 +267,13 @@ def lbm3d_slice_probes_table() -> str:
     """The slice's tuning range under each probe of the reading model (recipe
     lbm3d-slice-probes; studies/lbm3d_table.py and studies/pair_campaigns.py)."""
     folder = RESULTS / "lbm3d-slice-probes"
-    with (folder / "pairs.csv").open(encoding="utf-8") as f:
-        pairs = {r["arm"]: r for r in csv.DictReader(f)}
+    pairs = _pairs(folder, "arm")
     rows = []
     for name, change in SLICE_PROBES:
-        r = json.loads((folder / f"{name}.json").read_text(encoding="utf-8"))["rows"][0]
+        r = _campaign_row(folder, name)
         n = r["searches"]
         lo, hi = r["median_final_rmse_ci95"]
-        paired = ""
-        if name in pairs:
-            p = pairs[name]
-            change_m, p_value = float(p["median_rmse_b_minus_a"]), float(p["rmse_wilcoxon_p"])
-            paired = f"{change_m:+.2f} m (p = {p_value:.2g})"
+        paired = _paired(pairs[name]) if name in pairs else ""
         rows.append(
             [
                 change,

@@ -20,7 +20,7 @@ from dcee.scenarios import (
     unset_region_floor,
 )
 from dcee.scenarios.schema.reading_models import unset_plume
-from dcee.scenarios.schema.world import WorldSpec
+from dcee.scenarios.schema.world import WorldSpec, has_walls
 
 
 def _unicycle_defaults() -> dict[str, Any]:
@@ -190,9 +190,8 @@ def scenario_identity(scenario: dict[str, Any]) -> dict[str, Any]:
     estimator = out.get("estimator")
     if isinstance(estimator, dict) and "plume" in estimator and estimator["plume"] is None:
         # unset: the plume it resolved to (Scenario.plume_model), compared as that model
-        world_dump = out.get("world") or {}
         estimator["plume"] = unset_plume(
-            bool(world_dump.get("obstacles")) or world_dump.get("map") is not None,
+            has_walls(out.get("world")),
             str(out.get("unknown", "source")),
             int(estimator.get("max_sources", 1)),
             estimator.get("learn"),

@@ -305,7 +305,7 @@ def lbm_truth(scenario: Scenario, seed: int) -> SolverPlumeTruth:
     spec = scenario.truth.model
     theta = scenario.truth_theta()
     solids = None
-    if scenario.world.obstacles or scenario.world.map is not None:
+    if scenario.world.walls:
         # the gas flows around the site's buildings and walls (not its no-go zones)
         spec, solids = site_frame(
             spec,

@@ -232,7 +232,7 @@ def lbm3d_truth(scenario: Scenario, seed: int) -> SolverPlume3dTruth:
     spec = scenario.truth.model
     if not isinstance(spec, Lbm3dSpec):
         raise DceeInputError("truth.model", "expected the lbm3d parameters")
-    if scenario.world.obstacles or scenario.world.map is not None:
+    if scenario.world.walls:
         raise DceeInputError(
             "truth.model", "the lbm3d plume is open terrain; a site's walls need truth.model = lbm"
         )

@@ -78,7 +78,7 @@ class ReadingModelSettings:
                 f'"{self.wall_wind}" wind has none (set wall_wind = "wake" or leave it unset)'
             )
         what = f'{FIELD_MARK}estimator.plume: "walls" '
-        if not self.world.obstacles and self.world.map is None:
+        if not self.world.walls:
             raise ValueError(
                 f"{what}needs buildings or walls to flow round: [world] obstacles or a map "
                 '(no-go zones are nothing to the gas); use plume = "open"'
@@ -170,8 +170,7 @@ class ReadingModelSettings:
         e = self.estimator
         if e.plume is not None:
             return e.plume
-        walls = bool(self.world.obstacles) or self.world.map is not None
-        return unset_plume(walls, self.unknown, e.max_sources, e.learn)
+        return unset_plume(self.world.walls, self.unknown, e.max_sources, e.learn)
 
     @property
     def wall_wind(self) -> str:

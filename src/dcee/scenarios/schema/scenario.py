@@ -30,7 +30,7 @@ from dcee.scenarios.schema.messages import one_line_error
 from dcee.scenarios.schema.reading_models import ReadingModelSettings
 from dcee.scenarios.schema.resolved import ResolvedSettings
 from dcee.scenarios.schema.truth import Truth, Volume
-from dcee.scenarios.schema.world import WorldSpec
+from dcee.scenarios.schema.world import WorldSpec, has_walls
 
 GAS_MAP_MAX_CELL = 1.0
 """m: the coarsest map cell the gas round buildings is computed on (the lbm truth, the
@@ -40,16 +40,6 @@ SITE_TRUTH = "lbm"
 """The truth of a site with walls when ``truth.model`` is unset (issue 84): the fluid solver's
 plume, whose gas flows round the walls (planar, its source in the flight plane); elsewhere the
 unset truth is the paper's isotropic plume."""
-
-
-def site_has_walls(world: Any) -> bool:
-    """Whether a ``[world]`` (a mapping or a :class:`WorldSpec`) holds walls the gas flows round:
-    obstacles or an occupancy-grid map (a no-go zone is nothing to the gas)."""
-    if isinstance(world, WorldSpec):
-        return bool(world.obstacles) or world.map is not None
-    if not isinstance(world, dict):
-        return False
-    return bool(world.get("obstacles")) or world.get("map") is not None
 
 
 GAS_SOURCE_CLEARANCE = 2.0
@@ -108,7 +98,7 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, ResolvedSettings, BaseMod
     def _gas_round_walls(cls, data: Any) -> Any:
         # at a site with walls the gas goes round them: an unset truth model is the fluid
         # solver's plume, and an unset likelihood follows that turbulent truth (issue 84)
-        if not isinstance(data, dict) or not site_has_walls(data.get("world")):
+        if not isinstance(data, dict) or not has_walls(data.get("world")):
             return data
         truth = data.get("truth")
         if not isinstance(truth, dict):

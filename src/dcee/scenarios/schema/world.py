@@ -134,9 +134,24 @@ class WorldSpec(BaseModel):
     def empty(self) -> bool:
         return not self.obstacles and not self.no_go and self.map is None
 
+    @property
+    def walls(self) -> bool:
+        """Walls the gas flows round: obstacles or an occupancy-grid map (a no-go zone is
+        nothing to the gas)."""
+        return has_walls(self)
+
+
+def has_walls(world: WorldSpec | dict[str, Any] | None) -> bool:
+    """:attr:`WorldSpec.walls` of a ``[world]``, validated or as its raw (or stored) mapping."""
+    if isinstance(world, WorldSpec):
+        return bool(world.obstacles) or world.map is not None
+    if not isinstance(world, dict):
+        return False
+    return bool(world.get("obstacles")) or world.get("map") is not None
+
 
 def shapes_of(specs: tuple[ShapeSpec, ...]) -> list[Shape]:
     return [s.shape() for s in specs]
 
 
-__all__ = ["FrameSpec", "ShapeSpec", "WorldSpec", "shapes_of"]
+__all__ = ["FrameSpec", "ShapeSpec", "WorldSpec", "has_walls", "shapes_of"]
