@@ -6,6 +6,9 @@ robot's sensor height (x 1, 3, 5, 7, 9 m × y 1, 5 m), seed 0. One JSON per sear
 
     python studies/gaden_rooms.py tests/data/gaden/empty-room tests/data/gaden/empty-room-cfd \\
         --out results/gaden-rooms --table docs/results/gaden/searches.json
+
+``--set KEY=VALUE`` (repeatable) flies a variant of the room's scenario, e.g. what a robot alone
+could know, ``--set unknown=full --set estimator.plume=open``.
 """
 
 from __future__ import annotations
@@ -32,7 +35,9 @@ KEYS = (
 )
 
 
-def one(room: str, start: tuple[float, float], strategy: str, out: str) -> dict:
+def one(
+    room: str, start: tuple[float, float], strategy: str, out: str, overrides: dict | None = None
+) -> dict:
     import numba
 
     from dcee.runs import run_episode
@@ -43,9 +48,11 @@ def one(room: str, start: tuple[float, float], strategy: str, out: str) -> dict:
     path = Path(out) / Path(room).name / strategy / f"{start[0]:g}-{start[1]:g}.json"
     if path.exists():
         return json.loads(path.read_text())
-    scenario = load_scenario(room).with_overrides(**{"agent.start": [*start, SENSOR_HEIGHT]})
+    settings = {"agent.start": [*start, SENSOR_HEIGHT], **(overrides or {})}
+    scenario = load_scenario(room).with_overrides(**settings)
     result = run_episode(scenario, strategy, 0)
     row = {"room": Path(room).name, "start": list(start), "strategy": strategy}
+    row |= {"settings": overrides} if overrides else {}
     row |= {k: result.summary[k] for k in KEYS}
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".tmp")
@@ -60,10 +67,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", required=True)
     ap.add_argument("--table", required=True)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE")
     args = ap.parse_args(argv)
     from dcee.provenance import code_version
+    from dcee.scenarios import parse_setting
 
-    jobs = [(r, s, st, args.out) for r in args.rooms for st in STRATEGIES for s in STARTS]
+    overrides = dict(parse_setting(s) for s in args.settings)
+    jobs = [
+        (r, s, st, args.out, overrides) for r in args.rooms for st in STRATEGIES for s in STARTS
+    ]
     with ProcessPoolExecutor(args.workers) as pool:
         rows = list(pool.map(one, *zip(*jobs, strict=True)))
     table = Path(args.table)

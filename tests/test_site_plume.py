@@ -116,7 +116,7 @@ def test_refuses_a_model_without_diffusion() -> None:
 
 
 def test_the_field_cache_evicts_the_least_recent_and_keeps_the_numbers(monkeypatch) -> None:
-    import dcee.models.site_plume as module
+    import dcee.models.receptor_fields as module
 
     theta = np.vstack([_theta(30.0 + k, 12.0 + 2 * k, 1.0 + k) for k in range(5)])
     positions = np.array([[10.0 + 4 * k, 10.0 + k, 4.0] for k in range(7)])

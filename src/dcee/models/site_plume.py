@@ -34,14 +34,18 @@ closed-form planar plume in open terrain and against a wall that shelters what l
 from __future__ import annotations
 
 import math
-from collections import OrderedDict
 from collections.abc import Callable
 
 import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.models.plume import MIN_DISTANCE
-from dcee.models.plume_kernels import gather_receptor_fields
+from dcee.models.receptor_fields import (
+    ReceptorFieldPlume,
+    bernoulli,
+    interpolation_weights,
+    transport_operator,
+)
 from dcee.models.site_flow import site_wind
 
 LAYER_DEPTH = 2.0
@@ -52,20 +56,8 @@ MARGIN = 10.0
 """m of clean-air grid round the search area: the edge's zero concentration and zero
 potential are that far from any reading."""
 
-FIELD_CACHE = 1024
-"""Receptor fields kept (float32; 20,000 cells: 80 kB each)."""
 
-
-def bernoulli(x: np.ndarray) -> np.ndarray:
-    """B(x) = x / (eˣ − 1), B(0) = 1, for the fitted fluxes (accurate for small |x|)."""
-    x = np.asarray(x, dtype=np.float64)
-    out = np.ones_like(x)
-    big = np.abs(x) > 1e-10
-    out[big] = x[big] / np.expm1(x[big])
-    return out
-
-
-class SitePlume:
+class SitePlume(ReceptorFieldPlume):
     """The wall-aware planar plume over one site and one wind (module doc).
 
     Parameters
@@ -105,7 +97,6 @@ class SitePlume:
         self.wind = (float(u), float(phi))
         self.zeta1, self.zeta2 = float(zeta1), float(zeta2)
         self.layer_depth = float(layer_depth)
-        self.min_distance = float(min_distance)
         self.index = np.full(self.fluid.shape, -1, dtype=np.int64)
         self.index[self.fluid] = np.arange(int(self.fluid.sum()))
         if isinstance(wind, tuple):
@@ -115,15 +106,7 @@ class SitePlume:
         matrix = transport_matrix(
             self.fluid, self.index, self.resolution, self.face_u, self.face_v, zeta1, zeta2
         )
-        from scipy.sparse.linalg import splu
-
-        # the stencil's pattern is symmetric: minimum degree on Aᵀ + A fills in about half what
-        # the default column ordering does (site:wall: a solve 0.65 ms against 2.2 ms, measured)
-        self._adjoint = splu(matrix.T.tocsc(), permc_spec="MMD_AT_PLUS_A")
-        self._rhs = np.zeros(int(self.fluid.sum()))
-        # receptor fields, one row each (float32), and the row of each point (LRU order)
-        self._bank = np.empty((16, len(self._rhs)), np.float32)
-        self._slots: OrderedDict[tuple[float, float], int] = OrderedDict()
+        self._factorise(matrix, int(self.fluid.sum()), min_distance)
 
     # --- interpolation ------------------------------------------------------------------------
 
@@ -132,100 +115,16 @@ class SitePlume:
         (K, 4) weights), the weights renormalised over the air cells (0 where a point has
         none: inside a wall or off the grid)."""
         xy = np.asarray(xy, dtype=np.float64).reshape(-1, 2)
-        ny, nx = self.fluid.shape
-        fx = (xy[:, 0] - self.origin[0]) / self.resolution - 0.5
-        fy = (xy[:, 1] - self.origin[1]) / self.resolution - 0.5
-        j0, i0 = np.floor(fx).astype(np.int64), np.floor(fy).astype(np.int64)
-        tx, ty = fx - j0, fy - i0
-        cells = np.empty((len(xy), 4), dtype=np.int64)
-        w = np.empty((len(xy), 4))
-        for c, (di, dj, wc) in enumerate(
-            (
-                (0, 0, (1 - tx) * (1 - ty)),
-                (0, 1, tx * (1 - ty)),
-                (1, 0, (1 - tx) * ty),
-                (1, 1, tx * ty),
-            )
-        ):
-            i, j = i0 + di, j0 + dj
-            inside = (i >= 0) & (i < ny) & (j >= 0) & (j < nx)
-            k = np.where(inside, self.index[np.clip(i, 0, ny - 1), np.clip(j, 0, nx - 1)], -1)
-            cells[:, c] = np.maximum(k, 0)
-            w[:, c] = np.where(k >= 0, wc, 0.0)
-        total = w.sum(axis=1, keepdims=True)
-        w = np.divide(w, total, out=np.zeros_like(w), where=total > 1e-12)
-        return cells, w
+        return interpolation_weights(xy, np.asarray(self.origin), self.resolution, self.index.T)
 
-    def _slot(self, xy: np.ndarray) -> int:
-        """The row of :attr:`_bank` holding the receptor field of the point ``xy`` (2,) m,
-        solving it (one adjoint back-substitution) if it is not kept; least recently used rows
-        are reused beyond :data:`FIELD_CACHE`."""
-        key = (round(float(xy[0]), 6), round(float(xy[1]), 6))
-        row = self._slots.get(key)
-        if row is not None:
-            self._slots.move_to_end(key)
-            return row
-        n_cells = len(self._rhs)
-        if len(self._slots) < min(len(self._bank), FIELD_CACHE):
-            row = len(self._slots)
-        elif len(self._bank) < FIELD_CACHE:
-            grown = np.empty((min(2 * len(self._bank), FIELD_CACHE), n_cells), np.float32)
-            grown[: len(self._bank)] = self._bank
-            row, self._bank = len(self._bank), grown
-        else:
-            _, row = self._slots.popitem(last=False)
-        cells, w = self.weights(np.asarray(xy)[None, :2])
-        self._rhs[:] = 0.0
-        np.add.at(self._rhs, cells[0], w[0])
-        self._bank[row] = self._adjoint.solve(self._rhs) if self._rhs.any() else 0.0
-        self._slots[key] = row
-        return row
-
-    def receptor_field(self, xy: np.ndarray) -> np.ndarray:
-        """(cells,) float32: the concentration at the point ``xy`` (2,) m per unit of q/h
-        released at each air cell (one adjoint solve, cached; a view, valid until the next
-        field is solved)."""
-        return self._bank[self._slot(xy)]
-
-    # --- the plume ------------------------------------------------------------------------------
-
-    def concentration_distance(
-        self, theta: np.ndarray, positions: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """(N, K) concentrations (g/m³) and source distances (m, clamped at ``min_distance``)
-        of particles ``theta`` (N, 8) at (K, 3) positions. Only each particle's x, y and q are
-        read (the wind and ζ are the model's). The K fields are read at the particles' four
-        cells by a compiled kernel (at most half the field cache at a time)."""
-        theta = np.asarray(theta, dtype=np.float64).reshape(-1, theta.shape[-1])
-        positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
-        cells, w = self.weights(theta[:, :2])
-        conc = np.empty((len(theta), len(positions)))
-        step = FIELD_CACHE // 2
-        for start in range(0, len(positions), step):
-            chunk = positions[start : start + step]
-            rows = np.array([self._slot(p[:2]) for p in chunk], dtype=np.int64)
-            gather_receptor_fields(self._bank, rows, cells, w, conc[:, start : start + len(chunk)])
-        conc *= (theta[:, 3] / self.layer_depth)[:, None]
-        # the squared distance summed axis by axis, as einsum("nki,nki->nk") does (same bits)
-        d2 = np.square(positions[None, :, 0] - theta[:, None, 0])
-        d2 += np.square(positions[None, :, 1] - theta[:, None, 1])
-        d2 += np.square(positions[None, :, 2] - theta[:, None, 2])
-        dist = np.maximum(np.sqrt(d2, out=d2), self.min_distance)
-        return conc, dist
-
-    def concentration(self, theta: np.ndarray, positions: np.ndarray) -> np.ndarray:
-        """(N, K) concentrations, g/m³ (see :meth:`concentration_distance`)."""
-        return self.concentration_distance(theta, positions)[0]
+    def _rate(self, theta: np.ndarray) -> np.ndarray:
+        return theta[:, 3] / self.layer_depth
 
     def field(self, source: np.ndarray, q: float) -> np.ndarray:
         """(ny, nx) the forward solution of a release of ``q`` g/s at ``source`` (2,) m (NaN in
         walls): for figures and tests (the estimator uses receptor fields)."""
-        cells, w = self.weights(np.asarray(source, dtype=np.float64)[None, :2])
-        b = np.zeros(len(self._rhs))
-        np.add.at(b, cells[0], w[0] * q / self.layer_depth)
-        c = self._adjoint.solve(b, trans="T")
         out = np.full(self.fluid.shape, np.nan)
-        out[self.fluid] = c
+        out[self.fluid] = self._forward(source, q / self.layer_depth)
         return out
 
 
@@ -247,43 +146,11 @@ def transport_matrix(
     diffusivity: float,
     lifetime: float,
 ) -> object:
-    """The steady advection-diffusion-decay operator A (cells × cells, CSC) over the air cells:
-    (A C)_i = Σ_faces K [B(−Pe) C_i − B(Pe) C_j] + h² C_i / τ (g/s per metre of height out of
-    cell i), C_j = 0 beyond the grid, no flux through a wall's face (module doc)."""
-    from scipy.sparse import coo_matrix
-
-    ny, nx = fluid.shape
-    n = int(fluid.sum())
-    ii, jj = np.nonzero(fluid)
-    me = index[ii, jj]
-    k = float(diffusivity)
-    decay = 0.0 if math.isinf(lifetime) else h * h / float(lifetime)
-    rows = [me]
-    cols = [me]
-    vals = [np.full(n, decay)]
-    # outward velocity of each face of each air cell
-    faces = (
-        (0, 1, face_u[ii, jj + 1]),
-        (0, -1, -face_u[ii, jj]),
-        (1, 0, face_v[ii + 1, jj]),
-        (-1, 0, -face_v[ii, jj]),
-    )
-    for di, dj, v in faces:
-        i, j = ii + di, jj + dj
-        inside = (i >= 0) & (i < ny) & (j >= 0) & (j < nx)
-        nb = np.where(inside, index[np.clip(i, 0, ny - 1), np.clip(j, 0, nx - 1)], -1)
-        open_face = ~inside | (nb >= 0)
-        pe = v * h / k
-        rows.append(me[open_face])
-        cols.append(me[open_face])
-        vals.append(k * bernoulli(-pe[open_face]))
-        inner = inside & (nb >= 0)
-        rows.append(me[inner])
-        cols.append(nb[inner])
-        vals.append(-k * bernoulli(pe[inner]))
-    return coo_matrix(
-        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), (n, n)
-    ).tocsc()
+    """The steady advection-diffusion-decay operator A (cells × cells, CSC) over the air cells
+    of the plane: (A C)_i = Σ_faces K [B(−Pe) C_i − B(Pe) C_j] + h² C_i / τ (g/s per metre of
+    height out of cell i), C_j = 0 beyond the grid, no flux through a wall's face (module doc;
+    :func:`~dcee.models.receptor_fields.transport_operator` in two dimensions)."""
+    return transport_operator(fluid, index, h, (face_v, face_u), diffusivity, lifetime)
 
 
 def site_grid(

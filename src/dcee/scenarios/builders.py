@@ -19,6 +19,7 @@ from dcee.models.agent import GridAgent, SearchVolume
 from dcee.models.anemometer import Anemometer
 from dcee.models.motion import MotionModel, make_motion
 from dcee.models.plume import PARAMETER_NAMES, IsotropicPlume
+from dcee.models.room_plume import RoomPlume, room_flow
 from dcee.models.ros_map import load_ros_map
 from dcee.models.sensor import Sensor
 from dcee.models.site import SiteMap, compose_site
@@ -91,6 +92,21 @@ def _wall_plume(
     fluid, origin = _site_fluid(*site)
     u, phi = environment[:2]
     return SitePlume(fluid, origin, site[-1], *environment, wind=_site_wind(site, u, phi, *wind))
+
+
+@functools.lru_cache(maxsize=8)
+def _room_plume(folder: str, start: float, diffusivity: float, lifetime: float) -> RoomPlume:
+    """The plume in the GADEN room ``folder``'s own wind (the wind state of the result file
+    saved at ``start`` s; :mod:`dcee.models.room_plume`) at one K (m²/s) and τ (s), built once
+    per process and shared by the filter's members of that K and the planners."""
+    from dcee.recordings.gaden import FREE, GadenSimulation
+    from dcee.recordings.gaden_files import OUTLET
+
+    sim = GadenSimulation.open(folder)
+    wind = sim.wind(sim.result(sim.iteration_at(start)).wind_index)
+    occupancy = sim.occupancy
+    flow = room_flow(occupancy == FREE, occupancy == OUTLET, wind, sim.grid.low, sim.grid.cell)
+    return RoomPlume(flow, diffusivity, lifetime)
 
 
 def inside_world(world: WorldSpec, xy: np.ndarray, no_go: bool = True) -> np.ndarray:
@@ -192,11 +208,12 @@ class ScenarioBuilders:
             max_reading=s.max_reading,
         )
 
-    def make_plume(self, model: str | None = None) -> IsotropicPlume | SitePlume:
+    def make_plume(self, model: str | None = None) -> IsotropicPlume | SitePlume | RoomPlume:
         """The dispersion model of the filter and the planners under reading model ``model``
         (None: the first of :attr:`reading_models`): with ``estimator.plume = "walls"`` the
         site's wall-aware plume at the member's diffusivity (members of one diffusivity share
-        it: it has no open-plume shape setting to learn)."""
+        it: it has no open-plume shape setting to learn); in a GADEN room with ``wall_wind =
+        "room"`` the plume in the room's own wind field (:mod:`dcee.models.room_plume`)."""
         model = self._reading_model(model)
         if self.plume_model == "walls":
             u, phi = (float(v) for v in self.truth_theta()[4:6])
@@ -204,6 +221,9 @@ class ScenarioBuilders:
             zeta2 = math.inf if lifetime is None else float(lifetime)
             learned = dict(self.reading_model_variants).get(model, {})
             k = float(learned.get("wall_diffusivity", self.wall_diffusivity))
+            if self.wall_wind == "room":
+                spec = self.truth.model
+                return _room_plume(str(spec.folder), float(spec.start), k, zeta2)
             mtime = Path(self.world.map).stat().st_mtime if self.world.map is not None else 0.0
             site = (
                 tuple(self.volume.low[:2]),

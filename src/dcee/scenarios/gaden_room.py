@@ -17,18 +17,28 @@ two sample rooms beyond what is said there.
   0.5 m/s (the lab's 0.3 m in a 4.5 m room scaled to a 10 m one), a 4 s hold per reading (the
   default on a time-varying truth); it starts at the free cell at sensor height farthest from
   the release (``--set agent.start=[x, y, 0.5]`` for another).
-* **What the estimator knows** is what the robot could: the room's size and the wind it
-  measures at its start. Where that wind is at least :data:`CALM` (0.1 m/s), the prior of φ is
-  centred on its direction (sd 30°) and of u on its speed (sd 0.3 m/s); a slower wind tells no
-  direction, and the prior of φ is uniform, of u N(0.3, 0.3) m/s (a ventilated room's draught,
-  truncated at 0). Chosen on the samples: centred on the start's wind whatever its speed, the
-  first three searches in the solver-wind room ended 6.8-7.4 m off (every start off the doors'
-  axis lies in the slow recirculation, 0.01-0.05 m/s, that flows back against the jet); uniform
-  everywhere, the uniform-draught room's searches ended a median 1.2 m off (1 of 10 at 7.4 m)
-  against 0.47 m. Release rate and dispersion are unknown with broad priors (q gamma with mean
-  10 mg/s; ζ1 N(0.05, 0.05) m²/s; ζ2 N(5, 2) s). The reading model is the fluctuation
-  likelihood at the lab's room-scale fit (intermittency 0.96, log-sd 0.72, no near-source
-  fall: fitted on the filament truth in lab:upwind, not on GADEN).
+* **What the estimator knows**: the room's map and its whole wind field, as a building's CFD
+  model would give it (GADEN's wind file): the estimator's plume is the room's own
+  (``estimator.plume = "walls"`` with ``wall_wind = "room"``, :mod:`dcee.models.room_plume`),
+  the gas carried by that wind round walls and out through the doors, its diffusivity weighed
+  at :data:`~dcee.models.room_plume.ROOM_DIFFUSIVITY` and 3 and 10 times it. The source, its
+  height included, and its rate are unknown (``unknown = "source"``; q gamma with mean 10 mg/s).
+  Chosen on the samples: with only the wind the robot measures (``--set unknown=full --set
+  estimator.plume=open``, the priors below) the solver-wind room's searches ended a median
+  1.16 m off (docs/plumes.md reports both).
+* **What a robot alone could know** (``unknown = "full"``, ``estimator.plume = "open"``): the
+  room's size and the wind it measures at its start. Where that wind is at least :data:`CALM`
+  (0.1 m/s), the prior of φ is centred on its direction (sd 30°) and of u on its speed (sd 0.3
+  m/s); a slower wind tells no direction, and the prior of φ is uniform, of u N(0.3, 0.3) m/s (a
+  ventilated room's draught, truncated at 0). Chosen on the samples: centred on the start's wind
+  whatever its speed, the first three searches in the solver-wind room ended 6.8-7.4 m off
+  (every start off the doors' axis lies in the slow recirculation, 0.01-0.05 m/s, that flows
+  back against the jet); uniform everywhere, the uniform-draught room's searches ended a median
+  1.2 m off (1 of 10 at 7.4 m) against 0.47 m. Release rate and dispersion are unknown with
+  broad priors (q as above; ζ1 N(0.05, 0.05) m²/s; ζ2 N(5, 2) s).
+* **The reading model** is the fluctuation likelihood at the lab's room-scale fit
+  (intermittency 0.96, log-sd 0.72, no near-source fall: fitted on the filament truth in
+  lab:upwind, not on GADEN).
 * **Search**: 20,000 particles, 40 hypothesised readings, 450 s (the paper's indoor
   experiment's budget, as ``lab:*``) from 60 s into the simulation (the plume has crossed the
   room by then), the files replayed from 60 s again after their end (GADEN's player loops so),
@@ -47,6 +57,7 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.limits import read_text
+from dcee.models.room_plume import ROOM_DIFFUSIVITY
 from dcee.recordings.gaden import FREE, GAS_MOLAR_MASS, GadenSimulation
 from dcee.recordings.gaden_files import OBSTACLE
 
@@ -117,7 +128,7 @@ def gaden_room_configuration(folder: str | Path) -> dict[str, Any]:
             f"at {SENSOR_HEIGHT:g} m."
         ),
         "dimensions": 3,
-        "unknown": "full",
+        "unknown": "source",
         "volume": {"low": low.tolist(), "high": high.tolist()},
         "truth": {
             "x": float(source[0]),
@@ -142,6 +153,7 @@ def gaden_room_configuration(folder: str | Path) -> dict[str, Any]:
             "zeta2": {"kind": "normal", "mean": 5.0, "sd": 2.0},
         },
         "estimator": {
+            "wall_diffusivity": ROOM_DIFFUSIVITY,
             "likelihood": "fluctuation",
             "intermittency": 0.96,
             "log_sd": 0.72,

@@ -413,12 +413,14 @@ class EstimatorSpec(BaseModel):
     ``random-site:1-20`` (lbm truth, ``dcee-cl``, rule written before the run,
     docs/results/sites-walls-tune): without decay 11/20 acquired against 9/20 with ζ2 = 8 s
     (+3 / −1, McNemar p = 0.63; median final error 1.03 m against 4.32 m)"""
-    wall_wind: Literal["wake", "potential"] | None = None
+    wall_wind: Literal["wake", "potential", "room"] | None = None
     """the wall-aware plume's wind round the buildings (``plume = "walls"``,
     :mod:`dcee.models.site_flow`): ``wake``, the time-mean flow of a constant-eddy-viscosity
     Navier–Stokes model (a recirculating wake in a building's lee); ``potential``, the free wind
-    made mass-consistent (turned along walls, no wake). None: the default,
-    :data:`dcee.models.site_flow.WALL_WIND_DEFAULT`"""
+    made mass-consistent (turned along walls, no wake); ``room``, a GADEN room's own 3-D wind
+    field and occupancy grid (its wind file, as a building's CFD model gives it; the plume in
+    the room's volume, :mod:`dcee.models.room_plume`; needs a GADEN truth). None: ``room`` with
+    a GADEN truth, else :data:`dcee.models.site_flow.WALL_WIND_DEFAULT`"""
     wall_viscosity: Annotated[float | None, Field(gt=0, le=100, allow_inf_nan=False)] = None
     """m²/s: the eddy viscosity ν_t of the wake wind (``wall_wind = "wake"``); None:
     :data:`dcee.models.site_flow.WAKE_VISCOSITY` (1 m²/s, kept against 0.25 and 0.5 on the

@@ -78,7 +78,13 @@ class ReadingModelSettings:
                 f'"{self.wall_wind}" wind has none (set wall_wind = "wake" or leave it unset)'
             )
         what = f'{FIELD_MARK}estimator.plume: "walls" '
-        if not self.world.walls:
+        room = self.truth.model_name.startswith("gaden:")
+        if self.wall_wind == "room" and not room:
+            raise ValueError(
+                f'{FIELD_MARK}estimator.wall_wind: "room" is a GADEN room\'s own wind field; '
+                'needs truth.model = {kind = "gaden", folder = ...}'
+            )
+        if not self.world.walls and self.wall_wind != "room":
             raise ValueError(
                 f"{what}needs buildings or walls to flow round: [world] obstacles or a map "
                 '(no-go zones are nothing to the gas); use plume = "open"'
@@ -170,12 +176,17 @@ class ReadingModelSettings:
         e = self.estimator
         if e.plume is not None:
             return e.plume
-        return unset_plume(self.world.walls, self.unknown, e.max_sources, e.learn)
+        # a GADEN room's walls are its occupancy grid's, whatever [world] says
+        walls = self.world.walls or self.truth.model_name.startswith("gaden:")
+        return unset_plume(walls, self.unknown, e.max_sources, e.learn)
 
     @property
     def wall_wind(self) -> str:
-        """The wall-aware plume's wind model: ``estimator.wall_wind`` or its default."""
-        return self.estimator.wall_wind or WALL_WIND_DEFAULT
+        """The wall-aware plume's wind model: ``estimator.wall_wind``, or the room's own wind
+        field in a GADEN room, else :data:`~dcee.models.site_flow.WALL_WIND_DEFAULT`."""
+        if self.estimator.wall_wind is not None:
+            return self.estimator.wall_wind
+        return "room" if self.truth.model_name.startswith("gaden:") else WALL_WIND_DEFAULT
 
     @property
     def wall_viscosity(self) -> float:

@@ -315,7 +315,9 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, ResolvedSettings, BaseMod
                 f"{FIELD_MARK}world: the source area around ({src[0]:g}, {src[1]:g}) cannot be "
                 f"reached from agent.start {tuple(self.agent.start)}: obstacles enclose it"
             )
-        if self.truth.model_name == "lbm" or self.plume_model == "walls":
+        if self.truth.model_name == "lbm" or (
+            self.plume_model == "walls" and self.wall_wind != "room"
+        ):
             self._checked_gas_walls(src)
         return site
 
