@@ -57,7 +57,6 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.limits import read_text
-from dcee.models.room_plume import ROOM_DIFFUSIVITY
 from dcee.recordings.gaden import FREE, GAS_MOLAR_MASS, GadenSimulation
 from dcee.recordings.gaden_files import OBSTACLE
 
@@ -153,7 +152,6 @@ def gaden_room_configuration(folder: str | Path) -> dict[str, Any]:
             "zeta2": {"kind": "normal", "mean": 5.0, "sd": 2.0},
         },
         "estimator": {
-            "wall_diffusivity": ROOM_DIFFUSIVITY,
             "likelihood": "fluctuation",
             "intermittency": 0.96,
             "log_sd": 0.72,

@@ -11,6 +11,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from dcee.models.room_plume import ROOM_DIFFUSIVITY
 from dcee.models.site_flow import WAKE_VISCOSITY, WALL_WIND_DEFAULT
 from dcee.scenarios.schema.common import FIELD_MARK
 from dcee.scenarios.schema.estimator import LEARN_RANGES, PLUME_SHAPE_SETTINGS
@@ -197,10 +198,15 @@ class ReadingModelSettings:
 
     @property
     def wall_diffusivity(self) -> float:
-        """The wall-aware plume's fixed diffusivity K, m²/s: ``estimator.wall_diffusivity`` or
-        the scenario's ζ1."""
+        """The wall-aware plume's fixed diffusivity K, m²/s: ``estimator.wall_diffusivity``, or
+        in a room's own wind :data:`~dcee.models.room_plume.ROOM_DIFFUSIVITY`, else the
+        scenario's ζ1."""
         e = self.estimator
-        return float(e.wall_diffusivity if e.wall_diffusivity is not None else self.truth.zeta1)
+        if e.wall_diffusivity is not None:
+            return float(e.wall_diffusivity)
+        if self.plume_model == "walls" and self.wall_wind == "room":
+            return ROOM_DIFFUSIVITY
+        return float(self.truth.zeta1)
 
     @property
     def reading_model_variants(self) -> tuple[tuple[str, dict[str, float]], ...]:
