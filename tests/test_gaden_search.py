@@ -39,6 +39,27 @@ def test_the_room_s_scenario_comes_from_its_folder():
     assert s.truth.q == pytest.approx(10 * 6.440745e-6 * 46.07, rel=1e-6)
 
 
+def test_the_room_s_estimator_knows_its_wind_field_unless_told_it_knows_only_its_own(tmp_path):
+    """By default the estimator's plume is the room's own (its wind file, walls and doors: the
+    source and its rate unknown, K weighed at 0.002, 0.006, 0.02 m²/s); ``unknown = "full"``
+    is what a robot alone could know (the open plume, the wind estimated); the room's wind is
+    refused where there is no GADEN room, in one line."""
+    from dcee.models.plume import IsotropicPlume
+    from dcee.models.room_plume import RoomPlume
+
+    s = load_scenario(str(DATA / "empty-room-cfd"))
+    assert (s.unknown, s.plume_model, s.wall_wind) == ("source", "walls", "room")
+    assert s.unknown_names == ("x", "y", "z", "q")
+    assert isinstance(s.make_plume(), RoomPlume)
+    members = [dict(v).get("wall_diffusivity", s.wall_diffusivity) for _, v in
+               s.reading_model_variants[:3]]  # fmt: skip
+    assert members == pytest.approx([0.002, 0.006, 0.02])
+    robot = s.with_overrides(unknown="full")
+    assert robot.plume_model == "open" and isinstance(robot.make_plume(), IsotropicPlume)
+    with pytest.raises(DceeInputError, match="wall_wind"):
+        load_scenario("site:wall").with_overrides(**{"estimator.wall_wind": "room"})
+
+
 def test_the_truth_reads_gaden_s_ppm_in_grams_per_cubic_metre():
     """At search time t the truth reads the file saved at 60 s + t: GADEN's reference ppm ×
     10⁻⁶ × the air's 40.894633 mol/m³ × ethanol's 46.07 g/mol; past the files' end the

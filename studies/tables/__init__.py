@@ -6,7 +6,12 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from dcee.scenarios import REGION_FLOOR_DEFAULT
-from studies.tables.gaden import gaden_rooms_table, gaden_starts_table, gaden_timing_table
+from studies.tables.gaden import (
+    gaden_fit_table,
+    gaden_rooms_table,
+    gaden_starts_table,
+    gaden_timing_table,
+)
 from studies.tables.geo import geo_site_table
 from studies.tables.headline import headline_table
 from studies.tables.held_out import held_out_table, others_table, paired_table
@@ -67,6 +72,7 @@ from studies.tables.tuning import (
 from studies.tables.turbulent import cross_truth_table, turbulent_table
 
 TABLES: dict[str, Callable[[], str]] = {
+    "gaden-fit": gaden_fit_table,
     "gaden-rooms": gaden_rooms_table,
     "geo-site": geo_site_table,
     "lbm3d-sparse-tune": sparse_table,

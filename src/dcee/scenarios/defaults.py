@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-TRUTH_FAMILIES = ("isotropic", "filament", "puffs", "lbm", "lbm3d")
+TRUTH_FAMILIES = ("isotropic", "filament", "puffs", "lbm", "lbm3d", "gaden")
 """Every truth family the studies report on."""
 
 
@@ -103,14 +103,20 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
         ("lbm",), "random-site:1-20 (the tuning sites), dcee-cl, docs/results/sites-walls-tune"
     ),
     ("estimator", "wall_wind"): Provenance(
-        ("lbm",), "random-site:1-20 (the tuning sites), dcee-cl, docs/results/sites-walls-tune"
+        ("lbm", "gaden"),
+        "at a site: random-site:1-20 (the tuning sites), dcee-cl, docs/results/sites-walls-tune; "
+        'in a GADEN room "room", its own wind field: GADEN\'s two sample rooms, ten starts, '
+        "dcee-cl, docs/plumes.md",
     ),
     ("estimator", "wall_viscosity"): Provenance(
         ("lbm",),
         "random-site:1-20 (the tuning sites), dcee-cl, docs/results/sites-walls-tune/viscosity",
     ),
     ("estimator", "wall_diffusivity"): Provenance(
-        (), "unset: the scenario's ζ1, weighed with 3 and 10 times it (not chosen by measurement)"
+        ("gaden",),
+        "unset: in a GADEN room's own wind 0.002 m²/s (the room's plume against GADEN's "
+        "time-mean gas in its two sample rooms, docs/results/gaden/room-fit.json); elsewhere the "
+        "scenario's ζ1 (not chosen by measurement); weighed with 3 and 10 times it",
     ),
     ("search", "explore_guard"): Provenance(
         (),
