@@ -105,6 +105,16 @@ SUITES: dict[str, dict] = {
             "estimator.likelihood": "fluctuation",
         },
     },
+    # site:passage alone, as "sites-walls" flies it: its solver plume diverged until
+    # 2026-12-05 (issue 84), so its rows of the issue-44 tables were flown again on this
+    "sites-walls-passage": {
+        "configs": ["site:passage"],
+        "overrides": {
+            "truth.model": "lbm",
+            "truth.z": 4.0,
+            "estimator.likelihood": "fluctuation",
+        },
+    },
     # random sites for choosing the wall-aware estimator's settings (never report them)
     "sites-tune": {
         "configs": [f"random-site:{k}" for k in range(1, 21)],
