@@ -137,6 +137,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "sites-walls-tune": sites_walls_table("sites-walls-tune", all_only=True),
     "sites-walls-planners": sites_walls_table("sites-walls-planners", all_only=True),
     "sites-walls-lookahead": sites_walls_table("sites-walls-lookahead"),
+    "sites-walls-passage": sites_walls_table("sites-walls-passage"),
     "sites-walls-timing": sites_walls_timing_table,
     "speed": speed_table,
     "search-speed": search_speed_table,
