@@ -59,6 +59,9 @@ def sites_walls_table(name: str, all_only: bool = False) -> Callable[[], str]:
         frame = pd.read_csv(RESULTS / name / "summary.csv")
         if all_only:  # one search per configuration: only the pooled rows say anything
             frame = frame[frame["scenario"] == "all sites"]
+        single = frame["scenario"].nunique() == 2  # one site: its pooled rows are its own
+        if single:
+            frame = frame[frame["scenario"] != "all sites"]
         rows = []
         for _, r in frame.iterrows():
             n = int(r["searches"])
@@ -104,7 +107,9 @@ def sites_walls_table(name: str, all_only: bool = False) -> Callable[[], str]:
                 f"{r['wilcoxon_p']:.2g}",
             ]
             for _, r in pairs.iterrows()
-            if r["pairs"] >= 5 and not (all_only and r["scenario"] != "all sites")
+            if r["pairs"] >= 5
+            and not (all_only and r["scenario"] != "all sites")
+            and not (single and r["scenario"] == "all sites")
         ]
         return (
             head
