@@ -97,7 +97,8 @@ DEFAULTS: dict[tuple[str, str], Provenance] = {
         ("lbm",),
         '"walls" wherever there are walls and it applies (the wall-aware estimator against the '
         "wall-blind one on the sites site:wall, passage, canyon, block, 10 seeds, dcee-cl: 40/40 "
-        'against 21/40 acquired, issue 44; the default since issue 84), else "open"',
+        "against 21/40 acquired (39/40 with site:passage flown again on its corrected plume), "
+        'issue 44; the default since issue 84), else "open"',
     ),
     ("estimator", "wall_lifetime"): Provenance(
         ("lbm",), "random-site:1-20 (the tuning sites), dcee-cl, docs/results/sites-walls-tune"

@@ -32,7 +32,8 @@ def unset_plume(
     the wall-aware plume applies (one known flow, ``unknown = "source"``; one release; none of
     the open plume's shape settings learned by hand), else ``open``. Chosen by the held-out
     sites (issue 44, docs/scenarios.md): the wall-aware estimator against the wall-blind one
-    19 / 0 searches acquired by one and not the other, 40/40 against 21/40; the default since
+    19 / 0 searches acquired by one and not the other, 40/40 against 21/40 (39/40 with
+    site:passage flown again on its corrected plume, docs/results.md 8b); the default since
     issue 84 (before it: ``open`` everywhere)."""
     shaped = set(learn or {}) & set(PLUME_SHAPE_SETTINGS)
     if walls and unknown == "source" and max_sources == 1 and not shaped:
