@@ -119,3 +119,19 @@ def test_stone_soup_s_weights_are_read_from_its_log_weights():
             raise AssertionError("state.weight read")
 
     np.testing.assert_allclose(normalised_weights(State()), [0.125, 0.375, 0.5])
+
+
+def test_the_machine_is_named_by_its_cpu_and_simd_width():
+    """A stored timing names its CPU (model, SIMD width, cache) from /proc/cpuinfo, and the
+    one-line identity `dcee perf` prints beside each ratio carries it with the versions."""
+    from dcee.perf.machine import cpu_identity, machine_identity
+
+    text = (
+        "processor\t: 0\nmodel name\t: Example CPU 9000\ncache size\t: 512 KB\n"
+        "flags\t\t: fpu sse2 avx avx2\n\nprocessor\t: 1\nmodel name\t: Example CPU 9000\n"
+    )
+    cpu = cpu_identity(text)
+    assert cpu == {"cpu_model": "Example CPU 9000", "vector_bits": 256, "cache": "512 KB"}
+    assert cpu_identity("") == {}
+    line = machine_identity({"cpus": 2, **cpu, "versions": {"numpy": "2.4", "numba": "0.6"}})
+    assert line == "Example CPU 9000, 2 CPUs, 256-bit SIMD, numpy 2.4, numba 0.6"

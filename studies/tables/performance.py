@@ -7,6 +7,7 @@ import math
 
 import pandas as pd
 
+from dcee.perf.machine import machine_identity
 from studies.tables.common import (
     RESULTS,
     acquired,
@@ -36,7 +37,8 @@ def _timed(record: dict) -> str:
     else:
         state = f"**shared** (other processes {other:.1f} cores)"
     commit = (machine.get("code", {}).get("commit") or "")[:7]
-    return f"{when}, {machine['cpus']} CPUs, {state}, `{commit}`"
+    cpu = machine_identity(machine) if machine.get("cpu_model") else f"{machine['cpus']} CPUs"
+    return f"{when}, {cpu}, {state}, `{commit}`"
 
 
 def _repeats_text(result: dict) -> str:

@@ -35,7 +35,7 @@ def perf(
     from rich.console import Console
     from rich.table import Table
 
-    from dcee.perf.machine import LoadMonitor, load_warning, machine_record
+    from dcee.perf.machine import LoadMonitor, load_warning, machine_identity, machine_record
 
     if json_path:
         check_writable_file(Path(json_path), "json")  # before minutes of timing, not after
@@ -66,6 +66,7 @@ def perf(
             f"{f' (runs {low:.1f}-{high:.1f}x)' if repeats > 1 else ''}"
             f" (target >= {result['target_speedup']:.0f}x)"
         )
+        console.print(f"  on {machine_identity(machine)}")
         if warning:
             console.print(f"[yellow]{warning}")
         if json_path:
@@ -76,7 +77,7 @@ def perf(
 
     with console.status("timing") as status, LoadMonitor() as load:
         timings = run_workloads(quick, progress=lambda name: status.update(f"timing {name}"))
-    table = Table(title=f"dcee perf · {machine['cpus']} CPUs · {machine['machine']}")
+    table = Table(title=f"dcee perf · {machine_identity(machine)}")
     for col in ("workload", "median", "min", "max", "target", "pass"):
         if col == "workload":
             table.add_column(col, no_wrap=True, min_width=30)

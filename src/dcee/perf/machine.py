@@ -36,6 +36,49 @@ CI runner's background; one busy process beside the run is a whole core)."""
 LIBRARIES = ("numpy", "numba", "llvmlite", "scipy", "stonesoup")
 
 
+def cpu_identity(cpuinfo: str | None = None) -> dict[str, Any]:
+    """The CPU a timing ran on, from ``/proc/cpuinfo`` (Linux; ``cpuinfo`` its text, for
+    tests): ``cpu_model`` (its model name), ``vector_bits`` (the widest SIMD its flags offer:
+    512 with AVX-512F, 256 with AVX2, 128 with SSE2; a ratio can differ between machines by
+    it) and ``cache`` (its last-level cache as the kernel reports it). Empty where there is
+    no such file."""
+    if cpuinfo is None:
+        path = Path("/proc/cpuinfo")
+        try:
+            cpuinfo = path.read_text(errors="replace") if path.exists() else ""
+        except OSError:
+            cpuinfo = ""
+    fields: dict[str, str] = {}
+    for line in cpuinfo.splitlines():
+        key, sep, value = line.partition(":")
+        if sep and key.strip() not in fields:
+            fields[key.strip()] = value.strip()
+    if not fields:
+        return {}
+    flags = set(fields.get("flags", "").split())
+    bits = (
+        512 if "avx512f" in flags else 256 if "avx2" in flags else 128 if "sse2" in flags else None
+    )
+    out: dict[str, Any] = {"cpu_model": fields.get("model name", "")}
+    if bits is not None:
+        out["vector_bits"] = bits
+    if "cache size" in fields:
+        out["cache"] = fields["cache size"]
+    return out
+
+
+def machine_identity(machine: dict[str, Any]) -> str:
+    """One line naming the machine of a stored :func:`machine_record`: CPU model, cores, SIMD
+    width, numpy and numba versions."""
+    versions = machine.get("versions", {})
+    cpu = machine.get("cpu_model") or machine.get("processor") or machine.get("machine", "")
+    parts = [cpu, f"{machine.get('cpus')} CPUs"]
+    if machine.get("vector_bits"):
+        parts.append(f"{machine['vector_bits']}-bit SIMD")
+    parts += [f"{k} {versions[k]}" for k in ("numpy", "numba") if k in versions]
+    return ", ".join(p for p in parts if p)
+
+
 def machine_record() -> dict[str, Any]:
     """The machine and the software a timing ran on: CPU count, architecture, processor,
     Python, numba's thread count, library versions (absent ones omitted) and the code version
@@ -52,6 +95,7 @@ def machine_record() -> dict[str, Any]:
         "cpus": os.cpu_count(),
         "machine": platform.machine(),
         "processor": platform.processor() or platform.uname().processor,
+        **cpu_identity(),
         "python": platform.python_version(),
         "numba_threads": int(numba.get_num_threads()),
         "versions": versions,
@@ -179,7 +223,9 @@ __all__ = [
     "LoadMonitor",
     "alternation_args",
     "code_at",
+    "cpu_identity",
     "load_warning",
+    "machine_identity",
     "machine_record",
     "store_timing",
 ]
