@@ -33,6 +33,7 @@ from studies.tables.performance import (
     precision_single_table,
     search_speed_table,
     speed_table,
+    stonesoup_runs_table,
 )
 from studies.tables.robustness import (
     fuzz_readers_table,
@@ -140,6 +141,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "sites-walls-passage": sites_walls_table("sites-walls-passage"),
     "sites-walls-timing": sites_walls_timing_table,
     "speed": speed_table,
+    "stonesoup-runs": stonesoup_runs_table,
     "search-speed": search_speed_table,
     "kernel-speedup": kernel_speedup_table,
     "kernel-speedup-blas": lambda: kernel_speedup_table("kernel-speedup-blas"),
