@@ -115,3 +115,18 @@ def test_a_misspelt_tree_option_names_the_tree():
         planners.get("dcee-mcts:simulatons=3")
     with pytest.raises(DceeInputError, match="dcee-cl:raech=6: no option 'raech'; did you mean"):
         planners.get("dcee-cl:raech=6")
+
+
+def test_an_agent_keeps_each_position_s_move_set_read_only():
+    """The tree search asks for the same positions' moves thousands of times per decision: the
+    agent keeps them, the same arrays each time, read-only so no caller can change what the
+    next one gets, and equal to the moves worked out afresh."""
+    agent = GridAgent(SearchVolume((0.0, 0.0, 4.0), (10.0, 10.0, 4.0)), step=2.0)
+    first = agent.candidates(np.array([1.0, 1.0, 4.0]))
+    again = agent.candidates(np.array([1.0, 1.0, 4.0]))
+    assert first[0] is again[0] and first[1] is again[1]
+    assert not first[0].flags.writeable and not first[1].flags.writeable
+    fresh = GridAgent(SearchVolume((0.0, 0.0, 4.0), (10.0, 10.0, 4.0)), step=2.0)
+    np.testing.assert_array_equal(fresh.candidates(np.array([1.0, 1.0, 4.0]))[0], first[0])
+    # a corner keeps only the moves into the volume
+    assert set(agent.candidates(np.array([0.0, 0.0, 4.0]))[1].tolist()) == {0, 1, 2}

@@ -33,6 +33,10 @@ class SearchVolume:
         return np.all((p >= low - tol) & (p <= high + tol), axis=1)
 
 
+CANDIDATES_KEPT = 65_536
+"""Positions whose move sets a :class:`GridAgent` keeps (a few MB at most)."""
+
+
 @dataclass(frozen=True)
 class GridAgent:
     """Mobile sensor that moves ``step`` metres along one of ``headings`` directions.
@@ -92,14 +96,31 @@ class GridAgent:
         the same as a horizontal move)."""
         return self.step / self.speed + self.dwell
 
+    @functools.cached_property
+    def _candidates_kept(self) -> dict[bytes, tuple[np.ndarray, np.ndarray]]:
+        return {}
+
     def candidates(self, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Admissible next positions from ``position``: ((M, 3) positions, (M,) heading indices)."""
+        """Admissible next positions from ``position``: ((M, 3) positions, (M,) heading
+        indices), read-only. Kept per position (the move set from a point never changes, and
+        the tree search asks for the same few thousands of times per decision); at most
+        :data:`CANDIDATES_KEPT` positions, then the kept ones are dropped."""
         position = np.asarray(position, dtype=np.float64)
+        key = position.tobytes()
+        kept = self._candidates_kept.get(key)
+        if kept is not None:
+            return kept
         nxt = position[None, :] + self.moves
         ok = self.volume.contains(nxt)
         if self.site is not None and ok.any():
             ok[ok] = self.site.segment_clear(position, nxt[ok])
-        return nxt[ok], np.flatnonzero(ok)
+        out = (nxt[ok], np.flatnonzero(ok))
+        for a in out:
+            a.flags.writeable = False
+        if len(self._candidates_kept) >= CANDIDATES_KEPT:
+            self._candidates_kept.clear()
+        self._candidates_kept[key] = out
+        return out
 
 
 def travel_xy(site: SiteMap | None, start: np.ndarray, points: np.ndarray) -> np.ndarray:
