@@ -100,6 +100,13 @@ class GridAgent:
     def _candidates_kept(self) -> dict[bytes, tuple[np.ndarray, np.ndarray]]:
         return {}
 
+    def __getstate__(self) -> dict:
+        """What a checkpoint or a worker process gets: the fields, not the kept move sets (a
+        cache, rebuilt on use)."""
+        state = dict(self.__dict__)
+        state.pop("_candidates_kept", None)
+        return state
+
     def candidates(self, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Admissible next positions from ``position``: ((M, 3) positions, (M,) heading
         indices), read-only. Kept per position (the move set from a point never changes, and
