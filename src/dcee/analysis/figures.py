@@ -254,7 +254,8 @@ def _draw_altitude(ax: plt.Axes, result: EpisodeResult, scenario: Scenario, unti
     one."""
     recs = [r for r in result.records if r["time"] <= until + 1e-9]
     t = np.array([r["time"] for r in recs])
-    ax.step(t, [r["z"] for r in recs], where="post", color="tab:red", lw=1.0, label="UAV")
+    # the sensor's height: a UAV's altitude, or a ground robot's fixed sensor
+    ax.step(t, [r["z"] for r in recs], where="post", color="tab:red", lw=1.0, label="sensor")
     mean = np.array([r["mean_z"] for r in recs])
     sd = np.sqrt(np.maximum([r["cov_zz"] for r in recs], 0.0))
     ax.plot(t, mean, color="tab:blue", lw=1.0, label="source height, estimate ± sd")
