@@ -16,7 +16,6 @@ docs/performance.md is generated from it).
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import subprocess
 import sys
@@ -26,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.perf.machine import LoadMonitor, alternation_args, code_at, store_timing
+from dcee.perf.machine import LoadMonitor, alternation_args, code_at, package_env, store_timing
 
 ROOT = Path(__file__).resolve().parent.parent
 DEMO = ["run", "--scenario", "paper:1", "--strategy", "dcee-cl", "--seed", "0"]
@@ -35,7 +34,7 @@ ONE_CORE = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THRE
 
 def _search(src: Path, out: Path) -> dict:
     """One demo search with the package under ``src`` on one pinned core; its summary."""
-    env = {**os.environ, **ONE_CORE, "PYTHONPATH": str(src)}
+    env = package_env(src, **ONE_CORE)
     command = ["taskset", "-c", "0", sys.executable, "-m", "dcee.cli", *DEMO, "--out", str(out)]
     subprocess.run(command, env=env, check=True, capture_output=True, cwd=ROOT)
     return json.loads((out / "summary.json").read_text(encoding="utf-8"))

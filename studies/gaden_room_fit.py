@@ -26,14 +26,13 @@ FLOOR = 0.05  # ppm
 
 
 def fit(folder: str) -> dict:
-    from dcee.models.room_plume import RoomPlume, room_flow
-    from dcee.recordings.gaden import FREE, GadenSimulation
-    from dcee.recordings.gaden_files import OUTLET
+    from dcee.models.room_plume import RoomPlume
+    from dcee.recordings.gaden import GadenSimulation
+    from dcee.scenarios.builders import gaden_room_flow
 
     sim = GadenSimulation.open(folder)
     first = sim.result(int(sim.iterations[0]))
-    wind = sim.wind(first.wind_index)
-    flow = room_flow(sim.occupancy == FREE, sim.occupancy == OUTLET, wind, sim.grid.low, 0.1)
+    flow = gaden_room_flow(str(folder), float(TIMES[0]))  # the estimator's own cubes and wind
     nx, ny = flow.fluid.shape[:2]
     xs = flow.origin[0] + (np.arange(nx) + 0.5) * flow.h
     ys = flow.origin[1] + (np.arange(ny) + 0.5) * flow.h

@@ -16,16 +16,13 @@ with each run's median ms per decision, the machine and the load beside the run.
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.perf.machine import LoadMonitor, alternation_args, code_at, store_timing
+from dcee.perf.machine import alternate_versions, alternation_args, json_from_package, store_timing
 
 ROOT = Path(__file__).resolve().parent.parent
 TIMED = (
@@ -35,32 +32,16 @@ TIMED = (
 )
 
 
-def _timed(src: Path) -> dict:
-    """Median ms per decision and the x-y RMSE after every move, the package under ``src``."""
-    env = {**os.environ, "PYTHONPATH": str(src)}
-    done = subprocess.run(
-        [sys.executable, "-c", TIMED], env=env, check=True, capture_output=True, text=True
-    )
-    return json.loads(done.stdout.strip().splitlines()[-1])
-
-
 def main(argv: list[str] | None = None) -> int:
     try:
         args = alternation_args(argv, __doc__.splitlines()[0], 3)
-    except DceeInputError as e:
-        print(f"mcts_speedup: error: {e}", file=sys.stderr)
-        return 2
-    runs: dict[str, list[dict]] = {"before": [], "after": []}
-    try:
-        with code_at(ROOT, args.before) as before:
-            sides = {"before": before, "after": ROOT / "src"}
-            for src in sides.values():  # compile each side's kernels (not counted)
-                _timed(src)
-            with LoadMonitor() as load:
-                for r in range(args.rounds):
-                    for side, src in sides.items():
-                        runs[side].append(_timed(src))
-                        print(f"{side} round {r}: {runs[side][-1]['ms']:.2f} ms", flush=True)
+        runs, load = alternate_versions(
+            ROOT,
+            args.before,
+            lambda src: json_from_package(src, TIMED),
+            args.rounds,
+            lambda side, r, t: print(f"{side} round {r}: {t['ms']:.2f} ms", flush=True),
+        )
     except DceeInputError as e:
         print(f"mcts_speedup: error: {e}", file=sys.stderr)
         return 2
@@ -71,7 +52,7 @@ def main(argv: list[str] | None = None) -> int:
           f" the same searches: {same}")  # fmt: skip
     store_timing(
         args.json,
-        load.record(),
+        load,
         before=args.before,
         runs={side: [r["ms"] for r in rs] for side, rs in runs.items()},
         before_ms=before_ms,

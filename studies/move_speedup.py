@@ -16,16 +16,13 @@ speed table on docs/performance.md is generated from it).
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.perf.machine import LoadMonitor, alternation_args, code_at, store_timing
+from dcee.perf.machine import alternate_versions, alternation_args, json_from_package, store_timing
 
 ROOT = Path(__file__).resolve().parent.parent
 TIMED = (
@@ -36,34 +33,20 @@ TIMED = (
 
 
 def _timed(src: Path) -> dict[str, float]:
-    """Median ms of one filter update and of one resample + move, the package under ``src``."""
-    env = {**os.environ, "PYTHONPATH": str(src)}
-    done = subprocess.run(
-        [sys.executable, "-c", TIMED], env=env, check=True, capture_output=True, text=True
-    )
-    return json.loads(done.stdout.strip().splitlines()[-1])
+    """Median ms of one filter update and of one resample + move, the package under ``src``,
+    and their ratio."""
+    t = json_from_package(src, TIMED)
+    return {**t, "ratio": t["move_ms"] / t["update_ms"]}
 
 
 def main(argv: list[str] | None = None) -> int:
+    def report(side: str, r: int, t: dict[str, float]) -> None:
+        print(f"{side} round {r}: move {t['move_ms']:.1f} ms, update {t['update_ms']:.3f} ms, "
+              f"{t['ratio']:.0f}×", flush=True)  # fmt: skip
+
     try:
         args = alternation_args(argv, __doc__.splitlines()[0], 3)
-    except DceeInputError as e:
-        print(f"move_speedup: error: {e}", file=sys.stderr)
-        return 2
-    runs: dict[str, list[dict[str, float]]] = {"before": [], "after": []}
-    try:
-        with code_at(ROOT, args.before) as before:
-            sides = {"before": before, "after": ROOT / "src"}
-            for src in sides.values():  # compile each side's kernels (not counted)
-                _timed(src)
-            with LoadMonitor() as load:
-                for r in range(args.rounds):
-                    for side, src in sides.items():
-                        t = _timed(src)
-                        runs[side].append({**t, "ratio": t["move_ms"] / t["update_ms"]})
-                        print(f"{side} round {r}: move {t['move_ms']:.1f} ms, update "
-                              f"{t['update_ms']:.3f} ms, {runs[side][-1]['ratio']:.0f}×",
-                              flush=True)  # fmt: skip
+        runs, load = alternate_versions(ROOT, args.before, _timed, args.rounds, report)
     except DceeInputError as e:
         print(f"move_speedup: error: {e}", file=sys.stderr)
         return 2
@@ -81,7 +64,7 @@ def main(argv: list[str] | None = None) -> int:
     ratios = f"{summary['before_ratio']:.0f}× -> {summary['after_ratio']:.0f}×"
     print(f"move {summary['move_speedup']:.2f}× faster, update {summary['update_speedup']:.2f}× "
           f"faster; move / update {ratios}")  # fmt: skip
-    store_timing(args.json, load.record(), before=args.before, runs=runs, **summary,
+    store_timing(args.json, load, before=args.before, runs=runs, **summary,
                  ratio_target=76.0)  # fmt: skip
     return 0
 

@@ -19,7 +19,6 @@ generated from it).
 from __future__ import annotations
 
 import json
-import os
 import shutil
 import subprocess
 import sys
@@ -29,7 +28,7 @@ import numpy as np
 from demo_decision import ONE_CORE, ROOT
 
 from dcee.errors import DceeInputError
-from dcee.perf.machine import LoadMonitor, alternation_args, code_at, store_timing
+from dcee.perf.machine import LoadMonitor, alternation_args, code_at, package_env, store_timing
 
 PLANNERS = ("mpc", "dcee", "infotaxis", "entrotaxis", "dcee-ms")
 # run in a fresh process with one side's package first on sys.path: the campaign's own search
@@ -62,7 +61,7 @@ print("RESULT " + json.dumps(result))
 
 def _searches(src: Path) -> dict:
     """Each planner's search with the package under ``src``, one pinned core, one process."""
-    env = {**os.environ, **ONE_CORE, "PYTHONPATH": str(src)}
+    env = package_env(src, **ONE_CORE)
     command = ["taskset", "-c", "0", sys.executable, "-c", _DRIVER, ",".join(PLANNERS)]
     done = subprocess.run(command, env=env, capture_output=True, text=True, cwd=ROOT)
     if done.returncode != 0:

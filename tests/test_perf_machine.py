@@ -15,11 +15,14 @@ import pytest
 from dcee.errors import DceeInputError
 from dcee.perf.machine import (
     IDLE_OTHER_CORES,
+    KERNEL_CACHE_VARIABLES,
     LoadMonitor,
+    alternate_versions,
     alternation_args,
     code_at,
     load_warning,
     machine_record,
+    package_env,
     store_timing,
 )
 from tests.test_study_tables import _script
@@ -121,3 +124,29 @@ def test_alternation_args_checks_before_any_work(tmp_path):
     ):
         with pytest.raises(DceeInputError, match=field):
             alternation_args(argv, "d", 3)
+
+
+def test_another_version_runs_without_this_process_s_kernel_cache(monkeypatch):
+    """A process of another code version gets this one's environment with its package first on
+    the path and without the kernel cache this process chose (an older version cannot import
+    the locator it names: the perf recipe's move timing failed so)."""
+    monkeypatch.setenv("NUMBA_CACHE_DIR", "/tmp/ours")
+    monkeypatch.setenv("NUMBA_CACHE_LOCATOR_CLASSES", "dcee.kernel_locator.PackageRelativeLocator")
+    env = package_env(Path("/somewhere/src"), NUMBA_NUM_THREADS="1")
+    assert env["PYTHONPATH"] == "/somewhere/src" and env["NUMBA_NUM_THREADS"] == "1"
+    assert not set(KERNEL_CACHE_VARIABLES) & set(env)
+
+
+def test_two_versions_alternate_round_by_round():
+    """The uncounted first pass of each side, then before and after in turn, each reported."""
+    root = Path(__file__).resolve().parents[1]
+    seen: list[str] = []
+    reported: list[tuple[str, int]] = []
+    runs, load = alternate_versions(
+        root, "HEAD", lambda src: seen.append(str(src)) or str(src), 2,
+        lambda side, r, _: reported.append((side, r)),
+    )  # fmt: skip
+    assert reported == [("before", 0), ("after", 0), ("before", 1), ("after", 1)]
+    assert len(seen) == 6 and runs["after"] == [str(root / "src")] * 2
+    assert runs["before"][0] != runs["after"][0] and runs["before"][0].endswith("src")
+    assert "other_cores" in load

@@ -19,7 +19,7 @@ import shutil
 import subprocess
 import tempfile
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
@@ -56,9 +56,8 @@ def cpu_identity(cpuinfo: str | None = None) -> dict[str, Any]:
     if not fields:
         return {}
     flags = set(fields.get("flags", "").split())
-    bits = (
-        512 if "avx512f" in flags else 256 if "avx2" in flags else 128 if "sse2" in flags else None
-    )
+    widths = (("avx512f", 512), ("avx2", 256), ("sse2", 128))
+    bits = next((width for flag, width in widths if flag in flags), None)
     out: dict[str, Any] = {"cpu_model": fields.get("model name", "")}
     if bits is not None:
         out["vector_bits"] = bits
@@ -208,6 +207,59 @@ def code_at(root: Path, commit: str) -> Iterator[Path]:
         shutil.rmtree(work, ignore_errors=True)
 
 
+def package_env(src: Path, **extra: str) -> dict[str, str]:
+    """The environment of a process that runs the package under ``src`` (another version's,
+    for a timing in alternation): this one's, with ``src`` first on the path and without the
+    compiled-kernel cache this process chose (``NUMBA_CACHE_DIR``, and the locator older
+    versions cannot import): each version files its own kernels."""
+    env = {k: v for k, v in os.environ.items() if k not in KERNEL_CACHE_VARIABLES}
+    return {**env, **extra, "PYTHONPATH": str(src)}
+
+
+KERNEL_CACHE_VARIABLES = ("NUMBA_CACHE_DIR", "NUMBA_CACHE_LOCATOR_CLASSES")
+"""What :mod:`dcee.kernel_cache` sets for this process's own source."""
+
+
+def json_from_package(src: Path, code: str) -> Any:
+    """Run ``python -c code`` in a fresh process with the package under ``src`` first on the
+    path (:func:`package_env`); the JSON of the last line it prints."""
+    import json
+    import sys
+
+    env = package_env(src)
+    done = subprocess.run(
+        [sys.executable, "-c", code], env=env, check=True, capture_output=True, text=True
+    )
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def alternate_versions(
+    root: Path,
+    before: str,
+    timed: Callable[[Path], Any],
+    rounds: int,
+    report: Callable[[str, int, Any], None] | None = None,
+) -> tuple[dict[str, list[Any]], dict[str, Any]]:
+    """Time two code versions in alternation: ``timed(src)`` with the package of commit
+    ``before`` (:func:`code_at`) and with ``root``'s own ``src``, once each uncounted (it
+    compiles the kernels), then ``rounds`` times each in turn, ``report(side, round, result)``
+    after each. Returns ({"before": [...], "after": [...]}, the load beside the counted runs,
+    :meth:`LoadMonitor.record`). :class:`DceeInputError` when ``before`` cannot be checked
+    out."""
+    runs: dict[str, list[Any]] = {"before": [], "after": []}
+    with code_at(root, before) as old:
+        sides = {"before": old, "after": root / "src"}
+        for src in sides.values():
+            timed(src)
+        with LoadMonitor() as load:
+            for r in range(rounds):
+                for side, src in sides.items():
+                    runs[side].append(timed(src))
+                    if report is not None:
+                        report(side, r, runs[side][-1])
+    return runs, load.record()
+
+
 def store_timing(path: Path | None, load: dict[str, Any], **fields: Any) -> None:
     """Print :func:`load_warning`'s line for a run that was not idle, and write ``path`` (JSON;
     None: nothing): the machine (:func:`machine_record`), the ``load`` beside the run
@@ -221,11 +273,14 @@ def store_timing(path: Path | None, load: dict[str, Any], **fields: Any) -> None
 __all__ = [
     "IDLE_OTHER_CORES",
     "LoadMonitor",
+    "alternate_versions",
     "alternation_args",
     "code_at",
     "cpu_identity",
+    "json_from_package",
     "load_warning",
     "machine_identity",
     "machine_record",
+    "package_env",
     "store_timing",
 ]

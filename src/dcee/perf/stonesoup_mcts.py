@@ -33,15 +33,33 @@ from dcee.perf.stonesoup_compare import STONESOUP_START, stonesoup_example
 from dcee.planning import get as get_planner
 from dcee.searcher import Searcher
 
+TRUTH = np.array([30.0, 40.0, 1.0, 5.0, 4.0, math.radians(90.0), 1.0, 8.0])
+START = np.array([5.0, 15.0, 0.0])
+N_PARTICLES = 10_000
+MAX_MOVES = 100
+STOP_SQRT_TRACE = 3.0
+MANAGER = {
+    "niterations": 100,
+    "exploration_factor": 0.05,
+    "discount_factor": 0.9,
+    "search_depth": 5,
+    "best_child_policy": "max_average_reward",
+}
+"""``MCTSRolloutSensorManager``'s settings in the published example."""
+ACTIONS = {"n_steps": 2, "step_size": 2, "action_mapping": (0, 1)}
+"""``choose_actions``' settings in the published example."""
+
 PUBLISHED_EXAMPLE = {
     "source": (
         "Stone Soup 1.9 gallery, 'Monte Carlo Tree Search for Autonomous Source Term "
         "Estimation' (docs/examples/sensormanagement/Monte_Carlo_Tree_Search_for_Autonomous_"
         "Source_Term_Estimation.py; Glover et al., FUSION 2024)"
     ),
-    "truth": {"x": 30, "y": 40, "z": 1, "q": 5, "u": 4, "phi_deg": 90, "zeta1": 1, "zeta2": 8},
+    "truth": dict(
+        zip(("x", "y", "z", "q", "u", "phi_rad", "zeta1", "zeta2"), TRUTH.tolist(), strict=True)
+    ),
     "sensor": {
-        "start": [5, 15, 0],
+        "start": START.tolist(),
         "missed_detection_probability": 0.3,
         "sensing_threshold": 5e-4,
         "min_noise": 1e-4,
@@ -53,8 +71,8 @@ PUBLISHED_EXAMPLE = {
         "step_size": 1,
         "action_space": [[0, 50], [0, 50]],
     },
-    "choose_actions": {"n_steps": 2, "step_size": 2, "action_mapping": [0, 1]},
-    "particles": 10_000,
+    "choose_actions": {**ACTIONS, "action_mapping": list(ACTIONS["action_mapping"])},
+    "particles": N_PARTICLES,
     "prior": {
         "x": "U(0, 50)",
         "y": "U(0, 50)",
@@ -67,28 +85,15 @@ PUBLISHED_EXAMPLE = {
     },
     "updater": "ParticleUpdater(IsotropicPlume, ESSResampler, MCMCRegulariser, constraint)",
     "predictor": "ParticlePredictor(RandomWalk(0) x 8)",
-    "manager": {
-        "class": "MCTSRolloutSensorManager",
-        "niterations": 100,
-        "exploration_factor": 0.05,
-        "discount_factor": 0.9,
-        "search_depth": 5,
-        "best_child_policy": "max_average_reward",
-    },
+    "manager": {"class": "MCTSRolloutSensorManager", **MANAGER},
     "reward": "ExpectedKLDivergence(ParticleUpdater(measurement_model=None), "
     "measurement_noise=True, return_tracks=True)",
-    "max_moves": 100,
-    "stop": "sqrt(trace(P)) < 3",
+    "max_moves": MAX_MOVES,
+    "stop": f"sqrt(trace(P)) < {STOP_SQRT_TRACE:g}",
     "seeds": "np.random.seed(seed), seeds 0-2 (the example itself seeds 1991)",
 }
 """Every setting of Stone Soup's published example that :func:`stonesoup_mcts_search` flies,
-stored beside each comparison."""
-
-TRUTH = np.array([30.0, 40.0, 1.0, 5.0, 4.0, math.radians(90.0), 1.0, 8.0])
-START = np.array([5.0, 15.0, 0.0])
-N_PARTICLES = 10_000
-MAX_MOVES = 100
-STOP_SQRT_TRACE = 3.0
+stored beside each comparison (the numbers from the constants the search reads)."""
 
 
 def _xy_rmse(xy: np.ndarray, weights: np.ndarray) -> float:
@@ -130,11 +135,7 @@ def stonesoup_mcts_search(seed: int, max_moves: int = MAX_MOVES) -> dict[str, An
         sensors={sensor},
         platforms={platform},
         reward_function=reward,
-        niterations=100,
-        exploration_factor=0.05,
-        discount_factor=0.9,
-        search_depth=5,
-        best_child_policy="max_average_reward",
+        **MANAGER,
     )
     n = N_PARTICLES
     prior = ParticleState(
@@ -161,9 +162,7 @@ def stonesoup_mcts_search(seed: int, max_moves: int = MAX_MOVES) -> dict[str, An
         now = start + timedelta(seconds=k + 1)
         if k > 0:
             t0 = time.perf_counter()
-            chosen = manager.choose_actions(
-                {track}, now, n_steps=2, step_size=2, action_mapping=(0, 1)
-            )
+            chosen = manager.choose_actions({track}, now, **ACTIONS)
             ms.append(1e3 * (time.perf_counter() - t0))
             for s, actions in chosen[0].items():
                 s.add_actions(actions)

@@ -19,7 +19,7 @@ from dcee.models.agent import GridAgent, SearchVolume
 from dcee.models.anemometer import Anemometer
 from dcee.models.motion import MotionModel, make_motion
 from dcee.models.plume import PARAMETER_NAMES, IsotropicPlume
-from dcee.models.room_plume import RoomPlume, room_flow
+from dcee.models.room_plume import RoomFlow, RoomPlume, room_flow
 from dcee.models.ros_map import load_ros_map
 from dcee.models.sensor import Sensor
 from dcee.models.site import SiteMap, compose_site
@@ -94,19 +94,26 @@ def _wall_plume(
     return SitePlume(fluid, origin, site[-1], *environment, wind=_site_wind(site, u, phi, *wind))
 
 
-@functools.lru_cache(maxsize=8)
-def _room_plume(folder: str, start: float, diffusivity: float, lifetime: float) -> RoomPlume:
-    """The plume in the GADEN room ``folder``'s own wind (the wind state of the result file
-    saved at ``start`` s; :mod:`dcee.models.room_plume`) at one K (m²/s) and τ (s), built once
-    per process and shared by the filter's members of that K and the planners."""
+@functools.lru_cache(maxsize=4)
+def gaden_room_flow(folder: str, start: float) -> RoomFlow:
+    """The air of the GADEN room ``folder`` on the room plume's cubes
+    (:func:`~dcee.models.room_plume.room_flow`): its occupancy grid and the wind state of the
+    result file saved at ``start`` s, read once per process."""
     from dcee.recordings.gaden import FREE, GadenSimulation
     from dcee.recordings.gaden_files import OUTLET
 
     sim = GadenSimulation.open(folder)
     wind = sim.wind(sim.result(sim.iteration_at(start)).wind_index)
     occupancy = sim.occupancy
-    flow = room_flow(occupancy == FREE, occupancy == OUTLET, wind, sim.grid.low, sim.grid.cell)
-    return RoomPlume(flow, diffusivity, lifetime)
+    return room_flow(occupancy == FREE, occupancy == OUTLET, wind, sim.grid.low, sim.grid.cell)
+
+
+@functools.lru_cache(maxsize=8)
+def _room_plume(folder: str, start: float, diffusivity: float, lifetime: float) -> RoomPlume:
+    """The plume in the GADEN room ``folder``'s own wind (:func:`gaden_room_flow`) at one K
+    (m²/s) and τ (s), built once per process and shared by the filter's members of that K and
+    the planners."""
+    return RoomPlume(gaden_room_flow(folder, start), diffusivity, lifetime)
 
 
 def inside_world(world: WorldSpec, xy: np.ndarray, no_go: bool = True) -> np.ndarray:

@@ -80,8 +80,7 @@ class ReadingModelSettings:
                 f'"{self.wall_wind}" wind has none (set wall_wind = "wake" or leave it unset)'
             )
         what = f'{FIELD_MARK}estimator.plume: "walls" '
-        room = self.truth.model_name.startswith("gaden:")
-        if self.wall_wind == "room" and not room:
+        if self.wall_wind == "room" and not self.in_gaden_room:
             raise ValueError(
                 f'{FIELD_MARK}estimator.wall_wind: "room" is a GADEN room\'s own wind field; '
                 'needs truth.model = {kind = "gaden", folder = ...}'
@@ -179,7 +178,7 @@ class ReadingModelSettings:
         if e.plume is not None:
             return e.plume
         # a GADEN room's walls are its occupancy grid's, whatever [world] says
-        walls = self.world.walls or self.truth.model_name.startswith("gaden:")
+        walls = self.world.walls or self.in_gaden_room
         return unset_plume(walls, self.unknown, e.max_sources, e.learn)
 
     @property
@@ -188,7 +187,13 @@ class ReadingModelSettings:
         field in a GADEN room, else :data:`~dcee.models.site_flow.WALL_WIND_DEFAULT`."""
         if self.estimator.wall_wind is not None:
             return self.estimator.wall_wind
-        return "room" if self.truth.model_name.startswith("gaden:") else WALL_WIND_DEFAULT
+        return "room" if self.in_gaden_room else WALL_WIND_DEFAULT
+
+    @property
+    def in_gaden_room(self) -> bool:
+        """The truth is a GADEN simulation: its room's walls and wind are the wall-aware
+        plume's."""
+        return self.truth.model_name.startswith("gaden:")
 
     @property
     def wall_viscosity(self) -> float:
