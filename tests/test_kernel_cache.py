@@ -105,3 +105,22 @@ def test_kernels_are_filed_by_package_folder_so_another_checkout_reuses_them(tmp
         return x
 
     assert PackageRelativeLocator.from_function(outside, __file__) is None  # not dcee's
+
+
+def test_a_kernel_that_calls_another_modules_summation_runs_from_the_cache(tmp_path):
+    """The stratified hypotheses' kernel calls particle_terms.pairwise_sum; loaded from the
+    on-disk cache in a later process it must run. (A recursive pairwise_sum was compiled into
+    the cache unlinked: "unresolved symbol", or a segfault, in every process after the first.)"""
+    code = (
+        "import numpy as np\n"
+        "from dcee.planning.stratified_kernels import _systematic_picks\n"
+        "p = np.full((1, 300), 1e-3); prob = np.zeros((1, 4)); live = np.zeros(1, bool)\n"
+        "sel = np.zeros((3, 1, 3, 1)); terms = np.ones((1, 300))\n"
+        "_systematic_picks(p, 0.5, 3, terms, terms, terms, np.zeros((1, 1), np.int64),\n"
+        "                  prob, live, sel[0], sel[1], sel[2])\n"
+        "assert live[0] and abs(prob[0, 0] - 0.7) < 1e-12, prob\n"
+    )
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+    env["XDG_CACHE_HOME"] = str(tmp_path / "cache")
+    for _ in range(2):  # the first compiles and stores, the second loads
+        subprocess.run([sys.executable, "-c", code], env=env, check=True, timeout=300)

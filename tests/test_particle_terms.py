@@ -6,7 +6,7 @@ import pytest
 
 from dcee.models import IsotropicPlume, Sensor
 from dcee.planning.base import Belief
-from dcee.planning.particle_terms import ParticleTerms, merge_runs, run_sums
+from dcee.planning.particle_terms import ParticleTerms, merge_runs, pairwise_sum, run_sums
 from dcee.planning.position_kernels import content_hash
 from dcee.planning.predicted import PredictionContext
 from tests.helpers import random_theta
@@ -46,6 +46,14 @@ def test_run_sums_are_numpys_reduceat_bit_for_bit():
         cuts = int(rng.integers(1, 4)) if trial % 2 else int(rng.integers(1, n + 1))
         starts = np.unique(np.concatenate([[0], rng.integers(0, n, cuts)])).astype(np.int64)
         assert np.array_equal(run_sums(w, starts), np.add.reduceat(w, starts))
+
+
+def test_pairwise_sum_is_numpys_sum_bit_for_bit():
+    # below 8, up to 128 (one block), and the halvings above it, to past NumPy's 8,192 buffer
+    rng = np.random.default_rng(6)
+    for n in (1, 7, 8, 9, 127, 128, 129, 300, 1000, 8191, 8192, 8193, 10_000, 100_003):
+        a = rng.random(n + 5) * 10.0 ** rng.uniform(-12, 0, n + 5)
+        assert pairwise_sum(a, 3, n) == a[3 : 3 + n].sum(), n
 
 
 def _content_hash_reference(values: np.ndarray) -> tuple[int, int]:

@@ -39,6 +39,9 @@ class Belief:
     site: SiteMap | None = field(default=None, compare=False, repr=False)
     """the site's obstacles and no-go zones (:class:`~dcee.models.site.SiteMap`): distance
     costs are travel distances around them; None: open terrain"""
+    _variances: dict[int, float] = field(
+        default_factory=dict, init=False, compare=False, repr=False
+    )
 
     def __post_init__(self) -> None:
         # a wrong shape would otherwise be read as other columns and give silent nonsense
@@ -59,10 +62,13 @@ class Belief:
 
     def location_variance(self, dims: int = 3) -> float:
         """Σ of the posterior variances of the first ``dims`` source coordinates, m² (3: tr P of
-        the location; 2: the horizontal part)."""
-        loc = self.source[:, :dims]
-        centred = loc - self.weights @ loc
-        return float(self.weights @ np.einsum("ij,ij->i", centred, centred))
+        the location; 2: the horizontal part). Computed once per belief and ``dims`` (a tree
+        search's cost asks for it at every expansion)."""
+        if dims not in self._variances:
+            loc = self.source[:, :dims]
+            centred = loc - self.weights @ loc
+            self._variances[dims] = float(self.weights @ np.einsum("ij,ij->i", centred, centred))
+        return self._variances[dims]
 
 
 @dataclass

@@ -143,6 +143,8 @@ class HypothesisPlanner(Planner):
                 np.full(n, 1.0 / n),
                 belief.sensor,
                 belief.plume,
+                # a new particle set: no row carries over, the buffers do
+                None if belief.cache is None else belief.cache.derived(),
                 site=belief.site,
             )
         ctx = PredictionContext(

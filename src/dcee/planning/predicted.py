@@ -36,6 +36,7 @@ from dcee.planning.reading_terms import (
     gaussian_transformed,
     unique_tasks,
 )
+from dcee.planning.stratified_kernels import stratified_hypotheses
 
 
 @dataclass(frozen=True)
@@ -278,62 +279,13 @@ class PredictionContext:
 
     def _stratified_batch(self, pos_idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The stratified hypotheses of (S, T) sequences of cached positions at once: ((S, J', T)
-        readings, (S, J') probabilities). Per sequence: "no detection" with its probability,
-        then J detections spread evenly over the particles' detection probability (a
-        systematic draw with the shared offset), each at its first detecting stage (inverted
-        with the shared uniforms) with the model's readings before (none) and after it. Each
-        sequence's numbers are those of a loop over the sequences bit for bit (tested against
-        one, tests/helpers.py), computed in chunks that keep the gathered terms near 16 MB."""
-        s_count, t_count = pos_idx.shape
-        j_count = self._n
-        weights = self.belief.weights
-        n = len(weights)
-        z = np.zeros((s_count, j_count + 1, t_count))
-        prob = np.zeros((s_count, j_count + 1))
-        chunk = max(1, 2_000_000 // (t_count * n))
-        stage = np.arange(t_count)
-        for start in range(0, s_count, chunk):
-            rows = slice(start, min(start + chunk, s_count))
-            log_nd = self.terms.log_nd[pos_idx[rows]]  # (s, T, N)
-            p_detect_i = weights * -np.expm1(log_nd.sum(axis=1))  # (s, N)
-            p_detect = p_detect_i.sum(axis=1)
-            live = p_detect > 1e-300
-            prob[rows, 0] = np.where(live, np.maximum(1.0 - p_detect, 0.0), 1.0)
-            prob[rows, 1:] = np.where(live, p_detect / j_count, 0.0)[:, None]
-            if not live.any():
-                continue
-            targets = (self._offset + np.arange(j_count)) / j_count
-            idx = np.zeros((len(p_detect), j_count), dtype=np.intp)
-            for k in np.flatnonzero(live):
-                cumulative = np.cumsum(p_detect_i[k]) / p_detect[k]
-                cumulative[-1] = 1.0
-                idx[k] = np.searchsorted(cumulative, targets, "right")
-            idx = idx.clip(0, n - 1)
-            pick = idx[:, None, :]  # (s, 1, J) into the particle axis
-
-            def gathered(a: np.ndarray, pick: np.ndarray = pick) -> np.ndarray:
-                return np.take_along_axis(a, pick, axis=2).transpose(0, 2, 1)  # (s, J, T)
-
-            nd = np.exp(gathered(log_nd))
-            ones = np.ones((*nd.shape[:2], 1))
-            before = np.cumprod(np.concatenate([ones, nd[:, :, :-1]], axis=2), axis=2)
-            first_cdf = np.cumsum(before * (1.0 - nd), axis=2)
-            target = self._first_u * first_cdf[:, :, -1]
-            first = (first_cdf <= target[:, :, None]).sum(axis=2).clip(0, t_count - 1)
-            conc = gathered(self.conc[pos_idx[rows]])
-            dist = gathered(self.terms.dist[pos_idx[rows]])
-            zz = self.sensor.simulate_from(conc, self.noise[None, :, :t_count], dist)
-            zz[stage[None, None, :] < first[:, :, None]] = 0.0
-            at_first = first[:, :, None]
-            detection = self.sensor.simulate_detection(
-                np.take_along_axis(conc, at_first, axis=2)[:, :, 0],
-                self._detect_u[None],
-                np.take_along_axis(dist, at_first, axis=2)[:, :, 0],
-            )
-            np.put_along_axis(zz, at_first, detection[:, :, None], axis=2)
-            zz[~live] = 0.0
-            z[rows, 1:] = zz
-        return z, prob
+        readings, (S, J') probabilities), those of a loop over the sequences bit for bit
+        (:func:`~dcee.planning.stratified_kernels.stratified_hypotheses`)."""
+        terms = self.terms
+        return stratified_hypotheses(
+            terms.log_nd, terms.conc, terms.dist, self.belief.weights, pos_idx, self.sensor,
+            self.noise, self._offset, self._first_u, self._detect_u,
+        )  # fmt: skip
 
     def stats(
         self,

@@ -130,14 +130,23 @@ def search_tree(
 
 
 def _ucb_choice(live: Sequence[TreeNode], parent_visits: int, exploration: float) -> TreeNode:
-    values = np.array([c.value for c in live])
-    finite = np.isfinite(values)
-    low = values[finite].min() if finite.any() else 0.0
-    span = values[finite].max() - low if finite.any() else 0.0
-    norm = np.where(finite, (values - low) / span if span > 0 else 0.0, np.inf)
-    visits = np.array([c.visits for c in live], dtype=float)
-    bonus = exploration * np.sqrt(math.log(max(parent_visits, 1)) / visits)
-    return live[int(np.argmin(norm - bonus))]
+    """The sibling of least (value − min) / (max − min) − c √(ln n_parent / n_child), the
+    first on ties; an infinite value is never chosen over a finite one. Plain Python: a
+    handful of siblings, where NumPy's per-call cost was most of the time."""
+    finite = [c.value for c in live if math.isfinite(c.value)]
+    low = min(finite) if finite else 0.0
+    span = max(finite) - low if finite else 0.0
+    log_parent = math.log(max(parent_visits, 1))
+    best, best_score = live[0], math.inf
+    for c in live:
+        if not math.isfinite(c.value):
+            norm = math.inf
+        else:
+            norm = (c.value - low) / span if span > 0 else 0.0
+        score = norm - exploration * math.sqrt(log_parent / c.visits)
+        if score < best_score:
+            best, best_score = c, score
+    return best
 
 
 def _backup(ancestors: list[TreeNode]) -> None:
@@ -245,17 +254,29 @@ class TreeSearchPlanner(Planner):
                 for i, (p, h) in enumerate(zip(nxt, heads, strict=True))
             ]
 
+        # the move that keeps a heading from a position, or None: rollouts follow the same
+        # straight lines from the root again and again (a per-decision table, not a NumPy
+        # search of the move set at every step: 0.4 of a 6 ms decision, lab, 2026-12-05)
+        straight: dict[tuple[bytes, int], int | None] = {}
+
         def complete(node: TreeNode) -> np.ndarray:
             """The node's moves, then its heading kept (a random turn at an edge)."""
-            out = [*node.sequence]
+            out = np.empty((self.depth, 3))
+            done = len(node.sequence)
+            out[:done] = node.sequence
             pos, heading = node.position, node.heading
-            while len(out) < self.depth:
+            for t in range(done, self.depth):
                 nxt, heads = agent.candidates(pos)
-                same = np.flatnonzero(heads == heading)
-                k = int(same[0]) if len(same) else int(turn.integers(len(heads)))
+                key = (pos.tobytes(), heading)
+                if key not in straight:
+                    same = np.flatnonzero(heads == heading)
+                    straight[key] = int(same[0]) if len(same) else None
+                k = straight[key]
+                if k is None:
+                    k = int(turn.integers(len(heads)))
                 pos, heading = nxt[k], int(heads[k])
-                out.append(pos)
-            return np.array(out)
+                out[t] = pos
+            return out
 
         root = TreeNode((), np.empty((0, 3)), np.asarray(position, float), -1)
         scored = search_tree(
