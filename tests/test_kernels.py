@@ -423,8 +423,8 @@ def test_one_stage_task_sums_in_one_call_equal_the_kernels_it_replaces():
     interpolated precision still interpolates a group of 16 readings or more and takes the
     one call (the same numbers as double precision) below that."""
     from dcee.planning.block_sums import BLOCK
-    from dcee.planning.one_stage_sums import one_stage_sums, one_stage_task_sums
-    from dcee.planning.reading_terms import task_setup
+    from dcee.planning.one_stage_sums import model_ceilings, one_stage_sums, one_stage_task_sums
+    from dcee.planning.reading_terms import task_bounds, task_setup
 
     source, weights, conc = _stats_case(n=2100, seed=4)
     conc[1] = np.random.default_rng(0).uniform(1e-6, 2e-5, conc.shape[1])
@@ -436,16 +436,27 @@ def test_one_stage_task_sums_in_one_call_equal_the_kernels_it_replaces():
     args = (loc, log_nd, inv_sigma, det_offset, weights, task_pos, v, fa, out, sensor.params)
     done, setup, sums = one_stage_task_sums(*args, True, len(task_pos) + 1)
     assert done
-    group_start, bound, *_ = task_setup(
+    group_start, live_bound, *_ = task_setup(
         task_pos, v, fa, out, log_nd, det_offset, weights, sensor.params
     )
+    # the bounds from the model's ceilings: above those from the largest live terms (the sum
+    # of a bound too low would be clipped), and within a few nats of them here
+    ceiling_nd, ceiling_det = model_ceilings(sensor.params)
+    assert ceiling_nd >= log_nd.max() and ceiling_det >= det_offset.max()
+    bound = np.empty(len(task_pos))
+    rows = log_nd.shape[0]
+    task_bounds(
+        task_pos, v, fa, out, np.full(rows, ceiling_nd), np.full(rows, ceiling_det),
+        sensor.params, bound,
+    )  # fmt: skip
+    assert np.array_equal(setup[1], bound) and np.array_equal(setup[0], group_start)
+    assert np.all(bound >= live_bound) and np.all(bound - live_bound < 12.0)
     partial = np.empty(((len(weights) + BLOCK - 1) // BLOCK, len(task_pos), 6))
     one_stage_sums(
         loc, log_nd, inv_sigma, det_offset, weights, group_start, task_pos, v, out, bound,
         sensor.params, True, partial,
     )  # fmt: skip
     assert np.array_equal(sums, partial.sum(axis=0))
-    assert np.array_equal(setup[1], bound)
     assert not one_stage_task_sums(*args, True, 2)[0]  # a group of two: "interpolate it"
 
     ref = predicted_posterior_stats_reference(conc, source, weights, task_pos, task_z, sensor)
