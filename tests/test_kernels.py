@@ -423,8 +423,8 @@ def test_one_stage_task_sums_in_one_call_equal_the_kernels_it_replaces():
     interpolated precision still interpolates a group of 16 readings or more and takes the
     one call (the same numbers as double precision) below that."""
     from dcee.planning.block_sums import BLOCK
-    from dcee.planning.one_stage_sums import model_ceilings, one_stage_sums, one_stage_task_sums
-    from dcee.planning.reading_terms import task_bounds, task_setup
+    from dcee.planning.one_stage_sums import one_stage_sums, one_stage_task_sums
+    from dcee.planning.reading_terms import model_ceilings, task_bounds, task_setup
 
     source, weights, conc = _stats_case(n=2100, seed=4)
     conc[1] = np.random.default_rng(0).uniform(1e-6, 2e-5, conc.shape[1])

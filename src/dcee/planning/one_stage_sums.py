@@ -20,7 +20,7 @@ from dcee.models.sensor_kernels import SensorParams
 from dcee.numeric import HALF_LOG_2PI, exp_scalar, log_scalar
 from dcee.planning.block_sums import BLOCK
 from dcee.planning.multi_stage_kernels import EXP_FLOOR  # weights stay normal floats
-from dcee.planning.reading_terms import task_bounds, task_layout, task_setup
+from dcee.planning.reading_terms import task_setup
 
 
 @njit(cache=True, parallel=True, fastmath={"contract", "reassoc"}, error_model="numpy")
@@ -100,21 +100,6 @@ def one_stage_sums(
 
 
 @njit(cache=True)
-def model_ceilings(sp: SensorParams) -> tuple[float, float]:
-    """Upper bounds of every particle's log P(non-detection) and log Pd − log σ at any position,
-    for the Gaussian family, from the model alone: log P(missed) ≤ 0, so log_nd ≤ log(1 − fa)
-    + log(1 − outlier); σ = σ_frac C + σ_min ≥ σ_min and Pd(r) ≤ Pd. A bound only has to
-    lie above the terms (the sums are relative to it; a task whose weights all fall more than
-    600 nats below it is redone exactly): these lie at most log(σ(C)/σ_min) + a few nats above
-    the largest live terms. The margin keeps the vectorised log's last-bit wobble below them."""
-    margin = 1e-9
-    return (
-        sp.log_not_false_alarm + sp.log_keep + margin,
-        sp.log_pd - log_scalar(sp.sigma_min) + margin,
-    )
-
-
-@njit(cache=True)
 def one_stage_task_sums(
     loc: np.ndarray,
     log_nd: np.ndarray,
@@ -140,35 +125,14 @@ def one_stage_task_sums(
     ``interpolate_from`` tasks or more (the caller sums those over interpolation nodes)."""
     s_count = task_positions.shape[0]
     sums = np.zeros((s_count, 6))
-    if sp.lognormal == 0.0:
-        # the Gaussian family: the model's own ceilings of the terms (model_ceilings) bound
-        # every particle's, so the pass over the rows for their largest live terms is not
-        # needed (45 of a decision's 140 µs of sums on Stone Soup's STE workload, hot: it read
-        # two terms of every row from memory before the sums read them again; lab, 2026-12-05)
-        group_start, _ = task_layout(task_positions, log_nd.shape[0])
-        largest = 0
-        for g in range(group_start.shape[0] - 1):
-            largest = max(largest, group_start[g + 1] - group_start[g])
-        if largest >= interpolate_from:
-            setup = task_setup(
-                task_positions, task_v, task_fa, task_out, log_nd, det_offset, weights, sp
-            )
-            return False, setup, sums
-        max_log_nd = np.empty(log_nd.shape[0])
-        max_det_offset = np.empty(log_nd.shape[0])
-        max_log_nd[:], max_det_offset[:] = model_ceilings(sp)
-        bound = np.empty(s_count)
-        task_bounds(
-            task_positions, task_v, task_fa, task_out, max_log_nd, max_det_offset, sp, bound
-        )
-        setup = (group_start, bound, largest, max_log_nd, max_det_offset)
-    else:
-        setup = task_setup(
-            task_positions, task_v, task_fa, task_out, log_nd, det_offset, weights, sp
-        )
-        group_start, bound, largest, _, _ = setup
-        if largest >= interpolate_from:
-            return False, setup, sums
+    # bounds from the model's ceilings for the Gaussian family (task_setup)
+    setup = task_setup(
+        task_positions, task_v, task_fa, task_out, log_nd, det_offset, weights, sp,
+        sp.lognormal == 0.0,
+    )  # fmt: skip
+    group_start, bound, largest, _, _ = setup
+    if largest >= interpolate_from:
+        return False, setup, sums
     n_blocks = (weights.shape[0] + BLOCK - 1) // BLOCK
     partial = np.empty((n_blocks, s_count, 6))
     one_stage_sums(

@@ -305,15 +305,20 @@ def predicted_posterior_stats(
             loc, log_nd, inv_sigma, det_offset, weights, task_positions, task_v, task_fa,
             task_out, sp, want_kl, interpolate_from,
         )  # fmt: skip
+    single = precision == "single" and one_stage
+    products = stage_products_apply(task_positions.shape[1], sp)
+    # the model's ceilings as bounds (task_setup) wherever the kernels' slack allows: not
+    # float32 weights, not the product kernel's per-stage floors
+    ceilings = sp.lognormal == 0.0 and not products and not single
     group_start, bound, largest_group, max_log_nd, max_det_offset = (
-        task_setup(task_positions, task_v, task_fa, task_out, log_nd, det_offset, weights, sp)
+        task_setup(
+            task_positions, task_v, task_fa, task_out, log_nd, det_offset, weights, sp, ceilings
+        )
         if setup is None
         else setup
     )
     log_ref = bound.copy()
     common = (loc, log_nd, inv_sigma, det_offset, source, weights, center)
-    single = precision == "single" and one_stage
-    products = stage_products_apply(task_positions.shape[1], sp)
     if not done:  # the general kernels
         n_blocks = (source.shape[0] + _BLOCK - 1) // _BLOCK
         vector_path = sp.false_alarm == 0.0

@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit, prange
 
 from dcee.models.sensor_kernels import SensorParams
-from dcee.numeric import HALF_LOG_2PI, logaddexp
+from dcee.numeric import HALF_LOG_2PI, log_scalar, logaddexp
 
 
 @njit(cache=True, inline="always")
@@ -366,6 +366,22 @@ def exact_task_stats(
 
 
 @njit(cache=True)
+def model_ceilings(sp: SensorParams) -> tuple[float, float]:
+    """Upper bounds of every particle's log P(non-detection) and log Pd − log σ at any position,
+    for the Gaussian family, from the model alone: log P(missed) ≤ 0, so log_nd ≤ log(1 − fa)
+    + log(1 − outlier); σ = σ_frac C + σ_min ≥ σ_min and Pd(r) ≤ Pd. A bound only has to lie
+    above the terms (the sums are relative to it; a task whose weights all fall more than the
+    kernel's slack below it is redone exactly): these lie at most log(σ(C)/σ_min) + a few nats
+    per stage above the largest live terms. The margin keeps the vectorised log's last-bit
+    wobble below them."""
+    margin = 1e-9
+    return (
+        sp.log_not_false_alarm + sp.log_keep + margin,
+        sp.log_pd - log_scalar(sp.sigma_min) + margin,
+    )
+
+
+@njit(cache=True)
 def task_setup(
     task_positions: np.ndarray,
     task_v: np.ndarray,
@@ -375,15 +391,28 @@ def task_setup(
     det_offset: np.ndarray,
     weights: np.ndarray,
     sp: SensorParams,
+    ceilings: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray]:
     """What the statistics kernels need of a task list, in one call: (group_start
-    (:func:`task_layout`), each task's bound (S,) (:func:`task_bound` from the largest live
-    terms of the rows the tasks read, :func:`live_row_max`), the largest group's size, and
-    those largest terms per row (R,) (−inf for rows no task reads))."""
+    (:func:`task_layout`), each task's bound (S,) (:func:`task_bound` from the largest terms of
+    the rows the tasks read), the largest group's size, and those largest terms per row (R,)
+    (−inf for rows no task reads)).
+
+    The largest terms are those of the particles with weight (:func:`live_row_max`, a pass
+    over two terms of every row read), or with ``ceilings`` (a Gaussian-family sensor only)
+    the model's own bounds (:func:`model_ceilings`): no pass over the particles, bounds a few
+    nats looser (measured on Stone Soup's STE workload: 45 of the one-stage sums' 140 µs per
+    decision, hot; lab, 2026-12-05)."""
     group_start, used = task_layout(task_positions, log_nd.shape[0])
     max_log_nd = np.full(log_nd.shape[0], -np.inf)
     max_det_offset = np.full(log_nd.shape[0], -np.inf)
-    live_row_max(log_nd, det_offset, used, weights, max_log_nd, max_det_offset)
+    if ceilings:
+        ceiling_nd, ceiling_det = model_ceilings(sp)
+        for r in used:
+            max_log_nd[r] = ceiling_nd
+            max_det_offset[r] = ceiling_det
+    else:
+        live_row_max(log_nd, det_offset, used, weights, max_log_nd, max_det_offset)
     bound = np.empty(task_positions.shape[0])
     task_bounds(task_positions, task_v, task_fa, task_out, max_log_nd, max_det_offset, sp, bound)
     largest = 0
