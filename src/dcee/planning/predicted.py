@@ -26,7 +26,6 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.estimation.resampling import systematic_resample
-from dcee.models.sensor import Sensor
 from dcee.planning.base import Belief
 from dcee.planning.location_kl import location_cells, location_kl
 from dcee.planning.particle_terms import ParticleTerms, PositionTerms
@@ -34,6 +33,7 @@ from dcee.planning.predicted_kernels import predicted_posterior_stats
 from dcee.planning.reading_terms import (
     gaussian_sampled_readings,
     gaussian_transformed,
+    plain_gaussian,
     unique_tasks,
 )
 from dcee.planning.stratified_kernels import stratified_hypotheses
@@ -61,12 +61,6 @@ class SequenceStats:
 
 
 _NO_CENTER = np.zeros(3)  # passed where no statistic reads the reference point
-
-
-def _plain_gaussian(sensor: Sensor) -> bool:
-    """A Gaussian-family sensor with a constant Pd and no outliers: its readings and their
-    transformed terms have compiled forms (:mod:`dcee.planning.reading_terms`)."""
-    return not sensor.lognormal and sensor.near_length == 0 and sensor.outlier == 0
 
 
 EXPECTATIONS = ("sampled", "stratified")
@@ -267,7 +261,7 @@ class PredictionContext:
         the same as :meth:`readings` for each sequence (shared noise), in one NumPy pass."""
         t_count = pos_idx.shape[1]
         sensor = self.sensor
-        if _plain_gaussian(sensor):
+        if plain_gaussian(sensor):
             return gaussian_sampled_readings(
                 self.conc, self.indices, pos_idx, self.noise, sensor.sigma_frac,
                 sensor.sigma_min, sensor.pd, sensor.threshold, sensor.false_alarm,
@@ -367,7 +361,7 @@ class PredictionContext:
         reading or half the threshold, the other terms −inf and 0), without its dozen NumPy
         calls."""
         sensor = self.sensor
-        if _plain_gaussian(sensor) and sensor.false_alarm == 0:
+        if plain_gaussian(sensor) and sensor.false_alarm == 0:
             never = np.full_like(tz, -np.inf)
             return gaussian_transformed(tz, sensor.threshold), never, never, np.zeros_like(tz)
         return sensor.transformed_readings(tz)

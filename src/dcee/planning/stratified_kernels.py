@@ -24,6 +24,7 @@ from numba import njit
 
 from dcee.models.sensor import Sensor
 from dcee.planning.particle_terms import pairwise_sum
+from dcee.planning.reading_terms import gaussian_reading, plain_gaussian
 
 
 @njit(cache=True)
@@ -130,6 +131,30 @@ def _first_detecting_stage(
 
 
 @njit(cache=True)
+def _gaussian_readings(
+    conc_sel: np.ndarray,
+    noise: np.ndarray,
+    sigma_frac: float,
+    sigma_min: float,
+    pd: float,
+    threshold: float,
+    false_alarm: float,
+    false_alarm_scale: float,
+    out: np.ndarray,
+) -> None:
+    """out[s, j, t] = the reading of a plain Gaussian sensor at conc_sel[s, j, t] from the
+    shared noise[j, t] (:func:`~dcee.planning.reading_terms.gaussian_reading`)."""
+    s_count, j_count, t_count = conc_sel.shape
+    for s in range(s_count):
+        for j in range(j_count):
+            for t in range(t_count):
+                out[s, j, t] = gaussian_reading(
+                    conc_sel[s, j, t], noise[j, t], sigma_frac, sigma_min, pd, threshold,
+                    false_alarm, false_alarm_scale,
+                )  # fmt: skip
+
+
+@njit(cache=True)
 def _assemble(
     readings: np.ndarray, first: np.ndarray, detection: np.ndarray, live: np.ndarray, z: np.ndarray
 ) -> None:
@@ -193,7 +218,14 @@ def stratified_hypotheses(
         _first_detecting_stage(
             np.exp(selected[0]), first_u, selected[1], selected[2], first, at_first[0], at_first[1]
         )
-        readings = sensor.simulate_from(selected[1], noise[None, :, :t_count], selected[2])
+        if plain_gaussian(sensor):
+            readings = np.empty((s, j_count, t_count))
+            _gaussian_readings(
+                selected[1], noise, sensor.sigma_frac, sensor.sigma_min, sensor.pd,
+                sensor.threshold, sensor.false_alarm, sensor.false_alarm_scale, readings,
+            )  # fmt: skip
+        else:
+            readings = sensor.simulate_from(selected[1], noise[None, :, :t_count], selected[2])
         detection = sensor.simulate_detection(at_first[0], detect_u[None], at_first[1])
         _assemble(readings, first, detection, live, z[rows])
     return z, prob
