@@ -468,3 +468,24 @@ def test_lbm3d_errors_along_and_across_the_wind_by_hand(tmp_path: Path) -> None:
     assert errors["median_downwind_error"] == pytest.approx((-1.0 + 3.0) / 2)
     assert errors["median_crosswind_error"] == pytest.approx((0.5 + 0.25) / 2)
     assert errors["median_height_error"] == pytest.approx((0.2 - 0.2) / 2)
+
+
+def test_the_speed_table_publishes_the_lowest_run_of_the_newest_code() -> None:
+    """A speed-up belongs to one code version: of the stored Stone Soup runs the table takes
+    the lowest of those with the newest run's package source, and counts the others."""
+    from studies.tables.performance import _lowest_text, _of_newest_code
+
+    def run(day: str, source: str, ratio: float) -> dict:
+        code = {"commit": source * 7, "source_hash": source}
+        return {"load": {"started": f"2026-12-0{day}T08:00:00"}, "machine": {"code": code},
+                "speedup": ratio}  # fmt: skip
+
+    records = sorted(
+        [run("1", "a", 30.0), run("2", "b", 52.0), run("3", "b", 55.0), run("2", "c", 40.0)],
+        key=lambda r: r["speedup"],
+    )  # the table's order: lowest first; the newest run (day 3) measured source "b"
+    same, earlier = _of_newest_code(records)
+    assert [r["speedup"] for r in same] == [52.0, 55.0] and earlier == 2
+    text = _lowest_text(same, lambda r: r["speedup"], earlier)
+    assert "the lowest of 2 stored runs of this code (the others: 55.0× on 2026-12-03)" in text
+    assert text.endswith("2 of earlier code in the runs table below")
