@@ -28,9 +28,11 @@ class SearchVolume:
 
     def contains(self, points: np.ndarray, tol: float = 1e-9) -> np.ndarray:
         """(K, 3) points → (K,) bool, inside the volume (boundary included)."""
-        p = np.atleast_2d(points)
-        low, high = self._corners  # the tree search asks thousands of times per decision
-        return np.all((p >= low - tol) & (p <= high + tol), axis=1)
+        p = points if np.ndim(points) == 2 else np.atleast_2d(points)
+        # the tree search asks thousands of times per decision: array methods, not np.all's
+        # dispatch, and the corners kept
+        low, high = self._corners
+        return ((p >= low - tol) & (p <= high + tol)).all(axis=1)
 
 
 CANDIDATES_KEPT = 65_536

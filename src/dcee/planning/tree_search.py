@@ -250,7 +250,7 @@ class TreeSearchPlanner(Planner):
             else:  # the root's children are the candidates given
                 nxt, heads = candidates, first_headings
             return [
-                TreeNode((*node.path, i), np.vstack([node.sequence, p]), p, int(h))
+                TreeNode((*node.path, i), np.concatenate((node.sequence, p[None])), p, int(h))
                 for i, (p, h) in enumerate(zip(nxt, heads, strict=True))
             ]
 
