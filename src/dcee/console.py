@@ -50,14 +50,28 @@ def _redeliver_interrupts(unraisable: Any, fallback: Callable[[Any], None]) -> N
     returned (from a timer thread: a signal simulated here would be raised inside this hook and
     lost again; should it land in another finaliser, this hook defers it once more)."""
     if unraisable.exc_type is not None and issubclass(unraisable.exc_type, KeyboardInterrupt):
-        import _thread
-        import threading
-
-        timer = threading.Timer(0.01, _thread.interrupt_main)
-        timer.daemon = True
-        timer.start()
+        _interrupt_main_soon()
     else:
         fallback(unraisable)
+
+
+def _interrupt_main_soon(delay: float = 0.01) -> None:
+    """Raise KeyboardInterrupt in the main thread ``delay`` s from now, from a timer thread.
+    Should the main thread still be in here when the timer fires (``Timer.start`` waits for the
+    thread to start: on a loaded machine the 10 ms can pass first; seen once in a CI run), the
+    interrupt lands in this hook, where Python would print it and drop it: it is caught and
+    scheduled again, later each time."""
+    import _thread
+    import threading
+
+    while True:
+        try:
+            timer = threading.Timer(delay, _thread.interrupt_main)
+            timer.daemon = True
+            timer.start()
+            return
+        except KeyboardInterrupt:
+            delay *= 2
 
 
 def run_command(command: click.Command, program: str, argv: list[str] | None = None) -> None:
