@@ -285,6 +285,18 @@ def test_vectorised_erfc_and_log_match_scipy_and_numpy():
     normal = ref > 1e-300
     np.testing.assert_allclose(out[normal], ref[normal], rtol=1e-13, atol=0)
     assert np.all(out[~normal] <= 1e-300)
+    # the kernel evaluates the Chebyshev series of studies/fit_erfcx.py as the same polynomial
+    # in powers of t (Horner's rule); the literals in _verfc_pos are _ERFCX_POWERS'
+    from numpy.polynomial import chebyshev
+
+    from dcee.numeric import _ERFCX_CHEB, _ERFCX_POWERS
+
+    assert np.array_equal(chebyshev.cheb2poly(np.array(_ERFCX_CHEB)), np.array(_ERFCX_POWERS))
+    t = np.linspace(-1.0, 1.0, 4001)
+    horner = np.zeros_like(t)
+    for c in _ERFCX_POWERS[::-1]:
+        horner = c + t * horner
+    np.testing.assert_allclose(horner, chebyshev.chebval(t, _ERFCX_CHEB), rtol=2e-15, atol=0)
     # every normal float: the exponent is read from the bits (2^−1022 … 2^1023)
     tiny, huge = np.finfo(float).tiny, np.finfo(float).max
     x = np.concatenate(

@@ -167,8 +167,13 @@ def vlog1p(x: np.ndarray, out: np.ndarray) -> None:
 # --- erfc, Φ and log that the compiler can vectorise (issue 17) -------------------------------
 # erfc(y) = e^(−y²) · erfcx(y) for y ≥ 0, with (y + K) · erfcx(y) a Chebyshev series in
 # t = (y − K)/(y + K) ∈ [−1, 1) (K = 3; coefficients from studies/fit_erfcx.py, relative error
-# < 1e-14 against scipy.special.erfcx on [0, 1e6]). log(x) = m ln 2 + log1p(x 2^−m − 1) with m
-# and x 2^−m ∈ [1, 2) read from the float's bits (no frexp, which numba only has as a scalar call).
+# < 1e-14 against scipy.special.erfcx on [0, 1e6]), evaluated as the same polynomial in powers
+# of t by Horner's rule (_ERFCX_POWERS: numpy's cheb2poly of the series, tested; Σ|a_k| = 3.0,
+# so no cancellation): 24 fused multiply-adds where Clenshaw's recurrence took 24 and as many
+# subtractions, half the time per value (178 → 94 µs for 44,000 values, one core, lab
+# 2026-12-05), the same largest error against scipy (4.0e-15). log(x) = m ln 2 + log1p(x 2^−m − 1)
+# with m and x 2^−m ∈ [1, 2) read from the float's bits (no frexp, which numba only has as a scalar
+# call).
 _ERFCX_K = 3.0
 _ERFCX_CHEB = (
     1.4134382239808718,
@@ -197,6 +202,33 @@ _ERFCX_CHEB = (
     -6.280369834735103e-17,
     -1.2560739669470208e-16,
 )
+_ERFCX_POWERS = (
+    1.0740069070883378,
+    -0.883394453169885,
+    0.5902283571041358,
+    -0.31046726190113544,
+    0.11952776128845326,
+    -0.02682723460248894,
+    -0.0012124166574628338,
+    0.0030340617140000455,
+    -0.0005483094193117422,
+    -0.00027677594206967926,
+    0.00010756025099266497,
+    3.039074264262238e-05,
+    -1.7467570237306214e-05,
+    -4.731053693648649e-06,
+    2.7621434201622248e-06,
+    9.701828476691367e-07,
+    -4.0928108308012543e-07,
+    -2.0437002727029336e-07,
+    5.435050142444879e-08,
+    3.2264564987978334e-08,
+    -1.1080011346809263e-08,
+    -1.8274610096520464e-09,
+    4.60981155587904e-09,
+    -2.634178031930878e-10,
+    -1.0536712127723514e-09,
+)
 _LN2 = math.log(2.0)
 
 
@@ -206,34 +238,33 @@ def _verfc_pos(y: float) -> float:
     float (y < 26.5), 0 beyond."""
     inv = 1.0 / (y + _ERFCX_K)
     t = (y - _ERFCX_K) * inv
-    t2 = 2.0 * t
-    # Clenshaw's recurrence, unrolled so that the loop that calls this vectorises
-    b1 = -1.2560739669470208e-16
-    b2 = 0.0
-    b1, b2 = -6.280369834735103e-17 + t2 * b1 - b2, b1
-    b1, b2 = -8.164480785155627e-16 + t2 * b1 - b2, b1
-    b1, b2 = -3.1872876911280614e-15 + t2 * b1 - b2, b1
-    b1, b2 = -7.442238254161089e-15 + t2 * b1 - b2, b1
-    b1, b2 = 7.059135694242251e-14 + t2 * b1 - b2, b1
-    b1, b2 = 2.4553105868896866e-13 + t2 * b1 - b2, b1
-    b1, b2 = -1.2571416298189248e-12 + t2 * b1 - b2, b1
-    b1, b2 = -6.991301208084987e-12 + t2 * b1 - b2, b1
-    b1, b2 = 2.4374344807077615e-11 + t2 * b1 - b2, b1
-    b1, b2 = 1.8742300198431857e-10 + t2 * b1 - b2, b1
-    b1, b2 = -5.842010763322025e-10 + t2 * b1 - b2, b1
-    b1, b2 = -5.030507708370746e-09 + t2 * b1 - b2, b1
-    b1, b2 = 1.9195224395238778e-08 + t2 * b1 - b2, b1
-    b1, b2 = 1.3247975758016788e-07 + t2 * b1 - b2, b1
-    b1, b2 = -8.23944015919793e-07 + t2 * b1 - b2, b1
-    b1, b2 = -2.6427850743427207e-06 + t2 * b1 - b2, b1
-    b1, b2 = 3.904342109700625e-05 + t2 * b1 - b2, b1
-    b1, b2 = -6.429066714269583e-05 + t2 * b1 - b2, b1
-    b1, b2 = -0.0013795571636295227 + t2 * b1 - b2, b1
-    b1, b2 = 0.014615273272815577 + t2 * b1 - b2, b1
-    b1, b2 = -0.08508704009908587 + t2 * b1 - b2, b1
-    b1, b2 = 0.3541081003424861 + t2 * b1 - b2, b1
-    b1, b2 = -1.131476849074697 + t2 * b1 - b2, b1
-    series = 1.4134382239808718 + t * b1 - b2
+    # Horner's rule in t, the literals of _ERFCX_POWERS (unrolled so that the loop that calls
+    # this vectorises)
+    p = -1.0536712127723514e-09
+    p = -2.634178031930878e-10 + t * p
+    p = 4.60981155587904e-09 + t * p
+    p = -1.8274610096520464e-09 + t * p
+    p = -1.1080011346809263e-08 + t * p
+    p = 3.2264564987978334e-08 + t * p
+    p = 5.435050142444879e-08 + t * p
+    p = -2.0437002727029336e-07 + t * p
+    p = -4.0928108308012543e-07 + t * p
+    p = 9.701828476691367e-07 + t * p
+    p = 2.7621434201622248e-06 + t * p
+    p = -4.731053693648649e-06 + t * p
+    p = -1.7467570237306214e-05 + t * p
+    p = 3.039074264262238e-05 + t * p
+    p = 0.00010756025099266497 + t * p
+    p = -0.00027677594206967926 + t * p
+    p = -0.0005483094193117422 + t * p
+    p = 0.0030340617140000455 + t * p
+    p = -0.0012124166574628338 + t * p
+    p = -0.02682723460248894 + t * p
+    p = 0.11952776128845326 + t * p
+    p = -0.31046726190113544 + t * p
+    p = 0.5902283571041358 + t * p
+    p = -0.883394453169885 + t * p
+    series = 1.0740069070883378 + t * p
     y2 = y * y
     value = exp_scalar(max(-y2, -700.0)) * series * inv
     return value if y2 < 700.0 else 0.0
