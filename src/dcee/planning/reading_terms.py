@@ -394,7 +394,9 @@ def exact_task_stats(
 def model_ceilings(sp: SensorParams) -> tuple[float, float]:
     """Upper bounds of every particle's log P(non-detection) and log Pd − log σ at any position,
     for the Gaussian family, from the model alone: log P(missed) ≤ 0, so log_nd ≤ log(1 − fa)
-    + log(1 − outlier); σ = σ_frac C + σ_min ≥ σ_min and Pd(r) ≤ Pd. A bound only has to lie
+    + log(1 − outlier); σ = σ_frac C + σ_min ≥ σ_min for C ≥ 0 (every estimator plume's: the
+    isotropic formula, and the wall and room plumes' receptor fields, triangular solves of an
+    M-matrix's factors with a nonnegative right-hand side) and Pd(r) ≤ Pd. A bound only has to lie
     above the terms (the sums are relative to it; a task whose weights all fall more than the
     kernel's slack below it is redone exactly): these lie at most log(σ(C)/σ_min) + a few nats
     per stage above the largest live terms. The margin keeps the vectorised log's last-bit
