@@ -60,6 +60,23 @@ def test_the_room_s_estimator_knows_its_wind_field_unless_told_it_knows_only_its
         load_scenario("site:wall").with_overrides(**{"estimator.wall_wind": "room"})
 
 
+def test_dcee_show_says_which_wall_settings_the_reading_model_does_not_read():
+    """In the room's own wind the wake wind's viscosity is not read; with the open plume none
+    of the wall settings is: ``dcee show`` says so in place of a provenance that would read as
+    if it applied; the settings it does read keep theirs."""
+    from dcee.scenarios import to_toml
+
+    room = to_toml(load_scenario(str(DATA / "empty-room-cfd")))
+    assert '# wall_viscosity = 1.0  (unset; not read with estimator.wall_wind = "room")' in room
+    assert '# wall_wind = "room"  (unset: the default for this scenario)' in room
+    robot = to_toml(load_scenario(str(DATA / "empty-room-cfd")).with_overrides(unknown="full"))
+    for key in ("wall_diffusivity", "wall_wind", "wall_viscosity"):
+        line = next(x for x in robot.splitlines() if x.startswith(f"# {key} = "))
+        assert line.endswith('(unset; not read with estimator.plume = "open")'), line
+    site = to_toml(load_scenario("site:wall"))  # the wake wind: its viscosity is read
+    assert "# wall_viscosity = 1.0  (unset: the default for this scenario)" in site
+
+
 def test_the_truth_reads_gaden_s_ppm_in_grams_per_cubic_metre():
     """At search time t the truth reads the file saved at 60 s + t: GADEN's reference ppm ×
     10⁻⁶ × the air's 40.894633 mol/m³ × ethanol's 46.07 g/mol; past the files' end the

@@ -161,6 +161,19 @@ class ScenarioBuilders:
             ("estimator", "wall_viscosity"): self.wall_viscosity,
         }
 
+    def unread_settings(self) -> dict[tuple[str, str], str]:
+        """{(section, key): why}: the estimator's wall settings this scenario's reading model
+        does not read (``dcee show`` says so instead of their provenance): the wall ones
+        without the wall-aware plume, the wake wind's viscosity with another wind."""
+        if self.plume_model != "walls":
+            why = f'estimator.plume = "{self.plume_model}"'
+            return {
+                ("estimator", k): why for k in ("wall_diffusivity", "wall_wind", "wall_viscosity")
+            }
+        if self.wall_wind != "wake":
+            return {("estimator", "wall_viscosity"): f'estimator.wall_wind = "{self.wall_wind}"'}
+        return {}
+
     def resolved_unset(self) -> dict[str, Any]:
         """{"section.key": value}: each setting of :meth:`resolution_map` left unset, as the
         value it resolves to today. A campaign records it beside its scenarios, so that a later

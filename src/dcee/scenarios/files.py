@@ -143,6 +143,7 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
     # settings left unset follow the truth or the likelihood: shown as comments with the value
     # this scenario resolves them to, so the file reads back with them still unset
     resolved = scenario.resolution_map()
+    unread = scenario.unread_settings()
     # unset with no single resolved value: what unset means, in words
     unset = {
         ("search", "stop_spread"): (
@@ -176,6 +177,11 @@ def to_toml(scenario: Scenario, provenance: bool = True) -> str:
                 lines.append(_bearing_comment(v))
         for (section, k), v in resolved.items():
             if section == key and k not in table:
+                if (key, k) in unread:
+                    lines.append(
+                        f"# {k} = {_toml_value(v)}  (unset; not read with {unread[key, k]})"
+                    )
+                    continue
                 lines.append(f"# {k} = {_toml_value(v)}  (unset: the default for this scenario)")
                 if provenance and (key, k) in DEFAULTS:
                     lines.append(f"# ^ {DEFAULTS[key, k].line()}")
