@@ -434,36 +434,47 @@ def test_likelihood_applies_before_the_settings_that_need_it():
     assert scenario.reading_models == ("fluctuation", "fluctuation[decay=0.5]", "paper")
 
 
-def test_an_interrupt_inside_a_finaliser_still_ends_the_command(capsys):
-    """Ctrl-C landing inside a ``__del__`` (numba's finalisers, say) is not printed and lost:
-    the command ends with exit 130 and one line, no traceback."""
+class _InterruptedWhileCollected:
+    def __del__(self):
+        raise KeyboardInterrupt
+
+
+def _exit_of_a_command_interrupted_in_a_finaliser(capsys, busy_seconds: float) -> tuple:
+    """Run a command whose object raises KeyboardInterrupt in its finaliser and then keeps the
+    main thread busy ``busy_seconds`` (the redelivered interrupt must end it): (exit code,
+    stderr). Ctrl-C is handled as in a terminal meanwhile: a job started in the background
+    from a script starts with SIGINT ignored, and then Python neither raises nor redelivers
+    it."""
+    import time
+
     import click
 
     from dcee.console import run_command
 
-    class InterruptedWhileCollected:
-        def __del__(self):
-            raise KeyboardInterrupt
-
     @click.command()
     def busy():
-        obj = InterruptedWhileCollected()
+        obj = _InterruptedWhileCollected()
         del obj  # the interrupt is raised in the finaliser: Python would print and go on
-        for _ in range(10_000_000):  # the redelivered interrupt ends this loop at once
+        end = time.perf_counter() + busy_seconds
+        while time.perf_counter() < end:
             pass
         raise AssertionError("the interrupt was lost")
 
-    previous = sys.unraisablehook
-    # Ctrl-C handled as in a terminal: a job started in the background from a script starts
-    # with SIGINT ignored, and then Python neither raises nor redelivers it
     previous_int = signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         with pytest.raises(SystemExit) as exc:
             run_command(busy, "dcee", [])
     finally:
         signal.signal(signal.SIGINT, previous_int)
-    assert exc.value.code == 130 and sys.unraisablehook is previous
-    err = capsys.readouterr().err
+    return exc.value.code, capsys.readouterr().err
+
+
+def test_an_interrupt_inside_a_finaliser_still_ends_the_command(capsys):
+    """Ctrl-C landing inside a ``__del__`` (numba's finalisers, say) is not printed and lost:
+    the command ends with exit 130 and one line, no traceback."""
+    previous = sys.unraisablehook
+    code, err = _exit_of_a_command_interrupted_in_a_finaliser(capsys, 2.0)
+    assert code == 130 and sys.unraisablehook is previous
     assert err.strip() == "dcee: interrupted" and "Traceback" not in err
 
 
@@ -475,10 +486,6 @@ def test_an_interrupt_redelivered_while_its_timer_starts_is_delivered_again(caps
     import threading
     import time
 
-    import click
-
-    from dcee.console import run_command
-
     start = threading.Timer.start
 
     def slow_start(self):
@@ -488,26 +495,6 @@ def test_an_interrupt_redelivered_while_its_timer_starts_is_delivered_again(caps
             pass
 
     monkeypatch.setattr(threading.Timer, "start", slow_start)
-
-    class InterruptedWhileCollected:
-        def __del__(self):
-            raise KeyboardInterrupt
-
-    @click.command()
-    def busy():
-        obj = InterruptedWhileCollected()
-        del obj
-        end = time.perf_counter() + 5.0
-        while time.perf_counter() < end:  # the redelivered interrupt ends this loop
-            pass
-        raise AssertionError("the interrupt was lost")
-
-    previous_int = signal.signal(signal.SIGINT, signal.default_int_handler)
-    try:
-        with pytest.raises(SystemExit) as exc:
-            run_command(busy, "dcee", [])
-    finally:
-        signal.signal(signal.SIGINT, previous_int)
-    assert exc.value.code == 130
-    err = capsys.readouterr().err
+    code, err = _exit_of_a_command_interrupted_in_a_finaliser(capsys, 5.0)
+    assert code == 130
     assert err.strip() == "dcee: interrupted" and "Traceback" not in err

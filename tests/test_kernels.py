@@ -297,6 +297,15 @@ def test_vectorised_erfc_and_log_match_scipy_and_numpy():
     for c in _ERFCX_POWERS[::-1]:
         horner = c + t * horner
     np.testing.assert_allclose(horner, chebyshev.chebval(t, _ERFCX_CHEB), rtol=2e-15, atol=0)
+    # and the kernel's unrolled literals are those: erfc(y) = e^(−y²) · series(t) / (y + 3)
+    # with this Horner sum, to the last bits of the two exp implementations
+    y = np.linspace(0.0, 6.0, 3001)
+    series = np.zeros_like(y)
+    for c in _ERFCX_POWERS[::-1]:
+        series = c + (y - 3.0) / (y + 3.0) * series
+    kernel = np.empty_like(y)
+    verfc(y, kernel)
+    np.testing.assert_allclose(kernel, np.exp(-y * y) * series / (y + 3.0), rtol=1e-14, atol=0)
     # every normal float: the exponent is read from the bits (2^−1022 … 2^1023)
     tiny, huge = np.finfo(float).tiny, np.finfo(float).max
     x = np.concatenate(
@@ -408,10 +417,7 @@ def test_compiled_sampled_readings_are_the_sensors_bit_for_bit(sensor):
     indices = rng.integers(0, 300, 40)
     pos_idx = rng.integers(0, 7, (9, 2))
     noise = sensor.draw_noise(rng, (40, 3))
-    got = gaussian_sampled_readings(
-        conc, indices, pos_idx, noise, sensor.sigma_frac, sensor.sigma_min, sensor.pd,
-        sensor.threshold, sensor.false_alarm, sensor.false_alarm_scale,
-    )  # fmt: skip
+    got = gaussian_sampled_readings(conc, indices, pos_idx, noise, sensor.params)
     want = sensor.simulate_from(
         conc[:, indices][pos_idx].transpose(0, 2, 1), noise[None, :, :2], np.inf
     )

@@ -125,11 +125,10 @@ def one_stage_task_sums(
     ``interpolate_from`` tasks or more (the caller sums those over interpolation nodes)."""
     s_count = task_positions.shape[0]
     sums = np.zeros((s_count, 6))
-    # bounds from the model's ceilings for the Gaussian family (task_setup)
+    # bounds from the model's ceilings where the sensor has them (task_setup)
     setup = task_setup(
-        task_positions, task_v, task_fa, task_out, log_nd, det_offset, weights, sp,
-        sp.lognormal == 0.0,
-    )  # fmt: skip
+        task_positions, task_v, task_fa, task_out, log_nd, det_offset, weights, sp, True
+    )
     group_start, bound, largest, _, _ = setup
     if largest >= interpolate_from:
         return False, setup, sums

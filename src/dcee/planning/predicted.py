@@ -262,11 +262,7 @@ class PredictionContext:
         t_count = pos_idx.shape[1]
         sensor = self.sensor
         if plain_gaussian(sensor):
-            return gaussian_sampled_readings(
-                self.conc, self.indices, pos_idx, self.noise, sensor.sigma_frac,
-                sensor.sigma_min, sensor.pd, sensor.threshold, sensor.false_alarm,
-                sensor.false_alarm_scale,
-            )  # fmt: skip
+            return gaussian_sampled_readings(self.conc, self.indices, pos_idx, self.noise, self._sp)
         c = self.conc[:, self.indices][pos_idx].transpose(0, 2, 1)  # (S, J, T)
         r = self.terms.dist[:, self.indices][pos_idx].transpose(0, 2, 1)
         return self.sensor.simulate_from(c, self.noise[None, :, :t_count], r)

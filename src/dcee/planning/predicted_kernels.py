@@ -309,7 +309,7 @@ def predicted_posterior_stats(
     products = stage_products_apply(task_positions.shape[1], sp)
     # the model's ceilings as bounds (task_setup) wherever the kernels' slack allows: not
     # float32 weights, not the product kernel's per-stage floors
-    ceilings = sp.lognormal == 0.0 and not products and not single
+    ceilings = not products and not single
     group_start, bound, largest_group, max_log_nd, max_det_offset = (
         task_setup(
             task_positions, task_v, task_fa, task_out, log_nd, det_offset, weights, sp, ceilings

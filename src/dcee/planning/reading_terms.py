@@ -110,50 +110,34 @@ def gaussian_sampled_readings(
     indices: np.ndarray,
     pos_idx: np.ndarray,
     noise: np.ndarray,
-    sigma_frac: float,
-    sigma_min: float,
-    pd: float,
-    threshold: float,
-    false_alarm: float,
-    false_alarm_scale: float,
+    sp: SensorParams,
 ) -> np.ndarray:
     """(S, J, T) hypothesised readings of the J particles ``indices`` (J,) along (S, T)
     sequences of position rows ``pos_idx`` of ``conc`` (R, N), from standard noise (J, T', 4),
     T' ≥ T: :meth:`dcee.models.sensor.Sensor.simulate_from` for a Gaussian-family sensor with
-    a constant Pd and no outliers, the same arithmetic in the same order (the same bits, tested),
-    without its dozen NumPy calls and the gathers before them."""
+    a constant Pd and no outliers (:func:`plain_gaussian`), the same arithmetic in the same
+    order (the same bits, tested), without its dozen NumPy calls and the gathers before them."""
     s_count, t_count = pos_idx.shape
     j_count = indices.shape[0]
     z = np.empty((s_count, j_count, t_count))
     for s in range(s_count):
         for j in range(j_count):
             for t in range(t_count):
-                z[s, j, t] = gaussian_reading(
-                    conc[pos_idx[s, t], indices[j]], noise[j, t], sigma_frac, sigma_min, pd,
-                    threshold, false_alarm, false_alarm_scale,
-                )  # fmt: skip
+                z[s, j, t] = gaussian_reading(conc[pos_idx[s, t], indices[j]], noise[j, t], sp)
     return z
 
 
 @njit(cache=True, inline="always")
-def gaussian_reading(
-    c: float,
-    noise: np.ndarray,
-    sigma_frac: float,
-    sigma_min: float,
-    pd: float,
-    threshold: float,
-    false_alarm: float,
-    false_alarm_scale: float,
-) -> float:
+def gaussian_reading(c: float, noise: np.ndarray, sp: SensorParams) -> float:
     """One reading of a Gaussian-family sensor with a constant Pd and no outliers at mean
     concentration c from its standard noise (≥ 4,): :meth:`dcee.models.sensor.Sensor.
-    simulate_from`'s arithmetic in its order (no contraction: the same bits)."""
-    y = c + (sigma_frac * c + sigma_min) * noise[1]
-    if noise[0] < pd and y >= threshold:
+    simulate_from`'s arithmetic in its order (no contraction: the same bits). ``sp`` carries
+    the sensor's own σ_frac, σ_min, Pd, threshold and false-alarm values."""
+    y = c + (sp.sigma_frac * c + sp.sigma_min) * noise[1]
+    if noise[0] < sp.pd and y >= sp.threshold:
         return y
-    if noise[2] < false_alarm:
-        return threshold + false_alarm_scale * noise[3]
+    if noise[2] < sp.false_alarm:
+        return sp.threshold + sp.false_alarm_scale * noise[3]
     return 0.0
 
 
@@ -426,14 +410,15 @@ def task_setup(
     (−inf for rows no task reads)).
 
     The largest terms are those of the particles with weight (:func:`live_row_max`, a pass
-    over two terms of every row read), or with ``ceilings`` (a Gaussian-family sensor only)
-    the model's own bounds (:func:`model_ceilings`): no pass over the particles, bounds a few
+    over two terms of every row read), or, where the caller's slack allows ``ceilings`` and
+    the sensor is of the Gaussian family (other families have no such bounds), the model's own
+    (:func:`model_ceilings`): no pass over the particles, bounds a few
     nats looser (measured on Stone Soup's STE workload: 45 of the one-stage sums' 140 µs per
     decision, hot; lab, 2026-12-05)."""
     group_start, used = task_layout(task_positions, log_nd.shape[0])
     max_log_nd = np.full(log_nd.shape[0], -np.inf)
     max_det_offset = np.full(log_nd.shape[0], -np.inf)
-    if ceilings:
+    if ceilings and sp.lognormal == 0.0:
         ceiling_nd, ceiling_det = model_ceilings(sp)
         for r in used:
             max_log_nd[r] = ceiling_nd

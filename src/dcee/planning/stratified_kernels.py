@@ -23,6 +23,7 @@ import numpy as np
 from numba import njit
 
 from dcee.models.sensor import Sensor
+from dcee.models.sensor_kernels import SensorParams
 from dcee.planning.particle_terms import pairwise_sum
 from dcee.planning.reading_terms import gaussian_reading, plain_gaussian
 
@@ -132,15 +133,7 @@ def _first_detecting_stage(
 
 @njit(cache=True)
 def _gaussian_readings(
-    conc_sel: np.ndarray,
-    noise: np.ndarray,
-    sigma_frac: float,
-    sigma_min: float,
-    pd: float,
-    threshold: float,
-    false_alarm: float,
-    false_alarm_scale: float,
-    out: np.ndarray,
+    conc_sel: np.ndarray, noise: np.ndarray, sp: SensorParams, out: np.ndarray
 ) -> None:
     """out[s, j, t] = the reading of a plain Gaussian sensor at conc_sel[s, j, t] from the
     shared noise[j, t] (:func:`~dcee.planning.reading_terms.gaussian_reading`)."""
@@ -148,10 +141,7 @@ def _gaussian_readings(
     for s in range(s_count):
         for j in range(j_count):
             for t in range(t_count):
-                out[s, j, t] = gaussian_reading(
-                    conc_sel[s, j, t], noise[j, t], sigma_frac, sigma_min, pd, threshold,
-                    false_alarm, false_alarm_scale,
-                )  # fmt: skip
+                out[s, j, t] = gaussian_reading(conc_sel[s, j, t], noise[j, t], sp)
 
 
 @njit(cache=True)
@@ -220,10 +210,7 @@ def stratified_hypotheses(
         )
         if plain_gaussian(sensor):
             readings = np.empty((s, j_count, t_count))
-            _gaussian_readings(
-                selected[1], noise, sensor.sigma_frac, sensor.sigma_min, sensor.pd,
-                sensor.threshold, sensor.false_alarm, sensor.false_alarm_scale, readings,
-            )  # fmt: skip
+            _gaussian_readings(selected[1], noise, sensor.params, readings)
         else:
             readings = sensor.simulate_from(selected[1], noise[None, :, :t_count], selected[2])
         detection = sensor.simulate_detection(at_first[0], detect_u[None], at_first[1])
