@@ -303,6 +303,64 @@ def test_node_keeps_planning_through_hostile_message_streams() -> None:
         rclpy.try_shutdown(context=context)
 
 
+def test_a_negative_clock_message_does_not_end_the_node_s_spin() -> None:
+    """With use_sim_time, rclpy's own /clock callback raises on a negative time ("Seconds value
+    must not be negative"), which ends executor.spin() and with it the search.
+    spin_through_errors counts and logs it and spins on: the clock follows the next good
+    message."""
+    import threading
+    import time
+
+    import rclpy
+    from builtin_interfaces.msg import Time
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    from rosgraph_msgs.msg import Clock
+
+    from dcee.ros.launch import spin_through_errors
+    from dcee.ros.node import SearchNode
+
+    context = rclpy.Context()
+    rclpy.init(context=context, args=[], domain_id=_domain())
+    try:
+        node = SearchNode(
+            context=context,
+            parameter_overrides=[
+                Parameter("use_sim_time", value=True),
+                Parameter("particles", value=300),
+                Parameter("autostart", value=False),
+            ],
+        )
+        clock_node = rclpy.create_node("clock", context=context)
+        clock_pub = clock_node.create_publisher(Clock, "/clock", 10)
+        executor = SingleThreadedExecutor(context=context)
+        executor.add_node(node)
+        spinner = threading.Thread(target=spin_through_errors, args=(executor, node), daemon=True)
+        spinner.start()
+
+        def publish_until(sec: int, seen) -> None:
+            deadline = time.monotonic() + 10
+            while not seen() and time.monotonic() < deadline:
+                clock_pub.publish(Clock(clock=Time(sec=sec)))
+                time.sleep(0.02)
+
+        def clock_at(sec: int):
+            return lambda: node.get_clock().now().nanoseconds == sec * 10**9
+
+        publish_until(5, clock_at(5))
+        assert clock_at(5)()
+        publish_until(-3, lambda: node.callback_errors > 0)
+        assert node.callback_errors >= 1
+        assert spinner.is_alive(), "the negative /clock ended the node's spin"
+        publish_until(7, clock_at(7))
+        assert clock_at(7)(), "the node's clock stopped following /clock"
+        assert not node.done.is_set()
+    finally:
+        rclpy.try_shutdown(context=context)
+    spinner.join(timeout=10)
+    assert not spinner.is_alive(), "spin_through_errors did not end with its context"
+
+
 def test_node_plans_around_a_map_from_the_map_topic() -> None:
     """A wall arrives on ``map`` (nav_msgs/OccupancyGrid, transient local): every later goal
     and every move to it stays clear of it; a map that does not cover the search area is

@@ -5,6 +5,7 @@ the setup command and exit 2, not a traceback."""
 from __future__ import annotations
 
 import importlib.util
+from typing import Any
 
 from dcee.console import error_exit
 from dcee.errors import DceeInputError
@@ -20,6 +21,28 @@ def require_rclpy(program: str) -> None:
             f"rclpy is not installed in this environment; {SETUP_HINT}, then run "
             f".venv-ros/bin/{program}",
         )
+
+
+def spin_through_errors(executor: Any, node: Any) -> None:
+    """``executor.spin()`` until the node's context goes down, except that an error raised
+    out of a callback does not end it: it is counted and logged by
+    ``node.record_callback_error`` and spinning goes on. The node's own callbacks catch their
+    errors themselves; this catches those of the callbacks rclpy runs for it, which would
+    otherwise end ``spin()`` and with it the search: one ``/clock`` message with a negative
+    time (rclpy's time source raises ValueError "Seconds value must not be negative") from
+    any node on the robot, with ``use_sim_time`` set (tests/ros/test_ros_node.py)."""
+    import rclpy.executors
+
+    context = node.context
+    while context.ok():
+        try:
+            executor.spin_once()
+        except rclpy.executors.ExternalShutdownException:
+            return
+        except Exception as exc:
+            if not context.ok():  # the context went down between two waits: the normal end
+                return
+            node.record_callback_error("a callback run by rclpy", exc)
 
 
 def node_main(argv: list[str] | None = None) -> None:
@@ -48,8 +71,8 @@ def node_main(argv: list[str] | None = None) -> None:
     executor = rclpy.executors.SingleThreadedExecutor()
     executor.add_node(node)
     try:
-        executor.spin()
-    except (KeyboardInterrupt, rclpy.executors.ExternalShutdownException):
+        spin_through_errors(executor, node)
+    except KeyboardInterrupt:
         pass
     finally:
         node.destroy_node()

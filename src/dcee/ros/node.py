@@ -328,15 +328,21 @@ class SearchNode(NodeInputs, NodeOutputs, LifecycleNode):
             callback(*args)
             self._errors_in_a_row = 0
         except Exception as exc:  # a search node must never exit because of its inputs
-            self.callback_errors += 1
-            self._errors_in_a_row += 1
-            self.get_logger().error(
-                f"{what}: {type(exc).__name__}: {exc} (message ignored, the search continues)",
-                throttle_duration_sec=5.0,
-            )
-            if self._errors_in_a_row >= MAX_CONSECUTIVE_ERRORS and not self.done.is_set():
-                self._finish("error")
+            self.record_callback_error(what, exc)
         self._report_rejections()
+
+    def record_callback_error(self, what: str, exc: BaseException) -> None:
+        """Count and log (throttled) an unexpected error of a callback, this node's own or one
+        that rclpy runs for it (:func:`dcee.ros.launch.spin_through_errors`); after
+        MAX_CONSECUTIVE_ERRORS in a row the search ends cleanly."""
+        self.callback_errors += 1
+        self._errors_in_a_row += 1
+        self.get_logger().error(
+            f"{what}: {type(exc).__name__}: {exc} (message ignored, the search continues)",
+            throttle_duration_sec=5.0,
+        )
+        if self._errors_in_a_row >= MAX_CONSECUTIVE_ERRORS and not self.done.is_set():
+            self._finish("error")
 
     def _report_rejections(self) -> None:
         if self.cycle is None:
