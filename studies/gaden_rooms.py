@@ -8,7 +8,8 @@ robot's sensor height (x 1, 3, 5, 7, 9 m × y 1, 5 m), seed 0. One JSON per sear
         --out results/gaden-rooms --table docs/results/gaden/searches.json
 
 ``--set KEY=VALUE`` (repeatable) flies a variant of the room's scenario, e.g. what a robot alone
-could know, ``--set unknown=full --set estimator.plume=open``.
+could know, ``--set unknown=full --set estimator.plume=open``; ``--start-height H`` starts every
+search H m above the floor instead of at the robot's sensor height (a UAV above the release).
 """
 
 from __future__ import annotations
@@ -36,7 +37,12 @@ KEYS = (
 
 
 def one(
-    room: str, start: tuple[float, float], strategy: str, out: str, overrides: dict | None = None
+    room: str,
+    start: tuple[float, float],
+    strategy: str,
+    out: str,
+    overrides: dict | None = None,
+    height: float | None = None,
 ) -> dict:
     import numba
 
@@ -48,11 +54,13 @@ def one(
     path = Path(out) / Path(room).name / strategy / f"{start[0]:g}-{start[1]:g}.json"
     if path.exists():
         return json.loads(path.read_text())
-    settings = {"agent.start": [*start, SENSOR_HEIGHT], **(overrides or {})}
+    z = SENSOR_HEIGHT if height is None else height
+    settings = {"agent.start": [*start, z], **(overrides or {})}
     scenario = load_scenario(room).with_overrides(**settings)
     result = run_episode(scenario, strategy, 0)
     row = {"room": Path(room).name, "start": list(start), "strategy": strategy}
     row |= {"settings": overrides} if overrides else {}
+    row |= {"start_height": height} if height is not None else {}
     row |= {k: result.summary[k] for k in KEYS}
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(".tmp")
@@ -68,13 +76,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--table", required=True)
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE")
+    ap.add_argument("--start-height", type=float, default=None, metavar="M")
     args = ap.parse_args(argv)
     from dcee.provenance import code_version
     from dcee.scenarios import parse_setting
 
     overrides = dict(parse_setting(s) for s in args.settings)
     jobs = [
-        (r, s, st, args.out, overrides) for r in args.rooms for st in STRATEGIES for s in STARTS
+        (r, s, st, args.out, overrides, args.start_height)
+        for r in args.rooms
+        for st in STRATEGIES
+        for s in STARTS
     ]
     with ProcessPoolExecutor(args.workers) as pool:
         rows = list(pool.map(one, *zip(*jobs, strict=True)))
