@@ -132,6 +132,8 @@ def test_ros_map_unknown_cells_and_negate(tmp_path):
         ("image: m.png\nresolution: 1.0\n", "lacks origin"),
         ("image: m.png\nresolution: -1\norigin: [0, 0, 0]\n", "resolution must be"),
         ("image: m.png\nresolution: 1\norigin: [0, 0, 0.5]\n", "rotated map"),
+        ("image: m.png\nresolution: .inf\norigin: [0, 0, 0]\n", "resolution must be"),
+        ("image: m.png\nresolution: 1\norigin: [.nan, 0, 0]\n", "origin must be"),
         ("image: none.png\nresolution: 1\norigin: [0, 0, 0]\n", "does not exist"),
         ("image: m.png\nresolution: 1\norigin: [0, 0]\nfree_thresh: 0.9\n", "free_thresh"),
         ("- a\n- list\n", "YAML mapping"),
@@ -146,6 +148,14 @@ def test_malformed_maps_get_one_line(tmp_path, yaml_text, message):
     with pytest.raises(DceeInputError, match=message) as exc:
         load_ros_map(tmp_path / "bad.yaml")
     assert exc.value.field == "world.map" and "\n" not in str(exc.value)
+
+
+def test_a_map_with_a_nan_origin_is_refused():
+    """Found 2026-12-05: an OccupancyGrid on the map topic with a NaN origin was taken, every
+    position then fell in no cell and the map blocked nothing."""
+    with pytest.raises(DceeInputError, match="origin must be finite") as exc:
+        SiteMap.from_occupancy(np.zeros((4, 4)), (math.nan, 0.0), 0.5, name="map topic")
+    assert exc.value.field == "world.map"
 
 
 def test_a_map_must_cover_the_search_area():

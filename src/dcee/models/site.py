@@ -126,7 +126,14 @@ class SiteMap:
         if self.blocked.ndim != 2 or min(self.blocked.shape) < 1:
             raise DceeInputError("world.map", "the occupancy grid must be a non-empty 2-D array")
         if not (math.isfinite(self.resolution) and self.resolution > 0):
-            raise DceeInputError("world.resolution", f"must be > 0 m, got {self.resolution!r}")
+            raise DceeInputError(
+                "world.resolution", f"must be a finite length > 0 m, got {self.resolution!r}"
+            )
+        if not all(math.isfinite(v) for v in self.origin):
+            # a NaN origin put every position in no cell: a map that blocks nothing
+            raise DceeInputError(
+                "world.map", f"{self.name}: its origin must be finite, got {self.origin!r}"
+            )
 
     def __getstate__(self) -> dict[str, Any]:  # caches are rebuilt on demand
         return {**self.__dict__, "_fields": OrderedDict(), "_graph": None}
