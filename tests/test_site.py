@@ -150,6 +150,26 @@ def test_malformed_maps_get_one_line(tmp_path, yaml_text, message):
     assert exc.value.field == "world.map" and "\n" not in str(exc.value)
 
 
+@pytest.mark.parametrize(
+    ("points", "problem"),
+    [
+        ([(0, 0), (4, 0), (4, 4), (0, 4)], None),
+        ([(0, 0), (4, 0), (4, 4), (0, 4), (0, 0)], None),  # closed as GeoJSON closes a ring
+        ([(0, 0), (4, 0), (4, 0), (4, 4), (0, 4)], None),  # a point repeated
+        ([(0, 0), (4, 0), (2, 1), (4, 4), (0, 4)], None),  # not convex
+        ([(0, 0), (4, 4), (4, 0), (0, 4)], "edges 1 and 3 cross"),  # a bow tie
+        ([(0, 0), (4, 0), (4, 4), (2, 0), (0, 4)], "edges 1 and 3 cross or touch"),  # touches
+        ([(0, 0), (4, 0), (2, 2), (4, 4), (0, 4), (2, 2)], "edges 2 and 5"),  # a pinch
+        ([(0, 0), (2, 2), (4, 4)], "no area"),
+        ([(0, 0), (0, 0), (1, 1)], "at least 3 distinct points"),
+    ],
+)
+def test_a_polygon_is_simple_or_refused_by_hand(points, problem):
+    """Polygon.problem against cases drawn by hand (the shapes' edges numbered from 1)."""
+    found = Polygon(tuple(points)).problem()
+    assert (found is None) if problem is None else (problem in found)
+
+
 def test_a_map_with_a_nan_origin_is_refused():
     """Found 2026-12-05: an OccupancyGrid on the map topic with a NaN origin was taken, every
     position then fell in no cell and the map blocked nothing."""
@@ -261,6 +281,11 @@ def test_the_unicycle_stays_clear_of_the_raw_shapes():
         ('world.map="missing.yaml"', "world.map"),
         ("world.obstacles=[{kind='circle',center=[2,2],radius=1}]", "agent.start"),
         ("world.obstacles=[{kind='circle',center=[37.5,12.5],radius=1}]", "truth"),
+        # a bow tie: the corners of a square out of order
+        (
+            "world.no_go=[{kind='polygon',points=[[20,20],[30,30],[30,20],[20,30]]}]",
+            "world.no_go.0",
+        ),
         (
             "world.obstacles=[{kind='rectangle',low=[30,5],high=[45,6]},"
             "{kind='rectangle',low=[30,19],high=[45,20]},{kind='rectangle',low=[30,5],high=[31,20]},"

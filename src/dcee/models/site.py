@@ -86,6 +86,56 @@ class Polygon:
             return inside
         return inside | (_distance_to_edges(np.asarray(self.points, float), xy) <= margin)
 
+    def problem(self) -> str | None:
+        """Why these points make no simple polygon (None when they do): fewer than three, no
+        area, or two edges that are not neighbours meeting (a ring that crosses or touches
+        itself, e.g. corners listed out of order: a bow tie)."""
+        pts = np.asarray(self.points, dtype=float).reshape(-1, 2)
+        # a point repeated next to itself (the first again at the end, as GeoJSON closes a
+        # ring) adds no edge
+        pts = pts[np.any(pts != np.roll(pts, 1, axis=0), axis=1)] if len(pts) > 1 else pts
+        n = len(pts)
+        if n < 3:
+            return "a polygon needs at least 3 distinct points"
+        for i in range(n):
+            for j in range(i + 2, n):
+                if i == 0 and j == n - 1:
+                    continue  # the closing edge and the first are neighbours
+                if _segments_meet(pts[i], pts[(i + 1) % n], pts[j], pts[(j + 1) % n]):
+                    return (
+                        f"its edges {i + 1} and {j + 1} cross or touch: a polygon's points go in "
+                        "order round its boundary"
+                    )
+        x, y = pts[:, 0], pts[:, 1]
+        if abs(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) <= 1e-12:
+            return "the polygon has no area (its points lie on one line)"
+        return None
+
+
+def _segments_meet(a: np.ndarray, b: np.ndarray, c: np.ndarray, d: np.ndarray) -> bool:
+    """True when the closed segments ab and cd share a point (orientation tests, exact for
+    the collinear cases)."""
+
+    def orient(p: np.ndarray, q: np.ndarray, r: np.ndarray) -> float:
+        return float((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]))
+
+    def within(p: np.ndarray, q: np.ndarray, r: np.ndarray) -> bool:  # r on segment pq
+        return min(p[0], q[0]) <= r[0] <= max(p[0], q[0]) and min(p[1], q[1]) <= r[1] <= max(
+            p[1], q[1]
+        )
+
+    o1, o2, o3, o4 = orient(a, b, c), orient(a, b, d), orient(c, d, a), orient(c, d, b)
+    if ((o1 > 0 and o2 < 0) or (o1 < 0 and o2 > 0)) and (
+        (o3 > 0 and o4 < 0) or (o3 < 0 and o4 > 0)
+    ):
+        return True
+    return (
+        (o1 == 0 and within(a, b, c))
+        or (o2 == 0 and within(a, b, d))
+        or (o3 == 0 and within(c, d, a))
+        or (o4 == 0 and within(c, d, b))
+    )
+
 
 def _distance_to_edges(poly: np.ndarray, xy: np.ndarray) -> np.ndarray:
     """(K,) distance of (K, 2) points to the closed polyline ``poly`` (V, 2)."""

@@ -54,8 +54,10 @@ class ShapeSpec(BaseModel):
             for lo, h in zip(self.low, self.high, strict=True)  # type: ignore[arg-type]
         ):
             raise ValueError("a rectangle's high corner must lie above and right of its low one")
-        if self.kind == "polygon" and len(self.points) < 3:  # type: ignore[arg-type]
-            raise ValueError("a polygon needs at least 3 points")
+        if self.kind == "polygon":
+            problem = Polygon(tuple(self.points)).problem()  # type: ignore[arg-type]
+            if problem is not None:
+                raise ValueError(problem)
         return self
 
     def shape(self) -> Shape:
