@@ -11,13 +11,14 @@ from typing import Any
 
 from dcee.errors import DceeInputError
 from dcee.scenarios.builtin import (
+    RANDOM_FAMILIES,
     builtin_scenarios,
     random_family_configuration,
     random_family_name,
 )
 from dcee.scenarios.defaults import DEFAULTS
 from dcee.scenarios.gaden_room import gaden_room_configuration, is_gaden_folder
-from dcee.scenarios.geo_area import area_configuration, expand_area, packaged_site
+from dcee.scenarios.geo_area import SITES, area_configuration, expand_area, packaged_site
 from dcee.scenarios.schema import Scenario, validate_scenario
 from dcee.stopping import DEFAULT_STOP_SHARE
 
@@ -55,10 +56,13 @@ def load_scenario(name_or_path: str) -> Scenario:
     if path.suffix.lower() in (".geojson", ".json") and path.is_file():
         return validate_scenario(area_configuration(path))
     if not path.suffix == ".toml" and ":" in name_or_path:
+        families = ", ".join(f"{f}:K" for f in RANDOM_FAMILIES)
+        sites = ", ".join(f"area:{p.stem}" for p in sorted(SITES.glob("*.geojson")))
         raise DceeInputError(
             "scenario",
             f"unknown built-in {name_or_path!r}; choose one of {', '.join(builtins)}, "
-            "random:K, random-start:K, random2:K or random3:K (K an integer >= 1)",
+            f"{families} (K an integer >= 1), {sites}, a TOML file, a GeoJSON site or a GADEN "
+            "simulation folder",
         )
     if not path.is_file():
         raise DceeInputError("scenario", f"no such file {str(path)!r} and no such built-in")
