@@ -99,3 +99,36 @@ def test_searcher_ask_tell_contract():
     assert s.time == 3.0  # a rejected reading leaves the searcher unchanged
     with pytest.raises(DceeInputError, match="position"):
         s.tell(np.array([1.0, 2.0]), 0.0, time=4.0)
+
+
+@pytest.mark.parametrize("strategy", ["dcee-cl", "infotaxis", "dcee-mcts"])
+def test_a_sensor_outside_the_area_is_brought_into_it(strategy):
+    """A UAV taking off from a base 3 m beyond the area's edge (more than one 2 m move) has no
+    admissible move: ask() heads for the nearest point of the area (before 2026-12-05 it raised
+    "no admissible move", and the ROS node counted an error at every pose until it gave up),
+    then plans as usual from inside. Where that point is inside an obstacle, it still raises."""
+    sc = load_scenario("paper:1")
+    pf = ParticleFilter(
+        sc.make_prior(), sc.make_estimator_sensor(), sc.make_plume(), n_particles=500, seed=0
+    )
+    searcher = Searcher(pf, planners.get(strategy), sc.make_agent(), np.random.default_rng(1))
+    searcher.tell(np.array([-3.0, 60.0, 4.0]), 0.0, 1.0)  # west of x = 0, north of y = 50
+    entry = searcher.ask()
+    np.testing.assert_allclose(entry, [0.0, 50.0, 4.0], atol=1e-5)
+    assert sc.make_agent().volume.contains(entry[None])[0]
+    assert searcher.last_decision.info == {"entry": True}
+    searcher.tell(entry, 0.0, 2.0)
+    move = searcher.ask()
+    assert np.linalg.norm(move - entry) == pytest.approx(2.0)  # one of the agent's own moves
+
+    walled = sc.with_overrides(
+        **{"world.obstacles": [{"kind": "rectangle", "low": [0.0, 40.0], "high": [5.0, 50.0]}]}
+    )
+    pf = ParticleFilter(
+        walled.make_prior(), walled.make_estimator_sensor(), sc.make_plume(), n_particles=500,
+        seed=0,
+    )  # fmt: skip
+    searcher = Searcher(pf, planners.get(strategy), walled.make_agent(), np.random.default_rng(1))
+    searcher.tell(np.array([-3.0, 60.0, 4.0]), 0.0, 1.0)
+    with pytest.raises(DceeInputError, match="no admissible move"):
+        searcher.ask()

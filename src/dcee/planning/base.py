@@ -94,6 +94,29 @@ class Decision:
         return int(self.headings[self.index])
 
 
+ENTRY_INSET = 1e-6
+"""m: how far inside the search volume's face :func:`entry_point` puts its point (inside, not
+on the face, whatever the rounding of a robot's position)."""
+
+
+def entry_point(agent: GridAgent, position: np.ndarray) -> np.ndarray | None:
+    """(3,) the point of the search volume nearest ``position`` (m), for a sensor outside the
+    volume with no admissible move (a UAV taking off from a base beyond the area's edge, a
+    robot's first pose a few metres outside it): the waypoint that brings it in. None when the
+    position is inside the volume (no move there is another matter) or the nearest point is
+    blocked by the site (the planners' moves never end in a blocked cell)."""
+    p = np.asarray(position, dtype=np.float64)
+    low, high = (np.asarray(c, dtype=np.float64) for c in (agent.volume.low, agent.volume.high))
+    if bool(agent.volume.contains(p[None])[0]):
+        return None
+    inset = np.minimum(ENTRY_INSET, (high - low) / 2)
+    entry = np.clip(p, low + inset, high - inset)
+    site = getattr(agent, "site", None)
+    if site is not None and bool(site.is_blocked(entry[None, :2])[0]):
+        return None
+    return entry
+
+
 class Planner(ABC):
     """Chooses the next measurement position from the current belief.
 
@@ -130,7 +153,11 @@ class Planner(ABC):
     ) -> Decision:
         candidates, headings = agent.candidates(position)
         if len(candidates) == 0:
-            raise DceeInputError("position", f"no admissible move from {position}")
+            entry = entry_point(agent, position)
+            if entry is None:
+                raise DceeInputError("position", f"no admissible move from {position}")
+            # outside the search volume, beyond one move of it: head for it first
+            return Decision(0, entry[None, :], np.zeros(1), np.array([-1]), {"entry": True})
         costs, info = self.costs(belief, np.asarray(position, float), candidates, agent, rng)
         return Decision(int(np.argmin(costs)), candidates, costs, headings, info)
 
