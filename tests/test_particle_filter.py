@@ -286,6 +286,11 @@ def test_nan_reading_is_rejected(sensor, bad):
         pf.update(np.array([1.0, 1.0]), 0.0)
     with pytest.raises(DceeInputError, match="particles"):
         ParticleFilter(planar_prior(), sensor, n_particles=-5)
+    for seed in (-1, 1.5, "7", None):  # numpy's own ValueError or a fresh entropy seed before
+        with pytest.raises(DceeInputError, match="seed"):
+            ParticleFilter(planar_prior(), sensor, n_particles=10, seed=seed)
+    for seed in (3, np.int64(3), np.random.SeedSequence(3), np.random.default_rng(3)):
+        ParticleFilter(planar_prior(), sensor, n_particles=10, seed=seed)
 
 
 # --- the history likelihood kernel and its exact early rejection (issue 17) ---

@@ -114,7 +114,7 @@ class ParticleFilter(ResampleMove):
                 "estimator.repeat_power", f"must be in (0, 2], got {repeat_power!r}"
             )
         if int(n_particles) != n_particles or n_particles < 2:
-            raise DceeInputError("particles", f"must be an integer >= 2, got {n_particles}")
+            raise DceeInputError("particles", f"must be an integer >= 2, got {n_particles!r}")
         if not 0 < resample_threshold <= 1:
             raise DceeInputError("resample_threshold", "must be in (0, 1]")
         if not 0 <= collapse_threshold < resample_threshold:
@@ -133,6 +133,13 @@ class ParticleFilter(ResampleMove):
         self.sensor = sensor
         self.plume = plume or IsotropicPlume()
         self.n = int(n_particles)
+        seeds = np.random.Generator | np.random.SeedSequence | np.random.BitGenerator
+        if not isinstance(seed, seeds) and not (
+            isinstance(seed, int | np.integer) and not isinstance(seed, bool) and seed >= 0
+        ):
+            raise DceeInputError(
+                "seed", f"must be an integer >= 0 or a numpy.random.Generator, got {seed!r}"
+            )
         self.rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
         self.resample_threshold = resample_threshold
         self.mcmc_steps = mcmc_steps
