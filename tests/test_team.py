@@ -58,6 +58,21 @@ def test_a_boxed_in_robot_stays_and_unsupported_planners_are_refused():
             decide_team(planners.get(spec), belief, np.array([START, START]), AGENT, None)
 
 
+def test_a_robot_outside_the_area_heads_into_it():
+    """A robot further than one move outside the area (launched from beyond its edge) gets
+    the nearest point of the area as its goal; before, it had no move and stayed out."""
+    belief = _spread_belief()
+    outside = np.array([START[0], -5.0, START[2]])
+    inside, entering = decide_team(
+        planners.get("dcee-cl"), belief, np.array([START, outside]), AGENT,
+        np.random.default_rng(0),
+    )  # fmt: skip
+    assert inside is not None and inside.info != {"entry": True}
+    assert entering is not None and entering.info == {"entry": True}
+    np.testing.assert_allclose(entering.position, [START[0], 0.0, START[2]], atol=1e-5)
+    assert AGENT.volume.contains(entering.position[None])[0]
+
+
 def test_team_search_shares_one_filter_and_is_deterministic():
     scenario = load_scenario("paper:1").with_overrides(
         **{"search.particles": 500, "search.budget": 30.0, "agent.count": 3}
