@@ -224,9 +224,19 @@ def _too_large(doc: dict) -> None:
     ring[1][0] += 1.0  # one corner 68 km east
 
 
+def _levels_range(doc: dict) -> None:
+    _feature(doc, "Store B")["properties"]["building:levels"] = "3;4"  # OSM's multiple values
+
+
+def _height_in_feet(doc: dict) -> None:
+    _feature(doc, "Hall A")["properties"]["height"] = "40 ft"
+
+
 @pytest.mark.parametrize(
     ("edit", "field", "words"),
     [
+        (_levels_range, "Store B", "building:levels must be a number of storeys"),
+        (_height_in_feet, "Hall A", "height must be a number of metres"),
         (_open_ring, "Hall A", "ring not closed"),
         (_crossing_ring, "Hall A", "cross itself"),
         (_swapped_start, "gate", "swapped"),

@@ -95,16 +95,20 @@ def _is_building(props: dict[str, Any]) -> bool:
     return value is not None and str(value).lower() not in ("no", "false", "0")
 
 
-def _number(value: Any, label: str, what: str, low: float, high: float) -> float:
-    """A number given as JSON number or as text with an optional ``m`` unit."""
+def _number(
+    value: Any, label: str, what: str, low: float, high: float, unit: str = "metres"
+) -> float:
+    """A number given as JSON number or as text (of metres: with an optional ``m`` unit)."""
     if isinstance(value, bool):
         value = None
     if isinstance(value, str):
-        match = re.fullmatch(r"\s*([-+]?\d+(?:\.\d+)?)\s*(?:m|metres|meters)?\s*", value)
+        suffix = r"(?:m|metres|meters)?" if unit == "metres" else ""
+        match = re.fullmatch(r"\s*([-+]?\d+(?:\.\d+)?)\s*" + suffix + r"\s*", value)
         value = float(match.group(1)) if match else None
     if not isinstance(value, int | float) or not math.isfinite(value) or not low <= value <= high:
+        example = "12 or '12 m'" if unit == "metres" else "3"
         raise DceeInputError(
-            label, f"{what} must be a number of metres in [{low:g}, {high:g}] (e.g. 12 or '12 m')"
+            label, f"{what} must be a number of {unit} in [{low:g}, {high:g}] (e.g. {example})"
         )
     return float(value)
 
@@ -113,7 +117,8 @@ def _height(props: dict[str, Any], label: str) -> float | None:
     if props.get("height") is not None:
         return _number(props["height"], label, "height", 0.0, 1000.0)
     if props.get("building:levels") is not None:
-        return LEVEL_HEIGHT * _number(props["building:levels"], label, "building:levels", 0, 300)
+        levels = _number(props["building:levels"], label, "building:levels", 0, 300, "storeys")
+        return LEVEL_HEIGHT * levels
     return None
 
 
