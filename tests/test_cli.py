@@ -228,11 +228,17 @@ def test_report_reads_a_folder_of_run_outputs(tmp_path, capsys):
     for strategy in ("mpc", "infotaxis"):
         out = tmp_path / "runs" / strategy
         assert run_cli([*_tiny(strategy=strategy), "--out", str(out)], capsys)[0] == 0
-    code, out, _ = run_cli(["report", str(tmp_path / "runs")], capsys)
-    assert code == 0
+    code, out, err = run_cli(["report", str(tmp_path / "runs")], capsys)
+    assert code == 0 and "left out" not in err
     table = pd.read_csv(tmp_path / "runs/report/metrics.csv")
     assert sorted(table["strategy"]) == ["infotaxis", "mpc"] and (table["searches"] == 1).all()
     assert (tmp_path / "runs/report/pairwise.md").read_text().count("| infotaxis | mpc |") == 1
+    # a search whose summary was since corrupted is left out, and the report says so
+    (tmp_path / "runs/mpc/summary.json").write_text("{broken")
+    code, out, err = run_cli(["report", str(tmp_path / "runs")], capsys)
+    table = pd.read_csv(tmp_path / "runs/report/metrics.csv")
+    assert code == 0 and sorted(table["strategy"]) == ["infotaxis"]
+    assert "1 search folder(s) left out" in err and "mpc" in err
 
 
 @pytest.mark.parametrize(

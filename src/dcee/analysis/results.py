@@ -32,6 +32,15 @@ def find_runs(folder: str | Path) -> list[Path]:
     return [p for p in found if EpisodeResult.is_complete(p)]
 
 
+def incomplete_runs(folder: str | Path) -> list[Path]:
+    """The folders at or below ``folder`` with a ``summary.json`` that :func:`find_runs`
+    skips (sorted): a search killed mid-write, a failed one, a file since corrupted."""
+    from dcee.runs import EpisodeResult
+
+    found = sorted(p.parent for p in Path(folder).rglob("summary.json"))
+    return [p for p in found if not EpisodeResult.is_complete(p)]
+
+
 def load_summaries(folder: str | Path) -> pd.DataFrame:
     """One row per complete search below ``folder``: its summary (``scenario``, ``strategy``,
     ``seed``, ``final_rmse``, ``time_to_rmse_1m`` …) plus ``run_dir``, the folder it came

@@ -165,7 +165,16 @@ def report(results_dir: Path, out_dir: Path | None) -> None:
     """Tables (CSV, Markdown), paired tests, figures and a self-contained HTML report of a
     campaign or of any folder of `dcee run` results."""
     from dcee.analysis.report import write_report
+    from dcee.analysis.results import incomplete_runs
 
     paths = write_report(results_dir, out_dir or results_dir / "report")
     for p in paths:
         click.echo(str(p))
+    skipped = incomplete_runs(results_dir)
+    if skipped:  # a report that silently drops searches would mislead its pairs and counts
+        names = ", ".join(str(p) for p in skipped[:3]) + (", ..." if len(skipped) > 3 else "")
+        click.echo(
+            f"dcee: note: {len(skipped)} search folder(s) left out, not complete or not "
+            f"readable: {names}",
+            err=True,
+        )
