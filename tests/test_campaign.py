@@ -283,6 +283,26 @@ def test_dask_cluster_by_address_through_the_cli(tmp_path, capsys):
     assert all(is_done(t) for t in Campaign(out, "smoke", ("mpc",), 1, particles=300).tasks())
 
 
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        # found 2026-12-05: a traceback, and campaign.json written before it
+        (["--scheduler", "nonsense"], "scheduler: cannot connect to 'nonsense'"),
+        # found 2026-12-05: two workers wrote one folder, and searches failed
+        (["--strategies", "mpc,mpc"], "strategies: mpc given more than once"),
+    ],
+)
+def test_a_bad_scheduler_or_a_strategy_twice_is_one_line_before_any_work(
+    tmp_path, capsys, args, words
+):
+    out = tmp_path / "c"
+    with pytest.raises(SystemExit) as exc:
+        main(["bench", "--suite", "smoke", "--repeats", "1", "--out", str(out), *args])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert exc.value.code == 2 and words in err[-1] and "Traceback" not in "".join(err)
+    assert not out.exists() or not any(out.iterdir())
+
+
 def test_dask_local_cluster_runs_the_campaign(tmp_path):
     distributed = pytest.importorskip("distributed")
     with (

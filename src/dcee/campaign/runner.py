@@ -144,6 +144,9 @@ class Campaign:
             raise DceeInputError("repeats", f"must be >= 1, got {self.repeats}")
         if not self.strategies:
             raise DceeInputError("strategies", "give at least one strategy")
+        twice = sorted({s for s in self.strategies if self.strategies.count(s) > 1})
+        if twice:  # their searches would share one folder, written by two workers at once
+            raise DceeInputError("strategies", f"{', '.join(twice)} given more than once")
         for s in self.strategies:
             get_planner(s)  # unknown names and bad options fail before anything runs
         self.scenarios = {
@@ -362,31 +365,49 @@ def _local_results(
                 todo.append(i)
 
 
-def _dask_results(tasks: list[SearchTask], scheduler: Any) -> Iterator[dict[str, Any]]:
-    """Run ``tasks`` on a Dask cluster. Dask itself reschedules the searches of a lost worker
-    and gives up on one after its ``allowed-failures`` losses (``KilledWorker``)."""
+SCHEDULER_TIMEOUT = "10s"
+"""How long connecting to a Dask scheduler may take before the campaign is refused."""
+
+
+def connect_scheduler(scheduler: Any) -> tuple[Any, bool]:
+    """(client, whether this call opened it) for a Dask scheduler address
+    (``tcp://host:8786``) or a ``distributed.Client``; a missing ``distributed``, a malformed
+    address or a scheduler that does not answer within :data:`SCHEDULER_TIMEOUT` is
+    :class:`DceeInputError` (checked before a campaign writes anything)."""
     try:
-        from distributed import Client, as_completed
+        from distributed import Client
     except ImportError:
         raise DceeInputError(
             "scheduler", "dask.distributed is not installed: pip install 'dcee[distributed]'"
         ) from None
-    client = scheduler if isinstance(scheduler, Client) else Client(scheduler)
-    own = client is not scheduler
+    if isinstance(scheduler, Client):
+        return scheduler, False
     try:
-        client.run(_init_worker)
-        futures = {client.submit(run_search, t, pure=False): t for t in tasks}
-        try:
-            for fut in as_completed(futures):
-                try:
-                    yield fut.result()
-                except Exception as exc:  # KilledWorker, a lost connection, ...
-                    yield {"status": "failed", "task": futures[fut], "error": repr(exc)}
-        finally:
-            client.cancel(list(futures))
+        return Client(scheduler, timeout=SCHEDULER_TIMEOUT), True
+    except (ValueError, TypeError, OSError, TimeoutError) as exc:
+        raise DceeInputError(
+            "scheduler",
+            f"cannot connect to {scheduler!r} ({exc}); give a running Dask scheduler's address, "
+            "e.g. tcp://host:8786",
+        ) from None
+
+
+def _dask_results(tasks: list[SearchTask], client: Any) -> Iterator[dict[str, Any]]:
+    """Run ``tasks`` on a Dask cluster through ``client``. Dask itself reschedules the
+    searches of a lost worker and gives up on one after its ``allowed-failures`` losses
+    (``KilledWorker``)."""
+    from distributed import as_completed
+
+    client.run(_init_worker)
+    futures = {client.submit(run_search, t, pure=False): t for t in tasks}
+    try:
+        for fut in as_completed(futures):
+            try:
+                yield fut.result()
+            except Exception as exc:  # KilledWorker, a lost connection, ...
+                yield {"status": "failed", "task": futures[fut], "error": repr(exc)}
     finally:
-        if own:
-            client.close()
+        client.cancel(list(futures))
 
 
 def run_campaign(
@@ -405,18 +426,23 @@ def run_campaign(
         raise DceeInputError("workers", f"must be >= 1, got {workers}")
     if workers is not None and scheduler is not None:
         raise DceeInputError("workers", "give either --workers or --scheduler, not both")
-    campaign.prepare()
-    tasks = campaign.tasks()
-    todo = [t for t in tasks if not is_done(t)]
-    counts = {"total": len(tasks), "skipped": len(tasks) - len(todo), "done": 0, "failed": 0}
-    if not todo:
+    client, own = connect_scheduler(scheduler) if scheduler is not None else (None, False)
+    try:
+        campaign.prepare()
+        tasks = campaign.tasks()
+        todo = [t for t in tasks if not is_done(t)]
+        counts = {"total": len(tasks), "skipped": len(tasks) - len(todo), "done": 0, "failed": 0}
+        if not todo:
+            return counts
+        if client is not None:
+            results = _dask_results(todo, client)
+        else:
+            results = _local_results(todo, workers or os.cpu_count() or 1)
+        for res in results:
+            counts[res["status"]] += 1
+            if on_result is not None:
+                on_result(res, counts["done"] + counts["failed"], len(todo))
         return counts
-    if scheduler is not None:
-        results = _dask_results(todo, scheduler)
-    else:
-        results = _local_results(todo, workers or os.cpu_count() or 1)
-    for res in results:
-        counts[res["status"]] += 1
-        if on_result is not None:
-            on_result(res, counts["done"] + counts["failed"], len(todo))
-    return counts
+    finally:
+        if own:
+            client.close()
