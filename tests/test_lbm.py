@@ -265,3 +265,17 @@ def test_a_site_whose_run_diverges_is_computed_once_more_slower(tmp_path, monkey
     assert lbm.cached_recording(spec, solids=walls) == first and len(calls) == 2  # remembered
     with pytest.raises(DceeInputError, match="became unstable 1465 s into the run"):
         lbm.cached_recording(spec)  # open terrain: no slower run
+
+
+def test_an_unwritable_cache_is_refused_before_the_solver_runs(monkeypatch, tmp_path) -> None:
+    """Found 2026-12-05: the plume was solved for minutes, then its write failed."""
+
+    def no_solver(*args, **kwargs):
+        raise AssertionError("the solver ran")
+
+    monkeypatch.setattr(lbm, "solve", no_solver)
+    blocker = tmp_path / "a-file"
+    blocker.write_text("x")
+    monkeypatch.setenv("DCEE_CACHE", str(blocker))
+    with pytest.raises(DceeInputError, match="cache: cannot write"):
+        lbm.cached_recording(LbmSpec())

@@ -217,3 +217,25 @@ def test_a_plume_not_yet_cached_is_announced_before_it_is_computed(tmp_path, mon
         cached.touch()
         plume_notice(scenario, False)
         assert capsys.readouterr().err == ""
+
+
+def test_a_release_outside_the_stored_layer_and_an_unwritable_cache_are_refused_first(
+    monkeypatch, tmp_path
+) -> None:
+    """Found 2026-12-05: `dcee plume --model lbm3d --height 50` ran into an IndexError inside
+    the solver, and an unwritable cache failed only after minutes of solving."""
+
+    def no_solver(*args, **kwargs):  # the checks come before any solving
+        raise AssertionError("the solver ran")
+
+    monkeypatch.setattr(lbm3d, "solve", no_solver)
+    spec = Lbm3dSpec()
+    for height in (-0.5, 9.6, 50.0):
+        with pytest.raises(DceeInputError, match="outside the 3-D plume's stored layer"):
+            lbm3d.cached_recording(spec, height)
+    lbm3d.check_release_height(spec, 9.5, "truth.z")  # the top of the layer is allowed
+    blocker = tmp_path / "a-file"
+    blocker.write_text("x")
+    monkeypatch.setenv("DCEE_CACHE", str(blocker))
+    with pytest.raises(DceeInputError, match="cache: cannot write"):
+        lbm3d.cached_recording(spec, 1.0)

@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.io import write_atomic
+from dcee.io import check_writable_dir, write_atomic
 from dcee.provenance import package_version
 from dcee.scenarios.schema.truth import LbmSpec
 from dcee.simulation.lbm_solver import (
@@ -204,6 +204,7 @@ def cached_recording(
     slower = solids is not None and spec.lattice_speed > SITE_FALLBACK_SPEED
     if slower and marker.is_file():
         return cached_recording(_fallback(spec), progress, announce, solids)
+    check_writable_dir(path.parent, "cache")  # before minutes of solving, not after
     if announce is not None:
         announce(f"dcee: computing the lbm plume once (cached as {path})")
     try:

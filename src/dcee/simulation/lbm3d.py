@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from dcee.errors import DceeInputError
+from dcee.io import check_writable_dir
 from dcee.provenance import package_version
 from dcee.scenarios.schema.truth import Lbm3dSpec
 from dcee.simulation.lbm import cache_folder, save_dataset, xarray_module
@@ -108,16 +109,32 @@ def write_recording(path: Path, spec: Lbm3dSpec, run: dict[str, Any]) -> None:
     save_dataset(path, ds)
 
 
+def check_release_height(spec: Lbm3dSpec, height: float, field: str) -> None:
+    """:class:`DceeInputError` naming ``field`` unless a release ``height`` m above the ground
+    lies in the stored layer with its source ball (0 to ``store_height`` − ``source_radius``):
+    above it the solver has no cell to hold it (an IndexError before)."""
+    top = spec.store_height - spec.source_radius
+    if not 0.0 <= height <= top:
+        raise DceeInputError(
+            field,
+            f"a release {height:g} m above the ground is outside the 3-D plume's stored layer "
+            f"(0 to {top:g} m: truth.model.store_height {spec.store_height:g} m less the source "
+            f"ball's {spec.source_radius:g} m)",
+        )
+
+
 def cached_recording(
     spec: Lbm3dSpec,
     height: float,
     progress: Progress | None = None,
 ) -> Path:
     """The CF NetCDF recording of ``spec`` for a release ``height`` m above the ground,
-    computed and cached on first use."""
+    computed and cached on first use (the cache folder checked before the solver runs)."""
+    check_release_height(spec, height, "height")
     path = cache_path(spec, height)
     if path.is_file():
         return path
+    check_writable_dir(path.parent, "cache")
     run = solve(spec, height, progress)
     write_recording(path, spec, run)
     return path
@@ -239,6 +256,7 @@ def lbm3d_truth(scenario: Scenario, seed: int) -> SolverPlume3dTruth:
     theta = scenario.truth_theta()
     ground = float(scenario.volume.low[2])
     height = float(theta[2]) - ground
+    check_release_height(spec, height, "truth.z")
     recording, release = load_canonical(cached_recording(spec, height))
     rng = np.random.Generator(np.random.PCG64([0x3D1B, 1, seed]))
     start = float(rng.uniform(0.0, recording.period))
