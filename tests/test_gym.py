@@ -1,6 +1,7 @@
 """The Gymnasium environment: the standard API checks, determinism, and that a planner acting in
 it makes exactly the search `dcee run` makes."""
 
+import re
 import warnings
 
 import gymnasium
@@ -146,6 +147,18 @@ def test_multi_robot_env_passes_the_pettingzoo_tests():
 
     parallel_api_test(dcee.gym.multi_search_env(agents=3, **SMALL), num_cycles=40)
     parallel_seed_test(lambda: dcee.gym.multi_search_env(agents=2, **SMALL), num_cycles=40)
+
+
+def test_multi_robot_env_refuses_actions_it_cannot_place():
+    env = dcee.gym.multi_search_env(agents=2, **SMALL)
+    env.reset(seed=5)
+    for actions, words in [
+        ({"robot_0": 2}, "missing ['robot_1']"),
+        ({"robot_0": 2, "robot_1": 2, "robot_2": 0}, "no robot named ['robot_2']"),  # was ignored
+        ([2, 2], "must be a dict"),
+    ]:
+        with pytest.raises(DceeInputError, match=re.escape(words)):
+            env.step(actions)
 
 
 def test_multi_robot_env_shares_one_belief_and_blocks_collisions():

@@ -86,9 +86,18 @@ class MultiSearchEnv(ParallelEnv):
         sim = self._sim()
         if not self.agents:
             raise DceeInputError("step", "the episode has ended; call reset()")
+        if not isinstance(actions, dict):
+            raise DceeInputError(
+                "actions", f"must be a dict of robot name to heading index, got {actions!r}"
+            )
         missing = [a for a in self.agents if a not in actions]
         if missing:
             raise DceeInputError("actions", f"give an action for every robot; missing {missing}")
+        unknown = sorted(str(a) for a in actions if a not in self.possible_agents)
+        if unknown:  # a misspelt name would otherwise be ignored
+            raise DceeInputError(
+                "actions", f"no robot named {unknown}; the robots: {self.possible_agents}"
+            )
         before = sim.records[-1]
         targets, blocked = [], {}
         for k, agent in enumerate(self.agents):
