@@ -150,6 +150,17 @@ def test_node_command_line_errors_are_one_line_exit_2() -> None:
         )
 
 
+def test_a_particle_count_the_robot_cannot_hold_is_refused_at_configure(monkeypatch) -> None:
+    from dcee import search_memory
+    from dcee.ros.parameters import PARAMETERS, scenario_from_parameters
+
+    monkeypatch.setattr(search_memory, "available_bytes", lambda: 2**30)  # a 1 GiB computer
+    scenario_from_parameters({**PARAMETERS, "scenario": "lab:upwind", "particles": 20_000})
+    with pytest.raises(DceeInputError, match="1,000,000 particles need about") as exc:
+        scenario_from_parameters({**PARAMETERS, "scenario": "lab:upwind", "particles": 10**6})
+    assert exc.value.field == "particles"
+
+
 def test_node_with_pose_with_covariance_input_takes_readings_and_publishes_a_goal() -> None:
     """A robot that reports PoseWithCovarianceStamped (AMCL-style): speeds come from successive
     poses; standing still, it gets a reading after the hold and a goal one step away."""

@@ -3,6 +3,7 @@ tests, figures and HTML)."""
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from pathlib import Path
@@ -20,6 +21,7 @@ from dcee.cli.options import (
 )
 from dcee.console import climb_notice, clock, compile_notice
 from dcee.io import check_writable_dir
+from dcee.search_memory import check_search_memory
 
 
 @click.command(short_help="Run a campaign of searches (resumable).")
@@ -104,6 +106,13 @@ def bench(
         changes,
         allow_code_change,
     )
+    if scheduler is None:  # a Dask cluster's memory is its workers' own
+        scenarios = list(campaign.scenarios.values())
+        check_search_memory(
+            max(sc.search.particles for sc in scenarios),
+            max(sc.estimator.max_sources for sc in scenarios),
+            processes=workers or os.cpu_count() or 1,
+        )
     check_writable_dir(out_dir, "out")
     compile_notice(False)
     climb_notice(list(campaign.scenarios.values()))

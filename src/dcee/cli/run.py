@@ -22,6 +22,7 @@ from dcee.io import (
     write_atomic,
     write_json,
 )
+from dcee.search_memory import check_search_memory
 
 
 @click.command(short_help="One simulated search: record, summary and figure.")
@@ -144,6 +145,7 @@ def run(
     # an edited scenario's results carry a derived name (paper:1+3fa2c1d0) and the edits
     scenario = scenario.with_overrides(name=edited_name(scenario, base, changes))
     run_edits = edits(changes)
+    check_search_memory(scenario.search.particles, scenario.estimator.max_sources)
     with folder_kept_only_on_success(out_dir):  # a failed run leaves no folder
         check_writable_dir(out_dir, "out")
         check_same_run(out_dir, scenario, strategy, seed)

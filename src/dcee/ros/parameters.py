@@ -31,6 +31,7 @@ from dcee.robot.cycle import CycleSettings
 from dcee.robot.gps import map_frame
 from dcee.runs import make_searcher, planner_defaults, streams
 from dcee.scenarios import Scenario, load_scenario
+from dcee.search_memory import check_search_memory
 from dcee.searcher import Searcher
 
 RELIABLE = QoSProfile(depth=50, reliability=QoSReliabilityPolicy.RELIABLE)
@@ -86,6 +87,11 @@ def scenario_from_parameters(p: dict[str, Any], given: Scenario | None = None) -
     scenario = given if given is not None else load_scenario(str(p["scenario"]))
     if int(p["particles"]) > 0:
         scenario = scenario.with_overrides(**{"search.particles": int(p["particles"])})
+    # a robot's computer: a search that would outgrow its memory is refused at configure, not
+    # killed by the system part way through the mission
+    check_search_memory(
+        scenario.search.particles, scenario.estimator.max_sources, field="particles"
+    )
     for key in ("stop_spread", "stop_hold"):
         if float(p[key]) >= 0:
             scenario = scenario.with_overrides(**{f"search.{key}": float(p[key])})

@@ -187,7 +187,9 @@ class SearchSpec(BaseModel):
 
     model_config = FROZEN
     particles: Annotated[int, Field(ge=2, le=10_000_000)] = 20_000
-    """particles of the filter (the paper's 20,000)"""
+    """particles of the filter (the paper's 20,000); ``dcee run``, ``dcee bench`` and the ROS 2
+    node refuse a count whose search would not fit in the memory available
+    (:mod:`dcee.search_memory`: about 1.2 kB a particle, measured)"""
     hypotheses: Annotated[int, Field(ge=1, le=10_000)] = 40
     """hypothesised readings per candidate move (the paper's 40); a planner spec's own
     ``hypotheses=`` overrides it"""
