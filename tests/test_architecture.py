@@ -33,6 +33,7 @@ LAYERS = {
     "dcee.kernel_locator": 0,  # how numba files them there (numba imports it by name)
     "dcee.state_file": 0,  # state files that are data, not code (checkpoints)
     "dcee.limits": 0,  # what a reader of others' files will allocate
+    "dcee.search_memory": 0,  # whether a search's particles fit the memory available
     "dcee.models": 1,
     "dcee.recordings": 1,  # plume recordings on disk: CF reader, header layout, statistics
     "dcee.geo": 1,  # geographic coordinates: the local frame, site files, answers on a map
