@@ -46,3 +46,22 @@ def test_a_search_that_would_not_fit_is_one_line_exit_2_before_any_work(
     code, _, err = run_cli(args, capsys)
     assert code == 2 and err.count("\n") == 1 and "error: search.particles:" in err
     assert not out.exists()
+
+
+def test_the_estimate_covers_every_stored_measurement_and_is_not_far_above_it():
+    """docs/results/perf/search-memory.json (``python studies/search_memory.py``): peak memory
+    of ``dcee run`` by planner at 2 x 10^4 and 10^6 particles. The estimate must lie above each
+    peak (a refusal never lets through what the system would kill) and at 10^6 particles
+    within 3 times it (nor refuse what fits with room to spare; mpc, the cheapest, needs 2.6)."""
+    import json
+    from pathlib import Path
+
+    doc = json.loads(
+        (Path(__file__).parent.parent / "docs/results/perf/search-memory.json").read_text()
+    )
+    assert len(doc["runs"]) >= 12
+    for run in doc["runs"]:
+        estimate = search_memory.search_bytes(run["particles"], run["sources"])
+        assert estimate >= run["peak_bytes"], run
+        if run["particles"] >= 10**6:
+            assert estimate <= 3 * run["peak_bytes"], run
