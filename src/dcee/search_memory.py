@@ -6,12 +6,14 @@ with no message. :func:`check_search_memory` estimates a search's peak memory fr
 count and refuses, in one line naming the setting, one that would not fit in the memory the
 system reports available (``MemAvailable`` of ``/proc/meminfo``; elsewhere nothing is checked).
 
-The estimate is measured, not derived (2026-12-05, ``paper:1``, 10⁶ particles, peak resident
-memory with ``/usr/bin/time -v``, a Python process with numba's kernels loaded holding 0.37 GB
-at 2 × 10⁴ particles): ``mpc`` 0.61 GB, ``dcee-cl`` 1.11 GB (1.15 GB after 40 decisions: the
-position terms are capped), ``infotaxis`` 1.10 GB, ``dcee-mcts`` 1.49 GB, the fluctuation
-likelihood 1.29 GB, two sources (a bank of three filters) 1.76 GB. :data:`BYTES_PER_PARTICLE`
-is above the dearest single-source planner; a bank of K sources counts K times as many.
+The estimate is measured, not derived (2026-12-05, ``paper:1``, peak resident memory; ``bash
+studies/run.sh search-memory`` stores it in docs/results/perf/search-memory.json and
+``tests/test_search_memory.py`` holds the estimate above every stored peak). A process with
+numba's kernels loaded holds 0.3 GB at 2 × 10⁴ particles; at 10⁶: ``mpc`` 0.59 GiB, ``dcee-cl``
+1.07 GiB (4 % more after 40 decisions: the position terms are capped), ``infotaxis`` 1.05 GiB,
+``dcee-mcts`` 1.42 GiB, the fluctuation likelihood 1.23 GiB, two sources (a bank of three
+filters) 1.68 GiB. :data:`BYTES_PER_PARTICLE` is above the dearest single-source planner; a bank
+for K sources counts K times as many.
 """
 
 from __future__ import annotations
