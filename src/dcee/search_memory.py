@@ -9,7 +9,7 @@ system reports available (``MemAvailable`` of ``/proc/meminfo``; elsewhere nothi
 The estimate is measured, not derived (2026-12-05, ``paper:1``, peak resident memory; ``bash
 studies/run.sh search-memory`` stores it in docs/results/perf/search-memory.json and
 ``tests/test_search_memory.py`` holds the estimate above every stored peak). A process with
-numba's kernels loaded holds 0.3 GB at 2 × 10⁴ particles; at 10⁶: ``mpc`` 0.59 GiB, ``dcee-cl``
+its compiled kernels loaded holds 0.3 GB at 2 × 10⁴ particles; at 10⁶: ``mpc`` 0.59 GiB, ``dcee-cl``
 1.07 GiB (4 % more after 40 decisions: the position terms are capped), ``infotaxis`` 1.05 GiB,
 ``dcee-mcts`` 1.42 GiB, the fluctuation likelihood 1.23 GiB, two sources (a bank of three
 filters) 1.68 GiB. :data:`BYTES_PER_PARTICLE` is above the dearest single-source planner; a bank
@@ -23,7 +23,7 @@ from pathlib import Path
 from dcee.errors import DceeInputError
 
 BASE_BYTES = 400 * 2**20
-"""The process before any particle: Python, NumPy, numba and its compiled kernels (0.37 GB
+"""The process before any particle: Python, NumPy and the compiled kernels (0.3 GB
 measured at 2 × 10⁴ particles)."""
 
 BYTES_PER_PARTICLE = 1200
