@@ -149,6 +149,17 @@ def test_multi_robot_env_passes_the_pettingzoo_tests():
     parallel_seed_test(lambda: dcee.gym.multi_search_env(agents=2, **SMALL), num_cycles=40)
 
 
+def test_an_environment_whose_particles_would_not_fit_is_refused(monkeypatch):
+    from dcee import search_memory
+
+    monkeypatch.setattr(search_memory, "available_bytes", lambda: 2**30)  # 1 GiB free
+    with pytest.raises(DceeInputError, match="1,000,000 particles need about") as exc:
+        gymnasium.make("dcee/SourceSearch-v0", scenario="paper:1", particles=10**6)
+    assert exc.value.field == "particles"
+    with pytest.raises(DceeInputError, match="particles need about"):
+        dcee.gym.multi_search_env(agents=2, scenario="paper:1", particles=10**6)
+
+
 def test_multi_robot_env_refuses_actions_it_cannot_place():
     env = dcee.gym.multi_search_env(agents=2, **SMALL)
     env.reset(seed=5)

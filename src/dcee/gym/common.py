@@ -13,6 +13,7 @@ from gymnasium import spaces
 from dcee.errors import DceeInputError
 from dcee.runs import SearchSimulation
 from dcee.scenarios import Scenario, truth_choice
+from dcee.search_memory import check_search_memory
 
 REWARDS = ("spread", "rmse")
 """``spread``: the drop of the posterior spread √tr P over the step (m; what the robot itself
@@ -98,6 +99,10 @@ class EnvOptions:
         )
         rules = EpisodeRules.checked(
             self.reward, self.time_penalty, self.success_bonus, self.converged_spread
+        )
+        # an environment per process of a vectorised set: each is checked on its own
+        check_search_memory(
+            scenario.search.particles, scenario.estimator.max_sources, field="particles"
         )
         return scenario, rules
 
