@@ -22,23 +22,25 @@ from dcee.errors import DceeInputError
 
 def find_runs(folder: str | Path) -> list[Path]:
     """Every complete saved search at or below ``folder`` (sorted). Incomplete ones (a search
-    killed mid-write, a failed one) are skipped."""
+    killed mid-write, a failed one) are skipped: :func:`incomplete_runs`."""
+    return _runs(folder, complete=True)
+
+
+def incomplete_runs(folder: str | Path) -> list[Path]:
+    """The folders at or below ``folder`` with a ``summary.json`` that :func:`find_runs`
+    skips (sorted): a search killed mid-write, a failed one, a file since corrupted."""
+    return _runs(folder, complete=False)
+
+
+def _runs(folder: str | Path, complete: bool) -> list[Path]:
+    """The folders at or below ``folder`` holding a ``summary.json``, complete or not."""
     from dcee.runs import EpisodeResult
 
     folder = Path(folder)
     if not folder.is_dir():
         raise DceeInputError("results", f"no such folder {str(folder)!r}")
     found = sorted(p.parent for p in folder.rglob("summary.json"))
-    return [p for p in found if EpisodeResult.is_complete(p)]
-
-
-def incomplete_runs(folder: str | Path) -> list[Path]:
-    """The folders at or below ``folder`` with a ``summary.json`` that :func:`find_runs`
-    skips (sorted): a search killed mid-write, a failed one, a file since corrupted."""
-    from dcee.runs import EpisodeResult
-
-    found = sorted(p.parent for p in Path(folder).rglob("summary.json"))
-    return [p for p in found if not EpisodeResult.is_complete(p)]
+    return [p for p in found if EpisodeResult.is_complete(p) == complete]
 
 
 def load_summaries(folder: str | Path) -> pd.DataFrame:

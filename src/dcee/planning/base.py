@@ -117,6 +117,16 @@ def entry_point(agent: GridAgent, position: np.ndarray) -> np.ndarray | None:
     return entry
 
 
+def entry_decision(agent: GridAgent, position: np.ndarray) -> Decision | None:
+    """For a sensor outside the search volume, beyond one move of it: the :class:`Decision`
+    to head for :func:`entry_point` first (its one candidate; heading −1, no move of the
+    agent's set; ``info`` ``{"entry": True}``). None where :func:`entry_point` is."""
+    entry = entry_point(agent, position)
+    if entry is None:
+        return None
+    return Decision(0, entry[None, :], np.zeros(1), np.array([-1]), {"entry": True})
+
+
 class Planner(ABC):
     """Chooses the next measurement position from the current belief.
 
@@ -153,11 +163,10 @@ class Planner(ABC):
     ) -> Decision:
         candidates, headings = agent.candidates(position)
         if len(candidates) == 0:
-            entry = entry_point(agent, position)
+            entry = entry_decision(agent, position)
             if entry is None:
                 raise DceeInputError("position", f"no admissible move from {position}")
-            # outside the search volume, beyond one move of it: head for it first
-            return Decision(0, entry[None, :], np.zeros(1), np.array([-1]), {"entry": True})
+            return entry
         costs, info = self.costs(belief, np.asarray(position, float), candidates, agent, rng)
         return Decision(int(np.argmin(costs)), candidates, costs, headings, info)
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from dcee.errors import DceeInputError
 from dcee.models.agent import GridAgent
-from dcee.planning.base import Belief, Decision, Planner, entry_point
+from dcee.planning.base import Belief, Decision, Planner, entry_decision
 from dcee.planning.hypothesis import HypothesisPlanner
 
 
@@ -56,10 +56,10 @@ def decide_team(
     out: list[Decision | None] = []
     for position in positions:
         candidates, headings = agent.candidates(position)
-        entry = entry_point(agent, position) if len(candidates) == 0 else None
+        entry = entry_decision(agent, position) if len(candidates) == 0 else None
         if entry is not None:  # outside the area, beyond one move: head for it first
-            out.append(Decision(0, entry[None, :], np.zeros(1), np.array([-1]), {"entry": True}))
-            chosen.append(entry)
+            out.append(entry)
+            chosen.append(entry.position)
             continue
         if chosen:
             taken = np.array(chosen)
