@@ -215,13 +215,21 @@ def test_default_run_folder_encodes_the_settings(tmp_path, capsys, monkeypatch):
     assert len(folders) == 2 and folders[0] == "paper-1_mpc_seed0_n300_b10"
     assert folders[1].startswith("paper-1_mpc_seed0_n300_b10_")
     # changes the name says in words get no hash
-    from dcee.runs.folder import default_run_folder
+    from dcee.runs.folder import default_run_folder, edited_name
     from dcee.scenarios import load_scenario
 
     base = load_scenario("paper:1")
     changes = {"truth.model": "filament", "unknown": "full", "search.particles": 500}
     name = default_run_folder(base.with_overrides(**changes), base, changes, "dcee", 2)
     assert name == "paper-1_dcee_seed2_n500_full_filament"
+    # a named change that holds only with a --set (the planar lbm plume's source must be in
+    # the flight plane): an edited scenario, hashed, not the refusal of the change alone
+    base = load_scenario("random:13")
+    changes = {"truth.model": "lbm", "truth.z": 4.0}
+    scenario = base.with_overrides(**changes)
+    assert edited_name(scenario, base, changes).startswith("random:13+")
+    name = default_run_folder(scenario, base, changes, "dcee", 0)
+    assert name.startswith("random-13_dcee_seed0_lbm_")
 
 
 def test_report_reads_a_folder_of_run_outputs(tmp_path, capsys):

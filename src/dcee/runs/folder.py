@@ -33,7 +33,14 @@ def edited_name(scenario: Scenario, base: Scenario, changes: dict[str, Any]) -> 
     """The name a run's results carry: the built-in's (``paper:1``) when only settings the
     folder names in words changed, else the built-in's with a short hash of the resolved
     scenario (``paper:1+3fa2c1d0``), so an edited scenario never passes for the built-in."""
-    named_only = base.with_overrides(**{k: v for k, v in changes.items() if k in NAMED_CHANGES})
+    try:
+        named_only = base.with_overrides(
+            **{k: v for k, v in changes.items() if k in NAMED_CHANGES}
+        )
+    except DceeInputError:
+        # the named changes hold only with the others (``--truth lbm`` needs ``--set
+        # truth.z`` in the flight plane): the scenario is edited beyond what words say
+        named_only = None
     if scenario.model_copy(update={"name": base.name}) == named_only:
         return base.name
     resolved = scenario.model_copy(update={"name": base.name}).model_dump(mode="json")
