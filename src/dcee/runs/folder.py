@@ -34,9 +34,7 @@ def edited_name(scenario: Scenario, base: Scenario, changes: dict[str, Any]) -> 
     folder names in words changed, else the built-in's with a short hash of the resolved
     scenario (``paper:1+3fa2c1d0``), so an edited scenario never passes for the built-in."""
     try:
-        named_only = base.with_overrides(
-            **{k: v for k, v in changes.items() if k in NAMED_CHANGES}
-        )
+        named_only = base.with_overrides(**{k: v for k, v in changes.items() if k in NAMED_CHANGES})
     except DceeInputError:
         # the named changes hold only with the others (``--truth lbm`` needs ``--set
         # truth.z`` in the flight plane): the scenario is edited beyond what words say
