@@ -142,3 +142,32 @@ def test_searcher_asks_for_a_team_and_rejects_bad_positions():
     bare.tell(starts[0], 0.0, time=4.0)
     with pytest.raises(DceeInputError, match="planner"):
         bare.ask_team(starts)
+
+
+def test_team_figure_draws_each_robots_altitude():
+    """The altitude panel of a team's figure has one trace a robot (the records interleave
+    the robots at each time: one trace through them all zigzagged between robots)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from dcee.analysis.figures import draw_search_figure
+    from dcee.simulation import make_truth
+
+    scenario = load_scenario("paper:1").with_overrides(
+        **{"search.particles": 400, "search.budget": 12.0, "agent.count": 2, "agent.climb": 1.0}
+    )
+    result = run_episode(scenario, "infotaxis", 0)
+    fig = draw_search_figure(result, scenario, make_truth(scenario, 0))
+    try:
+        ax_z = next(ax for ax in fig.axes if ax.get_ylabel() == "height (m)")
+        lines = {ln.get_label(): ln for ln in ax_z.get_lines()}
+        steps = pd.DataFrame(result.records)
+        for k in (0, 1):
+            z = lines[f"robot {k} sensor"].get_ydata()
+            np.testing.assert_allclose(z, steps[steps.robot == k].z)
+        estimate = lines["source height, estimate ± sd"].get_xdata()
+        assert len(estimate) == len(steps[steps.robot == 0])
+    finally:
+        plt.close(fig)

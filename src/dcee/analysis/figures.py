@@ -104,13 +104,10 @@ def _draw_map(
     py = np.array([r["y"] for r in recs])
     robot = np.array([r.get("robot", 0) for r in recs])
     robots = np.unique(robot)
-    colours = ["tab:red", "tab:purple", "tab:orange", "tab:brown", "tab:pink", "tab:olive"]
     for k in robots:
         on = robot == k
         label = "trajectory" if len(robots) == 1 else f"robot {k} trajectory"
-        ax.plot(
-            px[on], py[on], "-", color=colours[k % len(colours)], lw=0.8, alpha=0.8, label=label
-        )
+        ax.plot(px[on], py[on], "-", color=_robot_colour(k), lw=0.8, alpha=0.8, label=label)
     det = np.array([r["detection"] for r in recs])
     z = np.array([r["reading"] for r in recs])
     ax.scatter(px[~det], py[~det], s=4, c="0.35", lw=0, label="non-detection")
@@ -242,6 +239,14 @@ def _draw_rmse(ax: plt.Axes, result: EpisodeResult, scenario: Scenario, until: f
     ax.grid(alpha=0.3, which="both")
 
 
+ROBOT_COLOURS = ("tab:red", "tab:purple", "tab:orange", "tab:brown", "tab:pink", "tab:olive")
+"""A team's robots by index, on the map and in the altitude panel."""
+
+
+def _robot_colour(k: int) -> str:
+    return ROBOT_COLOURS[int(k) % len(ROBOT_COLOURS)]
+
+
 def _shows_altitude(result: EpisodeResult, scenario: Scenario) -> bool:
     """A search in three dimensions: the agent changed altitude or the source height was
     estimated."""
@@ -253,9 +258,19 @@ def _draw_altitude(ax: plt.Axes, result: EpisodeResult, scenario: Scenario, unti
     """The agent's altitude over time, the estimated source height (mean ± sd) and the true
     one."""
     recs = [r for r in result.records if r["time"] <= until + 1e-9]
+    robot = np.array([r.get("robot", 0) for r in recs])
+    robots = np.unique(robot)
+    t_all = np.array([r["time"] for r in recs])
+    z_all = np.array([r["z"] for r in recs])
+    # the sensor's height: a UAV's altitude, or a ground robot's fixed sensor; one trace a
+    # robot (a team's records interleave its robots at each time)
+    for k in robots:
+        on = robot == k
+        label = "sensor" if len(robots) == 1 else f"robot {k} sensor"
+        ax.step(t_all[on], z_all[on], where="post", color=_robot_colour(k), lw=1.0, label=label)
+    # the team shares one belief: its estimate once per time, from the first robot's records
+    recs = [r for r, k in zip(recs, robot, strict=True) if k == robots[0]]
     t = np.array([r["time"] for r in recs])
-    # the sensor's height: a UAV's altitude, or a ground robot's fixed sensor
-    ax.step(t, [r["z"] for r in recs], where="post", color="tab:red", lw=1.0, label="sensor")
     mean = np.array([r["mean_z"] for r in recs])
     sd = np.sqrt(np.maximum([r["cov_zz"] for r in recs], 0.0))
     ax.plot(t, mean, color="tab:blue", lw=1.0, label="source height, estimate ± sd")
