@@ -73,6 +73,18 @@ def test_machine_record_names_the_code_and_libraries():
     assert set(m["code"]) >= {"version", "commit", "source_hash"}
 
 
+def test_the_boot_tells_two_machines_of_one_type_apart(tmp_path):
+    from dcee.perf.machine import boot_id, machine_identity
+
+    path = tmp_path / "boot_id"
+    path.write_text("e14d7531-6620-4ab4-a7ea-63a07c0078d5\n")
+    assert boot_id(path) == "e14d7531"
+    assert boot_id(tmp_path / "missing") is None
+    one = {"cpu_model": "Xeon", "cpus": 2, "versions": {"numpy": "2.4.6"}}
+    assert machine_identity(one) == "Xeon, 2 CPUs, numpy 2.4.6"  # a record from before
+    assert machine_identity({**one, "boot": "e14d7531"}).endswith("numpy 2.4.6, boot e14d7531")
+
+
 def test_the_speed_table_marks_a_shared_run():
     _script("publish_tables")  # puts the studies package on the path, as the script does
     from studies.tables.performance import _timed as timed

@@ -66,21 +66,33 @@ def cpu_identity(cpuinfo: str | None = None) -> dict[str, Any]:
     return out
 
 
+def boot_id(path: Path = Path("/proc/sys/kernel/random/boot_id")) -> str | None:
+    """The first 8 hex digits of the kernel's boot id (Linux), new at every boot: it tells
+    runs on one booted machine from runs on another (two cloud VMs of one type report the
+    same CPU, cores and cache). None where there is no such file."""
+    try:
+        return path.read_text().strip().replace("-", "")[:8] or None
+    except OSError:
+        return None
+
+
 def machine_identity(machine: dict[str, Any]) -> str:
     """One line naming the machine of a stored :func:`machine_record`: CPU model, cores, SIMD
-    width, numpy and numba versions."""
+    width, numpy and numba versions, and the boot (:func:`boot_id`) where it was recorded."""
     versions = machine.get("versions", {})
     cpu = machine.get("cpu_model") or machine.get("processor") or machine.get("machine", "")
     parts = [cpu, f"{machine.get('cpus')} CPUs"]
     if machine.get("vector_bits"):
         parts.append(f"{machine['vector_bits']}-bit SIMD")
     parts += [f"{k} {versions[k]}" for k in ("numpy", "numba") if k in versions]
+    if machine.get("boot"):
+        parts.append(f"boot {machine['boot']}")
     return ", ".join(p for p in parts if p)
 
 
 def machine_record() -> dict[str, Any]:
     """The machine and the software a timing ran on: CPU count, architecture, processor,
-    Python, numba's thread count, library versions (absent ones omitted) and the code version
+    the boot (:func:`boot_id`), Python, numba's thread count, library versions (absent ones omitted) and the code version
     (:func:`dcee.provenance.code_version`)."""
     import numba
 
@@ -95,6 +107,7 @@ def machine_record() -> dict[str, Any]:
         "machine": platform.machine(),
         "processor": platform.processor() or platform.uname().processor,
         **cpu_identity(),
+        "boot": boot_id(),
         "python": platform.python_version(),
         "numba_threads": int(numba.get_num_threads()),
         "versions": versions,
