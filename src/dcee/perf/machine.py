@@ -92,8 +92,8 @@ def machine_identity(machine: dict[str, Any]) -> str:
 
 def machine_record() -> dict[str, Any]:
     """The machine and the software a timing ran on: CPU count, architecture, processor,
-    the boot (:func:`boot_id`), Python, numba's thread count, library versions (absent ones omitted) and the code version
-    (:func:`dcee.provenance.code_version`)."""
+    the boot (:func:`boot_id`), Python, numba's thread count, library versions (absent ones
+    omitted) and the code version (:func:`dcee.provenance.code_version`)."""
     import numba
 
     versions = {}
