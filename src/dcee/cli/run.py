@@ -75,6 +75,12 @@ from dcee.search_memory import check_search_memory
 @click.option("--animate", is_flag=True, help="Also write animation.gif.")
 @click.option("--no-figure", is_flag=True, help="Skip figure.png.")
 @click.option("--quiet", "-q", is_flag=True, help="No progress display.")
+@click.option(
+    "--dry-run",
+    is_flag=True,
+    help="Check the command (scenario, settings, strategy, memory) and print what it would "
+    "run and where, then stop: no search, no files.",
+)
 def run(
     scenario_name: str | None,
     strategy: str,
@@ -93,6 +99,7 @@ def run(
     animate: bool,
     no_figure: bool,
     quiet: bool,
+    dry_run: bool,
 ) -> None:
     """Run one simulated search and write its record, summary, configuration and figure."""
     import numpy as np
@@ -146,6 +153,13 @@ def run(
     scenario = scenario.with_overrides(name=edited_name(scenario, base, changes))
     run_edits = edits(changes)
     check_search_memory(scenario.search.particles, scenario.estimator.max_sources)
+    if dry_run:  # the truth's data (a recording, a solver's plume) are read by the search
+        click.echo(
+            f"would run {scenario.name} ({scenario.truth.model_name} truth, "
+            f"{scenario.search.particles} particles, {scenario.search.budget:g} s) with "
+            f"{strategy}, seed {seed}, into {out_dir}"
+        )
+        return
     with folder_kept_only_on_success(out_dir):  # a failed run leaves no folder
         check_writable_dir(out_dir, "out")
         check_same_run(out_dir, scenario, strategy, seed)
