@@ -414,7 +414,7 @@ def test_snapshots_follow_the_budget(finished):
 def test_resume_with_other_code_is_refused_unless_allowed(finished, monkeypatch, tmp_path):
     import shutil
 
-    import dcee.campaign.runner as runner
+    import dcee.campaign.folder as campaign_folder
 
     out, _ = finished
 
@@ -423,7 +423,7 @@ def test_resume_with_other_code_is_refused_unless_allowed(finished, monkeypatch,
 
     before = code_versions(out)
     other = {**code_version(), "source_hash": "0123456789abcdef", "commit": "f" * 40}
-    monkeypatch.setattr(runner, "code_version", lambda: other)
+    monkeypatch.setattr(campaign_folder, "code_version", lambda: other)
     # complete: resuming runs nothing, so nothing is refused and no code is recorded
     assert run_campaign(_campaign(out), workers=1)["skipped"] == 8
     assert code_versions(out) == before

@@ -111,3 +111,17 @@ def test_a_bad_recipe_or_name_is_one_line_and_exit_2(tmp_path):
     first = json.loads(dry.stdout.splitlines()[0])
     assert first[:3] == ["dcee", "bench", "--suite"] and "results/paper-source" in first
     assert shlex.join(first)  # one command per line, as JSON
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_every_recipe_search_is_accepted_by_today_s_code(name, tmp_path, monkeypatch, capsys):
+    """Each ``dcee run`` and ``dcee bench`` step of the recipe, checked with ``--dry-run`` (its
+    scenario, settings, strategies and memory, no search): a published table stays
+    reproducible only while today's code takes the commands that made it."""
+    from tests.helpers import run_cli
+
+    monkeypatch.chdir(tmp_path)
+    for kind, argv in runner.commands(name, runner.load_pins()):
+        if kind == "dcee" and argv[0] in ("run", "bench"):
+            code, out, err = run_cli([*argv, "--dry-run"], capsys)
+            assert code == 0 and out.startswith("would run "), f"{shlex.join(argv)}\n{err}"

@@ -63,6 +63,12 @@ from dcee.search_memory import check_search_memory
     is_flag=True,
     help="Resume a campaign that other code started (every version used is recorded).",
 )
+@click.option(
+    "--dry-run",
+    is_flag=True,
+    help="Check the campaign (suite, strategies, settings, memory, an existing --out folder) "
+    "and print how many searches it would run, then stop: no search, no files.",
+)
 def bench(
     suite: str,
     strategies: str,
@@ -77,6 +83,7 @@ def bench(
     likelihood: str | None,
     settings: tuple[str, ...],
     allow_code_change: bool,
+    dry_run: bool,
 ) -> None:
     """Run a campaign of simulated searches; resumes where a previous run stopped."""
     from rich.progress import (
@@ -105,6 +112,7 @@ def bench(
         truth_choice(truth) if truth is not None else None,
         changes,
         allow_code_change,
+        open_truths=not dry_run,
     )
     if scheduler is None:  # a Dask cluster's memory is its workers' own
         scenarios = list(campaign.scenarios.values())
@@ -113,6 +121,9 @@ def bench(
             max(sc.estimator.max_sources for sc in scenarios),
             processes=workers or os.cpu_count() or 1,
         )
+    if dry_run:
+        _dry_run(campaign, scheduler)
+        return
     check_writable_dir(out_dir, "out")
     compile_notice(False)
     climb_notice(list(campaign.scenarios.values()))
@@ -146,6 +157,23 @@ def bench(
     )
     for line in failures[:20]:
         click.echo(f"  failed: {line}", err=True)
+
+
+def _dry_run(campaign: Any, scheduler: str | None) -> None:
+    """What ``dcee bench --dry-run`` prints: the searches the campaign holds and how many of
+    them an earlier run finished (its folder checked as a resume would check it, nothing
+    written; a scheduler is not contacted)."""
+    from dcee.campaign.folder import is_done
+
+    campaign.prepare(write=False)
+    tasks = campaign.tasks()
+    done = sum(is_done(t) for t in tasks)
+    where = f"on {scheduler}" if scheduler else "here"
+    click.echo(
+        f"would run {len(tasks) - done} of {len(tasks)} searches ({len(campaign.scenarios)} "
+        f"configurations × {len(campaign.strategies)} strategies × {campaign.repeats} repeats; "
+        f"{done} already done) {where}, into {campaign.out_dir}"
+    )
 
 
 def _log_progress(suite: str, finished: int, todo: int, failed: int, elapsed: float) -> None:
