@@ -517,11 +517,27 @@ def test_median_band_covers_the_median_at_95_percent():
         (["--repeats", "0"], "repeats"),
     ],
 )
-def test_bench_bad_input_is_one_line_exit_2(tmp_path, capsys, args, field):
+@pytest.mark.parametrize("dry_run", [[], ["--dry-run"]])
+def test_bench_bad_input_is_one_line_exit_2(tmp_path, capsys, args, field, dry_run):
     with pytest.raises(SystemExit) as exc:
-        main(["bench", "--suite", "smoke", "--out", str(tmp_path / "c"), *args])
+        main(["bench", "--suite", "smoke", "--out", str(tmp_path / "c"), *args, *dry_run])
     err = capsys.readouterr().err
     assert exc.value.code == 2 and field in err and err.count("\n") == 1
+    assert not (tmp_path / "c").exists()  # refused before the folder was made
+
+
+def test_bench_dry_run_writes_nothing_and_checks_the_folder(tmp_path, capsys):
+    out = tmp_path / "deep" / "c"
+    argv = ["bench", "--suite", "smoke", "--strategies", "mpc", "--repeats", "3"]
+    with pytest.raises(SystemExit) as exc:
+        main([*argv, "--out", str(out), "--dry-run"])
+    stdout = capsys.readouterr().out
+    assert exc.value.code == 0 and not (tmp_path / "deep").exists()
+    assert stdout.startswith("would run 6 of 6 searches (2 configurations × 1 strategies")
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(SystemExit) as exc:
+        main([*argv, "--out", str(tmp_path / "file" / "c"), "--dry-run"])
+    assert exc.value.code == 2 and "out:" in capsys.readouterr().err
 
 
 def test_report_names_the_region_floor():

@@ -263,6 +263,21 @@ def test_unwritable_out_is_exit_2_before_the_search(tmp_path, capsys, where, fie
     assert code == 2 and err.startswith(f"dcee: error: {field}:") and err.count("\n") == 1
 
 
+def test_a_dry_run_checks_the_outputs_and_writes_nothing(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    out = tmp_path / "new" / "run"
+    code, stdout, _ = run_cli([*_tiny(), "--out", str(out), "--dry-run"], capsys)
+    assert code == 0 and stdout.startswith("would run paper:1") and str(out) in stdout
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file"]  # nothing made
+    for extra, field in (
+        (["--out", str(blocker / "under")], "out"),
+        (["--json", str(blocker / "summary.json")], "json"),
+    ):
+        code, _, err = run_cli([*_tiny(), *extra, "--dry-run"], capsys)
+        assert code == 2 and err.startswith(f"dcee: error: {field}:") and err.count("\n") == 1
+
+
 def test_unwritable_json_and_report_out_are_exit_2(tmp_path, capsys):
     blocker = tmp_path / "file"
     blocker.write_text("x")

@@ -12,13 +12,23 @@ from pathlib import Path
 from typing import Any
 
 
-def check_writable_dir(path: Path, field: str) -> None:
+def check_writable_dir(path: Path, field: str, create: bool = True) -> None:
     """Create ``path`` (a folder) if needed and check that a file can be written in it, so a
-    command fails at once with one line instead of after its work."""
+    command fails at once with one line instead of after its work. ``create=False`` (a dry
+    run): leave the file system as it was, checking that the nearest existing folder on the
+    way takes a new folder (one made there and removed at once)."""
     path = Path(path)
     try:
         if path.exists() and not path.is_dir():
             raise NotADirectoryError(f"{path} is a file")
+        if not create and not path.exists():
+            parent = path.absolute().parent
+            while not parent.exists():
+                parent = parent.parent
+            if not parent.is_dir():
+                raise NotADirectoryError(f"{parent} is a file")
+            os.rmdir(tempfile.mkdtemp(prefix=".dcee-write-check.", dir=parent))
+            return
         path.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(prefix=".dcee-write-check.", dir=path)
         os.close(fd)

@@ -243,6 +243,15 @@ def _dask_results(tasks: list[SearchTask], client: Any) -> Iterator[dict[str, An
         client.cancel(list(futures))
 
 
+def check_workers(workers: int | None, scheduler: Any = None) -> None:
+    """:class:`DceeInputError` for a local worker count below 1, or one given with a
+    scheduler (whose cluster has its own workers)."""
+    if workers is not None and workers < 1:
+        raise DceeInputError("workers", f"must be >= 1, got {workers}")
+    if workers is not None and scheduler is not None:
+        raise DceeInputError("workers", "give either --workers or --scheduler, not both")
+
+
 def run_campaign(
     campaign: Campaign,
     workers: int | None = None,
@@ -255,10 +264,7 @@ def run_campaign(
     otherwise ``workers`` local processes (default: all cores). The campaign folder must be on a
     file system the Dask workers share.
     """
-    if workers is not None and workers < 1:
-        raise DceeInputError("workers", f"must be >= 1, got {workers}")
-    if workers is not None and scheduler is not None:
-        raise DceeInputError("workers", "give either --workers or --scheduler, not both")
+    check_workers(workers, scheduler)
     client, own = connect_scheduler(scheduler) if scheduler is not None else (None, False)
     try:
         campaign.prepare()

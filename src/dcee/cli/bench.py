@@ -96,8 +96,10 @@ def bench(
     )
 
     from dcee.campaign import Campaign, run_campaign
+    from dcee.campaign.runner import check_workers
     from dcee.scenarios import truth_choice
 
+    check_workers(workers, scheduler)
     names = tuple(s.strip() for s in strategies.split(",") if s.strip())
     changes = overrides(likelihood, settings)
     if agents is not None:
@@ -122,6 +124,7 @@ def bench(
             processes=workers or os.cpu_count() or 1,
         )
     if dry_run:
+        check_writable_dir(out_dir, "out", create=False)
         _dry_run(campaign, scheduler)
         return
     check_writable_dir(out_dir, "out")

@@ -154,6 +154,9 @@ def run(
     run_edits = edits(changes)
     check_search_memory(scenario.search.particles, scenario.estimator.max_sources)
     if dry_run:  # the truth's data (a recording, a solver's plume) are read by the search
+        check_writable_dir(out_dir, "out", create=False)
+        if json_file is not None:
+            check_writable_file(json_file, "json")
         click.echo(
             f"would run {scenario.name} ({scenario.truth.model_name} truth, "
             f"{scenario.search.particles} particles, {scenario.search.budget:g} s) with "
