@@ -59,6 +59,9 @@ def test_checkpoint_write_errors(tmp_path) -> None:
     (tmp_path / "bad.ckpt").write_text("a file where a folder is needed")
     with pytest.raises(DceeInputError, match="cannot write checkpoint"):
         sim.searcher.save(tmp_path / "bad.ckpt" / "sub" / "x.ckpt")
+    with pytest.raises(DceeInputError, match=r"is a folder; give the checkpoint a file name"):
+        sim.searcher.save(tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bad.ckpt"]  # no temporary left
 
 
 @pytest.mark.parametrize(

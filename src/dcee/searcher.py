@@ -340,6 +340,11 @@ class Searcher:
         from dcee.state_file import write_state
 
         path = Path(path)
+        if path.is_dir():  # else the atomic write's rename fails with a confusing message
+            raise DceeInputError(
+                "path",
+                f"{path} is a folder; give the checkpoint a file name, e.g. {path / 'search.ckpt'}",
+            )
         meta = {"scenario": self.scenario_key}
         try:
             write_atomic(
