@@ -238,3 +238,17 @@ def test_one_angle_convention_checked_on_input():
         with pytest.raises(DceeInputError, match=rf"prior.phi.{key}: .*radians.*math.radians"):
             SourcePrior.from_dict({**dists, "phi": phi})
     SourcePrior.from_dict({**dists, "phi": Fixed(math.radians(90.0))})  # radians: accepted
+
+
+def test_a_scenario_file_s_misspelt_section_is_named_before_what_it_leaves_missing(tmp_path):
+    """``[agnet]`` for ``[agent]`` also leaves required sections missing; the line names the
+    misspelling (the cause), and a section that is missing says so without echoing the file."""
+    typo = tmp_path / "typo.toml"
+    typo.write_text('name = "x"\n[agnet]\nstart = [1, 1, 1]\n')
+    with pytest.raises(DceeInputError, match=r"did you mean 'agent'") as exc:
+        load_scenario(str(typo))
+    assert exc.value.field == "agnet"
+    bare = tmp_path / "bare.toml"
+    bare.write_text('name = "x"\n')
+    with pytest.raises(DceeInputError, match=r"^volume: required: the scenario does not give it"):
+        load_scenario(str(bare))

@@ -20,6 +20,8 @@ def one_line_error(exc: ValidationError, root: type[BaseModel]) -> DceeInputErro
     # a union (truth.model) reports every branch; the literal branch's complaint is noise
     # when a table was given, so report the error of the branch the input was meant for
     relevant = [e for e in errors if not any(str(p).startswith("literal[") for p in e["loc"])]
+    # a misspelt field first: it is why a required one is missing ([agnet] leaves no [agent])
+    relevant.sort(key=lambda e: e["type"] != "extra_forbidden")
     err = (relevant or errors)[0]
     # drop pydantic's internal union labels ("tagged-union[...]"), keep the user's field path
     parts = [str(p) for p in err["loc"] if "[" not in str(p)]
@@ -31,6 +33,9 @@ def one_line_error(exc: ValidationError, root: type[BaseModel]) -> DceeInputErro
         loc, _, msg = msg.removeprefix(FIELD_MARK).partition(": ")
     if err["type"] == "extra_forbidden":
         msg = _unknown_field(root, parts)
+    elif err["type"] == "missing":  # its input is the whole section: say what is missing
+        section = ".".join(parts[:-1]) or "the scenario"
+        msg = f"required: {section} does not give it (`dcee show paper:1` prints a whole scenario)"
     elif "input" in err and err["type"] != "value_error":
         msg = f"{msg} (got {err['input']!r})"
     return DceeInputError(loc, msg)
