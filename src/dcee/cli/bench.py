@@ -170,7 +170,8 @@ def _dry_run(campaign: Any, scheduler: str | None) -> None:
 
     campaign.prepare(write=False)
     tasks = campaign.tasks()
-    done = sum(is_done(t) for t in tasks)
+    # a new folder holds no finished search (spares 2,000 lookups of a 100-configuration suite)
+    done = sum(is_done(t) for t in tasks) if (campaign.out_dir / "runs").is_dir() else 0
     where = f"on {scheduler}" if scheduler else "here"
     click.echo(
         f"would run {len(tasks) - done} of {len(tasks)} searches ({len(campaign.scenarios)} "
