@@ -19,6 +19,8 @@ from dcee.scenarios.schema import validate_scenario
 from tests.helpers import run_cli
 
 SITE = Path(__file__).parents[1] / "src" / "dcee" / "scenarios" / "sites" / "example-works.geojson"
+REAL_SITE = SITE.with_name("fontvieille.geojson")
+"""A real site: Fontvieille, Monaco, from OpenStreetMap (studies/osm_site.py)"""
 
 
 def test_frame_round_trip_and_distances_match_the_geodesic() -> None:
@@ -93,10 +95,13 @@ def _search(args: list[str], tmp_path: Path, name: str, capsys) -> Path:
     return out
 
 
-def test_estimate_geojson_is_rfc7946_and_its_point_round_trips(tmp_path: Path, capsys) -> None:
+@pytest.mark.parametrize("site", [SITE, REAL_SITE], ids=["constructed", "openstreetmap"])
+def test_estimate_geojson_is_rfc7946_and_its_point_round_trips(
+    site: Path, tmp_path: Path, capsys
+) -> None:
     import geojson
 
-    out = _search(["--area", str(SITE)], tmp_path, "geo", capsys)
+    out = _search(["--area", str(site)], tmp_path, "geo", capsys)
     doc = json.loads((out / "estimate.geojson").read_text())
     checked = geojson.loads(json.dumps(doc))
     assert checked.is_valid, checked.errors()
@@ -359,3 +364,31 @@ def test_a_scenario_file_names_the_area_and_places_start_and_release_in_degrees(
     assert s.truth.q == 3.0 and len(s.world.obstacles) == 3
     with pytest.raises(DceeInputError, match=r"agent\.start_geo"):
         load_scenario("paper:1").with_overrides(**{"agent.start_geo": {"latitude": 1.0}})
+
+
+def test_the_real_site_is_openstreetmap_s_as_mapped() -> None:
+    """area:fontvieille: the buildings and no-go zones of the OpenStreetMap extract with their
+    ids and tags as mapped (heights from building:levels, 3 m a storey; the incinerator has
+    none and so blocks every agent), the attribution the ODbL asks for, and a start and a
+    release outside every building."""
+    from shapely import Point, Polygon
+
+    from dcee.geo.site_file import read_site
+
+    doc = json.loads(REAL_SITE.read_text())
+    assert "OpenStreetMap contributors" in doc["attribution"] and "ODbL" in doc["attribution"]
+    mapped = [f for f in doc["features"] if "osm_id" in f["properties"]]
+    assert len(mapped) >= 10 and all(f["properties"]["osm_id"].startswith("way/") for f in mapped)
+    site = read_site(REAL_SITE)
+    heights = {b.footprint.label: b.height for b in site.buildings}
+    triton = next(v for k, v in heights.items() if "Le Triton" in k)
+    incinerator = next(v for k, v in heights.items() if "Incinérateur SMA" in k)
+    assert triton == 30.0 and incinerator is None
+    assert sum(h is not None for h in heights.values()) >= 4  # 7-10 storeys
+    assert {"cemetery", "construction"} <= {
+        f["properties"].get("landuse") for f in doc["features"]
+        if f["properties"].get("dcee") == "no-go"
+    }  # fmt: skip
+    for point in (site.start, site.source):
+        p = Point(point.lon, point.lat)
+        assert not any(Polygon(b.footprint.ring).contains(p) for b in site.buildings)

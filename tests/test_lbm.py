@@ -215,6 +215,15 @@ def test_a_site_grows_the_domain_round_the_search_area_and_walls_off_its_buildin
         lambda xy: np.zeros(len(xy), bool),
     )  # fmt: skip
     assert none is None and open_spec == spec
+    # a building the domain's edge cuts (a real map's block reaching past the area): the band
+    # along every edge stays air, the rest of the building walled off
+    _, cut = lbm.site_frame(
+        spec, (0.0, 0.0), (50.0, 50.0), theta[:2], float(theta[5]),
+        lambda xy: xy[:, 1] < 5.0,  # everything south of y = 5 m, past the domain's edge
+    )  # fmt: skip
+    edge = round(lbm.SITE_EDGE / grown.spacing)
+    assert cut.any() and not cut[:edge].any() and not cut[-edge:].any()
+    assert not cut[:, :edge].any() and not cut[:, -edge:].any()
 
 
 def test_a_run_that_diverges_but_stays_finite_is_refused() -> None:

@@ -12,7 +12,7 @@ from studies.tables.gaden import (
     gaden_starts_table,
     gaden_timing_table,
 )
-from studies.tables.geo import geo_site_table
+from studies.tables.geo import REAL_SITE_FOLDER, geo_site_table
 from studies.tables.headline import headline_table
 from studies.tables.held_out import held_out_table, others_table, paired_table
 from studies.tables.lbm import (
@@ -76,6 +76,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "gaden-fit": gaden_fit_table,
     "gaden-rooms": gaden_rooms_table,
     "geo-site": geo_site_table,
+    "geo-site-fontvieille": lambda: geo_site_table(REAL_SITE_FOLDER),
     "lbm3d-sparse-tune": sparse_table,
     "gaden-starts": gaden_starts_table,
     "gaden-timing": gaden_timing_table,

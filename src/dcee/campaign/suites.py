@@ -24,7 +24,8 @@
   configurations from ``random:8000`` whose source is 2-4 m below it (at most 2 m above the
   ground); ``lbm3d-slice-tune``, the same slice over the first 20 such configurations of the
   tuning range (choose here, never report).
-* ``geo-example``: the site on a map that ships with dcee (``area:example-works``, issue 81).
+* ``geo-example``: the constructed site on a map that ships with dcee (``area:example-works``,
+  issue 81); ``geo-fontvieille``: the real one (``area:fontvieille``, from OpenStreetMap).
 * ``lbm3d-sparse-tune``: ``random:1`` … ``random:16`` on the 3-D plume with the release cut to
   0.1 g/s so that gas is rare (issue 78, item 4; tuning, never reported as a claim).
 * ``smoke``: two of them at toy scale (1,000 particles, 10 hypothesised readings, 60 s) so a
@@ -216,6 +217,8 @@ SUITES: dict[str, dict] = {
     },
     # a site on a map in geographic coordinates (issue 81): the example site that ships with dcee
     "geo-example": {"configs": ["area:example-works"], "overrides": {}},
+    # and a real site from OpenStreetMap (studies/osm_site.py): Fontvieille, Monaco
+    "geo-fontvieille": {"configs": ["area:fontvieille"], "overrides": {}},
     # tuning configurations for slow studies (never report them)
     "random-tune-12": {"configs": [f"random:{k}" for k in range(1, 13)], "overrides": {}},
     "smoke": {
