@@ -274,6 +274,27 @@ def test_a_site_whose_run_diverges_is_computed_once_more_slower(tmp_path, monkey
     assert lbm.cached_recording(spec, solids=walls) == first and len(calls) == 2  # remembered
     with pytest.raises(DceeInputError, match="became unstable 1465 s into the run"):
         lbm.cached_recording(spec)  # open terrain: no slower run
+    # a site that diverges at the slower speed too: once more, more viscous, then no further
+    calls.clear()
+    tried: list[tuple[float, float]] = []
+
+    def steady_only_when_viscous(spec, progress=None, solids=None):
+        tried.append((spec.lattice_speed, spec.relaxation))
+        if spec.relaxation > lbm.SITE_FALLBACK_RELAXATION:
+            raise unstable(456.0)
+        return fake_solve(spec.model_copy(update={"lattice_speed": 0.01}))
+
+    monkeypatch.setattr(lbm, "solve", steady_only_when_viscous)
+    walls[4, 2] = True  # another site
+    third = lbm.cached_recording(spec, solids=walls)
+    assert tried == [(0.03, 1.99), (0.02, 1.99), (0.02, lbm.SITE_FALLBACK_RELAXATION)]
+    assert third == lbm.cache_path(
+        spec.model_copy(update={"lattice_speed": 0.02, "relaxation": 1.9}), walls
+    )
+    monkeypatch.setattr(lbm, "solve", lambda *a, **k: (_ for _ in ()).throw(unstable(9.0)))
+    walls[5, 2] = True
+    with pytest.raises(DceeInputError, match="became unstable 9 s"):
+        lbm.cached_recording(spec, solids=walls)  # every set-up diverged: one line
 
 
 def test_an_unwritable_cache_is_refused_before_the_solver_runs(monkeypatch, tmp_path) -> None:

@@ -93,6 +93,14 @@ least :data:`SITE_MARGIN` − 4 m beyond the search area; no earlier site had a 
 their recordings are unchanged (the mask is part of the cache key)."""
 
 
+SITE_FALLBACK_RELAXATION = 1.9
+"""The flow's relaxation rate of a site whose run diverged at :data:`SITE_FALLBACK_SPEED` too:
+a viscosity five times the default's (ω 1.99), the Smagorinsky eddy viscosity on top. Needed by
+the block of Monaco's real map (``area:fontvieille``: diverged 456 s into the run at 0.02 with
+ω 1.99, its streets 10-20 m wide between blocks up to 30 m, 2026-12-05); no earlier site
+reaches it (each is stable at 0.03 or 0.02), so their recordings are unchanged."""
+
+
 SITE_FALLBACK_SPEED = 0.02
 """The inflow's lattice speed of a site whose run at :data:`SITE_LATTICE_SPEED` diverged
 (:class:`~dcee.simulation.lbm_solver.LatticeDiverged`): ``site:passage``'s jet through its 4 m
@@ -213,7 +221,7 @@ def cached_recording(
     if path.is_file():
         return path
     marker = path.with_suffix(".diverged")
-    slower = solids is not None and spec.lattice_speed > SITE_FALLBACK_SPEED
+    slower = solids is not None and _fallback(spec) != spec
     if slower and marker.is_file():
         return cached_recording(_fallback(spec), progress, announce, solids)
     check_writable_dir(path.parent, "cache")  # before minutes of solving, not after
@@ -227,15 +235,23 @@ def cached_recording(
         # a site's jet diverged at this lattice speed: once more, slower (remembered, so the
         # diverging run is not repeated)
         marker.parent.mkdir(parents=True, exist_ok=True)
-        marker.write_text(f"diverged at lattice_speed {spec.lattice_speed:g}\n", encoding="utf-8")
+        marker.write_text(
+            f"diverged at lattice_speed {spec.lattice_speed:g}, relaxation {spec.relaxation:g}\n",
+            encoding="utf-8",
+        )
         return cached_recording(_fallback(spec), progress, announce, solids)
     write_recording(path, spec, run)
     return path
 
 
 def _fallback(spec: LbmSpec) -> LbmSpec:
-    """``spec`` at :data:`SITE_FALLBACK_SPEED`."""
-    return spec.model_copy(update={"lattice_speed": SITE_FALLBACK_SPEED})
+    """The next, steadier set-up of a site whose run diverged: first :data:`SITE_FALLBACK_SPEED`,
+    then also :data:`SITE_FALLBACK_RELAXATION`; ``spec`` itself after both (no further try)."""
+    if spec.lattice_speed > SITE_FALLBACK_SPEED:
+        return spec.model_copy(update={"lattice_speed": SITE_FALLBACK_SPEED})
+    if spec.relaxation > SITE_FALLBACK_RELAXATION:
+        return spec.model_copy(update={"relaxation": SITE_FALLBACK_RELAXATION})
+    return spec
 
 
 class SolverPlumeTruth(TruthModel):
