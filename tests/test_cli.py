@@ -98,8 +98,8 @@ def test_bad_scenarios_exit_2(tmp_path, capsys):
 
 def test_scenarios_and_show(capsys):
     code, out, _ = run_cli(["scenarios"], capsys)
-    assert code == 0 and out.count("\n") == 35 and "lab:upwind" in out and "random:K" in out
-    assert "area:example-works" in out
+    assert code == 0 and out.count("\n") == 36 and "lab:upwind" in out and "random:K" in out
+    assert "area:example-works" in out and "area:fontvieille" in out
     assert "site:wall" in out and "site:nogo" in out
     code, out, _ = run_cli(["show", "paper:3", "--format", "json"], capsys)
     assert code == 0 and json.loads(out)["truth"]["y"] == 40.0

@@ -72,7 +72,7 @@ def test_a_documented_command_does_what_the_page_says(
 ):
     # the repository's files (tests/data/...) where the pages name them, and no results of
     # this checkout's own (a campaign folder there would be checked as a resume)
-    for top in ("tests", "docs", "studies"):
+    for top in ("tests", "docs", "studies", "src"):
         (tmp_path / top).symlink_to(ROOT / top)
     monkeypatch.chdir(tmp_path)
     args = shlex.split(command, comments=True)[1:]
