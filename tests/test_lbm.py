@@ -309,3 +309,29 @@ def test_an_unwritable_cache_is_refused_before_the_solver_runs(monkeypatch, tmp_
     monkeypatch.setenv("DCEE_CACHE", str(blocker))
     with pytest.raises(DceeInputError, match="cache: cannot write"):
         lbm.cached_recording(LbmSpec())
+
+
+def test_plume_command_computes_a_scenario_s_site_plume_once(tmp_path, monkeypatch, capsys):
+    """``dcee plume --scenario NAME``: the plume the scenario's solver truth flies (a site's,
+    round its buildings) computed into the cache, then found there; a scenario without a
+    solver truth is refused in one line."""
+    from dcee.simulation import lbm
+    from tests.helpers import run_cli
+
+    monkeypatch.setenv("DCEE_CACHE", str(tmp_path))
+    solved: list[bool] = []
+
+    def fake_solve(spec, progress=None, solids=None):
+        solved.append(solids is not None and bool(solids.any()))
+        t, x, y = np.arange(3.0), np.arange(4.0), np.arange(-1.0, 2.0)
+        field = np.full((3, 3, 4), 0.5, np.float32)
+        return {"concentration": field, "t": t, "x": x, "y": y, "attrs": {"flux_lattice": 1.0}}
+
+    monkeypatch.setattr(lbm, "solve", fake_solve)
+    code, out, err = run_cli(["plume", "--scenario", "site:wall", "-q"], capsys)
+    assert code == 0, err
+    assert solved == [True] and "site:wall: lbm plume ready (" in out and str(tmp_path) in out
+    code, out, _ = run_cli(["plume", "--scenario", "site:wall", "-q"], capsys)
+    assert code == 0 and solved == [True] and "already in the cache" in out
+    code, _, err = run_cli(["plume", "--scenario", "paper:1"], capsys)
+    assert code == 2 and "not a solver's plume" in err and err.count("\n") == 1

@@ -65,9 +65,20 @@ def _spec(settings: tuple[str, ...], model: str = "lbm") -> Any:
     show_default=True,
     help="lbm3d: m above the ground of the release (its lattice cell's centre is used).",
 )
+@click.option(
+    "--scenario",
+    "scenario_name",
+    help="Instead: compute the plume a scenario's solver truth flies (a site's, round its "
+    "buildings: area:fontvieille takes minutes on first use), cache it and print where.",
+)
 @click.option("-q", "--quiet", is_flag=True, help="No progress bar.")
 def plume(
-    settings: tuple[str, ...], json_file: Path | None, model: str, height: float, quiet: bool
+    settings: tuple[str, ...],
+    json_file: Path | None,
+    model: str,
+    height: float,
+    scenario_name: str | None,
+    quiet: bool,
 ) -> None:
     """Compute the plume of `truth.model = "lbm"` (lbmpy's lattice Boltzmann, docs/plumes.md)
     or, with --model lbm3d, of the 3-D surface-layer plume, for the parameters given with
@@ -79,6 +90,9 @@ def plume(
     height, and the wind against the log law and the neutral surface layer's turbulence."""
     from rich.console import Console
 
+    if scenario_name is not None:
+        _scenario_plume(scenario_name, settings, quiet)
+        return
     spec = _spec(settings, model)
     if json_file is not None:
         check_writable_file(json_file, "--json")
@@ -132,6 +146,36 @@ def plume(
                 "sections": [r.__dict__ for r in rows],
             },
         )
+
+
+def _scenario_plume(name: str, settings: tuple[str, ...], quiet: bool) -> None:
+    """``dcee plume --scenario NAME``: build the scenario's truth once (its solver plume
+    computed and cached as a search would) and say where the recording is."""
+    from dcee.cli.options import overrides
+    from dcee.scenarios import load_scenario
+    from dcee.simulation import make_truth
+
+    scenario = load_scenario(name).with_overrides(**overrides(None, settings))
+    kind = scenario.truth.model_name
+    if kind not in ("lbm", "lbm3d"):
+        raise DceeInputError(
+            "scenario", f"{scenario.name}'s truth is {kind!r}, not a solver's plume (lbm, lbm3d)"
+        )
+    before = set(_cached_files())
+    if not quiet:
+        click.echo(f"dcee: computing {scenario.name}'s {kind} plume once (cached)", err=True)
+    make_truth(scenario, 0)
+    new = sorted(set(_cached_files()) - before)
+    where = ", ".join(str(p) for p in new) if new else "already in the cache"
+    click.echo(f"{scenario.name}: {kind} plume ready ({where})")
+
+
+def _cached_files() -> list[Path]:
+    """The recordings in the plume cache now."""
+    from dcee.simulation.lbm import cache_folder
+
+    folder = cache_folder()
+    return list(folder.glob("*.nc")) if folder.is_dir() else []
 
 
 def _computed(path: Path, compute: Any, quiet: bool) -> Path:
