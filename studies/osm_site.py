@@ -4,8 +4,8 @@ The buildings (``building`` with OpenStreetMap's ``height`` / ``building:levels`
 the no-go zones (ways of the extract, by id) and their tags come from the extract as they are;
 the search area ("the fence"), the start and the simulated release are this script's choices,
 given in metres east and north of the centroid of the way ``--around`` and written as
-longitude and latitude (the shift to degrees is the local equirectangular one, within a
-millimetre over a few hundred metres; dcee builds its own frame from the file). Every building
+longitude and latitude (by the local equirectangular scale, good to about 0.5 %: it only places
+the chosen shapes; dcee builds its own frame from the file). Every building
 and no-go way that meets the area is kept whole, with its OpenStreetMap id.
 
 The site that ships with dcee, ``area:fontvieille`` (src/dcee/scenarios/sites/fontvieille.geojson),

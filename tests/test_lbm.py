@@ -335,3 +335,5 @@ def test_plume_command_computes_a_scenario_s_site_plume_once(tmp_path, monkeypat
     assert code == 0 and solved == [True] and "already in the cache" in out
     code, _, err = run_cli(["plume", "--scenario", "paper:1"], capsys)
     assert code == 2 and "not a solver's plume" in err and err.count("\n") == 1
+    code, _, err = run_cli(["plume", "--scenario", "site:wall", "--model", "lbm3d"], capsys)
+    assert code == 2 and err.startswith("dcee: error: --model: not with --scenario")

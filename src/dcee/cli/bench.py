@@ -7,7 +7,7 @@ import os
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -22,6 +22,9 @@ from dcee.cli.options import (
 from dcee.console import climb_notice, clock, compile_notice
 from dcee.io import check_writable_dir
 from dcee.search_memory import check_search_memory
+
+if TYPE_CHECKING:  # imported where used: `dcee --help` stays light
+    from dcee.campaign.folder import Campaign
 
 
 @click.command(short_help="Run a campaign of searches (resumable).")
@@ -162,7 +165,7 @@ def bench(
         click.echo(f"  failed: {line}", err=True)
 
 
-def _dry_run(campaign: Any, scheduler: str | None) -> None:
+def _dry_run(campaign: Campaign, scheduler: str | None) -> None:
     """What ``dcee bench --dry-run`` prints: the searches the campaign holds and how many of
     them an earlier run finished (its folder checked as a resume would check it, nothing
     written; a scheduler is not contacted)."""

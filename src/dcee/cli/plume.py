@@ -91,6 +91,10 @@ def plume(
     from rich.console import Console
 
     if scenario_name is not None:
+        given = click.get_current_context().get_parameter_source
+        for name, flag in (("model", "--model"), ("height", "--height"), ("json_file", "--json")):
+            if given(name) == click.core.ParameterSource.COMMANDLINE:
+                raise DceeInputError(flag, "not with --scenario (the scenario's truth says it)")
         _scenario_plume(scenario_name, settings, quiet)
         return
     spec = _spec(settings, model)

@@ -85,12 +85,14 @@ the turbulence grid stands at least this far (plus its near wake, 15 m) upwind o
 
 
 SITE_EDGE = 4.0
-"""m: a band along the domain's edges kept air. A building the edge cuts (a real map's block
-reaches past the search area) put wall cells against the open boundaries, and the run diverged
-however slow its inflow (measured, 2026-12-05, the Fontvieille site, wind from 315°: 248 s into
-the run at lattice speed 0.03 and at 0.02, 128 s with the wind from 270°). The band lies at
-least :data:`SITE_MARGIN` − 4 m beyond the search area; no earlier site had a wall there, so
-their recordings are unchanged (the mask is part of the cache key)."""
+"""m: a band along the domain's edges kept air, so that no wall cell lies against the open
+boundaries (a real map's block reaches past the search area and the domain's edge cuts it).
+Measured on the Fontvieille site (wind from 315°, 2026-12-05): with walls on the edges the run
+diverged 248 s in at lattice speed 0.02, with the band 456 s in; it took
+:data:`SITE_FALLBACK_RELAXATION` as well to run through (whether that alone would have done
+was not tried). The band lies at least :data:`SITE_MARGIN` − 4 m beyond the search area; no
+earlier site had a wall there, so their recordings are unchanged (the mask is part of the
+cache key)."""
 
 
 SITE_FALLBACK_RELAXATION = 1.9
@@ -232,8 +234,8 @@ def cached_recording(
     except LatticeDiverged:
         if not slower:
             raise
-        # a site's jet diverged at this lattice speed: once more, slower (remembered, so the
-        # diverging run is not repeated)
+        # a site's jet diverged with this set-up: once more, steadier (:func:`_fallback`;
+        # remembered, so the diverging run is not repeated)
         marker.parent.mkdir(parents=True, exist_ok=True)
         marker.write_text(
             f"diverged at lattice_speed {spec.lattice_speed:g}, relaxation {spec.relaxation:g}\n",
