@@ -30,6 +30,7 @@ LAYERS = {
     "dcee.provenance": 0,
     "dcee.blas": 0,
     "dcee.kernel_cache": 0,  # where numba keeps compiled kernels (set before numba loads)
+    "dcee.kernel_target": 0,  # the kernels' vector width (set before numba loads)
     "dcee.kernel_locator": 0,  # how numba files them there (numba imports it by name)
     "dcee.state_file": 0,  # state files that are data, not code (checkpoints)
     "dcee.limits": 0,  # what a reader of others' files will allocate

@@ -13,9 +13,11 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 from dcee.kernel_cache import key_numba_cache
+from dcee.kernel_target import widen_vectors_when_numba_loads
 from dcee.provenance import package_version
 
 key_numba_cache()  # before numba is imported: compiled kernels keyed by the source (why: there)
+widen_vectors_when_numba_loads()  # 512-bit vectors where the CPU has AVX-512 (why: there)
 
 __version__ = package_version()
 

@@ -34,6 +34,7 @@ from dcee.planning.position_kernels import (
     plume_constants,
     position_rows,
     rows_from_concentration,
+    vectorised_case,
 )
 
 
@@ -58,6 +59,13 @@ class PositionTerms(NamedTuple):
 
 N_TERMS = len(PositionTerms._fields)
 """conc, dist, loc, log_nd, inv_sigma, det_offset (see :class:`PositionTerms`)."""
+
+SEPARATE_SLOTS = tuple(range(N_TERMS))
+LOC_IS_CONC_SLOTS = (0, 1, 0, 2, 3, 4)
+"""Which buffer row holds each of the terms: with the paper's sensor family the transformed
+location is the concentration itself (:func:`~dcee.planning.position_kernels.vectorised_case`),
+and its rows share the concentration's memory: a sixth less to write at every new position and
+to read back (measured: docs/performance.md, issue 82)."""
 
 DEFAULT_MAX_BYTES = 32 * 2**20
 """Rows kept across decisions are capped at this many bytes (a decision's own rows always fit)."""
@@ -188,7 +196,8 @@ class ParticleTerms:
         self.theta = np.zeros((0, 8))
         self.source = np.zeros((0, 3))
         self.starts = np.zeros(0, dtype=np.int64)
-        self._flat: np.ndarray | None = None  # (N_TERMS, capacity · M) buffer
+        self._flat: np.ndarray | None = None  # (stored terms, capacity · M) buffer
+        self._slots = SEPARATE_SLOTS  # the buffer row of each term
         self._index: dict[tuple[float, ...], int] = {}
         self._stamp = np.zeros(0, dtype=np.int64)
         self._clock = 0
@@ -233,6 +242,13 @@ class ParticleTerms:
         self._generic = generic
         if generic is None:
             self.min_distance, self.shape = plume.min_distance, plume.shape
+        slots = (
+            LOC_IS_CONC_SLOTS
+            if generic is None and vectorised_case(self.sp, *self.shape)
+            else SEPARATE_SLOTS
+        )
+        if slots != self._slots:
+            self._slots, self._flat = slots, None  # another layout: new buffers
         if self.merge:
             self.starts = merge_runs(theta)
             self.theta = np.ascontiguousarray(theta[self.starts])
@@ -287,7 +303,7 @@ class ParticleTerms:
         if self._terms is None:
             m, cap = max(self.n, 1), self.capacity
             self._terms = PositionTerms(
-                *(self._flat[k, : cap * m].reshape(cap, m) for k in range(N_TERMS))
+                *(self._flat[k, : cap * m].reshape(cap, m) for k in self._slots)
             )
         return self._terms
 
@@ -296,7 +312,7 @@ class ParticleTerms:
         m = max(self.n, 1)
         old = self.terms if self._flat is not None else None
         used = min(self.capacity, len(self._stamp))
-        flat = np.empty((N_TERMS, rows * m))
+        flat = np.empty((max(self._slots) + 1, rows * m))
         self._flat, self._terms = flat, None
         if old is not None and used:
             for k in range(N_TERMS):
@@ -313,7 +329,8 @@ class ParticleTerms:
         free = [r for r in range(self.capacity) if r not in used]
         if len(free) >= count:
             return free[:count]
-        cap_rows = max(self.max_bytes // (N_TERMS * 8 * max(self.n, 1)), 1)
+        stored = max(self._slots) + 1
+        cap_rows = max(self.max_bytes // (stored * 8 * max(self.n, 1)), 1)
         if len(used) + count > cap_rows:
             old = sorted((int(self._stamp[r]), r) for r in used if self._stamp[r] < self._clock)
             evict = [r for _, r in old[: count - len(free)]]
@@ -380,6 +397,7 @@ class ParticleTerms:
             other.min_distance, other.shape = self.min_distance, self.shape
             other._plume_constants = np.ascontiguousarray(self._plume_constants[:, keep])
         other._plume, other._sensor_params = self._plume, self._sensor_params
+        other._slots = self._slots
         other.theta = np.ascontiguousarray(self.theta[keep])
         other.source = np.ascontiguousarray(other.theta[:, :3])
         other.starts = np.arange(other.n, dtype=np.int64)

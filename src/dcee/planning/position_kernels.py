@@ -124,10 +124,10 @@ def _rows_plume(
     rmin: float,
     conc: np.ndarray,
     dist: np.ndarray,
-    loc: np.ndarray,
 ) -> None:
     """Phase 1 of the common case: C and the clamped distance r of particles i0..i1−1 at one
-    position (the transformed location of the Gaussian family is C itself)."""
+    position (the transformed location of the Gaussian family is C itself: copied by the
+    caller where it has rows of its own)."""
     for j in range(i1 - i0):
         # an unsigned index: numba then emits no negative-index wraparound, which would keep
         # LLVM from vectorising the loop
@@ -147,7 +147,6 @@ def _rows_plume(
         )
         conc[i] = c
         dist[i] = r
-        loc[i] = c
 
 
 @njit(cache=True, fastmath={"contract"}, error_model="numpy")
@@ -258,6 +257,9 @@ def position_rows(
     n = plume.shape[1]
     n_blocks = (n + _ROW_BLOCK - 1) // _ROW_BLOCK
     fast = vectorised_case(sp, meander, decay, backflow, radius, vertical, ground, meander_z)
+    # the location is C itself in the common case; its rows may share C's memory
+    # (ParticleTerms' LOC_IS_CONC_SLOTS), and are then not written twice
+    loc_own_rows = loc.ctypes.data != conc.ctypes.data
     for b in prange(n_blocks):
         i0 = b * _ROW_BLOCK
         i1 = min(n, i0 + _ROW_BLOCK)
@@ -267,7 +269,9 @@ def position_rows(
             pz = positions[k, 2]
             row = rows[k]
             if fast:
-                _rows_plume(plume, i0, i1, px, py, pz, rmin, conc[row], dist[row], loc[row])
+                _rows_plume(plume, i0, i1, px, py, pz, rmin, conc[row], dist[row])
+                if loc_own_rows:
+                    loc[row, i0:i1] = conc[row, i0:i1]
                 _rows_sigma(i0, i1, sp, conc[row], inv_sigma[row], det_offset[row])
                 _rows_detect(i0, i1, sp, conc[row], inv_sigma[row], log_nd[row])
                 _rows_missed(i0, i1, sp, conc[row], log_nd[row])
