@@ -456,11 +456,15 @@ def test_compiled_summaries_match_numpy_and_a_hand_calculation():
     logw = np.log(w) + 3.0
     logw[7] = -np.inf  # a dead particle
     ll = rng.normal(size=5000) * 4.0
-    new, log_ev, ess = reweighted(logw, ll)
+    ll[11] = -1000.0  # far below the rest: a weight of 0, not a subnormal
+    new, log_ev, ess, weights = reweighted(logw, ll)
     np.testing.assert_array_equal(new, logw + ll)
     assert log_ev == pytest.approx(logsumexp(logw + ll) - logsumexp(logw), rel=1e-12)
     scaled = np.exp(new - new.max())
     assert ess == pytest.approx(effective_sample_size(scaled / scaled.sum()), rel=1e-12)
+    # the normalised weights, from the same exponentials: NumPy's to the last bits
+    np.testing.assert_allclose(weights, scaled / scaled.sum(), rtol=1e-14, atol=0)
+    assert weights[7] == 0.0 and weights[11] == 0.0 and weights.sum() == pytest.approx(1.0)
 
 
 def test_a_move_budget_keeps_the_exact_grid_posterior(sensor):

@@ -328,11 +328,12 @@ class ParticleFilter(ResampleMove):
         entry, base_mult = self._add_to_history(position, reading)
         self.n_readings += 1
 
-        logw, log_ev, ess = self._reweighted(ll_new)
+        logw, log_ev, ess, weights = self._reweighted(ll_new)
         self.log_evidence += log_ev
         if ess >= self.collapse_threshold * self.n:
             self._hist_loglik += ll_new
             self._set_logw(logw)
+            self._weights = weights  # normalised already (resampling.reweighted)
             return self._resampled_if_needed(ess, log_ev)
         info = self._tempered_update(ll_new, entry, base_mult, ess)
         return dataclasses.replace(info, log_evidence=log_ev)
@@ -350,19 +351,21 @@ class ParticleFilter(ResampleMove):
         self.wind = self.wind + new
         if not ({U_COLUMN, PHI_COLUMN} & {int(i) for i in self._unknown}):
             return UpdateInfo(self.ess, False, math.nan, 1, 0, self.n)
-        logw, log_ev, ess = self._reweighted(new.log_likelihood(self.theta, self.anemometer))
+        logw, log_ev, ess, _ = self._reweighted(new.log_likelihood(self.theta, self.anemometer))
         # kept apart from log_evidence: every reading model predicts the wind alike, so the
         # model bank compares its members on the concentration readings only
         self.wind_log_evidence += log_ev
         self._set_logw(logw)
         return self._resampled_if_needed(ess, log_ev)
 
-    def _reweighted(self, ll: np.ndarray) -> tuple[np.ndarray, float, float]:
+    def _reweighted(self, ll: np.ndarray) -> tuple[np.ndarray, float, float, np.ndarray]:
         """The log weights after a reading of per-particle log-likelihood ``ll`` (N,), the
-        reading's log evidence log Σ wᵢ p(z|Θᵢ) (wᵢ the normalised weights before it) and the
-        effective sample size after it."""
-        logw, log_ev, ess = reweighted(self._logw, np.ascontiguousarray(ll, dtype=np.float64))
-        return logw, float(log_ev), float(ess)
+        reading's log evidence log Σ wᵢ p(z|Θᵢ) (wᵢ the normalised weights before it), the
+        effective sample size after it and the normalised weights after it."""
+        logw, log_ev, ess, weights = reweighted(
+            self._logw, np.ascontiguousarray(ll, dtype=np.float64)
+        )
+        return logw, float(log_ev), float(ess), weights
 
     def _resampled_if_needed(self, ess: float, log_ev: float) -> UpdateInfo:
         """Resample-move when the effective sample size fell below the threshold."""

@@ -25,7 +25,7 @@ from dcee.planning.block_sums import weighted_columns
 from dcee.planning.interpolated_kernels import MIN_READINGS, interpolate_groups
 from dcee.planning.interpolated_kernels import applicable as interpolation_applies
 from dcee.planning.multi_stage_kernels import multi_stage_weights
-from dcee.planning.one_stage_sums import one_stage_sums, one_stage_task_sums
+from dcee.planning.one_stage_sums import finish_one_stage, one_stage_sums, one_stage_task_sums
 from dcee.planning.predicted_single import BOUND_SLACK_SINGLE, single_stage_sums
 from dcee.planning.reading_terms import (
     cached_log_likelihood,
@@ -305,6 +305,13 @@ def predicted_posterior_stats(
             loc, log_nd, inv_sigma, det_offset, weights, task_positions, task_v, task_fa,
             task_out, sp, want_kl, interpolate_from,
         )  # fmt: skip
+        if done and finish_one_stage(
+            sums, setup[1], np.ascontiguousarray(task_jac, dtype=np.float64), _BOUND_SLACK,
+            want_kl, log_evidence, kl,
+        ):  # fmt: skip
+            mean[:] = np.nan  # (no moments on this path)
+            trace_cov[:] = np.nan
+            return
     single = precision == "single" and one_stage
     products = stage_products_apply(task_positions.shape[1], sp)
     # the model's ceilings as bounds (task_setup) wherever the kernels' slack allows: not
