@@ -9,7 +9,7 @@ from dcee.planning.base import Belief
 from dcee.planning.particle_terms import ParticleTerms, merge_runs, pairwise_sum, run_sums
 from dcee.planning.position_kernels import content_hash
 from dcee.planning.predicted import PredictionContext
-from tests.helpers import random_theta
+from tests.helpers import planar_prior, random_theta
 
 SENSOR = Sensor.paper_exact()
 PLUME = IsotropicPlume()
@@ -123,6 +123,62 @@ def test_rows_are_reused_across_decisions_and_recomputed_when_the_particles_chan
     for x, y in zip(new, ref, strict=True):
         np.testing.assert_array_equal(x, y)
     assert not np.array_equal(new[0], first[0])
+
+
+def test_read_only_particles_are_trusted_unchanged_and_anything_else_is_read_again(monkeypatch):
+    """An array that is read-only, with every array it views, cannot change: the same one
+    bound again is not hashed (what a filter's planning_particles hands over). A writeable
+    array, or a read-only view of a writeable one, is hashed at every binding, so an edit
+    through it is noticed."""
+    import dcee.planning.particle_terms as pt_module
+
+    theta, w = _resampled()
+    a = np.array([[10.0, 10.0, 2.0], [12.0, 10.0, 2.0]])
+    hashed = []
+
+    def counting_hash(bits):
+        hashed.append(len(bits))
+        return content_hash(bits)
+
+    monkeypatch.setattr(pt_module, "content_hash", counting_hash)
+    frozen = theta.copy()
+    frozen.flags.writeable = False
+    cache = ParticleTerms()
+    for seed in range(3):
+        PredictionContext(Belief(frozen, w, SENSOR, PLUME, cache), 5, 1,
+                          np.random.default_rng(seed))  # fmt: skip
+    assert len(hashed) == 1  # once, when it was first bound
+    rows = cache.rows(a)
+    # a read-only view of a writeable array: hashed every time, and an edit is noticed
+    base = theta.copy()
+    view = base[:]
+    view.flags.writeable = False
+    for _ in range(2):
+        PredictionContext(Belief(view, w, SENSOR, PLUME, cache), 5, 1, np.random.default_rng(0))
+    assert len(hashed) == 3
+    before = cache.terms.conc[cache.rows(a)].copy()
+    base[:, 0] += 1.0
+    PredictionContext(Belief(view, w, SENSOR, PLUME, cache), 5, 1, np.random.default_rng(0))
+    assert len(hashed) == 4
+    assert not np.array_equal(cache.terms.conc[cache.rows(a)], before)
+    assert rows.shape == (2,)
+
+
+def test_a_filters_planning_particles_never_change_under_the_planner():
+    """planning_particles makes the filter's particles read-only; its next move works on a
+    copy (the array a planner bound keeps its values) and an edit in place from outside
+    raises instead of going unnoticed."""
+    from dcee.estimation import ParticleFilter
+
+    pf = ParticleFilter(planar_prior(u=2.0), SENSOR, PLUME, n_particles=500, seed=1)
+    seen = pf.planning_particles()
+    kept = seen.copy()
+    assert not seen.flags.writeable
+    with pytest.raises(ValueError, match="read-only"):
+        pf.theta[0, 0] = 1.0
+    pf.resample()  # resample and move
+    np.testing.assert_array_equal(seen, kept)
+    assert pf.theta is not seen and pf.theta.flags.writeable
 
 
 def test_the_byte_cap_evicts_old_rows_never_the_current_decisions():

@@ -386,8 +386,12 @@ class Searcher:
 
     def belief(self) -> Belief:
         f = self.filter
+        # the particles read-only where the estimator can hand them over so (ResampleMove's
+        # planning_particles: the planner's cache then trusts them unchanged), else as they are
+        frozen = getattr(f, "planning_particles", None)
+        theta = f.theta if frozen is None else frozen()
         return Belief(
-            f.theta, f.weights, f.sensor, f.plume, self.planning_cache, site=self.agent.site
+            theta, f.weights, f.sensor, f.plume, self.planning_cache, site=self.agent.site
         )
 
     def estimate(self) -> SourceEstimate:

@@ -153,6 +153,10 @@ class ModelBank:
     def theta(self) -> np.ndarray:
         return self.current.theta
 
+    def planning_particles(self) -> np.ndarray:
+        """The current model's particles, read-only (ResampleMove.planning_particles)."""
+        return self.current.planning_particles()
+
     @property
     def weights(self) -> np.ndarray:
         return self.current.weights

@@ -132,7 +132,7 @@ class MultiSourceFilter(ParticleFilter):
                 return
             for j in range(1, self.n_sources):
                 for c in range(4):
-                    self.theta[todo, self._blocks[j, c]] = dists[c].sample(self.rng, k)
+                    self._editable_theta()[todo, self._blocks[j, c]] = dists[c].sample(self.rng, k)
             todo &= ~np.isfinite(self._log_prior(self.theta))
         raise DceeInputError(
             "prior",
@@ -237,7 +237,7 @@ class MultiSourceFilter(ParticleFilter):
             self._aligned(block, w, best_particle, np.eye(3)),  # m⁻²: squared distance
             self._aligned(block, w, *self._label_moments(block, w)),  # the labels as they are
         ]
-        self.theta[:, blocks] = min(candidates, key=lambda c: c[1])[0]
+        self._editable_theta()[:, blocks] = min(candidates, key=lambda c: c[1])[0]
 
     def _label_moments(self, block: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """((K, 3) mean location m, (K, 3, 3) precision m⁻²) of each label of ``block``."""

@@ -86,7 +86,12 @@ def dcee_decisions(n_decisions: int, seed: int = 1990) -> Iterator[float]:
         t0 = time.perf_counter()
         with one_blas_thread():  # as Searcher.ask does
             costs, _ = planner.costs(
-                Belief(pf.theta, pf.weights, sensor, plume, cache), position, cands, agent, rng
+                # the particles as Searcher.belief hands them over
+                Belief(pf.planning_particles(), pf.weights, sensor, plume, cache),
+                position,
+                cands,
+                agent,
+                rng,
             )
         elapsed = 1e3 * (time.perf_counter() - t0)
         position = cands[int(np.argmin(costs))]

@@ -180,6 +180,16 @@ def run_sums(weights: np.ndarray, starts: np.ndarray) -> np.ndarray:
     return out
 
 
+def _read_only(a: np.ndarray) -> bool:
+    """Whether no one can change ``a``'s values in place: it and every array it views are
+    read-only (a read-only view of a writeable array changes with it)."""
+    while isinstance(a, np.ndarray):
+        if a.flags.writeable:
+            return False
+        a = a.base
+    return a is None  # it owns its memory (a base of another kind might be written)
+
+
 class ParticleTerms:
     """Merged particles and a cache of their per-position terms, for one particle set at a time.
 
@@ -206,6 +216,7 @@ class ParticleTerms:
         self._generic: object | None = None  # a plume that predicts with its own method
         self._sensor_params: tuple | None = None
         self._derived: ParticleTerms | None = None
+        self._frozen: np.ndarray | None = None  # the read-only particles of the last binding
 
     def derived(self) -> ParticleTerms:
         """A second :class:`ParticleTerms` kept with this one, for a particle set derived from
@@ -227,14 +238,20 @@ class ParticleTerms:
         """Bind to the particles theta (N, 8) and the models; keeps the cached rows only if
         nothing changed."""
         theta = np.asarray(theta, dtype=np.float64)
-        key = self._fingerprint(theta)
         # a plume without compiled constants (the wall-aware one) predicts with its own method
         generic = None if isinstance(plume, IsotropicPlume) else plume
         shape = (
             ("generic", id(plume)) if generic is not None else (plume.min_distance, *plume.shape)
         )
         models = shape, tuple(sensor.params)
-        if key == self._key and models == (self._plume, self._sensor_params):
+        same_models = models == (self._plume, self._sensor_params)
+        if same_models and theta is self._frozen and not theta.flags.writeable:
+            # the same array, read-only since it was bound (a filter's planning_particles):
+            # its values cannot have changed, and need not all be read again (the hash below)
+            return
+        self._frozen = theta if _read_only(theta) else None
+        key = self._fingerprint(theta)
+        if key == self._key and same_models:
             return
         self._key = key
         self._plume, self._sensor_params = models
@@ -269,6 +286,7 @@ class ParticleTerms:
         """Drop every cached row and the binding (the buffers stay): the next decision computes
         all its terms, as one at a new position after the particles changed would."""
         self._key = None
+        self._frozen = None
         self._index.clear()
 
     def weights(self, weights: np.ndarray) -> np.ndarray:
