@@ -35,6 +35,11 @@ WIDTH_ENV = "DCEE_VECTOR_WIDTH"
 """``full`` (the default): 512-bit vectors where the CPU has AVX-512; ``llvm``: LLVM's tuning."""
 WIDTHS = ("full", "llvm")
 
+applied: str | None = None
+"""The ``NUMBA_CPU_FEATURES`` this process set (None: it set none): a process that runs another
+version of the package (:func:`dcee.perf.machine.package_env`) drops it, so that each version
+compiles as it would on its own."""
+
 
 def full_width_features(host_features: str) -> str | None:
     """The feature string that compiles for ``host_features`` (LLVM's ``+a,-b,...`` form) with
@@ -75,9 +80,10 @@ class _BeforeNumba(importlib.abc.MetaPathFinder):
     ) -> None:
         if fullname == "numba":
             _remove_hook()
+            global applied
             features = chosen_features()
             if features is not None:
-                os.environ["NUMBA_CPU_FEATURES"] = features
+                os.environ["NUMBA_CPU_FEATURES"] = applied = features
         return None
 
 

@@ -224,8 +224,18 @@ def package_env(src: Path, **extra: str) -> dict[str, str]:
     """The environment of a process that runs the package under ``src`` (another version's,
     for a timing in alternation): this one's, with ``src`` first on the path and without the
     compiled-kernel cache this process chose (``NUMBA_CACHE_DIR``, and the locator older
-    versions cannot import): each version files its own kernels."""
-    env = {k: v for k, v in os.environ.items() if k not in KERNEL_CACHE_VARIABLES}
+    versions cannot import): each version files its own kernels. Without the vector width
+    this process chose either (:mod:`dcee.kernel_target`; one the user set stays): each
+    version compiles as it would on its own, so a timing against an older version measures
+    what updating gives."""
+    from dcee import kernel_target
+
+    dropped = set(KERNEL_CACHE_VARIABLES)
+    if kernel_target.applied is not None and (
+        os.environ.get("NUMBA_CPU_FEATURES") == kernel_target.applied
+    ):
+        dropped.add("NUMBA_CPU_FEATURES")
+    env = {k: v for k, v in os.environ.items() if k not in dropped}
     return {**env, **extra, "PYTHONPATH": str(src)}
 
 
