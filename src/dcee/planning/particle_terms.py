@@ -16,7 +16,8 @@ Two exact savings:
 
 A :class:`ParticleTerms` recognises "the same particle set" by the array's identity, shape and
 a hash of its contents (:func:`~dcee.planning.position_kernels.content_hash`), so an edit in
-place is noticed as well.
+place is noticed as well; an array that is read-only with everything it views (a filter's
+``planning_particles``) cannot be edited, and the same one is taken unchanged without the hash.
 """
 
 from __future__ import annotations
