@@ -82,6 +82,37 @@ def test_only_the_final_combination_of_overrides_must_hold():
         )
 
 
+def test_changes_into_existing_sections_are_validated_once_with_the_same_result(monkeypatch):
+    """Changes that all go into sections the scenario has are applied at once and validated
+    once; the scenario is the one the change-by-change path makes. A change into a section an
+    earlier change makes (a model given by name, then one of its settings) takes that path."""
+    from dcee.scenarios.schema import scenario as schema
+
+    calls = []
+    real = schema.validate_scenario
+
+    def counted(data):
+        calls.append(1)
+        return real(data)
+
+    monkeypatch.setattr(schema, "validate_scenario", counted)
+    base = load_scenario("random:3")
+    changes = {
+        "search.particles": 4000,
+        "unknown": "full",
+        "truth.wind_from": 200.0,
+        "agent.step": 1.5,
+        "estimator.likelihood": "fluctuation",
+    }
+    fast = base.with_overrides(**changes)
+    assert len(calls) == 1
+    assert fast.model_dump() == base._with_overrides_stepwise(changes).model_dump()
+    calls.clear()
+    named = {"truth.model": "filament", "truth.model.meander_intensity": 0.3}
+    stepwise = base.with_overrides(**named)
+    assert len(calls) == 2 and stepwise.truth.model.meander_intensity == 0.3
+
+
 def test_toml_file_errors(tmp_path):
     good = tmp_path / "site.toml"
     good.write_text(
