@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.perf.machine import alternate_versions, alternation_args, json_from_package, store_timing
+from dcee.perf.machine import alternate_code, store_timing
 
 ROOT = Path(__file__).resolve().parent.parent
 TIMED = (
@@ -34,14 +34,10 @@ TIMED = (
 
 def main(argv: list[str] | None = None) -> int:
     try:
-        args = alternation_args(argv, __doc__.splitlines()[0], 3)
-        runs, load = alternate_versions(
-            ROOT,
-            args.before,
-            lambda src: json_from_package(src, TIMED),
-            args.rounds,
+        args, runs, load = alternate_code(
+            ROOT, argv, __doc__.splitlines()[0], TIMED, 3,
             lambda side, r, t: print(f"{side} round {r}: {t['ms']:.2f} ms", flush=True),
-        )
+        )  # fmt: skip
     except DceeInputError as e:
         print(f"mcts_speedup: error: {e}", file=sys.stderr)
         return 2

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from dcee.errors import DceeInputError
-from dcee.perf.machine import alternate_versions, alternation_args, json_from_package, store_timing
+from dcee.perf.machine import alternate_code, store_timing
 
 ROOT = Path(__file__).resolve().parent.parent
 REPEATS = 4
@@ -37,12 +37,12 @@ TIMED = (
 
 def main(argv: list[str] | None = None) -> int:
     try:
-        args = alternation_args(argv, __doc__.splitlines()[0], 3)
-        runs, load = alternate_versions(
+        args, runs, load = alternate_code(
             ROOT,
-            args.before,
-            lambda src: json_from_package(src, TIMED),
-            args.rounds,
+            argv,
+            __doc__.splitlines()[0],
+            TIMED,
+            3,
             lambda side, r, t: print(
                 f"{side} round {r}: ours {t['ours']:.3f} ms, Stone Soup {t['stonesoup']:.1f} ms,"
                 f" {t['ratio']:.1f}x",

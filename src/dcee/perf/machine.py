@@ -283,6 +283,25 @@ def alternate_versions(
     return runs, load.record()
 
 
+def alternate_code(
+    root: Path,
+    argv: list[str] | None,
+    description: str,
+    code: str,
+    rounds: int,
+    report: Callable[[str, int, Any], None] | None = None,
+) -> tuple[argparse.Namespace, dict[str, list[Any]], dict[str, Any]]:
+    """A timing study's whole alternation: its options (:func:`alternation_args`), then
+    :func:`alternate_versions` with ``python -c code`` run by each version
+    (:func:`json_from_package`, the JSON of its last line). Returns (the options, the runs,
+    the load); :class:`DceeInputError` naming a bad option or commit."""
+    args = alternation_args(argv, description, rounds)
+    runs, load = alternate_versions(
+        root, args.before, lambda src: json_from_package(src, code), args.rounds, report
+    )
+    return args, runs, load
+
+
 def store_timing(path: Path | None, load: dict[str, Any], **fields: Any) -> None:
     """Print :func:`load_warning`'s line for a run that was not idle, and write ``path`` (JSON;
     None: nothing): the machine (:func:`machine_record`), the ``load`` beside the run

@@ -313,6 +313,11 @@ class ParticleTerms:
         return 0 if self._flat is None else self._flat.shape[1] // max(self.n, 1)
 
     @property
+    def _stored_terms(self) -> int:
+        """Rows of the buffer per position (terms sharing a row counted once)."""
+        return max(self._slots) + 1
+
+    @property
     def terms(self) -> PositionTerms:
         """(conc, dist, loc, log_nd, inv_sigma, det_offset), each (capacity, M) C-contiguous;
         row r holds the terms at the position :meth:`rows` mapped to r (see
@@ -331,7 +336,7 @@ class ParticleTerms:
         m = max(self.n, 1)
         old = self.terms if self._flat is not None else None
         used = min(self.capacity, len(self._stamp))
-        flat = np.empty((max(self._slots) + 1, rows * m))
+        flat = np.empty((self._stored_terms, rows * m))
         self._flat, self._terms = flat, None
         if old is not None and used:
             for k in range(N_TERMS):
@@ -348,8 +353,7 @@ class ParticleTerms:
         free = [r for r in range(self.capacity) if r not in used]
         if len(free) >= count:
             return free[:count]
-        stored = max(self._slots) + 1
-        cap_rows = max(self.max_bytes // (stored * 8 * max(self.n, 1)), 1)
+        cap_rows = max(self.max_bytes // (self._stored_terms * 8 * max(self.n, 1)), 1)
         if len(used) + count > cap_rows:
             old = sorted((int(self._stamp[r]), r) for r in used if self._stamp[r] < self._clock)
             evict = [r for _, r in old[: count - len(free)]]

@@ -394,17 +394,11 @@ class Scenario(ScenarioBuilders, ReadingModelSettings, ResolvedSettings, BaseMod
         data = scenario.model_dump()
         pending: DceeInputError | None = None  # why the changes so far do not validate
         for path, value in changes.items():
-            node = data
-            *parents, leaf = path.split(".")
-            for p in parents:
-                if not isinstance(node.get(p), dict):
-                    if pending is not None:
-                        raise pending  # the section would exist once the earlier change held
-                    raise DceeInputError(path, f"no such setting ({p!r} is not a section)")
-                node = node[p]
-            node[leaf] = value
-            if leaf == "wind_from" and parents in (["truth"], ["prior"]):
-                node.pop("phi", None)  # the bearing replaces the angle it was given as
+            missing = _set_path(data, path, value)
+            if missing is not None:
+                if pending is not None:
+                    raise pending  # the section would exist once the earlier change held
+                raise DceeInputError(path, f"no such setting ({missing!r} is not a section)")
             try:
                 scenario = validate_scenario(data)
             except DceeInputError as exc:
@@ -421,17 +415,22 @@ def _apply_at_once(data: dict[str, Any], changes: dict[str, Any]) -> bool:
     """Apply every change (dotted path → value) to ``data`` in order, as
     :meth:`Scenario.with_overrides` does one at a time; False, ``data`` then partly changed,
     where a path goes through something that is not a section (yet)."""
-    for path, value in changes.items():
-        node = data
-        *parents, leaf = path.split(".")
-        for p in parents:
-            if not isinstance(node.get(p), dict):
-                return False
-            node = node[p]
-        node[leaf] = value
-        if leaf == "wind_from" and parents in (["truth"], ["prior"]):
-            node.pop("phi", None)
-    return True
+    return all(_set_path(data, path, value) is None for path, value in changes.items())
+
+
+def _set_path(data: dict[str, Any], path: str, value: Any) -> str | None:
+    """Set the dotted ``path`` of ``data`` to ``value``; the name on the way that is not a
+    section (nothing set), or None."""
+    node = data
+    *parents, leaf = path.split(".")
+    for p in parents:
+        if not isinstance(node.get(p), dict):
+            return p
+        node = node[p]
+    node[leaf] = value
+    if leaf == "wind_from" and parents in (["truth"], ["prior"]):
+        node.pop("phi", None)  # the bearing replaces the angle it was given as
+    return None
 
 
 def validate_scenario(data: dict[str, Any]) -> Scenario:
