@@ -9,7 +9,7 @@ import llvmlite.binding as llvm
 import numpy as np
 import pytest
 
-from dcee.kernel_target import full_width_features
+from dcee.kernel_target import SET_BY_DCEE_ENV, full_width_features
 
 HOST = llvm.get_host_cpu_features().flatten()
 
@@ -29,7 +29,7 @@ def _features_after_import(**env: str) -> str:
     base = {
         k: v
         for k, v in os.environ.items()
-        if k not in ("NUMBA_CPU_FEATURES", "NUMBA_CPU_NAME", "DCEE_VECTOR_WIDTH")
+        if k not in ("NUMBA_CPU_FEATURES", "NUMBA_CPU_NAME", "DCEE_VECTOR_WIDTH", SET_BY_DCEE_ENV)
     }
     code = "import dcee, numba; print(repr(numba.config.CPU_FEATURES))"
     out = subprocess.run(
@@ -45,6 +45,30 @@ def test_importing_dcee_widens_numbas_vectors_on_this_cpu_unless_told_not_to():
     assert _features_after_import(DCEE_VECTOR_WIDTH="llvm") == "None"
     # the user's own numba setting wins
     assert _features_after_import(NUMBA_CPU_FEATURES="+sse2") == repr("+sse2")
+
+
+@pytest.mark.skipif("+avx512f" not in HOST.split(","), reason="the CPU has no AVX-512")
+def test_a_child_of_a_dcee_process_chooses_its_own_width_but_keeps_the_users():
+    """The width a dcee parent chose reaches its children as that parent's choice, not as the
+    user's: a child asked for LLVM's width gets it; a value the user set stays in every child."""
+    child = (
+        "import os, subprocess, sys, dcee, numba\n"
+        "env = {**os.environ, 'DCEE_VECTOR_WIDTH': 'llvm'}\n"
+        "code = 'import dcee, numba; print(repr(numba.config.CPU_FEATURES))'\n"
+        "print(subprocess.run([sys.executable, '-c', code], env=env, capture_output=True,\n"
+        "                     text=True, check=True).stdout.strip())\n"
+    )
+    base = {
+        k: v
+        for k, v in os.environ.items()
+        if k not in ("NUMBA_CPU_FEATURES", "NUMBA_CPU_NAME", "DCEE_VECTOR_WIDTH", SET_BY_DCEE_ENV)
+    }
+    for env, expected in (({}, "None"), ({"NUMBA_CPU_FEATURES": "+sse2"}, repr("+sse2"))):
+        out = subprocess.run(
+            [sys.executable, "-c", child], env={**base, **env}, capture_output=True, text=True,
+            check=True,
+        )  # fmt: skip
+        assert out.stdout.strip() == expected, env
 
 
 @pytest.mark.skipif("+avx512f" not in HOST.split(","), reason="the CPU has no AVX-512")
@@ -64,7 +88,7 @@ def test_the_vectorised_exp_uses_512_bit_registers_on_avx512():
     env = {
         k: v
         for k, v in os.environ.items()
-        if k not in ("NUMBA_CPU_FEATURES", "NUMBA_CPU_NAME", "DCEE_VECTOR_WIDTH")
+        if k not in ("NUMBA_CPU_FEATURES", "NUMBA_CPU_NAME", "DCEE_VECTOR_WIDTH", SET_BY_DCEE_ENV)
     }
     for width, wide in (("full", True), ("llvm", False)):
         out = subprocess.run(

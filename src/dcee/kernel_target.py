@@ -35,10 +35,38 @@ WIDTH_ENV = "DCEE_VECTOR_WIDTH"
 """``full`` (the default): 512-bit vectors where the CPU has AVX-512; ``llvm``: LLVM's tuning."""
 WIDTHS = ("full", "llvm")
 
+SET_BY_DCEE_ENV = "DCEE_SET_NUMBA_CPU_FEATURES"
+"""Where a dcee process notes the ``NUMBA_CPU_FEATURES`` value it set itself, beside it: a child
+process inherits both, and one whose ``NUMBA_CPU_FEATURES`` equals the note knows that no user
+set it (the child's own ``DCEE_VECTOR_WIDTH`` then decides, as in its parent)."""
+
 applied: str | None = None
 """The ``NUMBA_CPU_FEATURES`` this process set (None: it set none): a process that runs another
 version of the package (:func:`dcee.perf.machine.package_env`) drops it, so that each version
 compiles as it would on its own."""
+
+
+def forget_inherited_choice() -> bool:
+    """Remove from this process's environment a ``NUMBA_CPU_FEATURES`` that a dcee parent set
+    (it equals the parent's note, :data:`SET_BY_DCEE_ENV`), with the note, so that what
+    remains of numba's CPU options is the user's; whether there was one."""
+    note = os.environ.pop(SET_BY_DCEE_ENV, None)
+    if note is not None and os.environ.get("NUMBA_CPU_FEATURES") == note:
+        del os.environ["NUMBA_CPU_FEATURES"]
+        return True
+    return False
+
+
+def _choose_for_this_process() -> tuple[str | None, bool]:
+    """Set ``NUMBA_CPU_FEATURES`` (and the note for child processes) to
+    :func:`chosen_features`; (the value set or None, whether a parent's choice was removed)."""
+    global applied
+    inherited = forget_inherited_choice()
+    features = chosen_features()
+    if features is not None:
+        os.environ["NUMBA_CPU_FEATURES"] = os.environ[SET_BY_DCEE_ENV] = features
+        applied = features
+    return features, inherited
 
 
 def full_width_features(host_features: str) -> str | None:
@@ -54,7 +82,8 @@ def full_width_features(host_features: str) -> str | None:
 def chosen_features() -> str | None:
     """The ``NUMBA_CPU_FEATURES`` value to set in this process, or None to leave numba's
     default: the user set numba's CPU options or ``DCEE_VECTOR_WIDTH=llvm``, or the CPU has no
-    AVX-512. Loads llvmlite (numba's own dependency) to read the host's features."""
+    AVX-512. Loads llvmlite (numba's own dependency) to read the host's features. Call
+    :func:`forget_inherited_choice` first: a value a dcee parent set is not the user's."""
     if os.environ.get("NUMBA_CPU_FEATURES") or os.environ.get("NUMBA_CPU_NAME"):
         return None
     width = os.environ.get(WIDTH_ENV, "full").strip().lower() or "full"
@@ -80,10 +109,7 @@ class _BeforeNumba(importlib.abc.MetaPathFinder):
     ) -> None:
         if fullname == "numba":
             _remove_hook()
-            global applied
-            features = chosen_features()
-            if features is not None:
-                os.environ["NUMBA_CPU_FEATURES"] = applied = features
+            _choose_for_this_process()
         return None
 
 
@@ -97,9 +123,9 @@ def widen_vectors_when_numba_loads() -> None:
     now, which holds unless that program already compiled something (numba then keeps the
     code generator it made, at LLVM's width: slower, not wrong)."""
     if "numba" in sys.modules:
-        features = chosen_features()
-        if features is not None:
-            sys.modules["numba"].config.CPU_FEATURES = features
+        features, inherited = _choose_for_this_process()
+        if features is not None or inherited:
+            sys.modules["numba"].config.CPU_FEATURES = features  # None: numba's own default
         return
     if not any(isinstance(f, _BeforeNumba) for f in sys.meta_path):
         sys.meta_path.insert(0, _BeforeNumba())

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -119,6 +119,14 @@ class LocalFrame:
             f"origin shifted by ({self.x0:.2f}, {self.y0:.2f}) m; scale error at most "
             f"{self.scale_error(half_width):.1e} over the area"
         )
+
+
+@lru_cache(maxsize=64)
+def shared_frame(latitude: float, longitude: float, x0: float = 0.0, y0: float = 0.0) -> LocalFrame:
+    """The :class:`LocalFrame` of these parameters, one instance per distinct frame (it is
+    immutable): its pyproj transformer, built on first use, takes about 8 ms, which a caller
+    converting one fix at a time would otherwise pay per call."""
+    return LocalFrame(latitude, longitude, x0, y0)
 
 
 def frame_for_bounds(lon_min: float, lat_min: float, lon_max: float, lat_max: float) -> LocalFrame:

@@ -230,7 +230,7 @@ def package_env(src: Path, **extra: str) -> dict[str, str]:
     what updating gives."""
     from dcee import kernel_target
 
-    dropped = set(KERNEL_CACHE_VARIABLES)
+    dropped = {*KERNEL_CACHE_VARIABLES, kernel_target.SET_BY_DCEE_ENV}
     if kernel_target.applied is not None and (
         os.environ.get("NUMBA_CPU_FEATURES") == kernel_target.applied
     ):
