@@ -299,3 +299,91 @@ def lbm3d_slice_probes_table() -> str:
         "paired RMSE change (Wilcoxon)",
     ]
     return table(header, rows)
+
+
+SLICE_ORACLES = (
+    (
+        "reading-model-rate-unknown",
+        "today's reading model, its exact posterior (height and wind known, ζ1, ζ2 and the rate "
+        "weighed)",
+    ),
+    ("reading-model", "the same, the release rate known too"),
+    ("mean", "the plume's exact time mean, read through the estimator's log-normal fluctuations"),
+    ("mixture", "the plume's own fluctuation statistics (its every frame, held-averaged)"),
+    ("mixture-rate-unknown", "the same, the release rate unknown (1/4 to 4 times)"),
+)
+"""The slice oracle's arms (recipe lbm3d-slice-oracle, studies/slice_oracle.py)."""
+
+
+def lbm3d_slice_oracle_table() -> str:
+    """How well an estimator that knows the plume could place the source from the readings the
+    slice's tuning searches took (recipe lbm3d-slice-oracle; studies/slice_oracle.py)."""
+    folder = RESULTS / "lbm3d-slice-oracle"
+    arms = {name: json.loads((folder / f"{name}.json").read_text()) for name, _ in SLICE_ORACLES}
+    searches = arms["mixture"]["searches"]
+    if any(a["campaign"] != arms["mixture"]["campaign"] for a in arms.values()):
+        raise ValueError("the slice oracle's arms read different campaigns")
+    n = len(searches)
+    own = np.array([s["search_final_rmse"] for s in searches])
+    rows = [
+        [
+            "`dcee-cl` itself at today's defaults (3-D, every parameter unknown)",
+            f"{np.median(own):.2f}",
+            f"{int((own <= 1.0).sum())}/{n}",
+            "",
+            "",
+            "",
+        ]
+    ]
+    for name, label in SLICE_ORACLES:
+        o = [s["oracle"] for s in arms[name]["searches"]]
+        rmse = np.array([x["rmse"] for x in o])
+        rows.append(
+            [
+                f"oracle: {label}",
+                f"{np.median(rmse):.2f}",
+                f"{int((rmse <= 1.0).sum())}/{n}",
+                f"{sum(x['truth_in_95'] for x in o)}/{n}",
+                f"{np.median([x['sd_along'] for x in o]):.2f}",
+                f"{np.median([x['error_along'] for x in o]):+.2f}",
+            ]
+        )
+    header = [
+        f"who places the source (lbm3d-slice-tune, the {n} searches' own readings)",
+        "median final RMSE (m)",
+        "≤ 1.0 m",
+        "truth in its 95 % region",
+        "spread along the wind (m, median)",
+        "error along the wind (m, median)",
+    ]
+    return table(header, rows)
+
+
+def lbm3d_slice_zeros_table() -> str:
+    """How often the slice reads nothing where its time mean is some value: the truth against
+    the estimator's fluctuation model, pooled over the tuning range's 20 planes (recipe
+    lbm3d-slice-oracle; studies/slice_oracle.py --zeros)."""
+    doc = json.loads((RESULTS / "lbm3d-slice-oracle" / "zeros.json").read_text())
+    pooled: dict[tuple[float, float], list[float]] = {}
+    for search in doc["searches"]:
+        for b in search["zeros"]:
+            acc = pooled.setdefault((b["low"], b["high"]), [0.0, 0.0, 0.0])
+            acc[0] += b["cells"]
+            acc[1] += b["cells"] * b["truth_zero_share"]
+            acc[2] += b["cells"] * b["model_zero_probability"]
+    rows = [
+        [
+            f"{lo * 1e3:g}-{hi * 1e3:g}",
+            f"{int(n):,}",
+            f"{truth / n:.2f}",
+            f"{model / n:.2f}",
+        ]
+        for (lo, hi), (n, truth, model) in sorted(pooled.items())
+    ]
+    header = [
+        "time mean at the plane (mg/m³)",
+        "cells (20 planes)",
+        "readings below the threshold: the plume",
+        "the reading model's P(non-detection)",
+    ]
+    return table(header, rows)

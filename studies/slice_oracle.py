@@ -1,0 +1,358 @@
+"""How well could any estimator place the source from a slice search's readings? An oracle
+posterior on the readings that stored searches of a planar slice took (issue 78, the slice bar).
+
+The oracle knows everything but the release's horizontal position: the plume's own statistics
+(the truth's recording: every frame of the turbulent field, held-averaged over the reading's
+window exactly as the simulation averages it), the release height, rate, wind speed and
+direction, and the instrument's model. For each candidate offset δ of the release from the truth
+(along and across the wind, on a ``--step`` m grid inside the search area) the likelihood of a
+reading z taken at canonical position c is the stationary mixture over the recording's phases,
+
+    p(z | δ) = (1/T) Σ_t p_sensor(z | A_t(c − δ)),
+
+A_t the hold-averaged field ending at frame t, and the readings are taken as independent given
+δ. That independence makes the oracle more certain than the readings allow (successive readings
+share a turbulent state), so its RMSE is optimistic: no estimator that knows less (the
+reading model's shape, the height, the rate, the wind unknown) can expect to do better on the
+same readings. Its final RMSE √(Σ w |δ|²) is horizontal (the height is known to it); the
+searches' own RMSE is 3-D with the height unknown.
+
+Two weaker oracles tell where the information lies: ``--phases 0`` knows the plume's exact
+time mean only and reads it through the estimator's own fluctuation model (the log-normal
+family with its fixed intermittency and spread: ``Scenario.make_estimator_sensor``), the best
+any reading model of today's form could do with the true shape; ``--rate-unknown`` does not
+know the release rate (nine factors from 1/4 to 4, equally likely, marginalised).
+
+    .venv/bin/python studies/slice_oracle.py results/lbm3d-slice-tune-oracle \\
+        --json docs/results/lbm3d-slice-oracle/oracle.json
+
+Diagnostic on a tuning range only: nothing is chosen from it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+from scipy.ndimage import map_coordinates
+from scipy.special import logsumexp
+
+from dcee.analysis.report import load_campaign
+from dcee.provenance import code_version
+from dcee.runs import EpisodeResult
+from dcee.scenarios import validate_scenario
+from dcee.simulation import make_truth
+
+
+def _inner(truth):  # type: ignore[no-untyped-def]
+    """The lbm3d truth under any wrapper (injected spikes)."""
+    while hasattr(truth, "inner"):
+        truth = truth.inner
+    return truth
+
+
+def held_averages(truth, average: float, response_time: float) -> np.ndarray:  # type: ignore[no-untyped-def]
+    """(T, ny, nx) g/m³: the plane's field at the truth's canonical height, averaged over the
+    ``average`` s window ending at each frame (looped), through the first-order response as
+    :meth:`dcee.simulation.truth.TruthModel.sensed` applies it, times the truth's scale."""
+    rec = truth.recording
+    height = truth.plane - truth.ground + truth.lift
+    iz = int(np.clip(np.searchsorted(rec.z, height) - 1, 0, len(rec.z) - 2))
+    fz = float(np.clip((height - rec.z[iz]) / (rec.z[iz + 1] - rec.z[iz]), 0.0, 1.0))
+    plane = (1.0 - fz) * rec.values[..., iz] + fz * rec.values[..., iz + 1]  # (T, ny, nx)
+    dt = truth.time_step  # episode s between frames
+    n = max(1, round(average / dt)) if average > 0 else 1
+    windows = np.stack([np.roll(plane, k, axis=0) for k in range(n - 1, -1, -1)])  # oldest first
+    if response_time > 0.0:
+        alpha = 1.0 - math.exp(-dt / response_time)
+        y = windows[0].copy()
+        for k in range(n):
+            y += alpha * (windows[k] - y)
+            windows[k] = y
+    return windows.mean(axis=0) * truth.scale
+
+
+def oracle_posterior(
+    truth,  # type: ignore[no-untyped-def]
+    sensor,  # type: ignore[no-untyped-def]
+    fields: np.ndarray,
+    positions: np.ndarray,
+    readings: np.ndarray,
+    low: np.ndarray,
+    high: np.ndarray,
+    step: float,
+    reach: tuple[float, float, float],
+    phases: int,
+    scales: tuple[float, ...] = (1.0,),
+) -> dict[str, float]:
+    """The oracle's posterior over the release's horizontal offset δ (along, across the wind)
+    given readings (K,) at positions (K, 3); summaries in m. With several ``scales`` (factors
+    on the release rate, equally likely) the rate is unknown to it and marginalised."""
+    rec = truth.recording
+    behind, ahead, side = reach
+    along = np.arange(-behind, ahead + step / 2, step)
+    across = np.arange(-side, side + step / 2, step)
+    da, dc = np.meshgrid(along, across, indexing="ij")
+    da, dc = da.ravel(), dc.ravel()
+    # the candidates' world positions: inside the search area only (the estimator's prior)
+    world = truth.source[:2] + np.outer(da, truth.downwind) + np.outer(dc, truth.left)
+    inside = np.all((world >= low[:2]) & (world <= high[:2]), axis=1)
+    da, dc = da[inside], dc[inside]
+    if phases == 0:  # the time mean alone (the reading model's view: its own fluctuations)
+        sub = fields.mean(axis=0, keepdims=True)
+    else:
+        sub = fields[np.linspace(0, len(fields) - 1, min(phases, len(fields))).round().astype(int)]
+    frames = np.arange(len(sub))
+    canon = truth.canonical(positions)
+    height_gap = float(truth.plane - truth.source[2])  # the plane above the release, m
+    x_step = rec.x[1] - rec.x[0]
+    y_step = rec.y[1] - rec.y[0]
+    log_post = np.zeros((len(scales), len(da)))
+    for (cx, cy, _), z in zip(canon, readings, strict=True):
+        px, py = cx - da, cy - dc  # the reading relative to each candidate, canonical m
+        ix = (px - rec.x[0]) / x_step
+        iy = (py - rec.y[0]) / y_step
+        coords = np.stack(
+            [
+                np.repeat(np.arange(len(frames), dtype=np.float64), len(da)),
+                np.tile(iy, len(frames)),
+                np.tile(ix, len(frames)),
+            ]
+        )
+        c = map_coordinates(sub, coords, order=1, mode="constant", cval=0.0)
+        distance = np.tile(np.sqrt(px * px + py * py + height_gap * height_gap), len(frames))
+        for k, scale in enumerate(scales):
+            ll = sensor.log_likelihood(float(z), scale * c, distance)
+            log_post[k] += logsumexp(ll.reshape(len(frames), len(da)), axis=0)
+    log_post = logsumexp(log_post, axis=0)  # the rate marginalised (a constant dropped)
+    return _summary(np.exp(log_post - logsumexp(log_post)), da, dc)
+
+
+ZETA1 = (0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0)
+"""m²/s, the diffusivities the model oracle weighs (the prior's mass lies at 0-4)."""
+ZETA2 = (5.0, 8.0, 11.0)
+"""s, the particle lifetimes it weighs (the prior: 8 ± 1.4)."""
+
+
+def model_posterior(
+    scenario,  # type: ignore[no-untyped-def]
+    truth,  # type: ignore[no-untyped-def]
+    positions: np.ndarray,
+    readings: np.ndarray,
+    step: float,
+    reach: tuple[float, float, float],
+    scales: tuple[float, ...] = (1.0,),
+) -> dict[str, float]:
+    """The exact grid posterior of the estimator's own reading model (its plume and its
+    fluctuation model, ``Scenario.make_plume`` and ``make_estimator_sensor``) over the release's
+    horizontal offset δ and the model's ζ1, ζ2 (on the grids above, weighted by the prior),
+    with the height, rate and wind known (the truth's); summaries as
+    :func:`oracle_posterior`'s. What today's reading model could do with the search's readings
+    if the filter found its exact posterior and the other parameters were known."""
+    behind, ahead, side = reach
+    along = np.arange(-behind, ahead + step / 2, step)
+    across = np.arange(-side, side + step / 2, step)
+    da, dc = (g.ravel() for g in np.meshgrid(along, across, indexing="ij"))
+    world = truth.source[:2] + np.outer(da, truth.downwind) + np.outer(dc, truth.left)
+    low, high = scenario.volume.low, scenario.volume.high
+    inside = np.all((world >= low[:2]) & (world <= high[:2]), axis=1)
+    da, dc, world = da[inside], dc[inside], world[inside]
+    plume, sensor, prior = (
+        scenario.make_plume(),
+        scenario.make_estimator_sensor(),
+        scenario.make_prior(),
+    )
+    base = scenario.truth_theta()
+    log_post = []
+    for z1 in ZETA1:
+        for z2 in ZETA2:
+            theta = np.tile(base, (len(da), 1))
+            theta[:, :2] = world
+            theta[:, 6], theta[:, 7] = z1, z2
+            conc = plume.concentration(theta, positions)  # (N, K)
+            distance = np.linalg.norm(positions[None, :, :] - theta[:, None, :3], axis=2)
+            for scale in scales:  # the rate's factors, equally likely
+                ll = sensor.log_likelihood(readings[None, :], scale * conc, distance).sum(axis=1)
+                log_post.append(ll + float(prior.log_density(theta[:1])[0]))
+    lp = np.stack(log_post)  # (combinations, N)
+    w_all = np.exp(lp - logsumexp(lp))
+    w = w_all.sum(axis=0)
+    return _summary(w, da, dc)
+
+
+def _summary(w: np.ndarray, da: np.ndarray, dc: np.ndarray) -> dict[str, float]:
+    """Posterior summaries of grid weights ``w`` over offsets (``da``, ``dc``) m."""
+    mean_a, mean_c = float(w @ da), float(w @ dc)
+    order = np.argsort(-w)
+    region = order[: int(np.searchsorted(np.cumsum(w[order]), 0.95)) + 1]
+    truth_cell = int(np.argmin(da * da + dc * dc))
+    return {
+        "truth_in_95": bool(truth_cell in set(region.tolist())),
+        "rmse": float(math.sqrt(w @ (da * da + dc * dc))),
+        "error_along": mean_a,
+        "error_across": mean_c,
+        "sd_along": float(math.sqrt(max(w @ (da - mean_a) ** 2, 0.0))),
+        "sd_across": float(math.sqrt(max(w @ (dc - mean_c) ** 2, 0.0))),
+        "candidates": len(da),
+    }
+
+
+ZERO_BINS = (1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2)
+"""g/m³: the time-mean classes of :func:`zero_shares`."""
+
+
+def zero_shares(scenario, fields: np.ndarray) -> list[dict[str, float]]:  # type: ignore[no-untyped-def]
+    """Per class of the plane's time-mean concentration (:data:`ZERO_BINS`): the cells, the
+    share of held averages below the threshold (what the truth gives) and the estimator's
+    probability of a non-detection at that mean (what its fluctuation model says), over every
+    stored cell of the plane."""
+    sensor = scenario.make_estimator_sensor()
+    mean = fields.mean(axis=0).ravel()
+    below = (fields < sensor.threshold).mean(axis=0).ravel()
+    out = []
+    for lo, hi in itertools.pairwise(ZERO_BINS):
+        m = (mean >= lo) & (mean < hi)
+        if not m.any():
+            continue
+        model = np.exp(sensor.log_likelihood(0.0, mean[m], np.inf))
+        out.append(
+            {
+                "low": lo,
+                "high": hi,
+                "cells": int(m.sum()),
+                "truth_zero_share": float(below[m].mean()),
+                "model_zero_probability": float(model.mean()),
+            }
+        )
+    return out
+
+
+REACH = (30.0, 15.0, 10.0)
+"""m: the candidates reach this far upwind of the release, downwind of it and across the wind."""
+
+
+def _row(run, result, post: dict[str, float]) -> dict:  # type: ignore[no-untyped-def]
+    s = result.summary
+    print(
+        f"{s['scenario']:>12} {run['strategy']}: search {s['final_rmse']:.2f} m, oracle "
+        f"{post['rmse']:.2f} m (sd along {post['sd_along']:.2f}, across "
+        f"{post['sd_across']:.2f}; error along {post['error_along']:+.2f} m), "
+        f"{s['detections']} detections",
+        flush=True,
+    )
+    return {
+        "scenario": s["scenario"],
+        "strategy": run["strategy"],
+        "seed": int(run["seed"]),
+        "readings": len(result.records),
+        "detections": int(s["detections"]),
+        "search_final_rmse": float(s["final_rmse"]),
+        "oracle": post,
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("campaign", help="a bench folder of planar lbm3d slice searches")
+    ap.add_argument("--json", required=True, help="where to write the per-search results")
+    ap.add_argument("--step", type=float, default=0.25, help="m, the candidates' grid")
+    ap.add_argument(
+        "--phases",
+        type=int,
+        default=120,
+        help="recording phases in the mixture; 0: the time-mean field read through the "
+        "estimator's own fluctuation model instead (the reading model's noise, the true shape)",
+    )
+    ap.add_argument(
+        "--rate-unknown",
+        action="store_true",
+        help="the release rate unknown to the oracle: 9 factors from 1/4 to 4, equally likely",
+    )
+    ap.add_argument(
+        "--reading-model",
+        action="store_true",
+        help="the exact grid posterior of today's reading model instead (model_posterior)",
+    )
+    ap.add_argument(
+        "--zeros",
+        action="store_true",
+        help="instead of posteriors: the share of zero readings by time-mean class, the truth's "
+        "against the estimator's fluctuation model (zero_shares)",
+    )
+    args = ap.parse_args()
+    scales = np.exp(np.linspace(math.log(0.25), math.log(4.0), 9)) if args.rate_unknown else None
+    _, runs = load_campaign(Path(args.campaign))
+    rows = []
+    for _, run in runs.sort_values(["scenario", "strategy"]).iterrows():
+        config = json.loads((Path(run["run_dir"]) / "config.json").read_text())
+        scenario = validate_scenario(config["scenario"])
+        truth = _inner(make_truth(scenario, int(run["seed"])))
+        if getattr(truth, "plane", None) is None:
+            raise SystemExit(f"{run['run_dir']}: not a planar lbm3d slice")
+        result = EpisodeResult.load(run["run_dir"])
+        rec = result.records
+        positions = np.array([[r["x"], r["y"], r["z"]] for r in rec])
+        readings = np.array([r["reading"] for r in rec])
+        if args.reading_model:
+            post = model_posterior(
+                scenario,
+                truth,
+                positions,
+                readings,
+                args.step,
+                REACH,
+                (1.0,) if scales is None else tuple(scales.tolist()),
+            )
+            rows.append(_row(run, result, post))
+            continue
+        fields = held_averages(truth, scenario.average, scenario.sensor.response_time)
+        if args.zeros:
+            rows.append({"scenario": run["scenario"], "zeros": zero_shares(scenario, fields)})
+            continue
+        post = oracle_posterior(
+            truth,
+            scenario.make_sensor() if args.phases > 0 else scenario.make_estimator_sensor(),
+            fields,
+            positions,
+            readings,
+            scenario.volume.low,
+            scenario.volume.high,
+            args.step,
+            REACH,
+            args.phases,
+            (1.0,) if scales is None else tuple(scales.tolist()),
+        )
+        rows.append(_row(run, result, post))
+    if args.zeros:
+        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+        doc = {"what": zero_shares.__doc__, "code": code_version(), "searches": rows}
+        Path(args.json).write_text(json.dumps(doc, indent=1))
+        return
+    oracle = np.array([r["oracle"]["rmse"] for r in rows])
+    out = {
+        "what": __doc__.split("\n\n")[0],
+        "campaign": str(args.campaign),
+        "step": args.step,
+        "phases": args.phases,
+        "rate_unknown": bool(args.rate_unknown),
+        "reading_model": bool(args.reading_model),
+        "code": code_version(),
+        "median_oracle_rmse": float(np.median(oracle)),
+        "oracle_within_1m": int((oracle <= 1.0).sum()),
+        "median_search_rmse": float(np.median([r["search_final_rmse"] for r in rows])),
+        "searches": rows,
+    }
+    Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.json).write_text(json.dumps(out, indent=1))
+    print(
+        f"median oracle RMSE {out['median_oracle_rmse']:.2f} m ({out['oracle_within_1m']}/"
+        f"{len(rows)} within 1 m); the searches' {out['median_search_rmse']:.2f} m"
+    )
+
+
+if __name__ == "__main__":
+    main()
