@@ -146,13 +146,21 @@ def model_posterior(
     step: float,
     reach: tuple[float, float, float],
     scales: tuple[float, ...] = (1.0,),
+    meander_mixture: float = 0.0,
 ) -> dict[str, float]:
     """The exact grid posterior of the estimator's own reading model (its plume and its
     fluctuation model, ``Scenario.make_plume`` and ``make_estimator_sensor``) over the release's
     horizontal offset δ and the model's ζ1, ζ2 (on the grids above, weighted by the prior),
     with the height, rate and wind known (the truth's); summaries as
     :func:`oracle_posterior`'s. What today's reading model could do with the search's readings
-    if the filter found its exact posterior and the other parameters were known."""
+    if the filter found its exact posterior and the other parameters were known.
+
+    With ``meander_mixture`` = i_z > 0, a probe of a fluctuating plume (Gifford 1959): the
+    plume's centre height meanders, Gaussian with the standard deviation i_z · d at d m
+    downwind (Taylor's short-range law), and a reading's likelihood is the mixture over it
+    (five Gauss-Hermite nodes; heights below the ground reflected) instead of the likelihood
+    at the time mean: a reading at the plume's upper fringe is then a rare burst, not a
+    reliable weak signal."""
     behind, ahead, side = reach
     along = np.arange(-behind, ahead + step / 2, step)
     across = np.arange(-side, side + step / 2, step)
@@ -173,15 +181,46 @@ def model_posterior(
             theta = np.tile(base, (len(da), 1))
             theta[:, :2] = world
             theta[:, 6], theta[:, 7] = z1, z2
-            conc = plume.concentration(theta, positions)  # (N, K)
             distance = np.linalg.norm(positions[None, :, :] - theta[:, None, :3], axis=2)
+            if meander_mixture > 0.0:
+                per_node = _meander_nodes(plume, theta, positions, truth, meander_mixture)
+            else:
+                per_node = [(1.0, plume.concentration(theta, positions))]  # (N, K)
             for scale in scales:  # the rate's factors, equally likely
-                ll = sensor.log_likelihood(readings[None, :], scale * conc, distance).sum(axis=1)
+                ll = logsumexp(
+                    [
+                        math.log(wj) + sensor.log_likelihood(readings[None, :], scale * c, distance)
+                        for wj, c in per_node
+                    ],
+                    axis=0,
+                ).sum(axis=1)
                 log_post.append(ll + float(prior.log_density(theta[:1])[0]))
     lp = np.stack(log_post)  # (combinations, N)
     w_all = np.exp(lp - logsumexp(lp))
     w = w_all.sum(axis=0)
     return _summary(w, da, dc)
+
+
+HERMITE_NODES = (0.0, -1.355626179974266, 1.355626179974266, -2.856970013872806, 2.856970013872806)
+HERMITE_WEIGHTS = (0.5333333333333333, 0.2220759220056126, 0.2220759220056126,
+                   0.011257411327720691, 0.011257411327720691)  # fmt: skip
+"""Five-point Gauss-Hermite rule for a standard normal (probabilists')."""
+
+
+def _meander_nodes(plume, theta: np.ndarray, positions: np.ndarray, truth, i_z: float):  # type: ignore[no-untyped-def]
+    """[(weight, (N, K) concentrations)] with the release height moved by i_z · d · ξ at each
+    node ξ, d the downwind distance from each candidate to each reading (0 upwind)."""
+    out = []
+    rel = positions[None, :, :2] - theta[:, None, :2]  # (N, K, 2)
+    d = np.maximum(rel @ truth.downwind, 0.0)  # (N, K)
+    for xi, wj in zip(HERMITE_NODES, HERMITE_WEIGHTS, strict=True):
+        c = np.empty(d.shape)
+        for k in range(len(positions)):
+            th = theta.copy()
+            th[:, 2] = np.abs(theta[:, 2] + i_z * d[:, k] * xi)  # the ground reflects
+            c[:, k] = plume.concentration(th, positions[k : k + 1])[:, 0]
+        out.append((wj, c))
+    return out
 
 
 def _summary(w: np.ndarray, da: np.ndarray, dc: np.ndarray) -> dict[str, float]:
@@ -278,6 +317,13 @@ def main() -> None:
         help="the exact grid posterior of today's reading model instead (model_posterior)",
     )
     ap.add_argument(
+        "--meander-mixture",
+        type=float,
+        default=0.0,
+        help="with --reading-model: the vertical meander's intensity i_z of a fluctuating-plume "
+        "likelihood (model_posterior); 0: today's likelihood at the time mean",
+    )
+    ap.add_argument(
         "--zeros",
         action="store_true",
         help="instead of posteriors: the share of zero readings by time-mean class, the truth's "
@@ -306,6 +352,7 @@ def main() -> None:
                 args.step,
                 REACH,
                 (1.0,) if scales is None else tuple(scales.tolist()),
+                args.meander_mixture,
             )
             rows.append(_row(run, result, post))
             continue
@@ -340,6 +387,7 @@ def main() -> None:
         "phases": args.phases,
         "rate_unknown": bool(args.rate_unknown),
         "reading_model": bool(args.reading_model),
+        "meander_mixture": args.meander_mixture,
         "code": code_version(),
         "median_oracle_rmse": float(np.median(oracle)),
         "oracle_within_1m": int((oracle <= 1.0).sum()),
