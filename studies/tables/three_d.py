@@ -308,6 +308,11 @@ SLICE_ORACLES = (
         "weighed)",
     ),
     ("reading-model", "the same, the release rate known too"),
+    (
+        "reading-model-meander-0.1",
+        "that, its likelihood a mixture over a meandering centre height, i_z = 0.1 (a probe)",
+    ),
+    ("reading-model-meander-0.2", "the same, i_z = 0.2 (a probe)"),
     ("mean", "the plume's exact time mean, read through the estimator's log-normal fluctuations"),
     ("mixture", "the plume's own fluctuation statistics (its every frame, held-averaged)"),
     ("mixture-rate-unknown", "the same, the release rate unknown (1/4 to 4 times)"),
