@@ -35,6 +35,7 @@ import argparse
 import itertools
 import json
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -46,6 +47,12 @@ from dcee.provenance import code_version
 from dcee.runs import EpisodeResult
 from dcee.scenarios import validate_scenario
 from dcee.simulation import make_truth
+
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT) not in sys.path:  # run as a script: the studies package sits beside it
+    sys.path.insert(0, str(ROOT))
+
+from studies.slice_models import candidate_grid, grid_summary, model_posterior  # noqa: E402
 
 
 def _inner(truth):  # type: ignore[no-untyped-def]
@@ -93,15 +100,7 @@ def oracle_posterior(
     given readings (K,) at positions (K, 3); summaries in m. With several ``scales`` (factors
     on the release rate, equally likely) the rate is unknown to it and marginalised."""
     rec = truth.recording
-    behind, ahead, side = reach
-    along = np.arange(-behind, ahead + step / 2, step)
-    across = np.arange(-side, side + step / 2, step)
-    da, dc = np.meshgrid(along, across, indexing="ij")
-    da, dc = da.ravel(), dc.ravel()
-    # the candidates' world positions: inside the search area only (the estimator's prior)
-    world = truth.source[:2] + np.outer(da, truth.downwind) + np.outer(dc, truth.left)
-    inside = np.all((world >= low[:2]) & (world <= high[:2]), axis=1)
-    da, dc = da[inside], dc[inside]
+    da, dc, _ = candidate_grid(truth, low, high, step, reach)
     if phases == 0:  # the time mean alone (the reading model's view: its own fluctuations)
         sub = fields.mean(axis=0, keepdims=True)
     else:
@@ -129,115 +128,7 @@ def oracle_posterior(
             ll = sensor.log_likelihood(float(z), scale * c, distance)
             log_post[k] += logsumexp(ll.reshape(len(frames), len(da)), axis=0)
     log_post = logsumexp(log_post, axis=0)  # the rate marginalised (a constant dropped)
-    return _summary(np.exp(log_post - logsumexp(log_post)), da, dc)
-
-
-ZETA1 = (0.25, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0)
-"""m²/s, the diffusivities the model oracle weighs (the prior's mass lies at 0-4)."""
-ZETA2 = (5.0, 8.0, 11.0)
-"""s, the particle lifetimes it weighs (the prior: 8 ± 1.4)."""
-
-
-def model_posterior(
-    scenario,  # type: ignore[no-untyped-def]
-    truth,  # type: ignore[no-untyped-def]
-    positions: np.ndarray,
-    readings: np.ndarray,
-    step: float,
-    reach: tuple[float, float, float],
-    scales: tuple[float, ...] = (1.0,),
-    meander_mixture: float = 0.0,
-) -> dict[str, float]:
-    """The exact grid posterior of the estimator's own reading model (its plume and its
-    fluctuation model, ``Scenario.make_plume`` and ``make_estimator_sensor``) over the release's
-    horizontal offset δ and the model's ζ1, ζ2 (on the grids above, weighted by the prior),
-    with the height, rate and wind known (the truth's); summaries as
-    :func:`oracle_posterior`'s. What today's reading model could do with the search's readings
-    if the filter found its exact posterior and the other parameters were known.
-
-    With ``meander_mixture`` = i_z > 0, a probe of a fluctuating plume (Gifford 1959): the
-    plume's centre height meanders, Gaussian with the standard deviation i_z · d at d m
-    downwind (Taylor's short-range law), and a reading's likelihood is the mixture over it
-    (five Gauss-Hermite nodes; heights below the ground reflected) instead of the likelihood
-    at the time mean: a reading at the plume's upper fringe is then a rare burst, not a
-    reliable weak signal."""
-    behind, ahead, side = reach
-    along = np.arange(-behind, ahead + step / 2, step)
-    across = np.arange(-side, side + step / 2, step)
-    da, dc = (g.ravel() for g in np.meshgrid(along, across, indexing="ij"))
-    world = truth.source[:2] + np.outer(da, truth.downwind) + np.outer(dc, truth.left)
-    low, high = scenario.volume.low, scenario.volume.high
-    inside = np.all((world >= low[:2]) & (world <= high[:2]), axis=1)
-    da, dc, world = da[inside], dc[inside], world[inside]
-    plume, sensor, prior = (
-        scenario.make_plume(),
-        scenario.make_estimator_sensor(),
-        scenario.make_prior(),
-    )
-    base = scenario.truth_theta()
-    log_post = []
-    for z1 in ZETA1:
-        for z2 in ZETA2:
-            theta = np.tile(base, (len(da), 1))
-            theta[:, :2] = world
-            theta[:, 6], theta[:, 7] = z1, z2
-            distance = np.linalg.norm(positions[None, :, :] - theta[:, None, :3], axis=2)
-            if meander_mixture > 0.0:
-                per_node = _meander_nodes(plume, theta, positions, truth, meander_mixture)
-            else:
-                per_node = [(1.0, plume.concentration(theta, positions))]  # (N, K)
-            for scale in scales:  # the rate's factors, equally likely
-                ll = logsumexp(
-                    [
-                        math.log(wj) + sensor.log_likelihood(readings[None, :], scale * c, distance)
-                        for wj, c in per_node
-                    ],
-                    axis=0,
-                ).sum(axis=1)
-                log_post.append(ll + float(prior.log_density(theta[:1])[0]))
-    lp = np.stack(log_post)  # (combinations, N)
-    w_all = np.exp(lp - logsumexp(lp))
-    w = w_all.sum(axis=0)
-    return _summary(w, da, dc)
-
-
-HERMITE_NODES = (0.0, -1.355626179974266, 1.355626179974266, -2.856970013872806, 2.856970013872806)
-HERMITE_WEIGHTS = (0.5333333333333333, 0.2220759220056126, 0.2220759220056126,
-                   0.011257411327720691, 0.011257411327720691)  # fmt: skip
-"""Five-point Gauss-Hermite rule for a standard normal (probabilists')."""
-
-
-def _meander_nodes(plume, theta: np.ndarray, positions: np.ndarray, truth, i_z: float):  # type: ignore[no-untyped-def]
-    """[(weight, (N, K) concentrations)] with the release height moved by i_z · d · ξ at each
-    node ξ, d the downwind distance from each candidate to each reading (0 upwind)."""
-    out = []
-    rel = positions[None, :, :2] - theta[:, None, :2]  # (N, K, 2)
-    d = np.maximum(rel @ truth.downwind, 0.0)  # (N, K)
-    for xi, wj in zip(HERMITE_NODES, HERMITE_WEIGHTS, strict=True):
-        c = np.empty(d.shape)
-        for k in range(len(positions)):
-            th = theta.copy()
-            th[:, 2] = np.abs(theta[:, 2] + i_z * d[:, k] * xi)  # the ground reflects
-            c[:, k] = plume.concentration(th, positions[k : k + 1])[:, 0]
-        out.append((wj, c))
-    return out
-
-
-def _summary(w: np.ndarray, da: np.ndarray, dc: np.ndarray) -> dict[str, float]:
-    """Posterior summaries of grid weights ``w`` over offsets (``da``, ``dc``) m."""
-    mean_a, mean_c = float(w @ da), float(w @ dc)
-    order = np.argsort(-w)
-    region = order[: int(np.searchsorted(np.cumsum(w[order]), 0.95)) + 1]
-    truth_cell = int(np.argmin(da * da + dc * dc))
-    return {
-        "truth_in_95": bool(truth_cell in set(region.tolist())),
-        "rmse": float(math.sqrt(w @ (da * da + dc * dc))),
-        "error_along": mean_a,
-        "error_across": mean_c,
-        "sd_along": float(math.sqrt(max(w @ (da - mean_a) ** 2, 0.0))),
-        "sd_across": float(math.sqrt(max(w @ (dc - mean_c) ** 2, 0.0))),
-        "candidates": len(da),
-    }
+    return grid_summary(np.exp(log_post - logsumexp(log_post)), da, dc)
 
 
 ZERO_BINS = (1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2)
@@ -324,6 +215,12 @@ def main() -> None:
         "likelihood (model_posterior); 0: today's likelihood at the time mean",
     )
     ap.add_argument(
+        "--gaussian",
+        action="store_true",
+        help="with --reading-model: a Gaussian plume with Taylor's near-field growth in place "
+        "of today's plume (gaussian_plume)",
+    )
+    ap.add_argument(
         "--zeros",
         action="store_true",
         help="instead of posteriors: the share of zero readings by time-mean class, the truth's "
@@ -353,6 +250,7 @@ def main() -> None:
                 REACH,
                 (1.0,) if scales is None else tuple(scales.tolist()),
                 args.meander_mixture,
+                args.gaussian,
             )
             rows.append(_row(run, result, post))
             continue
@@ -388,6 +286,7 @@ def main() -> None:
         "rate_unknown": bool(args.rate_unknown),
         "reading_model": bool(args.reading_model),
         "meander_mixture": args.meander_mixture,
+        "gaussian": bool(args.gaussian),
         "code": code_version(),
         "median_oracle_rmse": float(np.median(oracle)),
         "oracle_within_1m": int((oracle <= 1.0).sum()),

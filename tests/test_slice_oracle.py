@@ -122,3 +122,25 @@ def test_an_offset_release_is_placed_where_the_readings_came_from():
         0.25, (6.0, 4.0, 3.0), 4,
     )  # fmt: skip
     assert abs(post["error_along"] + 2.0) < 0.5 and abs(post["error_across"] + 1.0) < 0.5, post
+
+
+def test_the_gaussian_plume_probe_carries_the_release_rate_and_is_zero_upwind():
+    """Through a crosswind plane above the ground the reflected Gaussian plume carries q / u
+    (mass conserved); on its axis at the release height it is the textbook value; upwind 0."""
+    import sys
+
+    sys.path.insert(0, str(ROOT))
+    from studies.slice_models import GAUSSIAN_SIGMA0, gaussian_plume
+
+    theta = np.array([[0.0, 0.0, 1.0, 2.0, 4.0, 0.0, 1.0, 8.0]])  # q 2 g/s, u 4 m/s
+    downwind = np.array([1.0, 0.0])
+    ys, zs = np.meshgrid(np.linspace(-20, 20, 401), np.linspace(0, 30, 601))
+    plane = np.column_stack([np.full(ys.size, 10.0), ys.ravel(), zs.ravel()])
+    c = gaussian_plume(theta, plane, downwind, 0.2, 0.1)[0].reshape(ys.shape)
+    flux = np.trapezoid(np.trapezoid(c, zs[:, 0], axis=0), ys[0])
+    assert math.isclose(flux, 2.0 / 4.0, rel_tol=1e-3)
+    sy, sz = math.hypot(GAUSSIAN_SIGMA0, 2.0), math.hypot(GAUSSIAN_SIGMA0, 1.0)
+    axis = gaussian_plume(theta, np.array([[10.0, 0.0, 1.0]]), downwind, 0.2, 0.1)[0, 0]
+    expected = 2.0 / (2 * math.pi * 4.0 * sy * sz) * (1.0 + math.exp(-2.0 / sz**2))
+    assert math.isclose(axis, expected, rel_tol=1e-12)
+    assert gaussian_plume(theta, np.array([[-3.0, 0.0, 1.0]]), downwind, 0.2, 0.1)[0, 0] == 0.0
