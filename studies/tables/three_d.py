@@ -313,6 +313,11 @@ SLICE_ORACLES = (
         "that, its likelihood a mixture over a meandering centre height, i_z = 0.1 (a probe)",
     ),
     ("reading-model-meander-0.2", "the same, i_z = 0.2 (a probe)"),
+    (
+        "gaussian-rate-unknown",
+        "a textbook Gaussian plume instead (Taylor's growth, σ = √(0.3² + (i d)²), the ground "
+        "reflecting; i_y, i_z and the rate weighed; a probe)",
+    ),
     ("mean", "the plume's exact time mean, read through the estimator's log-normal fluctuations"),
     ("mixture", "the plume's own fluctuation statistics (its every frame, held-averaged)"),
     ("mixture-rate-unknown", "the same, the release rate unknown (1/4 to 4 times)"),
