@@ -90,7 +90,13 @@ def test_demo_searches_a_gaden_room_over_topics() -> None:
     assert live[-1]["rmse"] < live[0]["rmse"]
 
 
-def test_node_refuses_a_bad_pose_type() -> None:
+def test_node_refuses_a_bad_pose_type_and_leaves_no_node_behind() -> None:
+    """The refusal is one line, and the half-built node is gone from the graph at once, as is a
+    node destroyed: left to the garbage collector they were finalised inside a later node's
+    set-up, where Fast DDS deadlocked (the garbage collector is held off here, so only an
+    explicit destruction passes; SearchNode.destroy_node)."""
+    import gc
+
     import rclpy
     from rclpy.parameter import Parameter
 
@@ -98,17 +104,31 @@ def test_node_refuses_a_bad_pose_type() -> None:
 
     context = rclpy.Context()
     rclpy.init(context=context, args=[], domain_id=_domain())
+    gc.disable()
     try:
         with pytest.raises(DceeInputError, match="pose_type"):
             SearchNode(
                 context=context,
+                name="refused_search",
                 parameter_overrides=[
                     Parameter("pose_type", value="gps"),
                     Parameter("particles", value=200),
                 ],
             )
+        done = SearchNode(
+            context=context,
+            name="destroyed_search",
+            parameter_overrides=[Parameter("particles", value=200)],
+        )
+        done.destroy_node()
+        probe = rclpy.create_node("probe", context=context)
+        names = probe.get_node_names()
+        probe.destroy_node()
     finally:
+        gc.enable()
         rclpy.try_shutdown(context=context)
+    assert "probe" in names, names
+    assert "refused_search" not in names and "destroyed_search" not in names, names
 
 
 def test_yaw_and_quaternion_round_trip() -> None:

@@ -122,6 +122,27 @@ class SearchNode(NodeInputs, NodeOutputs, LifecycleNode):
         name: str = "dcee_search",
     ) -> None:
         super().__init__(name, context=context, parameter_overrides=parameter_overrides or [])
+        try:
+            self._set_up(true_location, scenario)
+        except BaseException:
+            # a node that refuses its configuration releases its DDS entities now, not when
+            # the garbage collector gets to it (destroy_node says why)
+            self.destroy_node()
+            raise
+
+    def destroy_node(self) -> None:
+        """Destroy the node now, its lifecycle state machine with it. rclpy's ``LifecycleNode``
+        (9.1) only marks its ROS 2 node for destruction while the state machine still holds the
+        node's handle, so the node stayed in the graph until the garbage collector finalised the
+        state machine, at a random moment: once inside another node's set-up in the same
+        process, where Fast DDS deadlocked (the ROS 2 tests hung, 2026-12-05)."""
+        super().destroy_node()
+        machine = getattr(self, "_state_machine", None)
+        if machine is not None and hasattr(machine, "destroy_when_not_in_use"):
+            machine.destroy_when_not_in_use()
+
+    def _set_up(self, true_location: np.ndarray | None, scenario: Scenario | None) -> None:
+        """Everything the constructor does after the ROS 2 node exists (see ``__init__``)."""
         for key, default in PARAMETERS.items():
             if not self.has_parameter(key):
                 self.declare_parameter(key, default)
