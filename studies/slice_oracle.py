@@ -227,7 +227,11 @@ def main() -> None:
         "against the estimator's fluctuation model (zero_shares)",
     )
     args = ap.parse_args()
-    scales = np.exp(np.linspace(math.log(0.25), math.log(4.0), 9)) if args.rate_unknown else None
+    scales = (
+        tuple(np.exp(np.linspace(math.log(0.25), math.log(4.0), 9)).tolist())
+        if args.rate_unknown
+        else (1.0,)
+    )
     _, runs = load_campaign(Path(args.campaign))
     rows = []
     for _, run in runs.sort_values(["scenario", "strategy"]).iterrows():
@@ -248,7 +252,7 @@ def main() -> None:
                 readings,
                 args.step,
                 REACH,
-                (1.0,) if scales is None else tuple(scales.tolist()),
+                scales,
                 args.meander_mixture,
                 args.gaussian,
             )
@@ -269,7 +273,7 @@ def main() -> None:
             args.step,
             REACH,
             args.phases,
-            (1.0,) if scales is None else tuple(scales.tolist()),
+            scales,
         )
         rows.append(_row(run, result, post))
     if args.zeros:

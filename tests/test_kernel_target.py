@@ -23,14 +23,17 @@ def test_full_width_features_prefer_512_bit_only_on_avx512():
     assert {"+avx2", "+avx512f", "+fma"} <= set(parts)
 
 
+def _without_width_settings() -> dict[str, str]:
+    """This process's environment without any setting of the kernels' vector width (numba's,
+    dcee's, and the note of dcee's own choice): a child starts from the user's defaults."""
+    dropped = ("NUMBA_CPU_FEATURES", "NUMBA_CPU_NAME", "DCEE_VECTOR_WIDTH", SET_BY_DCEE_ENV)
+    return {k: v for k, v in os.environ.items() if k not in dropped}
+
+
 def _features_after_import(**env: str) -> str:
     """NUMBA_CPU_FEATURES as numba's configuration holds it after ``import dcee, numba`` in a
     fresh process with ``env`` added."""
-    base = {
-        k: v
-        for k, v in os.environ.items()
-        if k not in ("NUMBA_CPU_FEATURES", "NUMBA_CPU_NAME", "DCEE_VECTOR_WIDTH", SET_BY_DCEE_ENV)
-    }
+    base = _without_width_settings()
     code = "import dcee, numba; print(repr(numba.config.CPU_FEATURES))"
     out = subprocess.run(
         [sys.executable, "-c", code], env={**base, **env}, capture_output=True, text=True,
@@ -58,11 +61,7 @@ def test_a_child_of_a_dcee_process_chooses_its_own_width_but_keeps_the_users():
         "print(subprocess.run([sys.executable, '-c', code], env=env, capture_output=True,\n"
         "                     text=True, check=True).stdout.strip())\n"
     )
-    base = {
-        k: v
-        for k, v in os.environ.items()
-        if k not in ("NUMBA_CPU_FEATURES", "NUMBA_CPU_NAME", "DCEE_VECTOR_WIDTH", SET_BY_DCEE_ENV)
-    }
+    base = _without_width_settings()
     for env, expected in (({}, "None"), ({"NUMBA_CPU_FEATURES": "+sse2"}, repr("+sse2"))):
         out = subprocess.run(
             [sys.executable, "-c", child], env={**base, **env}, capture_output=True, text=True,
@@ -84,12 +83,7 @@ def test_the_vectorised_exp_uses_512_bit_registers_on_avx512():
         "a = -np.arange(64.0); out = np.empty(64); f(a, out)\n"
         "print(sum(asm.count('zmm') for asm in f.inspect_asm().values()))\n"
     )
-    # (this process's own choice is in its environment: a child would take it as the user's)
-    env = {
-        k: v
-        for k, v in os.environ.items()
-        if k not in ("NUMBA_CPU_FEATURES", "NUMBA_CPU_NAME", "DCEE_VECTOR_WIDTH", SET_BY_DCEE_ENV)
-    }
+    env = _without_width_settings()
     for width, wide in (("full", True), ("llvm", False)):
         out = subprocess.run(
             [sys.executable, "-c", code], env={**env, "DCEE_VECTOR_WIDTH": width},

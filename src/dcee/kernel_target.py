@@ -40,32 +40,34 @@ SET_BY_DCEE_ENV = "DCEE_SET_NUMBA_CPU_FEATURES"
 process inherits both, and one whose ``NUMBA_CPU_FEATURES`` equals the note knows that no user
 set it (the child's own ``DCEE_VECTOR_WIDTH`` then decides, as in its parent)."""
 
-applied: str | None = None
-"""The ``NUMBA_CPU_FEATURES`` this process set (None: it set none): a process that runs another
-version of the package (:func:`dcee.perf.machine.package_env`) drops it, so that each version
-compiles as it would on its own."""
+
+def set_by_dcee() -> bool:
+    """Whether this process's ``NUMBA_CPU_FEATURES`` is dcee's own choice (it equals the note,
+    :data:`SET_BY_DCEE_ENV`), not the user's: a process that runs another version of the
+    package (:func:`dcee.perf.machine.package_env`) drops it, so that each version compiles as
+    it would on its own."""
+    note = os.environ.get(SET_BY_DCEE_ENV)
+    return note is not None and os.environ.get("NUMBA_CPU_FEATURES") == note
 
 
 def forget_inherited_choice() -> bool:
     """Remove from this process's environment a ``NUMBA_CPU_FEATURES`` that a dcee parent set
     (it equals the parent's note, :data:`SET_BY_DCEE_ENV`), with the note, so that what
     remains of numba's CPU options is the user's; whether there was one."""
-    note = os.environ.pop(SET_BY_DCEE_ENV, None)
-    if note is not None and os.environ.get("NUMBA_CPU_FEATURES") == note:
+    inherited = set_by_dcee()
+    if inherited:
         del os.environ["NUMBA_CPU_FEATURES"]
-        return True
-    return False
+    os.environ.pop(SET_BY_DCEE_ENV, None)
+    return inherited
 
 
 def _choose_for_this_process() -> tuple[str | None, bool]:
     """Set ``NUMBA_CPU_FEATURES`` (and the note for child processes) to
     :func:`chosen_features`; (the value set or None, whether a parent's choice was removed)."""
-    global applied
     inherited = forget_inherited_choice()
     features = chosen_features()
     if features is not None:
         os.environ["NUMBA_CPU_FEATURES"] = os.environ[SET_BY_DCEE_ENV] = features
-        applied = features
     return features, inherited
 
 

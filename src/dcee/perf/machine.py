@@ -231,9 +231,7 @@ def package_env(src: Path, **extra: str) -> dict[str, str]:
     from dcee import kernel_target
 
     dropped = {*KERNEL_CACHE_VARIABLES, kernel_target.SET_BY_DCEE_ENV}
-    if kernel_target.applied is not None and (
-        os.environ.get("NUMBA_CPU_FEATURES") == kernel_target.applied
-    ):
+    if kernel_target.set_by_dcee():
         dropped.add("NUMBA_CPU_FEATURES")
     env = {k: v for k, v in os.environ.items() if k not in dropped}
     return {**env, **extra, "PYTHONPATH": str(src)}
