@@ -3,8 +3,9 @@
 planner, both likelihoods, all eight parameters unknown, a measured wind, several releases, a
 site with walls, the turbulent truths).
 
-Why: on a fresh machine the kernels compile on first use (2026-12-05: the core job 45-50 s of
-one core, the two shards 25 and 33 s beside each other), and in a
+Why: on a fresh machine the kernels compile on first use (2026-12-05: the core job 45 s of
+one core, the two shards 30 s beside each other; 58-62 s and 33 s while the kernels that read
+the particles compiled twice, once for a frozen copy: ``dcee.numeric.read_only_view``), and in a
 suite run on two processes, whose campaign tests start worker processes of their own, the same
 kernel was compiled by several processes at once: the suite took 265 s there against 124 s
 with the cache filled. ``core`` compiles what every search uses on one core (the other installs

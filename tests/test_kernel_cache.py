@@ -124,3 +124,33 @@ def test_a_kernel_that_calls_another_modules_summation_runs_from_the_cache(tmp_p
     env["XDG_CACHE_HOME"] = str(tmp_path / "cache")
     for _ in range(2):  # the first compiles and stores, the second loads
         subprocess.run([sys.executable, "-c", code], env=env, check=True, timeout=300)
+
+
+def test_a_search_compiles_each_particle_kernel_once_whether_its_particles_are_frozen_or_not():
+    """The filter freezes its particles for the planners (``planning_particles``) and edits a
+    copy afterwards, so kernels saw them both writeable and read-only; numba types an array's
+    mutability, and compiled the history likelihood twice (14 s of a fresh machine's first
+    search). Kernels that only read their inputs take read-only views
+    (``dcee.numeric.read_only_view``): one specialisation each. In a fresh process, with the
+    suite's cache, so that no other test's calls count."""
+    code = (
+        "from dcee.runs import run_episode\n"
+        "from dcee.scenarios import load_scenario\n"
+        "from dcee.estimation import filter_kernels as f\n"
+        "from dcee.models import plume_kernels as p\n"
+        "from dcee.planning import particle_terms as t, position_kernels as k\n"
+        "s = load_scenario('random:1000').with_overrides(**{'search.particles': 300,\n"
+        "    'search.hypotheses': 4, 'search.budget': 12.0})\n"
+        "for planner in ('dcee-cl', 'infotaxis'):\n"
+        "    run_episode(s, planner, 0)\n"
+        "kernels = (f._history_kernel, p.concentration_distance_grid, t.merge_runs,\n"
+        "           k.content_hash)\n"
+        "print([len(kernel.signatures) for kernel in kernels])\n"
+    )
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+    out = subprocess.run(
+        [sys.executable, "-c", code], env=env, check=True, timeout=300, capture_output=True,
+        text=True,
+    )  # fmt: skip
+    counts = out.stdout.strip().splitlines()[-1]
+    assert counts == "[1, 1, 1, 1]", counts

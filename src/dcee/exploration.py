@@ -32,7 +32,7 @@ from dcee.models.plume import IsotropicPlume
 from dcee.models.plume_kernels import concentration_distance_grid, plume_from_terms
 from dcee.models.sensor import Sensor
 from dcee.models.sensor_kernels import SensorParams, log_likelihood, log_missed
-from dcee.numeric import exp_scalar, log_scalar, vlog1m, vndtr_upper
+from dcee.numeric import exp_scalar, log_scalar, read_only_view, vlog1m, vndtr_upper
 from dcee.planning.position_kernels import N_PLUME_CONSTANTS, plume_constants, vectorised_case
 
 DEFAULT_EXPLORE_SHARE = 0.5
@@ -76,7 +76,7 @@ def detection_information(
         plume_constants(np.ascontiguousarray(rows), constants[k])
     p_each = np.empty((len(points), len(theta)))
     h_each = np.empty_like(p_each)
-    _information_rows(constants, points, plume.min_distance, sp, p_each, h_each)
+    _information_rows(constants, read_only_view(points), plume.min_distance, sp, p_each, h_each)
     p_mean = np.clip(p_each @ weights, 1e-12, 1.0 - 1e-12)
     return _entropy(p_mean) - h_each @ weights
 
@@ -99,7 +99,9 @@ def detection_information_reference(
     for rows in source_rows(theta):
         grid = np.ascontiguousarray(rows)
         if isinstance(plume, IsotropicPlume):
-            concentration_distance_grid(grid, points, plume.min_distance, *plume.shape, c, r)
+            concentration_distance_grid(
+                read_only_view(grid), read_only_view(points), plume.min_distance, *plume.shape, c, r
+            )
         else:  # a plume that predicts with its own method (the wall-aware one)
             conc_t, dist_t = plume.concentration_distance(grid, points)
             c[:], r[:] = conc_t.T, dist_t.T

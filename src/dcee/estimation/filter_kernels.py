@@ -35,6 +35,7 @@ from dcee.numeric import (
     exp_scalar,
     log1p_scalar,
     log_scalar,
+    read_only_view,
     vlog1m,
     vndtr_upper,
 )
@@ -288,7 +289,7 @@ def history_log_likelihood(
     multiplicity = np.ascontiguousarray(multiplicity, dtype=np.float64)
     threshold, remaining = rejection_bounds(n, multiplicity, threshold, bounds)
     _history_kernel(
-        np.ascontiguousarray(theta, dtype=np.float64),
+        read_only_view(np.ascontiguousarray(theta, dtype=np.float64)),
         np.ascontiguousarray(active, dtype=np.bool_),
         np.ascontiguousarray(positions, dtype=np.float64),
         np.ascontiguousarray(readings, dtype=np.float64),

@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from dcee.numeric import exp_scalar
+from dcee.numeric import exp_scalar, read_only_view
 
 _FOUR_PI = 4.0 * math.pi
 
@@ -297,8 +297,8 @@ def concentration_matrix(
     tmp = np.empty((positions.shape[0], theta.shape[0]))
     dist = np.empty_like(tmp)
     concentration_distance_grid(
-        theta, positions, rmin, meander, decay, backflow, radius, vertical, ground, meander_z,
-        tmp, dist,
+        read_only_view(theta), read_only_view(positions), rmin, meander, decay, backflow,
+        radius, vertical, ground, meander_z, tmp, dist,
     )  # fmt: skip
     out[...] = tmp.T
 

@@ -33,7 +33,7 @@ from dcee.models.sensor_kernels import (
     log_likelihood,
     transform,
 )
-from dcee.numeric import HALF_LOG_2PI
+from dcee.numeric import HALF_LOG_2PI, read_only_view
 
 
 @njit(cache=True, parallel=True)
@@ -161,8 +161,8 @@ def floor_decision(
     shape = (positions.shape[0], theta.shape[0])
     conc, dist = np.empty(shape), np.empty(shape)
     concentration_distance_grid(
-        theta,
-        positions,
+        read_only_view(theta),
+        read_only_view(positions),
         plume.min_distance,
         *plume.shape,
         conc,

@@ -29,6 +29,7 @@ from numba import njit
 
 from dcee.models.plume import IsotropicPlume
 from dcee.models.sensor import Sensor
+from dcee.numeric import read_only_view
 from dcee.planning.position_kernels import (
     N_PLUME_CONSTANTS,
     content_hash,
@@ -233,7 +234,7 @@ class ParticleTerms:
 
     def _fingerprint(self, theta: np.ndarray) -> tuple:
         bits = np.ascontiguousarray(theta).reshape(-1).view(np.uint64)
-        return (id(theta), theta.shape, *content_hash(bits))
+        return (id(theta), theta.shape, *content_hash(read_only_view(bits)))
 
     def sync(self, theta: np.ndarray, sensor: Sensor, plume: object) -> None:
         """Bind to the particles theta (N, 8) and the models; keeps the cached rows only if
@@ -268,7 +269,7 @@ class ParticleTerms:
         if slots != self._slots:
             self._slots, self._flat = slots, None  # another layout: new buffers
         if self.merge:
-            self.starts = merge_runs(theta)
+            self.starts = merge_runs(read_only_view(theta))
             self.theta = np.ascontiguousarray(theta[self.starts])
         else:
             self.starts = np.arange(len(theta), dtype=np.int64)
