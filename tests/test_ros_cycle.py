@@ -107,6 +107,41 @@ def test_cycle_averages_over_the_hold_and_calibrates() -> None:
     assert cycle.dropped_readings == 2
 
 
+def test_clean_airs_noise_below_zero_is_a_measurement_and_a_fault_is_not() -> None:
+    """A zero-centred instrument in clean air reads a little below zero half the time: those
+    samples are kept (the hold's mean is about zero, a non-detection), where dropping them
+    kept only the positive half and its mean read gas (above the threshold). A sample
+    further below zero than the noise floor (the sensor's threshold by default) is a fault:
+    dropped and counted."""
+    sc = _lab()
+    threshold = sc.sensor.threshold
+    rng = np.random.default_rng(3)
+    noise = rng.uniform(-1.9 * threshold, 1.9 * threshold, 200)  # zero-centred, mostly small
+    noise = np.clip(noise, -0.95 * threshold, None)  # within the floor below zero
+    searcher = make_searcher(sc, None, *streams(0)[1:3])
+    cycle = SearchCycle(searcher, CycleSettings.from_scenario(sc, average=1.0), plan=False)
+    t = 0.0
+    for k in range(200):
+        cycle.on_reading(t, float(noise[k]))
+        cycle.on_reading(t, -1.5 * threshold)  # a fault
+        out = cycle.on_pose(Pose(t, 0.3, 3.2))
+        if out.record is not None:
+            break
+        t = round(t + 0.05, 10)
+    assert out.record is not None
+    window = noise[14 : k + 1]  # the last 1 s of the hold, 0.7-1.7 s
+    assert out.record["reading"] == pytest.approx(window.mean())
+    assert out.record["reading"] < threshold < window[window >= 0].mean()
+    assert cycle.rejected == {"reading below the noise floor": k + 1}
+    # a floor set by hand: 0 keeps no sample below zero
+    strict = CycleSettings.from_scenario(sc, noise_floor=0.0)
+    cycle = SearchCycle(make_searcher(sc, None, *streams(0)[1:3]), strict, plan=False)
+    cycle.on_reading(0.0, -1e-9)
+    assert cycle.rejected == {"reading below the noise floor": 1}
+    with pytest.raises(DceeInputError, match="noise_floor"):
+        CycleSettings.from_scenario(sc, noise_floor=math.nan)
+
+
 def test_cycle_waits_for_settling() -> None:
     sc = _lab()
     cycle = SearchCycle(make_searcher(sc, None, *streams(0)[1:3]), CycleSettings.from_scenario(sc))
@@ -183,7 +218,7 @@ def test_hostile_messages_are_dropped_counted_and_never_reach_the_estimator() ->
     assert bursts > 5
     assert cycle.rejected["reading above max_reading"] == 2 * bursts
     assert cycle.rejected["reading not finite"] == 3 * bursts
-    assert cycle.rejected["reading negative"] == bursts
+    assert cycle.rejected["reading below the noise floor"] == bursts
     assert cycle.rejected["reading not a number"] == bursts
     assert cycle.rejected["pose not finite"] == 3 * bursts
     assert cycle.rejected["pose far outside the area"] == bursts

@@ -314,7 +314,7 @@ def test_node_keeps_planning_through_hostile_message_streams() -> None:
         for reason in (
             "reading above max_reading",
             "reading not finite",
-            "reading negative",
+            "reading below the noise floor",
             "pose not finite",
             "pose far outside the area",
             "pose stamp went backwards",

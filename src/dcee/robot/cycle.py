@@ -46,7 +46,13 @@ class CycleSettings:
     ``settle_speed`` m/s and ``settle_turn_rate`` rad/s for ``settle_time`` s; ``altitude`` m of
     the readings (a ground robot's sensor height, the scenario's start z); ``budget`` s of
     search; ``shortest_move`` s, the fastest any move can be (a move that cannot end in the
-    budget is not asked for)."""
+    budget is not asked for); ``noise_floor`` g/m³, how far below zero a sample may read and
+    still be a measurement (from a scenario: its detection threshold ``sensor.threshold``). A
+    zero-centred instrument (a PID or an electrochemical cell after its baseline is taken
+    off) reads a little below zero in clean air; dropping those samples kept only the
+    positive half of the noise, and the hold's mean of them read gas where there was none. A
+    sample further below zero than the threshold, which the instrument's noise is below by
+    the threshold's definition, is a fault."""
 
     hold: float
     average: float
@@ -54,6 +60,7 @@ class CycleSettings:
     altitude: float
     shortest_move: float
     calibration: float = 1.0
+    noise_floor: float = 0.0
     goal_tolerance: float = 0.05
     settle_speed: float = 0.02
     settle_turn_rate: float = math.radians(5.0)
@@ -61,8 +68,8 @@ class CycleSettings:
 
     @classmethod
     def from_scenario(cls, scenario: Scenario, **changes: Any) -> CycleSettings:
-        """The scenario's hold, averaging, budget, altitude and move bound; ``changes``
-        (calibration, tolerances) override."""
+        """The scenario's hold, averaging, budget, altitude, move bound and noise floor (its
+        sensor's threshold); ``changes`` (calibration, noise floor, tolerances) override."""
         climb = scenario.agent.climb  # unset: one altitude on a robot (resolved_climb)
         if climb is not None and climb > 0:  # the cycle tells the estimator a fixed altitude
             raise DceeInputError(
@@ -78,12 +85,14 @@ class CycleSettings:
             "altitude": scenario.agent.start[2],
             "shortest_move": motion.shortest_move_time(scenario.agent.step),
         }
+        values["noise_floor"] = scenario.sensor.threshold
         values.update(changes)
         for name in (
             "hold",
             "average",
             "budget",
             "calibration",
+            "noise_floor",
             "goal_tolerance",
             "settle_speed",
             "settle_turn_rate",
@@ -181,14 +190,16 @@ class SearchCycle:
 
     def reading_problem(self, value: object) -> str | None:
         """Why a sample (sensor units) cannot be a measurement, or None: not a real number,
-        not finite, negative, or above the sensor's physical maximum (``sensor.max_reading``
-        g/m³ after ``calibration``: a glitch, a saturated or stuck sensor)."""
+        not finite, further below zero than the noise floor (``noise_floor`` g/m³ after
+        ``calibration``), or above the sensor's physical maximum (``sensor.max_reading`` g/m³:
+        a glitch, a saturated or stuck sensor). A sample between the floor and zero is kept:
+        the hold's mean of it is the reading, a non-detection to the estimator."""
         if isinstance(value, bool) or not isinstance(value, Real):
             return "reading not a number"
         if not math.isfinite(value):
             return "reading not finite"
-        if value < 0:
-            return "reading negative"
+        if value * self.settings.calibration < -self.settings.noise_floor:
+            return "reading below the noise floor"
         if value * self.settings.calibration > self.searcher.filter.sensor.max_reading:
             return "reading above max_reading"
         return None
@@ -382,7 +393,7 @@ MAX_WIND = 100.0
 REJECTION_REASONS = (
     "reading not a number",
     "reading not finite",
-    "reading negative",
+    "reading below the noise floor",
     "reading above max_reading",
     "pose not finite",
     "pose far outside the area",

@@ -5,7 +5,9 @@ profiles the dcee nodes share (:mod:`dcee.ros.node`, :mod:`dcee.ros.sim_node`,
 
 Parameters
     ``scenario`` (name or TOML path), ``strategy``, ``seed``, ``particles`` (0: the
-    scenario's), ``frame_id`` ("map"), ``calibration`` (1.0), ``concentration_topic``,
+    scenario's), ``frame_id`` ("map"), ``calibration`` (1.0), ``noise_floor`` (g/m³ a
+    sample may read below zero and still be clean air's noise; -1: the sensor's threshold),
+    ``concentration_topic``,
     ``pose_topic``, ``goal_topic``, ``pose_type`` (:data:`POSE_TYPES`),
     ``checkpoint`` (a file: the searcher is saved there after every reading and resumed from
     it at start), ``marker_particles`` (500); when the robot has settled for a reading:
@@ -53,6 +55,9 @@ PARAMETERS: dict[str, Any] = {
     "particles": 0,
     "frame_id": "map",
     "calibration": 1.0,
+    # g/m³ below zero a sample may read and still be clean air's noise; < 0: the sensor's
+    # detection threshold (dcee.robot.cycle.CycleSettings)
+    "noise_floor": -1.0,
     "concentration_topic": "concentration",
     "pose_topic": "odom",
     "map_topic": "map",
@@ -104,9 +109,11 @@ def scenario_from_parameters(p: dict[str, Any], given: Scenario | None = None) -
 
 def cycle_settings(p: dict[str, Any], scenario: Scenario) -> CycleSettings:
     """When the robot has settled for a reading, from the parameters (angles in °/s)."""
+    floor = float(p["noise_floor"])
     return CycleSettings.from_scenario(
         scenario,
         calibration=float(p["calibration"]),
+        **({} if floor < 0 else {"noise_floor": floor}),  # NaN reaches the check
         goal_tolerance=float(p["goal_tolerance"]),
         settle_speed=float(p["settle_speed"]),
         settle_turn_rate=math.radians(float(p["settle_turn_rate"])),
