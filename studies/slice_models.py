@@ -48,6 +48,7 @@ def model_posterior(
     scales: tuple[float, ...] = (1.0,),
     meander_mixture: float = 0.0,
     gaussian: bool = False,
+    gamma_intensity: float = 0.0,
 ) -> dict[str, float]:
     """The exact grid posterior of the estimator's own reading model (its plume and its
     fluctuation model, ``Scenario.make_plume`` and ``make_estimator_sensor``) over the release's
@@ -66,12 +67,23 @@ def model_posterior(
     With ``gaussian``, the plume's shape is instead the Gaussian plume of the dispersion
     literature with Taylor's near-field growth, reflected at the ground (:func:`gaussian_plume`),
     its two intensities weighed on :data:`GAUSSIAN_IY` × :data:`GAUSSIAN_IZ` (equally likely):
-    a shape chosen from textbooks, not from this plume."""
+    a shape chosen from textbooks, not from this plume.
+
+    With ``gamma_intensity`` = i > 0, a probe of the fluctuation model: the reading is the
+    instrument's model (``make_sensor``) given the held-averaged concentration, itself the
+    model's time mean times a unit-mean gamma variate of standard deviation i
+    (:func:`gamma_multipliers`), in place of the log-normal family with its fixed intermittency:
+    the share of zero readings then grows where the mean is weak."""
     da, dc, world = candidate_grid(truth, scenario.volume.low, scenario.volume.high, step, reach)
     plume, sensor, prior = (
         scenario.make_plume(),
-        scenario.make_estimator_sensor(),
+        scenario.make_sensor() if gamma_intensity > 0.0 else scenario.make_estimator_sensor(),
         scenario.make_prior(),
+    )
+    fluctuation = (
+        list(zip(*gamma_multipliers(gamma_intensity), strict=True))
+        if gamma_intensity > 0.0
+        else [(1.0, 1.0)]
     )
     base = scenario.truth_theta()
     theta = np.tile(base, (len(da), 1))
@@ -84,8 +96,10 @@ def model_posterior(
         for scale in scales:  # the rate's factors, equally likely
             ll = logsumexp(
                 [
-                    math.log(wj) + sensor.log_likelihood(readings[None, :], scale * c, distance)
+                    math.log(wj * wg)
+                    + sensor.log_likelihood(readings[None, :], scale * g * c, distance)
                     for wj, c in per_node
+                    for wg, g in fluctuation
                 ],
                 axis=0,
             ).sum(axis=1)
@@ -162,6 +176,23 @@ def _meander_nodes(plume, theta: np.ndarray, positions: np.ndarray, truth, i_z: 
             c[:, k] = plume.concentration(th, positions[k : k + 1])[:, 0]
         out.append((wj, c))
     return out
+
+
+GAMMA_NODES = 48
+"""Equal-probability nodes of the unit-mean gamma distribution in :func:`gamma_multipliers`."""
+
+
+def gamma_multipliers(intensity: float) -> tuple[np.ndarray, np.ndarray]:
+    """(weights, multipliers) of a fluctuating concentration: the instantaneous (held-averaged)
+    value is the time mean times a gamma variate of mean 1 and standard deviation
+    ``intensity`` (the fluctuation intensity σ_c / C̄; Hanna 1984's exponential at 1, the
+    clipped-gamma family of Yee & Chan 1997 without its clipping), discretised at
+    :data:`GAMMA_NODES` mid-quantiles (equal weights)."""
+    from scipy.stats import gamma
+
+    shape = 1.0 / (intensity * intensity)
+    q = (np.arange(GAMMA_NODES) + 0.5) / GAMMA_NODES
+    return np.full(GAMMA_NODES, 1.0 / GAMMA_NODES), gamma.ppf(q, shape, scale=1.0 / shape)
 
 
 def grid_summary(w: np.ndarray, da: np.ndarray, dc: np.ndarray) -> dict[str, float]:

@@ -52,7 +52,12 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:  # run as a script: the studies package sits beside it
     sys.path.insert(0, str(ROOT))
 
-from studies.slice_models import candidate_grid, grid_summary, model_posterior  # noqa: E402
+from studies.slice_models import (  # noqa: E402
+    candidate_grid,
+    gamma_multipliers,
+    grid_summary,
+    model_posterior,
+)
 
 
 def _inner(truth):  # type: ignore[no-untyped-def]
@@ -95,13 +100,16 @@ def oracle_posterior(
     reach: tuple[float, float, float],
     phases: int,
     scales: tuple[float, ...] = (1.0,),
+    gamma_intensity: float = 0.0,
 ) -> dict[str, float]:
     """The oracle's posterior over the release's horizontal offset δ (along, across the wind)
     given readings (K,) at positions (K, 3); summaries in m. With several ``scales`` (factors
     on the release rate, equally likely) the rate is unknown to it and marginalised."""
     rec = truth.recording
     da, dc, _ = candidate_grid(truth, low, high, step, reach)
-    if phases == 0:  # the time mean alone (the reading model's view: its own fluctuations)
+    if gamma_intensity > 0.0:  # the time mean times gamma fluctuations (gamma_multipliers)
+        sub = fields.mean(axis=0)[None] * gamma_multipliers(gamma_intensity)[1][:, None, None]
+    elif phases == 0:  # the time mean alone (the reading model's view: its own fluctuations)
         sub = fields.mean(axis=0, keepdims=True)
     else:
         sub = fields[np.linspace(0, len(fields) - 1, min(phases, len(fields))).round().astype(int)]
@@ -159,6 +167,43 @@ def zero_shares(scenario, fields: np.ndarray) -> list[dict[str, float]]:  # type
             }
         )
     return out
+
+
+PROFILE_DISTANCES = (2.0, 5.0, 10.0, 20.0)
+"""m downwind of the release at which :func:`vertical_tails` compares the profiles."""
+
+
+def vertical_tails(truth) -> dict:  # type: ignore[no-untyped-def]
+    """How much gas the plane holds above the release against a Gaussian profile of the same
+    spread: at each of :data:`PROFILE_DISTANCES` on the time mean's centreline (y = 0), the
+    ratio of the plane's concentration to the release height's, the section's centroid z̄ and
+    spread σ_z about it (m), and the ratio a Gaussian profile of that centroid and spread gives,
+    exp(−(z_p − z̄)² / 2σ_z²) / exp(−(h − z̄)² / 2σ_z²). A plume whose tail above it is heavier
+    than a Gaussian's sends gas to the plane near the release, where a Gaussian reading model
+    sends none and explains it by a release further upwind."""
+    rec = truth.recording
+    mean = rec.values.mean(axis=0)  # (ny, nx, nz)
+    iy = int(np.argmin(np.abs(rec.y)))
+    release = truth.source[2] - truth.ground + truth.lift  # canonical m (the cell's centre)
+    plane = truth.plane - truth.ground + truth.lift
+    rows = []
+    for d in PROFILE_DISTANCES:
+        ix = int(np.argmin(np.abs(rec.x - d)))
+        column = mean[iy, ix, :]
+        zbar = float(column @ rec.z / column.sum())
+        sz = float(math.sqrt(column @ (rec.z - zbar) ** 2 / column.sum()))
+        at_plane, at_release = np.interp([plane, release], rec.z, column)
+        gauss = math.exp(-0.5 * ((plane - zbar) / sz) ** 2 + 0.5 * ((release - zbar) / sz) ** 2)
+        rows.append(
+            {
+                "distance": d,
+                "centroid": zbar,
+                "sigma_z": sz,
+                "plane_over_release": float(at_plane / at_release),
+                "gaussian_plane_over_release": gauss,
+            }
+        )
+    return {"release": float(release), "plane": float(plane), "sections": rows}
 
 
 REACH = (30.0, 15.0, 10.0)
@@ -221,6 +266,20 @@ def main() -> None:
         "of today's plume (gaussian_plume)",
     )
     ap.add_argument(
+        "--gamma",
+        type=float,
+        default=0.0,
+        help="a probe of the fluctuation model: the time mean (the exact one, or with "
+        "--reading-model the model's) times gamma fluctuations of this intensity σ_c / C̄, read "
+        "through the instrument's model (gamma_multipliers)",
+    )
+    ap.add_argument(
+        "--tails",
+        action="store_true",
+        help="instead of posteriors: the plane's gas against a Gaussian profile's, once per "
+        "recording (vertical_tails)",
+    )
+    ap.add_argument(
         "--zeros",
         action="store_true",
         help="instead of posteriors: the share of zero readings by time-mean class, the truth's "
@@ -240,6 +299,11 @@ def main() -> None:
         truth = _inner(make_truth(scenario, int(run["seed"])))
         if getattr(truth, "plane", None) is None:
             raise SystemExit(f"{run['run_dir']}: not a planar lbm3d slice")
+        if args.tails:
+            tails = vertical_tails(truth)
+            if all(tails["release"] != r["release"] for r in rows):
+                rows.append(tails)
+            continue
         result = EpisodeResult.load(run["run_dir"])
         rec = result.records
         positions = np.array([[r["x"], r["y"], r["z"]] for r in rec])
@@ -255,6 +319,7 @@ def main() -> None:
                 scales,
                 args.meander_mixture,
                 args.gaussian,
+                args.gamma,
             )
             rows.append(_row(run, result, post))
             continue
@@ -264,7 +329,9 @@ def main() -> None:
             continue
         post = oracle_posterior(
             truth,
-            scenario.make_sensor() if args.phases > 0 else scenario.make_estimator_sensor(),
+            scenario.make_sensor()
+            if args.phases > 0 or args.gamma > 0
+            else scenario.make_estimator_sensor(),
             fields,
             positions,
             readings,
@@ -274,11 +341,14 @@ def main() -> None:
             REACH,
             args.phases,
             scales,
+            args.gamma,
         )
         rows.append(_row(run, result, post))
-    if args.zeros:
+    if args.zeros or args.tails:
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        doc = {"what": zero_shares.__doc__, "code": code_version(), "searches": rows}
+        what = (zero_shares if args.zeros else vertical_tails).__doc__
+        key = "searches" if args.zeros else "recordings"
+        doc = {"what": what, "code": code_version(), key: rows}
         Path(args.json).write_text(json.dumps(doc, indent=1))
         return
     oracle = np.array([r["oracle"]["rmse"] for r in rows])
@@ -291,6 +361,7 @@ def main() -> None:
         "reading_model": bool(args.reading_model),
         "meander_mixture": args.meander_mixture,
         "gaussian": bool(args.gaussian),
+        "gamma": args.gamma,
         "code": code_version(),
         "median_oracle_rmse": float(np.median(oracle)),
         "oracle_within_1m": int((oracle <= 1.0).sum()),

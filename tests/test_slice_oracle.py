@@ -144,3 +144,57 @@ def test_the_gaussian_plume_probe_carries_the_release_rate_and_is_zero_upwind():
     expected = 2.0 / (2 * math.pi * 4.0 * sy * sz) * (1.0 + math.exp(-2.0 / sz**2))
     assert math.isclose(axis, expected, rel_tol=1e-12)
     assert gaussian_plume(theta, np.array([[-3.0, 0.0, 1.0]]), downwind, 0.2, 0.1)[0, 0] == 0.0
+
+
+def test_the_gamma_fluctuations_have_unit_mean_and_the_asked_intensity():
+    """Equal-probability nodes of the unit-mean gamma: at intensity 1 the exponential's
+    quantiles −ln(1 − q) exactly; mean 1 and standard deviation the intensity within what 48
+    nodes hold of the tail (1.5 % and 7 %)."""
+    import sys
+
+    sys.path.insert(0, str(ROOT))
+    from studies.slice_models import GAMMA_NODES, gamma_multipliers
+
+    w, m = gamma_multipliers(1.0)
+    q = (np.arange(GAMMA_NODES) + 0.5) / GAMMA_NODES
+    np.testing.assert_allclose(m, -np.log1p(-q), rtol=1e-10)
+    for intensity in (0.7, 1.0, 1.5):
+        w, m = gamma_multipliers(intensity)
+        assert math.isclose(w.sum(), 1.0) and np.all(np.diff(m) > 0)
+        assert abs(w @ m - 1.0) < 0.015, intensity
+        assert abs(math.sqrt(w @ (m - 1.0) ** 2) / intensity - 1.0) < 0.07, intensity
+
+
+def _profile_truth(profile) -> SolverPlume3dTruth:  # type: ignore[no-untyped-def]
+    """A stationary recording on a 0.1 m vertical grid whose column at every x > 0 is
+    ``profile(z, x)`` (uniform across the wind), the source at z = 1 m, the plane at 3 m."""
+    t = np.arange(2, dtype=float)
+    x = np.linspace(-10.0, 30.0, 81)
+    y = np.linspace(-10.0, 10.0, 5)
+    z = np.arange(0.0, 12.0, 0.1)
+    column = np.where(x[None, :, None] > 0, profile(z[None, None, :], x[None, :, None]), 0.0)
+    values = np.broadcast_to(column, (2, len(y), len(x), len(z))).copy()
+    rec = PlaybackTruth(values, t, x, y, z, "linear", loop=True)
+    source = np.array([20.0, 25.0, 1.0])
+    return SolverPlume3dTruth(rec, source, 1.0, 1.0, 1.0, math.pi, 0.0, 0.0, 3.0)
+
+
+def test_the_tails_of_a_gaussian_profile_are_a_gaussians_and_a_heavier_tail_holds_more():
+    """On a column that is a Gaussian about z̄ = 1.5 m, the plane's ratio to the release height
+    is the Gaussian's (up to the 0.1 m grid's share of the spread); on one with an exponential
+    tail above the centroid it is far larger than the Gaussian of the same z̄ and σ_z gives."""
+    oracle = _oracle()
+
+    def gaussian(z, x):  # type: ignore[no-untyped-def]
+        s = 0.3 + 0.01 * x  # narrow enough that the ground cuts off none of it
+        return np.exp(-0.5 * ((z - 1.5) / s) ** 2)
+
+    for section in oracle.vertical_tails(_profile_truth(gaussian))["sections"]:
+        plume, model = section["plane_over_release"], section["gaussian_plane_over_release"]
+        assert abs(math.log(plume / model)) < 0.1, section  # ratios of e^-11 to e^-7
+
+    def exponential(z, x):  # type: ignore[no-untyped-def]
+        return np.exp(-np.abs(z - 1.5) / (0.2 + 0.05 * x))
+
+    near = oracle.vertical_tails(_profile_truth(exponential))["sections"][0]
+    assert near["plane_over_release"] > 5 * near["gaussian_plane_over_release"], near

@@ -314,11 +314,23 @@ SLICE_ORACLES = (
     ),
     ("reading-model-meander-0.2", "the same, i_z = 0.2 (a probe)"),
     (
+        "reading-model-gamma-1",
+        "today's plume, rate known, its fluctuations gamma of intensity 1 (the exponential; a "
+        "probe)",
+    ),
+    (
         "gaussian-rate-unknown",
         "a textbook Gaussian plume instead (Taylor's growth, σ = √(0.3² + (i d)²), the ground "
         "reflecting; i_y, i_z and the rate weighed; a probe)",
     ),
     ("mean", "the plume's exact time mean, read through the estimator's log-normal fluctuations"),
+    (
+        "mean-gamma-0.7",
+        "the plume's exact time mean, its fluctuations gamma of intensity 0.7 (a probe)",
+    ),
+    ("mean-gamma-1", "the same, intensity 1 (the exponential of Hanna 1984; a probe)"),
+    ("mean-gamma-1.5", "the same, intensity 1.5 (a probe)"),
+    ("mean-gamma-1-rate-unknown", "intensity 1, the release rate unknown (1/4 to 4 times)"),
     ("mixture", "the plume's own fluctuation statistics (its every frame, held-averaged)"),
     ("mixture-rate-unknown", "the same, the release rate unknown (1/4 to 4 times)"),
 )
@@ -395,5 +407,33 @@ def lbm3d_slice_zeros_table() -> str:
         "cells (20 planes)",
         "readings below the threshold: the plume",
         "the reading model's P(non-detection)",
+    ]
+    return table(header, rows)
+
+
+def lbm3d_slice_tails_table() -> str:
+    """The plane's gas against a Gaussian profile's, per recording of the slice's tuning range
+    (recipe lbm3d-slice-oracle; studies/slice_oracle.py --tails)."""
+    doc = json.loads((RESULTS / "lbm3d-slice-oracle" / "tails.json").read_text())
+    rows = []
+    for rec in sorted(doc["recordings"], key=lambda r: r["release"]):
+        for s in rec["sections"]:
+            rows.append(
+                [
+                    f"{rec['release']:.2f}",
+                    f"{rec['plane'] - rec['release']:.2f}",
+                    f"{s['distance']:g}",
+                    f"{s['centroid']:.2f} / {s['sigma_z']:.2f}",
+                    f"{s['plane_over_release']:.2g}",
+                    f"{s['gaussian_plane_over_release']:.2g}",
+                ]
+            )
+    header = [
+        "release cell (m)",
+        "plane above it (m)",
+        "downwind (m)",
+        "centroid z̄ / σ_z (m)",
+        "plane / release height: the plume",
+        "a Gaussian of that z̄ and σ_z",
     ]
     return table(header, rows)
