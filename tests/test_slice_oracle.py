@@ -186,7 +186,7 @@ def test_the_tails_of_a_gaussian_profile_are_a_gaussians_and_a_heavier_tail_hold
     oracle = _oracle()
 
     def gaussian(z, x):  # type: ignore[no-untyped-def]
-        s = 0.3 + 0.01 * x  # narrow enough that the ground cuts off none of it
+        s = 0.3 + 0.01 * np.maximum(x, 0.0)  # narrow enough that the ground cuts off none of it
         return np.exp(-0.5 * ((z - 1.5) / s) ** 2)
 
     for section in oracle.vertical_tails(_profile_truth(gaussian))["sections"]:
@@ -194,7 +194,7 @@ def test_the_tails_of_a_gaussian_profile_are_a_gaussians_and_a_heavier_tail_hold
         assert abs(math.log(plume / model)) < 0.1, section  # ratios of e^-11 to e^-7
 
     def exponential(z, x):  # type: ignore[no-untyped-def]
-        return np.exp(-np.abs(z - 1.5) / (0.2 + 0.05 * x))
+        return np.exp(-np.abs(z - 1.5) / (0.2 + 0.05 * np.maximum(x, 0.0)))
 
     near = oracle.vertical_tails(_profile_truth(exponential))["sections"][0]
     assert near["plane_over_release"] > 5 * near["gaussian_plane_over_release"], near
