@@ -49,6 +49,7 @@ def model_posterior(
     meander_mixture: float = 0.0,
     gaussian: bool = False,
     gamma_intensity: float = 0.0,
+    zetas: tuple[tuple[float, float], ...] | None = None,
 ) -> dict[str, float]:
     """The exact grid posterior of the estimator's own reading model (its plume and its
     fluctuation model, ``Scenario.make_plume`` and ``make_estimator_sensor``) over the release's
@@ -73,7 +74,10 @@ def model_posterior(
     instrument's model (``make_sensor``) given the held-averaged concentration, itself the
     model's time mean times a unit-mean gamma variate of standard deviation i
     (:func:`gamma_multipliers`), in place of the log-normal family with its fixed intermittency:
-    the share of zero readings then grows where the mean is weak."""
+    the share of zero readings then grows where the mean is weak.
+
+    ``zetas``: the (ζ1, ζ2) pairs weighed (None: :data:`ZETA1` × :data:`ZETA2`); one pair
+    declares them known."""
     da, dc, world = candidate_grid(truth, scenario.volume.low, scenario.volume.high, step, reach)
     plume, sensor, prior = (
         scenario.make_plume(),
@@ -90,8 +94,10 @@ def model_posterior(
     theta[:, :2] = world
     distance = np.linalg.norm(positions[None, :, :] - theta[:, None, :3], axis=2)
     log_post = []
+    if zetas is None:
+        zetas = tuple((z1, z2) for z1 in ZETA1 for z2 in ZETA2)
     for log_weight, per_node in _shapes(
-        plume, prior, theta, positions, truth, meander_mixture, gaussian
+        plume, prior, theta, positions, truth, meander_mixture, gaussian, zetas
     ):
         for scale in scales:  # the rate's factors, equally likely
             ll = logsumexp(
@@ -137,7 +143,7 @@ def gaussian_plume(
     return np.where(d > 0, c * np.exp(-0.5 * (y / sy) ** 2) * vertical, 0.0)
 
 
-def _shapes(plume, prior, theta, positions, truth, meander_mixture: float, gaussian: bool):  # type: ignore[no-untyped-def]
+def _shapes(plume, prior, theta, positions, truth, meander_mixture: float, gaussian: bool, zetas):  # type: ignore[no-untyped-def]
     """Yield (log prior weight, [(node weight, (N, K) concentrations)]) for each shape setting
     the model posterior weighs (see :func:`model_posterior`)."""
     if gaussian:
@@ -145,15 +151,15 @@ def _shapes(plume, prior, theta, positions, truth, meander_mixture: float, gauss
             for i_z in GAUSSIAN_IZ:
                 yield 0.0, [(1.0, gaussian_plume(theta, positions, truth.downwind, i_y, i_z))]
         return
-    for z1 in ZETA1:
-        for z2 in ZETA2:
-            th = theta.copy()
-            th[:, 6], th[:, 7] = z1, z2
-            if meander_mixture > 0.0:
-                per_node = _meander_nodes(plume, th, positions, truth, meander_mixture)
-            else:
-                per_node = [(1.0, plume.concentration(th, positions))]  # (N, K)
-            yield float(prior.log_density(th[:1])[0]), per_node
+    for z1, z2 in zetas:
+        th = theta.copy()
+        th[:, 6], th[:, 7] = z1, z2
+        if meander_mixture > 0.0:
+            per_node = _meander_nodes(plume, th, positions, truth, meander_mixture)
+        else:
+            per_node = [(1.0, plume.concentration(th, positions))]  # (N, K)
+        weight = float(prior.log_density(th[:1])[0]) if len(zetas) > 1 else 0.0
+        yield weight, per_node
 
 
 HERMITE_NODES = (0.0, -1.355626179974266, 1.355626179974266, -2.856970013872806, 2.856970013872806)
@@ -209,4 +215,34 @@ def grid_summary(w: np.ndarray, da: np.ndarray, dc: np.ndarray) -> dict[str, flo
         "sd_along": float(math.sqrt(max(w @ (da - mean_a) ** 2, 0.0))),
         "sd_across": float(math.sqrt(max(w @ (dc - mean_c) ** 2, 0.0))),
         "candidates": len(da),
+    }
+
+
+def filter_replay(scenario, truth, records: list[dict], particles: int, seed: int) -> dict:  # type: ignore[no-untyped-def]
+    """The scenario's own filter (:func:`dcee.runs.make_searcher`, no planner) told a search's
+    readings (``records``: x, y, z, reading, time) in order with ``particles`` particles;
+    its final posterior over the release's horizontal offset summarised as
+    :func:`grid_summary`'s (the 95 % region the Gaussian ellipse of its covariance)."""
+    from dcee.runs import make_searcher, streams
+
+    scenario = scenario.with_overrides(**{"search.particles": particles})
+    _, filter_rng, planner_rng, _ = streams(seed)
+    searcher = make_searcher(scenario, None, filter_rng, planner_rng, on_robot=False)
+    for r in records:
+        searcher.tell(np.array([r["x"], r["y"], r["z"]]), float(r["reading"]), float(r["time"]))
+    theta, w = searcher.filter.theta, searcher.filter.weights
+    rel = theta[:, :2] - truth.source[:2]
+    da, dc = rel @ truth.downwind, rel @ truth.left
+    mean = np.array([w @ da, w @ dc])
+    dev = np.stack([da - mean[0], dc - mean[1]])
+    cov = (dev * w) @ dev.T
+    inside = float(mean @ np.linalg.solve(cov, mean)) <= 5.991  # χ²(2) at 95 %
+    return {
+        "truth_in_95": bool(inside),
+        "rmse": float(math.sqrt(w @ (da * da + dc * dc))),
+        "error_along": float(mean[0]),
+        "error_across": float(mean[1]),
+        "sd_along": float(math.sqrt(cov[0, 0])),
+        "sd_across": float(math.sqrt(cov[1, 1])),
+        "candidates": len(w),
     }

@@ -54,6 +54,7 @@ if str(ROOT) not in sys.path:  # run as a script: the studies package sits besid
 
 from studies.slice_models import (  # noqa: E402
     candidate_grid,
+    filter_replay,
     gamma_multipliers,
     grid_summary,
     model_posterior,
@@ -274,6 +275,27 @@ def main() -> None:
         "through the instrument's model (gamma_multipliers)",
     )
     ap.add_argument(
+        "--known-environment",
+        action="store_true",
+        help="the source height, the wind and ζ1, ζ2 declared known (the scenario's values: "
+        "unknown = source, dimensions = 2); with --reading-model its ζ grid is the one pair",
+    )
+    ap.add_argument(
+        "--filter-replay",
+        type=int,
+        default=0,
+        help="instead of an oracle: the scenario's own filter with this many particles told "
+        "each search's readings (filter_replay); with --known-environment the filter's too",
+    )
+    ap.add_argument(
+        "--replay-set",
+        action="append",
+        default=[],
+        metavar="PATH=VALUE",
+        help="with --filter-replay: a scenario setting for the replayed filter (a number), e.g. "
+        "estimator.reading_weight=1; repeatable",
+    )
+    ap.add_argument(
         "--tails",
         action="store_true",
         help="instead of posteriors: the plane's gas against a Gaussian profile's, once per "
@@ -308,7 +330,16 @@ def main() -> None:
         rec = result.records
         positions = np.array([[r["x"], r["y"], r["z"]] for r in rec])
         readings = np.array([r["reading"] for r in rec])
+        if args.known_environment:
+            scenario = scenario.with_overrides(unknown="source", dimensions=2)
+        if args.filter_replay:
+            changes = {k: float(v) for k, v in (s.split("=", 1) for s in args.replay_set)}
+            replayed = scenario.with_overrides(**changes)
+            post = filter_replay(replayed, truth, rec, args.filter_replay, int(run["seed"]))
+            rows.append(_row(run, result, post))
+            continue
         if args.reading_model:
+            theta0 = scenario.truth_theta()
             post = model_posterior(
                 scenario,
                 truth,
@@ -320,6 +351,7 @@ def main() -> None:
                 args.meander_mixture,
                 args.gaussian,
                 args.gamma,
+                ((float(theta0[6]), float(theta0[7])),) if args.known_environment else None,
             )
             rows.append(_row(run, result, post))
             continue
@@ -362,6 +394,9 @@ def main() -> None:
         "meander_mixture": args.meander_mixture,
         "gaussian": bool(args.gaussian),
         "gamma": args.gamma,
+        "known_environment": bool(args.known_environment),
+        "filter_replay": args.filter_replay,
+        "replay_set": args.replay_set,
         "code": code_version(),
         "median_oracle_rmse": float(np.median(oracle)),
         "oracle_within_1m": int((oracle <= 1.0).sum()),

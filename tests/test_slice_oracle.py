@@ -198,3 +198,29 @@ def test_the_tails_of_a_gaussian_profile_are_a_gaussians_and_a_heavier_tail_hold
 
     near = oracle.vertical_tails(_profile_truth(exponential))["sections"][0]
     assert near["plane_over_release"] > 5 * near["gaussian_plane_over_release"], near
+
+
+def test_the_filter_replay_ends_where_the_search_it_replays_ended():
+    """Told a search's readings in order, with the search's particles and seed, the scenario's
+    filter (no planner) ends with the posterior the search ended with: the replay's RMSE about
+    the truth is the search's own final RMSE (the height declared known, so both are
+    horizontal)."""
+    import sys
+    from types import SimpleNamespace
+
+    sys.path.insert(0, str(ROOT))
+    from studies.slice_models import filter_replay
+
+    from dcee.runs import run_episode
+    from dcee.scenarios import load_scenario
+
+    scenario = load_scenario("paper:1").with_overrides(
+        **{"search.particles": 500, "search.hypotheses": 4, "search.budget": 60.0},
+        dimensions=2,
+    )
+    result = run_episode(scenario, "infotaxis", 3)
+    source = scenario.truth_theta()[:3]
+    truth = SimpleNamespace(source=source, downwind=np.array([1.0, 0.0]), left=np.array([0.0, 1.0]))
+    post = filter_replay(scenario, truth, result.records, 500, 3)
+    assert math.isclose(post["rmse"], result.summary["final_rmse"], rel_tol=1e-9)
+    assert post["candidates"] == 500

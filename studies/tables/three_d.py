@@ -258,6 +258,10 @@ SLICE_PROBES = (
     ("lbm3d-slice-tune-decay-surface", "that, with the ground and vertical ratio 0.66"),
     ("lbm3d-slice-tune-vmeander", "a vertical meander, i_z = 0.1"),
     ("lbm3d-slice-tune-anemometer", "a measured wind (the anemometer on)"),
+    (
+        "lbm3d-slice-tune-height-wind",
+        "the source height declared known and the wind measured (a diagnostic)",
+    ),
 )
 """The slice's tuning probes, one change of the reading model at a time (recipes
 lbm3d-store-tune and lbm3d-slice-probes)."""
@@ -304,35 +308,55 @@ def lbm3d_slice_probes_table() -> str:
 SLICE_ORACLES = (
     (
         "reading-model-rate-unknown",
-        "today's reading model, its exact posterior (height and wind known, ζ1, ζ2 and the rate "
-        "weighed)",
+        "oracle: today's reading model, its exact posterior (height and wind known, ζ1, ζ2 and "
+        "the rate weighed)",
     ),
-    ("reading-model", "the same, the release rate known too"),
+    ("reading-model", "oracle: the same, the release rate known too"),
     (
         "reading-model-meander-0.1",
-        "that, its likelihood a mixture over a meandering centre height, i_z = 0.1 (a probe)",
+        "oracle: that, its likelihood a mixture over a meandering centre height, i_z = 0.1 (a "
+        "probe)",
     ),
-    ("reading-model-meander-0.2", "the same, i_z = 0.2 (a probe)"),
+    ("reading-model-meander-0.2", "oracle: the same, i_z = 0.2 (a probe)"),
     (
         "reading-model-gamma-1",
-        "today's plume, rate known, its fluctuations gamma of intensity 1 (the exponential; a "
-        "probe)",
+        "oracle: today's plume, rate known, its fluctuations gamma of intensity 1 (the "
+        "exponential; a probe)",
     ),
     (
         "gaussian-rate-unknown",
-        "a textbook Gaussian plume instead (Taylor's growth, σ = √(0.3² + (i d)²), the ground "
-        "reflecting; i_y, i_z and the rate weighed; a probe)",
+        "oracle: a textbook Gaussian plume instead (Taylor's growth, σ = √(0.3² + (i d)²), the "
+        "ground reflecting; i_y, i_z and the rate weighed; a probe)",
     ),
-    ("mean", "the plume's exact time mean, read through the estimator's log-normal fluctuations"),
+    (
+        "mean",
+        "oracle: the plume's exact time mean, read through the estimator's log-normal fluctuations",
+    ),
     (
         "mean-gamma-0.7",
-        "the plume's exact time mean, its fluctuations gamma of intensity 0.7 (a probe)",
+        "oracle: the plume's exact time mean, its fluctuations gamma of intensity 0.7 (a probe)",
     ),
-    ("mean-gamma-1", "the same, intensity 1 (the exponential of Hanna 1984; a probe)"),
-    ("mean-gamma-1.5", "the same, intensity 1.5 (a probe)"),
-    ("mean-gamma-1-rate-unknown", "intensity 1, the release rate unknown (1/4 to 4 times)"),
-    ("mixture", "the plume's own fluctuation statistics (its every frame, held-averaged)"),
-    ("mixture-rate-unknown", "the same, the release rate unknown (1/4 to 4 times)"),
+    ("mean-gamma-1", "oracle: the same, intensity 1 (the exponential of Hanna 1984; a probe)"),
+    ("mean-gamma-1.5", "oracle: the same, intensity 1.5 (a probe)"),
+    ("mean-gamma-1-rate-unknown", "oracle: intensity 1, the release rate unknown (1/4 to 4 times)"),
+    ("mixture", "oracle: the plume's own fluctuation statistics (its every frame, held-averaged)"),
+    ("mixture-rate-unknown", "oracle: the same, the release rate unknown (1/4 to 4 times)"),
+    (
+        "known-environment-exact",
+        "oracle: today's reading model, its exact posterior, the height, wind and ζ declared "
+        "known (the scenario's ζ), the rate weighed (1/4 to 4 times)",
+    ),
+    (
+        "known-environment-filter-10000",
+        "not an oracle: `dcee-cl`'s own filter (10,000 particles, its own priors) told the same "
+        "readings, the height, wind and ζ declared known",
+    ),
+    ("known-environment-filter-40000", "the same, 40,000 particles"),
+    (
+        "known-environment-filter-10000-untempered",
+        "the same, 10,000 particles, each reading weighing 1 (`reading_weight` 1, "
+        "`repeat_radius` 0)",
+    ),
 )
 """The slice oracle's arms (recipe lbm3d-slice-oracle, studies/slice_oracle.py)."""
 
@@ -362,7 +386,7 @@ def lbm3d_slice_oracle_table() -> str:
         rmse = np.array([x["rmse"] for x in o])
         rows.append(
             [
-                f"oracle: {label}",
+                label,
                 f"{np.median(rmse):.2f}",
                 f"{int((rmse <= 1.0).sum())}/{n}",
                 f"{sum(x['truth_in_95'] for x in o)}/{n}",
