@@ -454,7 +454,7 @@ def lbm3d_slice_tails_table() -> str:
             )
     header = [
         "release cell (m)",
-        "plane above it (m)",
+        "plane above the release (m; the cell's first search)",
         "downwind (m)",
         "centroid z̄ / σ_z (m)",
         "plane / release height: the plume",
