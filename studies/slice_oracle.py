@@ -23,6 +23,13 @@ family with its fixed intermittency and spread: ``Scenario.make_estimator_sensor
 any reading model of today's form could do with the true shape; ``--rate-unknown`` does not
 know the release rate (nine factors from 1/4 to 4, equally likely, marginalised).
 
+Probes on the same readings: ``--reading-model`` (today's reading model's exact posterior, with
+``--meander-mixture``, ``--gaussian`` or ``--gamma`` changing its shape or fluctuations),
+``--gamma`` on the exact time mean (a published fluctuation family), ``--known-environment``
+(the height, wind and ζ declared known), ``--filter-replay N`` (not an oracle: ``dcee-cl``'s own
+filter told the readings, to compare with its model's exact posterior), and two summaries that
+are not posteriors, ``--zeros`` and ``--tails``. The recipe ``lbm3d-slice-oracle`` runs them all.
+
     .venv/bin/python studies/slice_oracle.py results/lbm3d-slice-tune-oracle \\
         --json docs/results/lbm3d-slice-oracle/oracle.json
 
