@@ -223,6 +223,7 @@ def filter_replay(scenario, truth, records: list[dict], particles: int, seed: in
     readings (``records``: x, y, z, reading, time) in order with ``particles`` particles;
     its final posterior over the release's horizontal offset summarised as
     :func:`grid_summary`'s (the 95 % region the Gaussian ellipse of its covariance)."""
+    from dcee.estimation.summaries import weighted_moments
     from dcee.runs import make_searcher, streams
 
     scenario = scenario.with_overrides(**{"search.particles": particles})
@@ -233,16 +234,6 @@ def filter_replay(scenario, truth, records: list[dict], particles: int, seed: in
     theta, w = searcher.filter.theta, searcher.filter.weights
     rel = theta[:, :2] - truth.source[:2]
     da, dc = rel @ truth.downwind, rel @ truth.left
-    mean = np.array([w @ da, w @ dc])
-    dev = np.stack([da - mean[0], dc - mean[1]])
-    cov = (dev * w) @ dev.T
+    mean, cov = weighted_moments(np.column_stack([da, dc]), w)
     inside = float(mean @ np.linalg.solve(cov, mean)) <= 5.991  # χ²(2) at 95 %
-    return {
-        "truth_in_95": bool(inside),
-        "rmse": float(math.sqrt(w @ (da * da + dc * dc))),
-        "error_along": float(mean[0]),
-        "error_across": float(mean[1]),
-        "sd_along": float(math.sqrt(cov[0, 0])),
-        "sd_across": float(math.sqrt(cov[1, 1])),
-        "candidates": len(w),
-    }
+    return grid_summary(w, da, dc) | {"truth_in_95": inside}

@@ -35,7 +35,8 @@ CLAIM = "lbm3d-held-out-100b"
 """The flight of issue 78's claim (the truth stored cell by cell, a range never flown before)."""
 
 
-def _load(name: str) -> dict:
+def load_result(name: str) -> dict:
+    """A stored JSON of docs/results/lbm3d (studies/lbm3d_table.py and the plume checks)."""
     return json.loads((FOLDER / name).read_text(encoding="utf-8"))
 
 
@@ -44,7 +45,7 @@ def lbm3d_plume_table() -> str:
     Dutton (``dcee plume --model lbm3d --json``)."""
     rows = []
     for h in HEIGHTS:
-        doc = _load(f"plume-{h}.json")
+        doc = load_result(f"plume-{h}.json")
         by_x = {round(s["x"]): s for s in doc["sections"]}
         cells = []
         for d in DISTANCES:
@@ -77,7 +78,7 @@ def lbm3d_search_table() -> str:
     """The held-out 3-D searches and the slice's (studies/lbm3d_table.py)."""
     rows = []
     for name, what, range_ in CAMPAIGNS:
-        for r in _load(f"{name}.json")["rows"]:
+        for r in load_result(f"{name}.json")["rows"]:
             n = r["searches"]
             lo, hi = r["median_final_rmse_ci95"]
             rows.append(
@@ -110,7 +111,7 @@ def lbm3d_search_table() -> str:
 def lbm3d_altitude_table() -> str:
     """The share of readings at each altitude (studies/lbm3d_table.py)."""
     name = CLAIM  # the claim's flight
-    rows_in = _load(f"{name}.json")["rows"]
+    rows_in = load_result(f"{name}.json")["rows"]
     levels = sorted({float(z) for r in rows_in for z in r["altitude_share"]})
     rows = [
         [
@@ -124,7 +125,7 @@ def lbm3d_altitude_table() -> str:
 
 def lbm3d_timing_table() -> str:
     """One decision with the altitude free and at a fixed altitude (studies/altitude_timing.py)."""
-    doc = _load("altitude-timing.json")
+    doc = load_result("altitude-timing.json")
     med = doc["median_ms"]
     load = doc["load"]
     rows = [

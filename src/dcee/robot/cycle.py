@@ -84,8 +84,8 @@ class CycleSettings:
             "budget": scenario.search.budget,
             "altitude": scenario.agent.start[2],
             "shortest_move": motion.shortest_move_time(scenario.agent.step),
+            "noise_floor": scenario.sensor.threshold,
         }
-        values["noise_floor"] = scenario.sensor.threshold
         values.update(changes)
         for name in (
             "hold",
@@ -198,9 +198,10 @@ class SearchCycle:
             return "reading not a number"
         if not math.isfinite(value):
             return "reading not finite"
-        if value * self.settings.calibration < -self.settings.noise_floor:
+        concentration = value * self.settings.calibration  # g/m³
+        if concentration < -self.settings.noise_floor:
             return "reading below the noise floor"
-        if value * self.settings.calibration > self.searcher.filter.sensor.max_reading:
+        if concentration > self.searcher.filter.sensor.max_reading:
             return "reading above max_reading"
         return None
 
