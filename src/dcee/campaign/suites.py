@@ -125,6 +125,16 @@ SUITES: dict[str, dict] = {
             "estimator.likelihood": "fluctuation",
         },
     },
+    # random sites never flown before 2026-12-05: the wander guard's release checked once
+    # (docs/results/wander-release); a tuning range for anything changed after that look
+    "sites-held-out-20": {
+        "configs": [f"random-site:{k}" for k in range(101, 121)],
+        "overrides": {
+            "truth.model": "lbm",
+            "truth.z": 4.0,
+            "estimator.likelihood": "fluctuation",
+        },
+    },
     "random-tune": {"configs": [f"random:{k}" for k in range(1, 41)], "overrides": {}},
     "held-out": {
         "configs": [
