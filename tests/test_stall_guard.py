@@ -162,6 +162,17 @@ def test_the_wander_guard_sends_a_robot_out_of_a_region_it_keeps_to():
     assert np.array_equal(s.wander_goal(), goal)  # held
     s.tell(goal + np.array([1.0, 0.0, 0.0]), 0.0, 200.0)
     assert s.wander_goal() is None or not np.array_equal(s.wander_goal(), goal)
+    # held only while the belief is wider than the region: once readings on the way narrow it
+    # to the region's radius, the reason to leave is gone and the goal is dropped (before, it
+    # was held until the stop rule's spread: area:fontvieille seed 1 went on 80 m out)
+    s.tell(centre, 0.0, 205.0)  # on the way back, far from the goal
+    s.wander_target = goal.copy()
+    assert s.estimate().spread > WANDER_RADIUS and np.array_equal(s.wander_goal(), goal)
+    theta = pf.theta.copy()
+    theta[:, :2] = np.array([30.0, 30.0]) + np.random.default_rng(1).normal(0, 1.0, (len(theta), 2))
+    pf.theta[:] = theta
+    assert 0.45 < s.estimate().spread <= WANDER_RADIUS  # narrower than the region, not located
+    assert s.wander_goal() is None and s.wander_target is None
     # a whole search: the homing planner paces round (10, 10) to the end without the guard
     # (the stall guard off), and leaves that region within the guard's time with it
     for guarded in (False, True):
