@@ -22,6 +22,10 @@ from dcee.analysis.results import find_runs
 from dcee.analysis.statistics import median_ci, wilson
 from dcee.runs.metrics import search_wander
 
+SAME_SEARCH = 1e-6
+"""m: paired final errors closer than this are the same search (code changed elsewhere between
+two campaigns moves a search's numbers by rounding, 1e-14 m)."""
+
 WANDER_LIMIT = 120.0
 """s: issue 44's bar for the longest wander of any search of the study."""
 
@@ -110,7 +114,9 @@ def paired(frame: pd.DataFrame, a: str, b: str) -> pd.DataFrame:
         only_a = int((m.acquired_a & ~m.acquired_b).sum())
         only_b = int((~m.acquired_a & m.acquired_b).sum())
         mcnemar = stats.binomtest(only_a, only_a + only_b).pvalue if only_a + only_b else 1.0
-        diff = m.final_rmse_a - m.final_rmse_b
+        diff = (m.final_rmse_a - m.final_rmse_b).to_numpy(copy=True)
+        # a search the change left as it was, flown on other code, may differ in its last bits
+        diff[np.abs(diff) < SAME_SEARCH] = 0.0
         wilcoxon = stats.wilcoxon(diff).pvalue if np.any(diff != 0) else 1.0
         out.append(
             {
@@ -119,10 +125,14 @@ def paired(frame: pd.DataFrame, a: str, b: str) -> pd.DataFrame:
                 "a": a,
                 "b": b,
                 "pairs": len(m),
+                "changed": int(np.sum(diff != 0)),
                 "acquired_a_only": only_a,
                 "acquired_b_only": only_b,
                 "mcnemar_p": float(mcnemar),
                 "median_rmse_difference": float(np.median(diff)),
+                "median_changed_difference": float(np.median(diff[diff != 0]))
+                if np.any(diff != 0)
+                else 0.0,
                 "wilcoxon_p": float(wilcoxon),
             }
         )

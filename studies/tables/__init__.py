@@ -46,6 +46,7 @@ from studies.tables.sites import (
     sites_table,
     sites_walls_table,
     sites_walls_timing_table,
+    wander_release_table,
 )
 from studies.tables.source_count import _source_count, source_count_timing_table
 from studies.tables.sparse import sparse_table
@@ -147,6 +148,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "sites-walls-lookahead": sites_walls_table("sites-walls-lookahead"),
     "sites-walls-passage": sites_walls_table("sites-walls-passage"),
     "sites-walls-timing": sites_walls_timing_table,
+    "wander-release": wander_release_table,
     "speed": speed_table,
     "stonesoup-runs": stonesoup_runs_table,
     "search-speed": search_speed_table,

@@ -5,8 +5,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+import numpy as np
 import pandas as pd
+from scipy import stats
 
+from studies.sites_walls_table import SAME_SEARCH
 from studies.tables.common import (
     RESULTS,
     acquired,
@@ -161,6 +164,57 @@ def sites_walls_timing_table() -> str:
             "mean update per reading (ms)",
             "× open terrain",
             "load before",
+        ],
+        rows,
+    )
+
+
+WANDER_RELEASE = {
+    "held-out": "`random-site:101-120` (flown once)",
+    "fontvieille": "`area:fontvieille` (where the fault was found)",
+}
+"""docs/results/wander-release's folders and the range each flew (recipe wander-release)."""
+
+
+def wander_release_table() -> str:
+    """The wander guard's release (recipe wander-release): per range and planner, the searches
+    the change altered, acquisition and median final error before and after, the median change
+    over the altered searches (an exact Wilcoxon test over them) and the decisions the wander guard
+    steered, from each folder's ``searches.csv`` and ``paired.csv``
+    (studies/sites_walls_table.py; ``a`` is the release at the region, ``b`` the code before)."""
+    rows = []
+    for folder, label in WANDER_RELEASE.items():
+        runs = pd.read_csv(RESULTS / "wander-release" / folder / "searches.csv")
+        pairs = pd.read_csv(RESULTS / "wander-release" / folder / "paired.csv")
+        for _, p in pairs[pairs["scenario"] == "all sites"].iterrows():
+            mine = runs[runs["strategy"] == p["strategy"]]
+            after, before = (mine[mine["estimator"] == p[k]] for k in ("a", "b"))
+            keys = ["scenario", "seed"]
+            both = after.merge(before, on=keys, suffixes=("_a", "_b"))
+            diff = (both.final_rmse_a - both.final_rmse_b).to_numpy()
+            diff = diff[np.abs(diff) >= SAME_SEARCH]
+            test = stats.wilcoxon(diff, method="exact").pvalue if len(diff) else 1.0
+            rows.append(
+                [
+                    label,
+                    f"`{p['strategy']}`",
+                    f"{int(p['changed'])} of {int(p['pairs'])}",
+                    f"{int(before.acquired.sum())} → {int(after.acquired.sum())}",
+                    f"{before.final_rmse.median():.2f} → {after.final_rmse.median():.2f}",
+                    f"{p['median_changed_difference']:+.2f} (p = {test:.2g})",
+                    f"{int(before.wander_guard_fired.sum())} → "
+                    f"{int(after.wander_guard_fired.sum())}",
+                ]
+            )
+    return table(
+        [
+            "range",
+            "planner",
+            "searches changed",
+            "acquired, before → after",
+            "median final RMSE (m), before → after",
+            "median change where changed (m; exact Wilcoxon over those)",
+            "decisions the wander guard steered",
         ],
         rows,
     )
