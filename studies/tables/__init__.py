@@ -43,6 +43,7 @@ from studies.tables.robustness import (
     soak_worst_table,
 )
 from studies.tables.sites import (
+    site_upwind_table,
     sites_table,
     sites_walls_table,
     sites_walls_timing_table,
@@ -149,6 +150,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "sites-walls-passage": sites_walls_table("sites-walls-passage"),
     "sites-walls-timing": sites_walls_timing_table,
     "wander-release": wander_release_table,
+    "site-upwind-gas": site_upwind_table,
     "speed": speed_table,
     "stonesoup-runs": stonesoup_runs_table,
     "search-speed": search_speed_table,

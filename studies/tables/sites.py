@@ -218,3 +218,49 @@ def wander_release_table() -> str:
         ],
         rows,
     )
+
+
+SITE_UPWIND = {
+    "tuning.csv": "`random-site:1-20` (tuning; three moves ahead, code 47b92ab)",
+    "held-out.csv": "`random-site:101-120` (flown once; code 338317f)",
+}
+"""docs/results/site-upwind-gas's tables and the range of each (recipe site-upwind-gas)."""
+
+
+def site_upwind_table() -> str:
+    """Per range, the acquired and the failed `dcee-cl` searches: how many, the share of the
+    lbm truth's time-mean gas upwind of the release (median and range), how far upwind it
+    reaches 1 % of the near-axis gas, and the share the wall-aware estimator's own model puts
+    upwind for the same release (studies/site_upwind_gas.py)."""
+    rows = []
+    for name, label in SITE_UPWIND.items():
+        path = RESULTS / "site-upwind-gas" / name
+        if not path.exists():
+            continue
+        frame = pd.read_csv(path)
+        for got, g in ((True, frame[frame.acquired]), (False, frame[~frame.acquired])):
+            share, reach = 100 * g.upwind_share, g.upwind_reach_m
+            model = 100 * g.model_upwind_share
+            rows.append(
+                [
+                    label,
+                    "acquired" if got else "not acquired",
+                    str(len(g)),
+                    f"{share.median():.1f} ({share.min():.1f}-{share.max():.1f})",
+                    f"{100 * g.upwind_5m_share.median():.1f}",
+                    f"{reach.median():.1f} ({reach.min():.1f}-{reach.max():.1f})",
+                    f"{model.median():.0f} ({model.min():.0f}-{model.max():.0f})",
+                ]
+            )
+    return table(
+        [
+            "sites",
+            "`dcee-cl`",
+            "searches",
+            "truth's time-mean gas upwind of the release, % (range)",
+            "more than 5 m upwind, % (median)",
+            "upwind reach of 1 % of the axis's gas, m (range)",
+            "the estimator's model, upwind, % (range)",
+        ],
+        rows,
+    )
