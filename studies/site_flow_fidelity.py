@@ -39,6 +39,25 @@ OVERRIDES = {
 }
 
 
+def model_field(
+    plume: SitePlume, theta: np.ndarray, faces: object, factor: float, points: np.ndarray
+) -> np.ndarray:
+    """(M,) g/m³: the wall-aware plume's time-mean field of the release ``theta`` (8,) at
+    ``points`` (M, 3) m, in the wind ``faces`` (:func:`site_wind`), its diffusivity ``factor``
+    × ζ1 and no decay (the bank's members)."""
+    model = SitePlume(
+        plume.fluid,
+        plume.origin,
+        plume.resolution,
+        theta[4],
+        theta[5],
+        factor * theta[6],
+        math.inf,
+        wind=faces,
+    )
+    return model.concentration(theta[None], points)[0]
+
+
 def site_rows(k: int, viscosities: tuple[float, ...] = (WAKE_VISCOSITY,)) -> list[dict]:
     sc = load_scenario(f"random-site:{k}").with_overrides(**OVERRIDES)
     truth = make_truth(sc, 0)
@@ -55,17 +74,7 @@ def site_rows(k: int, viscosities: tuple[float, ...] = (WAKE_VISCOSITY,)) -> lis
     for wind, nu in winds:
         faces = site_wind(plume.fluid, plume.resolution, theta[4], theta[5], wind, nu)
         for factor in (1.0, 3.0, 10.0):
-            model = SitePlume(
-                plume.fluid,
-                plume.origin,
-                plume.resolution,
-                theta[4],
-                theta[5],
-                factor * theta[6],
-                math.inf,
-                wind=faces,
-            )
-            c = model.concentration(theta[None], pos)[0]
+            c = model_field(plume, theta, faces, factor, pos)
             keep = air & ((mean > threshold) | (c > threshold))
             a = np.log10(np.maximum(mean[keep], threshold / 10))
             b = np.log10(np.maximum(c[keep], threshold / 10))

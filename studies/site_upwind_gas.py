@@ -18,7 +18,6 @@ plumes (each site's is computed once, about a minute, where it is not cached).
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 
@@ -27,9 +26,14 @@ import pandas as pd
 from scipy import stats
 
 from dcee.models.site_flow import WAKE_VISCOSITY, site_wind
-from dcee.models.site_plume import SitePlume
 from dcee.scenarios import load_scenario
 from dcee.simulation.lbm import lbm_truth
+
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT) not in sys.path:  # run as a script: the studies package sits beside it
+    sys.path.insert(0, str(ROOT))
+
+from studies.site_flow_fidelity import model_field  # noqa: E402
 
 FLIGHT_HEIGHT = 4.0
 """m: the sites' studies fly the lbm truth at this height (suites sites-tune, sites-held-out-20)."""
@@ -62,17 +66,7 @@ def upwind_gas(name: str, cells: int = 101, frames: int = 61, span: float = 300.
     faces = site_wind(plume.fluid, plume.resolution, theta[4], theta[5], "wake", WAKE_VISCOSITY)
     model_share = 0.0
     for factor in (1.0, 3.0, 10.0):
-        model = SitePlume(
-            plume.fluid,
-            plume.origin,
-            plume.resolution,
-            theta[4],
-            theta[5],
-            factor * theta[6],
-            math.inf,
-            wind=faces,
-        )
-        c = model.concentration(theta[None], points)[0]
+        c = model_field(plume, theta, faces, factor, points)
         c[sc.in_obstacle(points[:, :2], no_go=False)] = 0.0
         model_share = max(model_share, float(c[along[:, 0] < 0].sum() / c.sum()))
     return {

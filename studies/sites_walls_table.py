@@ -133,6 +133,9 @@ def paired(frame: pd.DataFrame, a: str, b: str) -> pd.DataFrame:
                 "median_changed_difference": float(np.median(diff[diff != 0]))
                 if np.any(diff != 0)
                 else 0.0,
+                "changed_wilcoxon_p": float(stats.wilcoxon(diff[diff != 0], method="exact").pvalue)
+                if np.any(diff != 0)
+                else 1.0,
                 "wilcoxon_p": float(wilcoxon),
             }
         )
