@@ -3,14 +3,16 @@ costs at most 3× one on open terrain"), in one run on one pinned core.
 
 For each site with walls (``site:wall``, ``site:passage``, ``site:canyon``) the same search
 (``dcee-cl``, seed 0, 10,000 particles, 900 s, the lbm truth at the flight height, the
-fluctuation likelihood, as the ``sites-walls`` suite) three ways: in open terrain (the site's
+fluctuation likelihood, as the ``sites-walls`` suite) four ways: in open terrain (the site's
 source, wind and start with ``world.obstacles = []``: no walls, no guard), on the site with the
-wall-blind estimator, and with the wall-aware one (``estimator.plume = "walls"``). Each in its own
+wall-blind estimator, with the wall-aware one (``estimator.plume = "walls"``), and with the
+wall-aware one as it was before its wake's eddy viscosity was learned (one wake, three
+members). Each in its own
 process pinned to core 0 with one thread (``taskset -c 0``, NUMBA/OMP/OPENBLAS threads 1), the
 kernels compiled by a first warm-up search; the truths' plumes must be cached (run the suite
 first). Run it with nothing else on the machine; the load is recorded beside the times.
 
-All three ways look the same number of moves ahead (``--lookahead``, default the wall-aware
+All four ways look the same number of moves ahead (``--lookahead``, default the wall-aware
 estimator's unset default at a site, :data:`dcee.scenarios.SITE_LOOKAHEAD`): unset, open terrain
 would look :data:`~dcee.scenarios.AUTO_LOOKAHEAD` moves ahead and the wall-blind estimator one,
 and the ratio would compare planners, not terrain.
@@ -37,6 +39,15 @@ WAYS = {
     "open terrain": ["--set", "world.obstacles=[]"],
     "site, wall-blind": [],
     "site, wall-aware": ["--set", 'estimator.plume="walls"'],
+    # the wall-aware estimator before the wake's eddy viscosity was learned (2026-12-06): one
+    # wake, the diffusivity alone weighed (three fluctuation members for six; ζ1 = 1 at every
+    # site here)
+    "site, wall-aware, one wake": [
+        "--set",
+        'estimator.plume="walls"',
+        "--set",
+        "estimator.learn={wall_diffusivity=[1.0,3.0,10.0]}",
+    ],
 }
 
 
@@ -55,7 +66,7 @@ def main(argv: list[str] | None = None) -> int:
         type=int,
         choices=(1, 2, 3),
         default=SITE_LOOKAHEAD,
-        help="moves dcee-cl looks ahead, all three ways (default: SITE_LOOKAHEAD)",
+        help="moves dcee-cl looks ahead, all four ways (default: SITE_LOOKAHEAD)",
     )
     args = ap.parse_args(argv)
     try:

@@ -24,6 +24,31 @@ def _wall_site() -> np.ndarray:
     return fluid
 
 
+@pytest.fixture
+def stand_in_wake(monkeypatch):
+    """The wake solver replaced by a recording stand-in (the mass-consistent wind), so a
+    scenario's wind costs nothing; the list of (viscosity, faces) it was asked for. The site
+    caches are emptied before and after: no stand-in wind outlives the test."""
+    from dcee.models import site_flow
+    from dcee.models.site_flow import WAKE_VISCOSITY
+    from dcee.scenarios import builders
+
+    solved = []
+
+    def recording_wake_wind(fluid, h, free, viscosity=WAKE_VISCOSITY, **_):
+        faces = site_flow.mass_consistent_wind(fluid, h, free)
+        solved.append((viscosity, faces))
+        return faces
+
+    caches = (builders._site_wind, builders._wall_plume)
+    for cache in caches:
+        cache.cache_clear()
+    monkeypatch.setattr(site_flow, "wake_wind", recording_wake_wind)
+    yield solved
+    for cache in caches:
+        cache.cache_clear()
+
+
 def _divergence(fu: np.ndarray, fv: np.ndarray) -> np.ndarray:
     return fu[:, 1:] - fu[:, :-1] + fv[1:, :] - fv[:-1, :]
 
@@ -103,23 +128,15 @@ def test_a_lower_eddy_viscosity_gives_a_longer_wake() -> None:
     assert 0.0 < viscous < 0.6 * lower
 
 
-def test_the_scenarios_eddy_viscosity_reaches_the_wake_wind(monkeypatch) -> None:
+def test_the_scenarios_eddy_viscosity_reaches_the_wake_wind(stand_in_wake) -> None:
     """The scenario's ``estimator.wall_viscosity`` (unset: WAKE_VISCOSITY) is the viscosity
     the site plume's wind is solved with, and the plume's faces are that solve's. The solver is
-    replaced by a recording stand-in (the solves themselves are tested above), so each
-    scenario's wind costs nothing here."""
+    replaced by a recording stand-in (the solves themselves are tested above)."""
     from dcee.models import site_flow
     from dcee.models.site_flow import WAKE_VISCOSITY
     from dcee.scenarios import load_scenario
 
-    solved = []
-
-    def recording_wake_wind(fluid, h, free, viscosity=WAKE_VISCOSITY, **_):
-        faces = site_flow.mass_consistent_wind(fluid, h, free)
-        solved.append((viscosity, faces))
-        return faces
-
-    monkeypatch.setattr(site_flow, "wake_wind", recording_wake_wind)
+    solved = stand_in_wake
     sc = load_scenario("site:wall").with_overrides(**{"estimator.plume": "walls"})
     assert sc.wall_viscosity == WAKE_VISCOSITY  # unset: the default
     default = sc.make_plume()
@@ -137,3 +154,32 @@ def _free(plume: SitePlume) -> np.ndarray:
     """(2,) m/s: the free wind of a site plume (it blows towards −(cos φ, sin φ))."""
     u, phi = plume.wind
     return -u * np.array([math.cos(phi), math.sin(phi)])
+
+
+def test_a_learned_eddy_viscosity_gives_each_member_its_own_wake(stand_in_wake) -> None:
+    """``estimator.learn.wall_viscosity``: each member of the bank is solved in the wake wind
+    of its own ν_t (one solve per ν_t, shared by the members that differ only in K), the
+    preferred member in the fixed one's."""
+    from dcee.scenarios import load_scenario
+
+    solved = stand_in_wake
+    sc = load_scenario("site:wall").with_overrides(
+        **{
+            "estimator.plume": "walls",
+            "estimator.likelihood": "fluctuation",
+            "estimator.wall_viscosity": 0.7,
+            "estimator.learn": {"wall_diffusivity": [1.0, 3.0], "wall_viscosity": [0.7, 0.15]},
+        }
+    )
+    assert sc.reading_models[:4] == (
+        "fluctuation",
+        "fluctuation[wall_diffusivity=1,wall_viscosity=0.15]",
+        "fluctuation[wall_diffusivity=3,wall_viscosity=0.7]",
+        "fluctuation[wall_diffusivity=3,wall_viscosity=0.15]",
+    )
+    plumes = [sc.make_plume(m) for m in sc.reading_models[:4]]
+    assert sorted({v for v, _ in solved}) == [0.15, 0.7] and len(solved) == 2
+    by_nu = {v: faces for v, faces in solved}
+    assert [p.zeta1 for p in plumes] == [1.0, 1.0, 3.0, 3.0]
+    for plume, nu in zip(plumes, (0.7, 0.15, 0.7, 0.15), strict=True):
+        assert plume.face_u is by_nu[nu][0]

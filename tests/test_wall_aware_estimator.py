@@ -109,6 +109,21 @@ def test_exploration_information_of_a_plume_by_its_own_method_is_the_compiled_on
             "wall_viscosity",
         ),
         (
+            {
+                "estimator.likelihood": "fluctuation",
+                "estimator.wall_wind": "potential",
+                "estimator.learn": {"wall_viscosity": [1.0, 0.2]},
+            },
+            "wall_viscosity: is the wake wind's",
+        ),
+        (
+            {
+                "estimator.likelihood": "fluctuation",
+                "estimator.learn": {"wall_viscosity": [0.5, 0.2]},
+            },
+            "must include the fixed value 1",
+        ),
+        (
             {"estimator.likelihood": "fluctuation", "estimator.learn": {"decay": [1.0, 0.5]}},
             "shape the open plume",
         ),
@@ -127,18 +142,30 @@ def test_the_fluctuation_likelihood_learns_no_open_plume_shape_round_walls() -> 
     sc = load_scenario("site:wall").with_overrides(
         **{"estimator.plume": "walls", "estimator.likelihood": "fluctuation"}
     )
-    # the diffusivity weighed at 1, 3 and 10 times ζ1 (no backflow or disc member), and the calm
-    # member with the first; no decay (a conserved gas)
+    # the diffusivity weighed at 1, 3 and 10 times ζ1 and the wake's eddy viscosity at 1 and 0.2
+    # times its own (no backflow or disc member), and the calm member with the first; no decay
+    # (a conserved gas)
     assert sc.reading_models == (
         "fluctuation",
-        "fluctuation[wall_diffusivity=3]",
-        "fluctuation[wall_diffusivity=10]",
+        "fluctuation[wall_diffusivity=1,wall_viscosity=0.2]",
+        "fluctuation[wall_diffusivity=3,wall_viscosity=1]",
+        "fluctuation[wall_diffusivity=3,wall_viscosity=0.2]",
+        "fluctuation[wall_diffusivity=10,wall_viscosity=1]",
+        "fluctuation[wall_diffusivity=10,wall_viscosity=0.2]",
         "paper",
     )
     plumes = [sc.make_plume(m) for m in sc.reading_models]
     assert all(isinstance(p, SitePlume) for p in plumes)
-    assert [p.zeta1 for p in plumes] == [1.0, 3.0, 10.0, 1.0]
-    assert plumes[0] is plumes[3] and all(p.zeta2 == float("inf") for p in plumes)
+    assert [p.zeta1 for p in plumes] == [1.0, 1.0, 3.0, 3.0, 10.0, 10.0, 1.0]
+    assert plumes[0] is plumes[6] and all(p.zeta2 == float("inf") for p in plumes)
+    # one wake per viscosity, shared by the members of that viscosity
+    assert plumes[0].face_u is plumes[2].face_u is plumes[4].face_u
+    assert plumes[1].face_u is plumes[3].face_u is not plumes[0].face_u
+    # a fixed viscosity by hand is the bank's first; the potential wind has none to weigh
+    hand = sc.with_overrides(**{"estimator.wall_viscosity": 0.5})
+    assert hand.learn["wall_viscosity"] == [0.5, 0.1]
+    potential = sc.with_overrides(**{"estimator.wall_wind": "potential"})
+    assert "wall_viscosity" not in potential.learn and len(potential.reading_models) == 4
     fixed = sc.with_overrides(**{"estimator.learn": {}, "estimator.wall_lifetime": 8.0})
     assert fixed.reading_models == ("fluctuation", "paper") and fixed.make_plume().zeta2 == 8.0
 

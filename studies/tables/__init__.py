@@ -43,6 +43,7 @@ from studies.tables.robustness import (
     soak_worst_table,
 )
 from studies.tables.sites import (
+    lee_viscosity_table,
     site_upwind_table,
     sites_table,
     sites_walls_table,
@@ -151,6 +152,7 @@ TABLES: dict[str, Callable[[], str]] = {
     "sites-walls-timing": sites_walls_timing_table,
     "wander-release": wander_release_table,
     "site-upwind-gas": site_upwind_table,
+    "lee-viscosity": lee_viscosity_table,
     "speed": speed_table,
     "stonesoup-runs": stonesoup_runs_table,
     "search-speed": search_speed_table,

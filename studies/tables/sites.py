@@ -213,6 +213,65 @@ def wander_release_table() -> str:
     )
 
 
+LEE_VISCOSITY = {
+    "tuning": "`random-site:101-120` (tuning; chosen on it)",
+    "held-out": "`random-site:201-220` (never flown before; flown once)",
+}
+"""docs/results/lee-viscosity's folders and the range each flew (recipe lee-viscosity)."""
+
+
+def lee_viscosity_table() -> str:
+    """The wake's eddy viscosity learned (recipe lee-viscosity): per range, acquisition, median
+    final error [95 % CI], the truth in the 95 % region and the median decision time of each
+    arm (the mean over searches of each one's mean decision; two campaign workers, not an idle
+    timing), the searches acquired by one arm only and the median paired change of the final error
+    (exact Wilcoxon), from each folder's ``summary.csv`` and ``paired.csv``
+    (studies/sites_walls_table.py; ``a`` the learned viscosity, ``b`` the one wake before)."""
+    rows = []
+    for folder, label in LEE_VISCOSITY.items():
+        path = RESULTS / "lee-viscosity" / folder
+        if not path.exists():
+            continue
+        summary = pd.read_csv(path / "summary.csv")
+        pairs = pd.read_csv(path / "paired.csv")
+        p = pairs[pairs["scenario"] == "all sites"].iloc[0]
+        arms = summary[summary["scenario"] == "all sites"].set_index("estimator")
+        for arm in (p["b"], p["a"]):
+            r = arms.loc[arm]
+            n = int(r["searches"])
+            paired = (
+                f"+{int(p['acquired_a_only'])} / −{int(p['acquired_b_only'])} "
+                f"(McNemar p = {p['mcnemar_p']:.2g}); {p['median_rmse_difference']:+.2f} m "
+                f"(p = {p['wilcoxon_p']:.2g})"
+                if arm == p["a"]
+                else ""
+            )
+            rows.append(
+                [
+                    label if arm == p["b"] else "",
+                    arm,
+                    f"{int(r['acquired'])}/{n}",
+                    f"{r['median_final_rmse']:.2f} [{r['median_final_rmse_lo']:.2f}, "
+                    f"{r['median_final_rmse_hi']:.2f}]",
+                    f"{round(r['truth_in_95'] * n)}/{n}",
+                    f"{r['decision_ms']:.0f}",
+                    paired,
+                ]
+            )
+    return table(
+        [
+            "range",
+            "wall-aware estimator",
+            "acquired",
+            "median final RMSE (m) [95 % CI]",
+            "truth in 95 % region",
+            "mean decision (ms; in the campaign)",
+            "paired: acquired by one only; median change of the final error (Wilcoxon)",
+        ],
+        rows,
+    )
+
+
 SITE_UPWIND = {
     "tuning.csv": "`random-site:1-20` (tuning; three moves ahead, code 47b92ab)",
     "held-out.csv": "`random-site:101-120` (flown once; code 338317f)",

@@ -135,6 +135,16 @@ SUITES: dict[str, dict] = {
             "estimator.likelihood": "fluctuation",
         },
     },
+    # random sites never flown before 2026-12-06: the learned wake viscosity checked once
+    # (docs/results/lee-viscosity)
+    "sites-held-out-20b": {
+        "configs": [f"random-site:{k}" for k in range(201, 221)],
+        "overrides": {
+            "truth.model": "lbm",
+            "truth.z": 4.0,
+            "estimator.likelihood": "fluctuation",
+        },
+    },
     "random-tune": {"configs": [f"random:{k}" for k in range(1, 41)], "overrides": {}},
     "held-out": {
         "configs": [

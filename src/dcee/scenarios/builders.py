@@ -82,7 +82,7 @@ def _site_wind(
     return site_wind(_site_fluid(*site)[0], site[-1], u, phi, model, viscosity)
 
 
-@functools.lru_cache(maxsize=8)
+@functools.lru_cache(maxsize=16)
 def _wall_plume(
     site: tuple, environment: tuple[float, float, float, float], wind: tuple[str, float]
 ) -> SitePlume:
@@ -252,7 +252,8 @@ class ScenarioBuilders:
                 mtime,
                 float(self.site_resolution),
             )
-            return _wall_plume(site, (u, phi, k, zeta2), (self.wall_wind, self.wall_viscosity))
+            nu = float(learned.get("wall_viscosity", self.wall_viscosity))
+            return _wall_plume(site, (u, phi, k, zeta2), (self.wall_wind, nu))
         e = self.estimator
         learned = dict(self.reading_model_variants).get(model, {})
         # the ground and the vertical spread are the air's, not a member's shape: every member

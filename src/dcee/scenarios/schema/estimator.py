@@ -190,6 +190,7 @@ LearnedName = Literal[
     "ground",
     "vertical_meander",
     "wall_diffusivity",
+    "wall_viscosity",
 ]
 """The reading model's nuisance parameters ``estimator.learn`` may weigh."""
 PLUME_SHAPE_SETTINGS = (
@@ -216,6 +217,7 @@ LEARN_RANGES: dict[str, tuple[float, float]] = {
     "ground": (0.0, 1.0),
     "vertical_meander": (0.0, 2.0),
     "wall_diffusivity": (1e-3, 1000.0),
+    "wall_viscosity": (1e-3, 100.0),
 }
 """Allowed values of each learned setting (as for the fixed setting)."""
 LEARN_DEFAULT: dict[str, dict[str, list[float]]] = {
@@ -252,6 +254,22 @@ fluid solver's eddies) is not known before the search, and each member is a filt
 every reading. A fourth member at 30 × was tried on the tuning sites and not taken (13/20
 acquired either way, median final error 0.54 against 0.52 m;
 docs/results/sites-walls-tune/diffusivity-bank)."""
+
+WALL_VISCOSITY_FACTORS = (1.0, 0.2)
+"""The wake wind's eddy viscosity ν_t the fluctuation likelihood weighs by default beside the
+fixed one (``estimator.wall_viscosity``, else :data:`~dcee.models.site_flow.WAKE_VISCOSITY`),
+as multiples of it; each value is its own wake, solved once, and each (K, ν_t) a member. A
+lower ν_t gives a longer, stronger recirculation that carries gas from a release in a
+building's lee back upwind, as the fluid solver's truth does on the sites searches failed on
+(docs/results/site-upwind-gas); a fixed lower ν_t did no better over all (0.25 and 0.5 m²/s:
+14/20 against 13/20, docs/results/sites-walls-tune/viscosity): the readings choose per site.
+The factor 0.2 was read off the model's upwind share at 1, 0.2 and 0.05 m²/s on four failed
+sites, not searched for. Chosen on the tuning sites ``random-site:101-120`` (``dcee-cl``, rule
+written before the run: more acquired, wins > losses, the median final error no higher by
+more than 0.1 m): 17/20 against 13/20 (+4 / −0), median final error 0.61 against 0.97 m
+(paired −0.11 m, Wilcoxon p = 0.03). Flown once on ``random-site:201-220``, never flown
+before: 15/20 against 11/20 (+4 / −0, McNemar p = 0.13), the truth in the 95 % region 17/20
+against 13/20, paired −0.10 m (p = 0.04); docs/results/lee-viscosity."""
 
 
 class EstimatorSpec(BaseModel):
@@ -424,7 +442,8 @@ class EstimatorSpec(BaseModel):
     wall_viscosity: Annotated[float | None, Field(gt=0, le=100, allow_inf_nan=False)] = None
     """m²/s: the eddy viscosity ν_t of the wake wind (``wall_wind = "wake"``); None:
     :data:`dcee.models.site_flow.WAKE_VISCOSITY` (1 m²/s, kept against 0.25 and 0.5 on the
-    tuning sites, docs/results/sites-walls-tune/viscosity)"""
+    tuning sites, docs/results/sites-walls-tune/viscosity). The fluctuation likelihood weighs
+    it and 0.2 times it (:data:`WALL_VISCOSITY_FACTORS`) unless ``learn`` says otherwise"""
     region_floor: Annotated[float | None, Field(ge=0, le=10, allow_inf_nan=False)] = None
     """m: the model-discrepancy scale σ of the reported 95 % region (``truth_in_95``): the
     posterior of the source location convolved with N(0, σ² I), the error of a reading model

@@ -13,6 +13,7 @@ from dcee.scenarios.schema.estimator import (
     LEARN_PRIOR_DEFAULT,
     PLUME_SHAPE_SETTINGS,
     WALL_DIFFUSIVITY_FACTORS,
+    WALL_VISCOSITY_FACTORS,
 )
 
 
@@ -21,7 +22,10 @@ def default_learn(likelihood: str, fixed: Mapping[str, float]) -> dict[str, list
     without the settings fixed by hand (``fixed``: the estimator's settings by name; one of the
     grid's whose value is not its grid's first, the plain model's, is not learned; one absent
     counts as the plain model's), and without the open plume's shape settings under the
-    wall-aware plume (``fixed["plume"] == "walls"``)."""
+    wall-aware plume (``fixed["plume"] == "walls"``), which weighs its diffusivity
+    (:data:`WALL_DIFFUSIVITY_FACTORS` × ``fixed["wall_diffusivity"]``) and, in the wake wind
+    (``fixed["wall_wind"] == "wake"``), its eddy viscosity (:data:`WALL_VISCOSITY_FACTORS` ×
+    ``fixed["wall_viscosity"]``) instead."""
     grid = LEARN_DEFAULT[likelihood]
     walls = fixed.get("plume") == "walls"
     # a copy: callers may edit it
@@ -33,6 +37,9 @@ def default_learn(likelihood: str, fixed: Mapping[str, float]) -> dict[str, list
     if walls and likelihood == "fluctuation" and fixed.get("wall_diffusivity") is not None:
         k0 = float(fixed["wall_diffusivity"])
         out["wall_diffusivity"] = [k0 * f for f in WALL_DIFFUSIVITY_FACTORS]
+    if walls and likelihood == "fluctuation" and fixed.get("wall_wind") == "wake":
+        nu0 = float(fixed["wall_viscosity"])
+        out["wall_viscosity"] = [nu0 * f for f in WALL_VISCOSITY_FACTORS]
     return out
 
 

@@ -68,13 +68,16 @@ class ReadingModelSettings:
         e = self.estimator
         if self.plume_model != "walls":
             walls_only = (e.wall_diffusivity, e.wall_lifetime, e.wall_wind, e.wall_viscosity)
-            if walls_only != (None,) * 4 or "wall_diffusivity" in (e.learn or {}):
+            learned = set(e.learn or {}) & {"wall_diffusivity", "wall_viscosity"}
+            if walls_only != (None,) * 4 or learned:
                 raise ValueError(
                     f"{FIELD_MARK}estimator.wall_diffusivity, wall_lifetime, wall_wind, "
                     'wall_viscosity: are the wall-aware plume\'s; need estimator.plume = "walls"'
                 )
             return
-        if e.wall_viscosity is not None and self.wall_wind != "wake":
+        if (
+            e.wall_viscosity is not None or "wall_viscosity" in (e.learn or {})
+        ) and self.wall_wind != "wake":
             raise ValueError(
                 f"{FIELD_MARK}estimator.wall_viscosity: is the wake wind's eddy viscosity; the "
                 f'"{self.wall_wind}" wind has none (set wall_wind = "wake" or leave it unset)'
@@ -162,12 +165,14 @@ class ReadingModelSettings:
         return default_learn_prior(e.likelihood, self._learn_fixed(), e.learn)
 
     def _learn_fixed(self) -> dict:
-        """The estimator's settings by name, the plume and the wall-aware plume's diffusivity
-        resolved."""
+        """The estimator's settings by name, the plume and the wall-aware plume's diffusivity,
+        eddy viscosity and wind resolved."""
         return {
             **dict(self.estimator),
             "plume": self.plume_model,
             "wall_diffusivity": self.wall_diffusivity,
+            "wall_viscosity": self.wall_viscosity,
+            "wall_wind": self.wall_wind,
         }
 
     @property
@@ -240,6 +245,8 @@ class ReadingModelSettings:
         """The fixed (resolved) value of a setting ``estimator.learn`` may weigh."""
         if key == "wall_diffusivity":
             return self.wall_diffusivity
+        if key == "wall_viscosity":
+            return self.wall_viscosity
         return self.meander if key == "meander" else float(getattr(self.estimator, key))
 
     @property
