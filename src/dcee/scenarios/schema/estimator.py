@@ -263,12 +263,12 @@ lower ν_t gives a longer, stronger recirculation that carries gas from a releas
 building's lee back upwind, as the fluid solver's truth does on the sites searches failed on
 (docs/results/site-upwind-gas); a fixed lower ν_t did no better over all (0.25 and 0.5 m²/s:
 14/20 against 13/20, docs/results/sites-walls-tune/viscosity): the readings choose per site.
-The factor 0.2 was read off the model's upwind share at 1, 0.2 and 0.05 m²/s on four failed
-sites, not searched for. Chosen on the tuning sites ``random-site:101-120`` (``dcee-cl``, rule
+The factor 0.2 from a look at the model's field for the true release at 1, 0.2 and
+0.05 m²/s on five failed sites of the tuning range, not from a search. Chosen on the tuning sites ``random-site:101-120`` (``dcee-cl``, rule
 written before the run: more acquired, wins > losses, the median final error no higher by
 more than 0.1 m): 17/20 against 13/20 (+4 / −0), median final error 0.61 against 0.97 m
 (paired −0.11 m, Wilcoxon p = 0.03). Flown once on ``random-site:201-220``, never flown
-before: 15/20 against 11/20 (+4 / −0, McNemar p = 0.13), the truth in the 95 % region 17/20
+before: 15/20 against 11/20 (+4 / −0, McNemar p = 0.125), the truth in the 95 % region 17/20
 against 13/20, paired −0.10 m (p = 0.04); docs/results/lee-viscosity."""
 
 
