@@ -37,7 +37,8 @@ SITES = ("site:wall", "site:passage", "site:canyon")
 COMMON = ["--truth", "lbm", "--likelihood", "fluctuation", "--set", "truth.z=4"]
 WAYS = {
     "open terrain": ["--set", "world.obstacles=[]"],
-    "site, wall-blind": [],
+    # an unset estimator.plume is "walls" at a site since issue 84 (2026-12-05): pinned open
+    "site, wall-blind": ["--set", 'estimator.plume="open"'],
     "site, wall-aware": ["--set", 'estimator.plume="walls"'],
     # the wall-aware estimator before the wake's eddy viscosity was learned (2026-12-06): one
     # wake, the diffusivity alone weighed (three fluctuation members for six; ζ1 = 1 at every
