@@ -216,6 +216,7 @@ def wander_release_table() -> str:
 LEE_VISCOSITY = {
     "tuning": "`random-site:101-120` (tuning; chosen on it)",
     "held-out": "`random-site:201-220` (never flown before; flown once)",
+    "fontvieille": "`area:fontvieille`, seeds 0-9 (a tuning site; flown a third time, after it)",
 }
 """docs/results/lee-viscosity's folders and the range each flew (recipe lee-viscosity)."""
 
@@ -234,34 +235,15 @@ def lee_viscosity_table() -> str:
             continue
         summary = pd.read_csv(path / "summary.csv")
         pairs = pd.read_csv(path / "paired.csv")
-        p = pairs[pairs["scenario"] == "all sites"].iloc[0]
-        arms = summary[summary["scenario"] == "all sites"].set_index("estimator")
-        for arm in (p["b"], p["a"]):
-            r = arms.loc[arm]
-            n = int(r["searches"])
-            paired = (
-                f"+{int(p['acquired_a_only'])} / −{int(p['acquired_b_only'])} "
-                f"(McNemar p = {p['mcnemar_p']:.2g}); {p['median_rmse_difference']:+.2f} m "
-                f"(p = {p['wilcoxon_p']:.2g})"
-                if arm == p["a"]
-                else ""
-            )
-            rows.append(
-                [
-                    label if arm == p["b"] else "",
-                    arm,
-                    f"{int(r['acquired'])}/{n}",
-                    f"{r['median_final_rmse']:.2f} [{r['median_final_rmse_lo']:.2f}, "
-                    f"{r['median_final_rmse_hi']:.2f}]",
-                    f"{round(r['truth_in_95'] * n)}/{n}",
-                    f"{r['decision_ms']:.0f}",
-                    paired,
-                ]
-            )
+        for _, p in pairs[pairs["scenario"] == "all sites"].iterrows():
+            everything = summary[
+                (summary["scenario"] == "all sites") & (summary["strategy"] == p["strategy"])
+            ]
+            rows += _lee_rows(everything.set_index("estimator"), p, label)
     return table(
         [
             "range",
-            "wall-aware estimator",
+            "planner, wall-aware estimator",
             "acquired",
             "median final RMSE (m) [95 % CI]",
             "truth in 95 % region",
@@ -270,6 +252,35 @@ def lee_viscosity_table() -> str:
         ],
         rows,
     )
+
+
+def _lee_rows(arms: pd.DataFrame, p: pd.Series, label: str) -> list[list[str]]:
+    """The before and the learned arm of one planner's pairs ``p`` (``a`` learned, ``b``
+    before) as table rows, the range's ``label`` on the first."""
+    rows = []
+    for arm in (p["b"], p["a"]):
+        r = arms.loc[arm]
+        n = int(r["searches"])
+        paired = (
+            f"+{int(p['acquired_a_only'])} / −{int(p['acquired_b_only'])} "
+            f"(McNemar p = {p['mcnemar_p']:.2g}); {p['median_rmse_difference']:+.2f} m "
+            f"(p = {p['wilcoxon_p']:.2g})"
+            if arm == p["a"]
+            else ""
+        )
+        rows.append(
+            [
+                label if arm == p["b"] else "",
+                f"`{p['strategy']}`, {arm}",
+                f"{int(r['acquired'])}/{n}",
+                f"{r['median_final_rmse']:.2f} [{r['median_final_rmse_lo']:.2f}, "
+                f"{r['median_final_rmse_hi']:.2f}]",
+                f"{round(r['truth_in_95'] * n)}/{n}",
+                f"{r['decision_ms']:.0f}",
+                paired,
+            ]
+        )
+    return rows
 
 
 SITE_UPWIND = {
