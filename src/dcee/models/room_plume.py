@@ -47,16 +47,16 @@ that. The robot steps 0.5 m and the jet of the solver-wind room is about 1 m wid
 resolves both."""
 
 ROOM_DIFFUSIVITY = 0.002
-"""m²/s: the diffusivity K of a room's plume by default (the fluctuation likelihood weighs it and
-3 and 10 times it, :data:`~dcee.scenarios.schema.estimator.WALL_DIFFUSIVITY_FACTORS`). Chosen on
-GADEN's two sample rooms, the only GADEN simulations here: the time-mean concentration GADEN's
-player gives at the sensor's height over 60-300 s against the model's for the true release, on
-the 0.2 m cubes where GADEN's mean exceeds 0.05 ppm, log-RMS after the best scale, K = 0.001,
-0.002, 0.005, 0.01, 0.02, 0.05 m²/s: solver-wind room 0.54, **0.45**, 0.77, 1.01, 1.19, 1.42;
-uniform-draught room 1.82, 1.17, **1.02**, 1.25, 1.45, 1.65 (studies/gaden_room_fit.py). The
-bank 0.002-0.02 holds both rooms' best. GADEN's own spreading is smaller still (its filaments'
-noise, 0.02 m a 0.1 s step, is 0.002 m²/s; their growth 0.0005 m²/s): the rest of a plume's
-width is the cubes' numerical diffusion, about |u| h / 2 = 0.04 m²/s in the jet."""
+"""m²/s: the diffusivity K of a room's plume by default (the fluctuation likelihood weighs it and 3
+and 10 times it, :data:`~dcee.scenarios.schema.learned_settings.WALL_DIFFUSIVITY_FACTORS`).
+Chosen on GADEN's two sample rooms, the only GADEN simulations here: the time-mean concentration
+GADEN's player gives at the sensor's height over 60-300 s against the model's for the true
+release, on the 0.2 m cubes where GADEN's mean exceeds 0.05 ppm, log-RMS after the best scale, K
+= 0.001, 0.002, 0.005, 0.01, 0.02, 0.05 m²/s: solver-wind room 0.54, **0.45**, 0.77, 1.01, 1.19,
+1.42; uniform-draught room 1.82, 1.17, **1.02**, 1.25, 1.45, 1.65 (studies/gaden_room_fit.py).
+The bank 0.002-0.02 holds both rooms' best. GADEN's own spreading is smaller still (its
+filaments' noise, 0.02 m a 0.1 s step, is 0.002 m²/s; their growth 0.0005 m²/s): the rest of a
+plume's width is the cubes' numerical diffusion, about |u| h / 2 = 0.04 m²/s in the jet."""
 
 ROOM_MAX_CELLS = 40_000
 """Air cubes at most: a larger room is modelled on coarser cubes (its cell side grown by whole

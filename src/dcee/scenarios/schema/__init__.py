@@ -13,8 +13,6 @@ from dcee.scenarios.schema.agent import (
 )
 from dcee.scenarios.schema.common import FROZEN, Finite, Positive
 from dcee.scenarios.schema.estimator import (
-    LEARN_DEFAULT,
-    LEARN_PRIOR_DEFAULT,
     LIKELIHOODS,
     MEANDER_DEFAULT,
     OLD_OUTLIER_DEFAULT,
@@ -31,6 +29,7 @@ from dcee.scenarios.schema.estimator import (
     unset_region_floor,
 )
 from dcee.scenarios.schema.learn import default_learn, default_learn_prior
+from dcee.scenarios.schema.learned_settings import LEARN_DEFAULT, LEARN_PRIOR_DEFAULT
 from dcee.scenarios.schema.scenario import FIELD_MARK, Scenario, validate_scenario
 from dcee.scenarios.schema.truth import TURBULENT_HOLD, Truth, Volume
 from dcee.scenarios.schema.truth_models import (

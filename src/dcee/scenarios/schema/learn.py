@@ -8,7 +8,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from dcee.scenarios.schema.estimator import (
+from dcee.scenarios.schema.learned_settings import (
     LEARN_DEFAULT,
     LEARN_PRIOR_DEFAULT,
     PLUME_SHAPE_SETTINGS,

@@ -14,7 +14,6 @@ import numpy as np
 from dcee.models.room_plume import ROOM_DIFFUSIVITY
 from dcee.models.site_flow import WAKE_VISCOSITY, WALL_WIND_DEFAULT
 from dcee.scenarios.schema.common import FIELD_MARK
-from dcee.scenarios.schema.estimator import LEARN_RANGES, PLUME_SHAPE_SETTINGS
 from dcee.scenarios.schema.learn import (
     LEARN_MEMBERS_MAX,
     default_learn,
@@ -22,6 +21,7 @@ from dcee.scenarios.schema.learn import (
     learn_member_weight,
     learn_prior_problem,
 )
+from dcee.scenarios.schema.learned_settings import LEARN_RANGES, PLUME_SHAPE_SETTINGS
 
 
 def unset_plume(
