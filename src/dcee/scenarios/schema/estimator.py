@@ -330,7 +330,8 @@ class EstimatorSpec(BaseModel):
     wall_diffusivity: Annotated[float | None, Field(gt=0, le=1000, allow_inf_nan=False)] = None
     """m²/s: the wall-aware plume's diffusivity K (``plume = "walls"``); None: the scenario's
     ζ1. The fluctuation likelihood weighs it and 3 and 10 times it
-    (:data:`WALL_DIFFUSIVITY_FACTORS`) unless ``learn`` says otherwise"""
+    (:data:`~dcee.scenarios.schema.learned_settings.WALL_DIFFUSIVITY_FACTORS`) unless ``learn``
+    says otherwise"""
     wall_lifetime: Annotated[float | None, Field(gt=0, le=1e6, allow_inf_nan=False)] = None
     """s: the wall-aware plume's gas lifetime τ (``plume = "walls"``), the decay term C/τ; None:
     no decay, a conserved gas (not the scenario's ζ2). Chosen on the tuning sites
@@ -349,7 +350,9 @@ class EstimatorSpec(BaseModel):
     """m²/s: the eddy viscosity ν_t of the wake wind (``wall_wind = "wake"``); None:
     :data:`dcee.models.site_flow.WAKE_VISCOSITY` (1 m²/s, kept against 0.25 and 0.5 on the
     tuning sites, docs/results/sites-walls-tune/viscosity). The fluctuation likelihood weighs
-    it and 0.2 times it (:data:`WALL_VISCOSITY_FACTORS`) unless ``learn`` says otherwise"""
+    it and 0.2 times it
+    (:data:`~dcee.scenarios.schema.learned_settings.WALL_VISCOSITY_FACTORS`) unless ``learn``
+    says otherwise"""
     region_floor: Annotated[float | None, Field(ge=0, le=10, allow_inf_nan=False)] = None
     """m: the model-discrepancy scale σ of the reported 95 % region (``truth_in_95``): the
     posterior of the source location convolved with N(0, σ² I), the error of a reading model

@@ -34,12 +34,13 @@ def default_learn(likelihood: str, fixed: Mapping[str, float]) -> dict[str, list
         for key, v in grid.items()
         if fixed.get(key, v[0]) == v[0] and not (walls and key in PLUME_SHAPE_SETTINGS)
     }
-    if walls and likelihood == "fluctuation" and fixed.get("wall_diffusivity") is not None:
-        k0 = float(fixed["wall_diffusivity"])
-        out["wall_diffusivity"] = [k0 * f for f in WALL_DIFFUSIVITY_FACTORS]
-    if walls and likelihood == "fluctuation" and fixed.get("wall_wind") == "wake":
-        nu0 = float(fixed["wall_viscosity"])
-        out["wall_viscosity"] = [nu0 * f for f in WALL_VISCOSITY_FACTORS]
+    if walls and likelihood == "fluctuation":
+        if fixed.get("wall_diffusivity") is not None:
+            k0 = float(fixed["wall_diffusivity"])
+            out["wall_diffusivity"] = [k0 * f for f in WALL_DIFFUSIVITY_FACTORS]
+        if fixed.get("wall_wind") == "wake":
+            nu0 = float(fixed["wall_viscosity"])
+            out["wall_viscosity"] = [nu0 * f for f in WALL_VISCOSITY_FACTORS]
     return out
 
 
